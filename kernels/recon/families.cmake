@@ -1,0 +1,1 @@
+seamless_kernel_family(recon/preprocess)

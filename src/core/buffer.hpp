@@ -1,0 +1,113 @@
+// Buffer<T>: owns one allocation on one device (RAII, move-only, no managed memory). Transfers are
+// explicit: copy_from / to_host. Image<T> is a Buffer with a width and height.
+#pragma once
+#include <algorithm>
+#include <cstddef>
+#include <cstring>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "core/device.hpp"
+#include "core/view.hpp"
+
+namespace seamless {
+
+namespace memory {
+void* allocate(std::size_t bytes, Device d);  // throws Error naming the size when out of memory
+void release(void* p, Device d) noexcept;
+void copy(void* dst, Device dst_dev, const void* src, Device src_dev, std::size_t bytes);
+void fill_zero(void* p, Device d, std::size_t bytes);
+std::size_t bytes_in_use(Device d);  // live bytes allocated through Buffer on this device
+}  // namespace memory
+
+template <class T>
+class Buffer {
+  static_assert(std::is_trivially_copyable_v<T>, "Buffer holds plain data only");
+
+ public:
+  Buffer() = default;
+  Buffer(std::int64_t n, Device d) : device_(d), size_(n) {
+    if (n > 0) data_ = static_cast<T*>(memory::allocate(sizeof(T) * n, d));
+  }
+  static Buffer from_host(const std::vector<T>& v, Device d) {
+    Buffer b(static_cast<std::int64_t>(v.size()), d);
+    b.copy_from_host(v.data(), b.size());
+    return b;
+  }
+  ~Buffer() { memory::release(data_, device_); }
+  Buffer(Buffer&& o) noexcept { swap(o); }
+  Buffer& operator=(Buffer&& o) noexcept {
+    Buffer tmp(std::move(o));
+    swap(tmp);
+    return *this;
+  }
+  Buffer(const Buffer&) = delete;
+  Buffer& operator=(const Buffer&) = delete;
+
+  T* data() const { return data_; }
+  std::int64_t size() const { return size_; }
+  std::size_t bytes() const { return sizeof(T) * static_cast<std::size_t>(size_); }
+  Device device() const { return device_; }
+  View<T> view() const { return {data_, size_}; }
+  View<const T> cview() const { return {data_, size_}; }
+
+  void zero() { memory::fill_zero(data_, device_, bytes()); }
+  void copy_from_host(const T* src, std::int64_t n) { memory::copy(data_, device_, src, Device::CPU, sizeof(T) * n); }
+  void copy_from(const Buffer& o) { memory::copy(data_, device_, o.data_, o.device_, std::min(bytes(), o.bytes())); }
+  std::vector<T> to_host() const {
+    std::vector<T> v(static_cast<std::size_t>(size_));
+    memory::copy(v.data(), Device::CPU, data_, device_, bytes());
+    return v;
+  }
+  Buffer clone(Device d) const {
+    Buffer b(size_, d);
+    b.copy_from(*this);
+    return b;
+  }
+  // Grows (never shrinks) without keeping the contents.
+  void reserve_discard(std::int64_t n) {
+    if (n > size_) *this = Buffer(n, device_);
+  }
+
+ private:
+  void swap(Buffer& o) noexcept {
+    std::swap(device_, o.device_);
+    std::swap(data_, o.data_);
+    std::swap(size_, o.size_);
+  }
+  Device device_ = Device::CPU;
+  T* data_ = nullptr;
+  std::int64_t size_ = 0;
+};
+
+template <class T>
+class Image {
+ public:
+  Image() = default;
+  Image(int w, int h, Device d) : buf_(static_cast<std::int64_t>(w) * h, d), w_(w), h_(h) {}
+  static Image from_host(const std::vector<T>& v, int w, int h, Device d) {
+    Image im(w, h, d);
+    im.buf_.copy_from_host(v.data(), im.buf_.size());
+    return im;
+  }
+  int width() const { return w_; }
+  int height() const { return h_; }
+  Device device() const { return buf_.device(); }
+  View2D<T> view() const { return {buf_.data(), w_, h_, w_}; }
+  View2D<const T> cview() const { return {buf_.data(), w_, h_, w_}; }
+  Buffer<T>& buffer() { return buf_; }
+  const Buffer<T>& buffer() const { return buf_; }
+  std::vector<T> to_host() const { return buf_.to_host(); }
+  Image clone(Device d) const {
+    Image im(w_, h_, d);
+    im.buf_.copy_from(buf_);
+    return im;
+  }
+
+ private:
+  Buffer<T> buf_;
+  int w_ = 0, h_ = 0;
+};
+
+}  // namespace seamless

@@ -1,0 +1,82 @@
+// The OpenMP executor. Include only from *_cpu.cpp instantiation files and CPU-only code.
+#pragma once
+#include <omp.h>
+
+#include <algorithm>
+#include <cstring>
+#include <numeric>
+#include <vector>
+
+#include "core/exec.hpp"
+
+namespace seamless {
+
+template <class F>
+void CpuExec::for_each(std::int64_t n, F fn) const {
+  // Small ranges are not worth waking the thread team.
+  if (n < 2048) {
+    for (std::int64_t i = 0; i < n; ++i) fn(i);
+    return;
+  }
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < n; ++i) fn(i);
+}
+
+template <class T>
+T CpuExec::exclusive_scan(const T* in, T* out, std::int64_t n) const {
+  T sum{};
+  for (std::int64_t i = 0; i < n; ++i) {
+    T v = in[i];  // in may alias out
+    out[i] = sum;
+    sum = sum + v;
+  }
+  return sum;
+}
+
+// LSD radix sort, 8 bits a pass: stable, O(n) per pass, like the GPU's radix sort.
+template <class K, class V>
+void CpuExec::sort_by_key(K* keys, V* values, std::int64_t n, int key_bits) const {
+  if (n <= 1) return;
+  std::vector<K> k2(static_cast<std::size_t>(n));
+  std::vector<V> v2(static_cast<std::size_t>(n));
+  K* ks = keys;
+  V* vs = values;
+  K* kd = k2.data();
+  V* vd = v2.data();
+  for (int shift = 0; shift < key_bits; shift += 8) {
+    std::int64_t count[257] = {0};
+    for (std::int64_t i = 0; i < n; ++i) ++count[((ks[i] >> shift) & 0xFF) + 1];
+    for (int b = 0; b < 256; ++b) count[b + 1] += count[b];
+    for (std::int64_t i = 0; i < n; ++i) {
+      std::int64_t dst = count[(ks[i] >> shift) & 0xFF]++;
+      kd[dst] = ks[i];
+      vd[dst] = vs[i];
+    }
+    std::swap(ks, kd);
+    std::swap(vs, vd);
+  }
+  if (ks != keys) {
+    std::memcpy(keys, ks, sizeof(K) * n);
+    std::memcpy(values, vs, sizeof(V) * n);
+  }
+}
+
+// Per-thread partial sums combined in thread order: deterministic for a fixed thread count.
+template <class T, class F>
+T CpuExec::transform_reduce(std::int64_t n, T init, F fn) const {
+  int threads = n < 2048 ? 1 : omp_get_max_threads();
+  std::vector<T> partial(static_cast<std::size_t>(threads), T{});
+#pragma omp parallel num_threads(threads)
+  {
+    int t = omp_get_thread_num();
+    T local{};
+#pragma omp for schedule(static)
+    for (std::int64_t i = 0; i < n; ++i) local = local + fn(i);
+    partial[t] = local;
+  }
+  T sum = init;
+  for (const T& p : partial) sum = sum + p;
+  return sum;
+}
+
+}  // namespace seamless

@@ -1,0 +1,127 @@
+// Small POD math types for kernels (host and device). Eigen stays on the host side; see
+// core/eigen_conv.hpp for the conversions at the boundary.
+#pragma once
+#include <cmath>
+#include <cstdint>
+
+#include "core/hd.hpp"
+
+namespace seamless {
+
+struct vec2 { float x, y; };
+struct vec3 { float x, y, z; };
+struct vec4 { float x, y, z, w; };
+struct int3 { int x, y, z; };
+struct uchar3 { std::uint8_t x, y, z; };
+
+// vec2
+SEAMLESS_HD inline vec2 operator+(vec2 a, vec2 b) { return {a.x + b.x, a.y + b.y}; }
+SEAMLESS_HD inline vec2 operator-(vec2 a, vec2 b) { return {a.x - b.x, a.y - b.y}; }
+SEAMLESS_HD inline vec2 operator*(vec2 a, float s) { return {a.x * s, a.y * s}; }
+
+// vec3
+SEAMLESS_HD inline vec3 operator+(vec3 a, vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+SEAMLESS_HD inline vec3 operator-(vec3 a, vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+SEAMLESS_HD inline vec3 operator-(vec3 a) { return {-a.x, -a.y, -a.z}; }
+SEAMLESS_HD inline vec3 operator*(vec3 a, float s) { return {a.x * s, a.y * s, a.z * s}; }
+SEAMLESS_HD inline vec3 operator*(float s, vec3 a) { return a * s; }
+SEAMLESS_HD inline vec3 operator/(vec3 a, float s) { return {a.x / s, a.y / s, a.z / s}; }
+SEAMLESS_HD inline vec3 cmul(vec3 a, vec3 b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
+SEAMLESS_HD inline vec3& operator+=(vec3& a, vec3 b) { a = a + b; return a; }
+SEAMLESS_HD inline vec3& operator-=(vec3& a, vec3 b) { a = a - b; return a; }
+SEAMLESS_HD inline vec3& operator*=(vec3& a, float s) { a = a * s; return a; }
+SEAMLESS_HD inline float dot(vec3 a, vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+SEAMLESS_HD inline vec3 cross(vec3 a, vec3 b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+SEAMLESS_HD inline float length2(vec3 a) { return dot(a, a); }
+SEAMLESS_HD inline float length(vec3 a) { return sqrtf(dot(a, a)); }
+// Returns the zero vector for a zero input rather than NaN: callers test for that case.
+SEAMLESS_HD inline vec3 normalize(vec3 a) {
+  float l = length(a);
+  return l > 0.f ? a / l : vec3{0.f, 0.f, 0.f};
+}
+SEAMLESS_HD inline vec3 vmin(vec3 a, vec3 b) { return {fminf(a.x, b.x), fminf(a.y, b.y), fminf(a.z, b.z)}; }
+SEAMLESS_HD inline vec3 vmax(vec3 a, vec3 b) { return {fmaxf(a.x, b.x), fmaxf(a.y, b.y), fmaxf(a.z, b.z)}; }
+SEAMLESS_HD inline bool is_finite(float v) {
+#ifdef __CUDA_ARCH__
+  return isfinite(v);
+#else
+  return std::isfinite(v);
+#endif
+}
+SEAMLESS_HD inline bool is_finite(vec3 a) { return is_finite(a.x) && is_finite(a.y) && is_finite(a.z); }
+
+// int3
+SEAMLESS_HD inline int3 operator+(int3 a, int3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+SEAMLESS_HD inline int3 operator-(int3 a, int3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+SEAMLESS_HD inline bool operator==(int3 a, int3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+SEAMLESS_HD inline int3 floor_to_int(vec3 a) {
+  return {static_cast<int>(floorf(a.x)), static_cast<int>(floorf(a.y)), static_cast<int>(floorf(a.z))};
+}
+SEAMLESS_HD inline vec3 to_vec3(int3 a) {
+  return {static_cast<float>(a.x), static_cast<float>(a.y), static_cast<float>(a.z)};
+}
+
+// vec4
+SEAMLESS_HD inline vec4 operator+(vec4 a, vec4 b) { return {a.x + b.x, a.y + b.y, a.z + b.z, a.w + b.w}; }
+SEAMLESS_HD inline vec4 operator*(vec4 a, float s) { return {a.x * s, a.y * s, a.z * s, a.w * s}; }
+SEAMLESS_HD inline vec3 xyz(vec4 a) { return {a.x, a.y, a.z}; }
+
+// mat3, row-major: m[r][c].
+struct mat3 {
+  float m[3][3];
+  SEAMLESS_HD static mat3 identity() { return {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}}; }
+  SEAMLESS_HD static mat3 zero() { return {{{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}}; }
+  SEAMLESS_HD vec3 row(int r) const { return {m[r][0], m[r][1], m[r][2]}; }
+  SEAMLESS_HD vec3 col(int c) const { return {m[0][c], m[1][c], m[2][c]}; }
+};
+SEAMLESS_HD inline vec3 operator*(const mat3& a, vec3 v) {
+  return {dot(a.row(0), v), dot(a.row(1), v), dot(a.row(2), v)};
+}
+SEAMLESS_HD inline mat3 operator*(const mat3& a, const mat3& b) {
+  mat3 r;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r.m[i][j] = a.m[i][0] * b.m[0][j] + a.m[i][1] * b.m[1][j] + a.m[i][2] * b.m[2][j];
+  return r;
+}
+SEAMLESS_HD inline mat3 operator+(const mat3& a, const mat3& b) {
+  mat3 r;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r.m[i][j] = a.m[i][j] + b.m[i][j];
+  return r;
+}
+SEAMLESS_HD inline mat3 operator*(const mat3& a, float s) {
+  mat3 r;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r.m[i][j] = a.m[i][j] * s;
+  return r;
+}
+SEAMLESS_HD inline mat3 transpose(const mat3& a) {
+  mat3 r;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r.m[i][j] = a.m[j][i];
+  return r;
+}
+// a b^T
+SEAMLESS_HD inline mat3 outer(vec3 a, vec3 b) {
+  return {{{a.x * b.x, a.x * b.y, a.x * b.z}, {a.y * b.x, a.y * b.y, a.y * b.z}, {a.z * b.x, a.z * b.y, a.z * b.z}}};
+}
+SEAMLESS_HD inline float determinant(const mat3& a) { return dot(a.row(0), cross(a.row(1), a.row(2))); }
+
+// A rigid transform x -> R x + t. Poses are named a_T_b: maps coordinates in frame b to frame a
+// (world_T_camera maps camera coordinates to world coordinates).
+struct SE3 {
+  mat3 R;
+  vec3 t;
+  SEAMLESS_HD static SE3 identity() { return {mat3::identity(), {0, 0, 0}}; }
+  SEAMLESS_HD vec3 operator*(vec3 p) const { return R * p + t; }
+  SEAMLESS_HD vec3 rotate(vec3 v) const { return R * v; }
+  SEAMLESS_HD SE3 inverse() const {
+    mat3 Rt = transpose(R);
+    return {Rt, -(Rt * t)};
+  }
+};
+SEAMLESS_HD inline SE3 operator*(const SE3& a, const SE3& b) { return {a.R * b.R, a.R * b.t + a.t}; }
+
+}  // namespace seamless

@@ -1,0 +1,109 @@
+#include <cstdlib>
+#include <cstring>
+#include <mutex>
+#include <string>
+#include <unordered_map>
+
+#include "core/buffer.hpp"
+#include "core/cuda_check.hpp"
+#include "core/error.hpp"
+
+namespace seamless::memory {
+
+namespace {
+// Live allocations and their sizes, for the memory statistics the pipeline reports.
+struct Ledger {
+  std::mutex mutex;
+  std::unordered_map<void*, std::size_t> sizes;
+  std::size_t bytes[2] = {0, 0};
+};
+Ledger& ledger() {
+  static Ledger l;
+  return l;
+}
+void record(void* p, std::size_t bytes, Device d) {
+  Ledger& l = ledger();
+  std::lock_guard lock(l.mutex);
+  l.sizes[p] = bytes;
+  l.bytes[static_cast<int>(d)] += bytes;
+}
+void forget(void* p, Device d) {
+  Ledger& l = ledger();
+  std::lock_guard lock(l.mutex);
+  auto it = l.sizes.find(p);
+  if (it == l.sizes.end()) return;
+  l.bytes[static_cast<int>(d)] -= it->second;
+  l.sizes.erase(it);
+}
+[[noreturn]] void out_of_memory(std::size_t bytes, Device d) {
+  throw Error("out of " + std::string(device_name(d)) + " memory allocating " + std::to_string(bytes >> 20) +
+              " MiB (reduce the volume size, hash capacity or particle count in the config)");
+}
+constexpr std::size_t kAlign = 64;
+}  // namespace
+
+void* allocate(std::size_t bytes, Device d) {
+  if (bytes == 0) return nullptr;
+  void* p = nullptr;
+  if (d == Device::CPU) {
+    p = std::aligned_alloc(kAlign, (bytes + kAlign - 1) / kAlign * kAlign);
+    if (!p) out_of_memory(bytes, d);
+  } else {
+#if SEAMLESS_HAS_CUDA
+    cudaError_t e = cudaMalloc(&p, bytes);
+    if (e == cudaErrorMemoryAllocation) {
+      cudaGetLastError();
+      out_of_memory(bytes, d);
+    }
+    SEAMLESS_CUDA_CHECK(e);
+#else
+    throw Error("CUDA allocation requested in a build without CUDA");
+#endif
+  }
+  record(p, bytes, d);
+  return p;
+}
+
+void release(void* p, Device d) noexcept {
+  if (!p) return;
+  forget(p, d);
+  if (d == Device::CPU) {
+    std::free(p);
+    return;
+  }
+#if SEAMLESS_HAS_CUDA
+  cudaFree(p);
+#endif
+}
+
+void copy(void* dst, Device dst_dev, const void* src, Device src_dev, std::size_t bytes) {
+  if (bytes == 0) return;
+  if (dst_dev == Device::CPU && src_dev == Device::CPU) {
+    std::memcpy(dst, src, bytes);
+    return;
+  }
+#if SEAMLESS_HAS_CUDA
+  SEAMLESS_CUDA_CHECK(cudaMemcpy(dst, src, bytes, cudaMemcpyDefault));
+#else
+  throw Error("CUDA copy requested in a build without CUDA");
+#endif
+}
+
+void fill_zero(void* p, Device d, std::size_t bytes) {
+  if (bytes == 0) return;
+  if (d == Device::CPU) {
+    std::memset(p, 0, bytes);
+    return;
+  }
+#if SEAMLESS_HAS_CUDA
+  SEAMLESS_CUDA_CHECK(cudaMemset(p, 0, bytes));
+#endif
+}
+
+std::size_t bytes_in_use(Device d) {
+  Ledger& l = ledger();
+  std::lock_guard lock(l.mutex);
+  return l.bytes[static_cast<int>(d)];
+}
+
+}  // namespace seamless::memory

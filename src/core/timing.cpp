@@ -1,0 +1,100 @@
+#include "core/timing.hpp"
+
+#include <algorithm>
+#include <fstream>
+
+#include "core/cuda_check.hpp"
+#include "core/error.hpp"
+
+namespace seamless {
+
+struct StageTimer::Pending {
+  std::string stage;
+  std::chrono::steady_clock::time_point t0, t1;
+#if SEAMLESS_HAS_CUDA
+  cudaEvent_t e0 = nullptr, e1 = nullptr;
+#endif
+  bool open = true;
+};
+
+StageTimer::StageTimer(Device d) : device_(d) {}
+
+StageTimer::~StageTimer() {
+  for (Pending* p : pending_) {
+#if SEAMLESS_HAS_CUDA
+    if (p->e0) cudaEventDestroy(p->e0);
+    if (p->e1) cudaEventDestroy(p->e1);
+#endif
+    delete p;
+  }
+}
+
+void StageTimer::begin(const std::string& stage) {
+  auto* p = new Pending{stage, std::chrono::steady_clock::now(), {}};
+#if SEAMLESS_HAS_CUDA
+  if (device_ == Device::CUDA) {
+    SEAMLESS_CUDA_CHECK(cudaEventCreate(&p->e0));
+    SEAMLESS_CUDA_CHECK(cudaEventCreate(&p->e1));
+    SEAMLESS_CUDA_CHECK(cudaEventRecord(p->e0));
+  }
+#endif
+  pending_.push_back(p);
+}
+
+void StageTimer::end(const std::string& stage) {
+  for (auto it = pending_.rbegin(); it != pending_.rend(); ++it) {
+    Pending* p = *it;
+    if (p->open && p->stage == stage) {
+      p->open = false;
+      p->t1 = std::chrono::steady_clock::now();
+#if SEAMLESS_HAS_CUDA
+      if (device_ == Device::CUDA) SEAMLESS_CUDA_CHECK(cudaEventRecord(p->e1));
+#endif
+      return;
+    }
+  }
+  throw Error("StageTimer::end(\"" + stage + "\") without a matching begin");
+}
+
+void StageTimer::end_frame(std::int64_t frame) {
+  for (Pending* p : pending_) {
+    if (p->open) throw Error("stage '" + p->stage + "' still open at the end of frame " + std::to_string(frame));
+    double ms = std::chrono::duration<double, std::milli>(p->t1 - p->t0).count();
+#if SEAMLESS_HAS_CUDA
+    if (device_ == Device::CUDA) {
+      float f = 0;
+      SEAMLESS_CUDA_CHECK(cudaEventSynchronize(p->e1));
+      SEAMLESS_CUDA_CHECK(cudaEventElapsedTime(&f, p->e0, p->e1));
+      ms = f;
+      cudaEventDestroy(p->e0);
+      cudaEventDestroy(p->e1);
+    }
+#endif
+    rows_.push_back({frame, p->stage, ms});
+    delete p;
+  }
+  pending_.clear();
+}
+
+void StageTimer::write_csv(const std::string& path) const {
+  std::ofstream f(path);
+  if (!f) throw Error("cannot write timings to " + path);
+  f << "frame,stage,ms\n";
+  for (const Row& r : rows_) f << r.frame << ',' << r.stage << ',' << r.ms << '\n';
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+double StageTimer::median_ms(const std::string& stage) const {
+  std::vector<double> v;
+  for (const Row& r : rows_)
+    if (r.stage == stage) v.push_back(r.ms);
+  return median(v);
+}
+
+}  // namespace seamless

@@ -1,0 +1,58 @@
+// Per-stage timings. On the CPU a steady clock; on CUDA events recorded around the stage, read back
+// once per frame (end_frame) so that timing does not serialise the pipeline.
+#pragma once
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/device.hpp"
+
+namespace seamless {
+
+class StageTimer {
+ public:
+  explicit StageTimer(Device d);
+  ~StageTimer();
+  StageTimer(const StageTimer&) = delete;
+  StageTimer& operator=(const StageTimer&) = delete;
+
+  void begin(const std::string& stage);
+  void end(const std::string& stage);
+  // Resolves this frame's stages into milliseconds and appends one row per stage.
+  void end_frame(std::int64_t frame);
+
+  struct Row {
+    std::int64_t frame;
+    std::string stage;
+    double ms;
+  };
+  const std::vector<Row>& rows() const { return rows_; }
+  void write_csv(const std::string& path) const;  // frame,stage,ms
+  // Median ms of a stage over all frames (0 if none).
+  double median_ms(const std::string& stage) const;
+
+ private:
+  struct Pending;
+  Device device_;
+  std::vector<Pending*> pending_;
+  std::vector<Row> rows_;
+};
+
+// RAII helper: StageScope s(timer, "integrate");
+class StageScope {
+ public:
+  StageScope(StageTimer& t, std::string stage) : t_(t), stage_(std::move(stage)) { t_.begin(stage_); }
+  ~StageScope() { t_.end(stage_); }
+  StageScope(const StageScope&) = delete;
+  StageScope& operator=(const StageScope&) = delete;
+
+ private:
+  StageTimer& t_;
+  std::string stage_;
+};
+
+double median(std::vector<double> v);
+
+}  // namespace seamless
