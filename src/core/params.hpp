@@ -30,8 +30,4 @@ struct Choices {
   Choices(std::initializer_list<const char*> v) : values(v.begin(), v.end()) {}
 };
 
-// Satisfied by structs that describe their fields with visit().
-template <class T>
-concept Visitable = requires(T t) { t.visit(std::declval<int&>()); } || requires { typename T::is_params; };
-
 }  // namespace seamless
