@@ -1,0 +1,1 @@
+# seamless_kernel_family(physics/...) lines go here
