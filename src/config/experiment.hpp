@@ -1,0 +1,66 @@
+// The whole experiment file: one struct per section, each owned by its layer and described by
+// visit() (core/params.hpp). src/config loads it from YAML, validates it and writes it back.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/params.hpp"
+#include "io/input_params.hpp"
+#include "physics/solver_params.hpp"
+#include "recon/tracker_params.hpp"
+#include "recon/volume_params.hpp"
+#include "render/render_params.hpp"
+
+namespace seamless {
+
+// What a run writes into its output folder.
+struct OutputParams {
+  std::string dir = "out";
+  bool write_config = true;       // effective config (every key, after --set) as config.yaml
+  bool write_mesh = true;         // mesh.ply (marching cubes, with colour)
+  bool write_trajectory = true;   // trajectory.txt, TUM format
+  bool write_timings = true;      // timings.csv, one row per frame and stage
+  bool write_stats = true;        // stats.csv: hash fill, tracking inliers, particle counts
+
+  template <class V> void visit(V& v) {
+    v("dir", dir, "output folder (created if missing)");
+    v("write_config", write_config, "write the effective config as config.yaml");
+    v("write_mesh", write_mesh, "write the reconstructed mesh as mesh.ply");
+    v("write_trajectory", write_trajectory, "write the camera trajectory (TUM format) as trajectory.txt");
+    v("write_timings", write_timings, "write per-stage timings as timings.csv");
+    v("write_stats", write_stats, "write per-frame statistics as stats.csv");
+  }
+};
+
+struct Experiment {
+  std::string name = "experiment";
+  std::string device = "auto";
+  std::string mode = "live";
+  std::int64_t frames = 0;        // 0 = as many as the input gives
+  InputParams input;
+  VolumeParams volume;
+  TrackerParams tracker;
+  SolverParams solver;
+  std::vector<SpawnParams> spawn;
+  RenderParams render;
+  OutputParams output;
+
+  template <class V> void visit(V& v) {
+    v("name", name, "experiment name (used in logs and output names)");
+    v("device", device, "compute backend (auto: CUDA when built and a GPU is present)",
+      Choices{"cpu", "cuda", "auto"});
+    v("mode", mode, "reconstruct and simulate at once, or scan first then simulate",
+      Choices{"live", "scan_then_simulate"});
+    v("frames", frames, "frames to process; 0 = all the input has", Range{0, 1e12});
+    v("input", input, "where frames come from");
+    v("volume", volume, "TSDF volume");
+    v("tracker", tracker, "camera tracking");
+    v("solver", solver, "particle solver");
+    v("spawn", spawn, "what to drop into the scene and when (list)");
+    v("render", render, "rendering");
+    v("output", output, "what to write into the output folder");
+  }
+};
+
+}  // namespace seamless

@@ -1,0 +1,45 @@
+// Tracker section (`tracker:`): camera tracking after KinectFusion (Newcombe et al. 2011):
+// projective data association, point-to-plane ICP over a 3-level pyramid; plus an RGB-D variant.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "core/math.hpp"
+#include "core/params.hpp"
+
+namespace seamless {
+
+struct TrackerParams {
+  std::string kind = "icp";
+  std::string mode = "frame_to_model";
+  std::vector<int> iterations{10, 5, 4};  // finest level first (KinectFusion, sec. 3.5)
+  float dist_threshold = 0.1f;            // metres
+  float angle_threshold_deg = 20.f;
+  float photometric_weight = 0.1f;        // rgbd only: weight of the colour term vs geometry
+  float min_inlier_ratio = 0.3f;
+  float max_translation_jump = 0.3f;      // metres per frame
+  float max_rotation_jump_deg = 30.f;     // degrees per frame
+  std::string gravity = "auto";
+  vec3 fixed_gravity{0.f, 1.f, 0.f};      // camera frame (y down), used when gravity: fixed
+
+  template <class V> void visit(V& v) {
+    v("kind", kind, "tracker", Choices{"icp", "rgbd", "ground_truth"});
+    v("mode", mode, "align to the model raycast or to the previous frame",
+      Choices{"frame_to_model", "frame_to_frame"});
+    v("iterations", iterations, "ICP iterations per pyramid level, finest first", Range{0, 1000});
+    v("dist_threshold", dist_threshold, "reject correspondences farther apart, metres", Range{0.0, 10.0});
+    v("angle_threshold_deg", angle_threshold_deg, "reject correspondences whose normals differ more, degrees",
+      Range{0.0, 180.0});
+    v("photometric_weight", photometric_weight, "weight of the photometric term (rgbd)", Range{0.0, 1e6});
+    v("min_inlier_ratio", min_inlier_ratio, "tracking is lost below this fraction of inliers", Range{0.0, 1.0});
+    v("max_translation_jump", max_translation_jump, "tracking is lost above this per-frame motion, metres",
+      Range{0.0, 100.0});
+    v("max_rotation_jump_deg", max_rotation_jump_deg, "tracking is lost above this per-frame rotation, degrees",
+      Range{0.0, 180.0});
+    v("gravity", gravity, "where 'down' comes from (auto: accelerometer if present, else floor plane)",
+      Choices{"auto", "accelerometer", "floor", "fixed", "none"});
+    v("fixed_gravity", fixed_gravity, "down direction in the first camera frame (gravity: fixed)");
+  }
+};
+
+}  // namespace seamless

@@ -1,0 +1,42 @@
+// Volume section (`volume:`): the TSDF volume layout and fusion parameters.
+// Voxel hashing after Niessner et al. 2013; the dense grid is the KinectFusion comparator.
+#pragma once
+#include <cstdint>
+#include <string>
+
+#include "core/math.hpp"
+#include "core/params.hpp"
+
+namespace seamless {
+
+struct VolumeParams {
+  std::string layout = "hash";
+  float voxel_size = 0.005f;         // metres
+  float truncation = 0.02f;          // metres (4 voxels at the default size)
+  float max_weight = 100.f;          // running-average weight cap (lets the model adapt)
+  std::int64_t hash_buckets = 1 << 20;
+  std::int64_t capacity = 1 << 18;   // 8^3-voxel blocks the pool can hold
+  int dense_resolution = 512;        // voxels per side of the dense cube
+  vec3 dense_origin{-1.28f, -1.28f, 0.f};  // world position of the dense cube's min corner
+  float min_depth = 0.3f;            // Kinect v1 minimum range, metres
+  float max_depth = 4.0f;            // beyond this depth is too noisy to fuse
+  bool integrate_color = true;
+  bool remove_empty_blocks = true;
+
+  template <class V> void visit(V& v) {
+    v("layout", layout, "volume layout: voxel hashing or dense grid", Choices{"hash", "dense"});
+    v("voxel_size", voxel_size, "voxel edge length, metres", Range{0.0005, 1.0});
+    v("truncation", truncation, "TSDF truncation distance, metres", Range{0.001, 2.0});
+    v("max_weight", max_weight, "maximum fusion weight per voxel", Range{1.0, 1e6});
+    v("hash_buckets", hash_buckets, "hash table buckets (hash layout)", Range{1024, 1e9});
+    v("capacity", capacity, "voxel blocks in the pool (hash layout)", Range{64, 1e9});
+    v("dense_resolution", dense_resolution, "voxels per side (dense layout)", Range{8, 2048});
+    v("dense_origin", dense_origin, "min corner of the dense cube in world coordinates, metres");
+    v("min_depth", min_depth, "ignore depth closer than this, metres", Range{0.0, 100.0});
+    v("max_depth", max_depth, "ignore depth farther than this, metres", Range{0.01, 100.0});
+    v("integrate_color", integrate_color, "fuse RGB colour into the voxels");
+    v("remove_empty_blocks", remove_empty_blocks, "free blocks whose voxels all became empty");
+  }
+};
+
+}  // namespace seamless
