@@ -1,0 +1,26 @@
+// A small kernel family that exercises every executor primitive, instantiated for both backends
+// (exec_probe_cpu.cpp, exec_probe_cuda.cu) so the same test checks both.
+#pragma once
+#include <cstdint>
+
+#include "core/math.hpp"
+#include "core/view.hpp"
+
+namespace seamless::probe {
+
+// 3 floats and a count, summed by transform_reduce: checks reductions of a struct type.
+struct Moments {
+  double sum = 0, sum_sq = 0;
+  std::int64_t count = 0;
+  SEAMLESS_HD Moments operator+(const Moments& o) const { return {sum + o.sum, sum_sq + o.sum_sq, count + o.count}; }
+};
+
+template <class Exec> void square(const Exec& ex, View<const float> in, View<float> out);
+template <class Exec> Moments moments(const Exec& ex, View<const float> in);
+template <class Exec> std::uint32_t scan(const Exec& ex, View<const std::uint32_t> in, View<std::uint32_t> out);
+template <class Exec> void sort(const Exec& ex, View<std::uint32_t> keys, View<std::int32_t> values, int bits);
+// Histogram with atomics: counts[v % bins]++ for every v.
+template <class Exec> void histogram(const Exec& ex, View<const std::uint32_t> in, View<std::uint32_t> counts);
+template <class Exec> void atomic_float_sum(const Exec& ex, View<const float> in, float* total);
+
+}  // namespace seamless::probe

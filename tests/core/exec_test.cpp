@@ -1,0 +1,137 @@
+// The executor primitives on every available backend, against exact host results. Inputs are
+// small integers stored as floats, so every sum below is exact in float/double arithmetic and the
+// comparisons can be exact whatever the summation order.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <numeric>
+#include <random>
+
+#include "core/buffer.hpp"
+#include "core/exec.hpp"
+#include "exec_probe.hpp"
+
+using namespace seamless;
+
+namespace {
+
+class ExecTest : public ::testing::TestWithParam<Device> {
+ protected:
+  void SetUp() override {
+    if (GetParam() == Device::CUDA && !cuda_available()) GTEST_SKIP() << "no CUDA device on this machine";
+  }
+  Device dev() const { return GetParam(); }
+};
+
+std::vector<std::uint32_t> random_keys(std::size_t n, std::uint32_t max, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<std::uint32_t> d(0, max);
+  std::vector<std::uint32_t> v(n);
+  for (auto& k : v) k = d(rng);
+  return v;
+}
+
+TEST_P(ExecTest, ForEachCoversEveryElementOnce) {
+  const std::int64_t n = 100003;  // not a multiple of any block size
+  std::vector<float> h(n);
+  for (std::int64_t i = 0; i < n; ++i) h[i] = static_cast<float>(i % 1000);
+  auto in = Buffer<float>::from_host(h, dev());
+  Buffer<float> out(n, dev());
+  with_exec(dev(), [&](const auto& ex) { probe::square(ex, in.cview(), out.view()); });
+  auto r = out.to_host();
+  for (std::int64_t i = 0; i < n; ++i) ASSERT_EQ(r[i], h[i] * h[i]) << "at " << i;
+}
+
+TEST_P(ExecTest, TransformReduceOfStruct) {
+  const std::int64_t n = 250001;
+  std::vector<float> h(n);
+  double sum = 0, sq = 0;
+  for (std::int64_t i = 0; i < n; ++i) {
+    h[i] = static_cast<float>(i % 17);
+    sum += h[i];
+    sq += double(h[i]) * h[i];
+  }
+  auto in = Buffer<float>::from_host(h, dev());
+  auto m = with_exec(dev(), [&](const auto& ex) { return probe::moments(ex, in.cview()); });
+  EXPECT_EQ(m.count, n);
+  EXPECT_EQ(m.sum, sum);
+  EXPECT_EQ(m.sum_sq, sq);
+}
+
+TEST_P(ExecTest, ExclusiveScanAndTotal) {
+  auto h = random_keys(77777, 9, 1);
+  auto in = Buffer<std::uint32_t>::from_host(h, dev());
+  Buffer<std::uint32_t> out(in.size(), dev());
+  auto total = with_exec(dev(), [&](const auto& ex) { return probe::scan(ex, in.cview(), out.view()); });
+  std::vector<std::uint32_t> expect(h.size());
+  std::exclusive_scan(h.begin(), h.end(), expect.begin(), 0u);
+  EXPECT_EQ(out.to_host(), expect);
+  EXPECT_EQ(total, std::accumulate(h.begin(), h.end(), 0u));
+}
+
+TEST_P(ExecTest, SortByKeyIsStable) {
+  for (int bits : {8, 20, 32}) {
+    std::uint32_t max = bits == 32 ? 0xFFFFFFFFu : (1u << bits) - 1;
+    auto keys = random_keys(50000, max, 2);
+    std::vector<std::int32_t> vals(keys.size());
+    std::iota(vals.begin(), vals.end(), 0);
+    auto k = Buffer<std::uint32_t>::from_host(keys, dev());
+    auto v = Buffer<std::int32_t>::from_host(vals, dev());
+    with_exec(dev(), [&](const auto& ex) { probe::sort(ex, k.view(), v.view(), bits); });
+    std::vector<std::int32_t> order(vals);
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return keys[a] < keys[b]; });
+    EXPECT_EQ(v.to_host(), order) << bits << " bits";
+    std::sort(keys.begin(), keys.end());
+    EXPECT_EQ(k.to_host(), keys) << bits << " bits";
+  }
+}
+
+TEST_P(ExecTest, AtomicsUnderContention) {
+  auto h = random_keys(200000, 1000, 3);
+  auto in = Buffer<std::uint32_t>::from_host(h, dev());
+  Buffer<std::uint32_t> counts(7, dev());
+  counts.zero();
+  with_exec(dev(), [&](const auto& ex) { probe::histogram(ex, in.cview(), counts.view()); });
+  std::vector<std::uint32_t> expect(7, 0);
+  for (auto x : h) ++expect[x % 7];
+  EXPECT_EQ(counts.to_host(), expect);
+
+  std::vector<float> ones(100000, 1.0f);  // 1e5 < 2^24: the float sum is exact in any order
+  auto f = Buffer<float>::from_host(ones, dev());
+  Buffer<float> total(1, dev());
+  total.zero();
+  with_exec(dev(), [&](const auto& ex) { probe::atomic_float_sum(ex, f.cview(), total.data()); });
+  EXPECT_EQ(total.to_host()[0], 100000.0f);
+}
+
+// The CUDA instantiation carries "Parity" in its name: it gets the ctest label `gpu`.
+auto device_label = [](const auto& info) { return std::string(device_name(info.param)); };
+INSTANTIATE_TEST_SUITE_P(Cpu, ExecTest, ::testing::Values(Device::CPU), device_label);
+INSTANTIATE_TEST_SUITE_P(CudaParity, ExecTest, ::testing::Values(Device::CUDA), device_label);
+
+TEST(Buffer, MoveOwnsAndLedgerCounts) {
+  std::size_t before = memory::bytes_in_use(Device::CPU);
+  {
+    Buffer<double> a(1000, Device::CPU);
+    EXPECT_EQ(memory::bytes_in_use(Device::CPU), before + 8000);
+    Buffer<double> b(std::move(a));
+    EXPECT_EQ(a.data(), nullptr);
+    EXPECT_EQ(b.size(), 1000);
+    EXPECT_EQ(memory::bytes_in_use(Device::CPU), before + 8000);
+  }
+  EXPECT_EQ(memory::bytes_in_use(Device::CPU), before);
+}
+
+TEST(Device, CudaRequestWithoutCudaIsAClearError) {
+  if (cuda_available()) GTEST_SKIP() << "a CUDA device is present";
+  try {
+    resolve_device("cuda");
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--device cpu"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(resolve_device("auto"), Device::CPU);
+  EXPECT_THROW(resolve_device("gpu"), Error);
+}
+
+}  // namespace
