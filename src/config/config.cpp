@@ -1,0 +1,79 @@
+#include "config/config.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "config/params_yaml.hpp"
+
+namespace seamless {
+namespace fs = std::filesystem;
+
+namespace {
+
+YAML::Node parse_yaml(const std::string& text, const std::string& source) {
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw Error(source + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
+                ": YAML syntax error: " + e.msg);
+  }
+}
+
+}  // namespace
+
+Experiment parse_experiment(const std::string& yaml_text, const std::vector<std::string>& overrides,
+                            const std::string& source_name) {
+  YAML::Node root = parse_yaml(yaml_text, source_name);
+  std::vector<config::Override> applied;
+  for (const auto& o : overrides) applied.push_back(config::apply_override(root, o));
+  config::LoadContext ctx(source_name, std::move(applied), experiment_keys());
+  return config::load_params<Experiment>(root, ctx);
+}
+
+Experiment load_experiment(const std::string& path, const std::vector<std::string>& overrides) {
+  std::ifstream in(path);
+  if (!in) throw Error("cannot open config file '" + path + "' (check the path; examples are in configs/)");
+  std::stringstream text;
+  text << in.rdbuf();
+  return parse_experiment(text.str(), overrides, path);
+}
+
+std::string to_yaml(const Experiment& e) {
+  return "# Effective configuration of experiment '" + e.name +
+         "': every key, defaults included, after --set overrides.\n"
+         "# Load it back with `seamless run <this file>`; keys are described in docs/CONFIG.md.\n" +
+         config::params_to_yaml(e);
+}
+
+std::string write_effective_config(const Experiment& e, const std::string& path) {
+  fs::path file = path;
+  std::error_code ec;
+  if (fs::is_directory(file, ec) || (!path.empty() && path.back() == '/')) file /= "config.yaml";
+  if (file.has_parent_path()) fs::create_directories(file.parent_path(), ec);
+  std::ofstream out(file);
+  out << to_yaml(e);
+  out.close();
+  if (!out) throw Error("cannot write the effective config to '" + file.string() + "' (is the output folder writable?)");
+  return file.string();
+}
+
+std::vector<config::KeyInfo> experiment_keys() { return config::list_keys<Experiment>(); }
+
+std::string experiment_keys_markdown() {
+  std::string md = "| key | type | default | allowed | meaning |\n| --- | --- | --- | --- | --- |\n";
+  auto cell = [](std::string s) {
+    for (std::size_t p = 0; (p = s.find('|', p)) != std::string::npos; p += 2) s.replace(p, 1, "\\|");
+    return s;
+  };
+  for (const auto& k : experiment_keys())
+    md += "| `" + k.path + "` | " + k.type + " | " + (k.value.empty() ? "" : "`" + cell(k.value) + "`") + " | " +
+          cell(k.constraint) + " | " + cell(k.doc) + " |\n";
+  return md;
+}
+
+std::vector<std::string> diff_experiments(const Experiment& a, const Experiment& b) {
+  return config::diff_params(a, b);
+}
+
+}  // namespace seamless
