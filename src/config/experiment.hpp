@@ -8,6 +8,7 @@
 #include "core/params.hpp"
 #include "io/input_params.hpp"
 #include "physics/solver_params.hpp"
+#include "recon/preprocess_params.hpp"
 #include "recon/tracker_params.hpp"
 #include "recon/volume_params.hpp"
 #include "render/render_params.hpp"
@@ -39,6 +40,7 @@ struct Experiment {
   std::string mode = "live";
   std::int64_t frames = 0;        // 0 = as many as the input gives
   InputParams input;
+  PreprocessParams preprocess;
   VolumeParams volume;
   TrackerParams tracker;
   SolverParams solver;
@@ -54,6 +56,7 @@ struct Experiment {
       Choices{"live", "scan_then_simulate"});
     v("frames", frames, "frames to process; 0 = all the input has", Range{0, 1e12});
     v("input", input, "where frames come from");
+    v("preprocess", preprocess, "depth filtering, pyramid, vertex and normal maps");
     v("volume", volume, "TSDF volume");
     v("tracker", tracker, "camera tracking");
     v("solver", solver, "particle solver");

@@ -98,3 +98,28 @@ double StageTimer::median_ms(const std::string& stage) const {
 }
 
 }  // namespace seamless
+
+namespace seamless {
+double measure_ms(Device d, const std::function<void()>& fn) {
+#if SEAMLESS_HAS_CUDA
+  if (d == Device::CUDA) {
+    cudaEvent_t a, b;
+    SEAMLESS_CUDA_CHECK(cudaEventCreate(&a));
+    SEAMLESS_CUDA_CHECK(cudaEventCreate(&b));
+    SEAMLESS_CUDA_CHECK(cudaEventRecord(a));
+    fn();
+    SEAMLESS_CUDA_CHECK(cudaEventRecord(b));
+    SEAMLESS_CUDA_CHECK(cudaEventSynchronize(b));
+    float ms = 0;
+    SEAMLESS_CUDA_CHECK(cudaEventElapsedTime(&ms, a, b));
+    cudaEventDestroy(a);
+    cudaEventDestroy(b);
+    return ms;
+  }
+#endif
+  (void)d;
+  auto t0 = std::chrono::steady_clock::now();
+  fn();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace seamless

@@ -2,6 +2,7 @@
 // once per frame (end_frame) so that timing does not serialise the pipeline.
 #pragma once
 #include <chrono>
+#include <functional>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -55,4 +56,10 @@ class StageScope {
 
 double median(std::vector<double> v);
 
+}  // namespace seamless
+
+namespace seamless {
+// Time of one call of fn in milliseconds: CUDA events around it on the GPU, a steady clock on the
+// CPU (after synchronising), so device work is counted and host launch overhead alone is not.
+double measure_ms(Device d, const std::function<void()>& fn);
 }  // namespace seamless

@@ -1,0 +1,7 @@
+// Factories of the benchmarks registered in bench.cpp, one per pipeline part.
+#pragma once
+#include "app/bench.hpp"
+
+namespace seamless::app {
+std::vector<BenchCase> make_preprocess_bench(const BenchOptions& o);
+}  // namespace seamless::app

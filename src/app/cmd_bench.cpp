@@ -1,0 +1,84 @@
+// seamless bench <name>: warm-up, N repetitions, min/median/max, JSON.
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+
+#include "app/bench.hpp"
+#include "app/commands.hpp"
+#include "core/timing.hpp"
+
+namespace seamless::app {
+
+namespace {
+struct BenchArgs {
+  std::string name, device = "auto", json, data, filter;
+  int reps = 50, warmup = 5;
+};
+
+void write_json(const std::string& path, const std::string& bench, Device dev, const std::vector<std::string>& rows) {
+  std::ofstream f(path);
+  f << "{\n  \"benchmark\": \"" << bench << "\",\n  \"device\": \"" << device_name(dev) << "\",\n  \"gpu\": \""
+    << cuda_device_description() << "\",\n  \"cases\": [\n";
+  for (std::size_t i = 0; i < rows.size(); ++i) f << "    " << rows[i] << (i + 1 < rows.size() ? ",\n" : "\n");
+  f << "  ]\n}\n";
+}
+
+int run_bench(const BenchArgs& a) {
+  auto& reg = bench_registry();
+  auto it = reg.find(a.name);
+  if (it == reg.end()) {
+    std::string names;
+    for (auto& [n, info] : reg) names += "\n  " + n + ": " + info.description;
+    spdlog::error("no benchmark named '{}'; this build has:{}", a.name, names);
+    return 1;
+  }
+  BenchOptions o{resolve_device(a.device), a.data, a.filter};
+  spdlog::info("bench {} on {} {}", a.name, device_name(o.device), cuda_device_description());
+  std::vector<std::string> json_rows;
+  std::printf("%-32s %10s %10s %10s  %s\n", "case", "min ms", "median ms", "max ms", "detail");
+  for (BenchCase& c : it->second.factory(o)) {
+    if (!a.filter.empty() && c.name.find(a.filter) == std::string::npos) continue;
+    for (int i = 0; i < a.warmup; ++i) measure_ms(o.device, c.step);
+    std::vector<double> t;
+    for (int i = 0; i < a.reps; ++i) t.push_back(measure_ms(o.device, c.step));
+    double lo = *std::min_element(t.begin(), t.end()), hi = *std::max_element(t.begin(), t.end());
+    double med = median(t);
+    std::printf("%-32s %10.4f %10.4f %10.4f  %s\n", c.name.c_str(), lo, med, hi, c.detail.c_str());
+    char row[512];
+    std::snprintf(row, sizeof row, "{\"name\": \"%s\", \"reps\": %d, \"min_ms\": %.6f, \"median_ms\": %.6f, \"max_ms\": %.6f, \"detail\": \"%s\"}",
+                  c.name.c_str(), a.reps, lo, med, hi, c.detail.c_str());
+    json_rows.push_back(row);
+  }
+  if (!a.json.empty()) {
+    write_json(a.json, a.name, o.device, json_rows);
+    spdlog::info("wrote {}", a.json);
+  }
+  return 0;
+}
+}  // namespace
+
+void add_bench_command(CLI::App& app, std::function<int()>& action) {
+  auto a = std::make_shared<BenchArgs>();
+  auto* cmd = app.add_subcommand("bench", "run a named benchmark (warm-up, repetitions, min/median/max, JSON)");
+  cmd->add_option("name", a->name, "benchmark name (seamless bench --list)");
+  cmd->add_option("--reps", a->reps, "timed repetitions")->check(CLI::PositiveNumber);
+  cmd->add_option("--warmup", a->warmup, "untimed repetitions first")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--device", a->device, "cpu, cuda or auto")->check(CLI::IsMember({"cpu", "cuda", "auto"}));
+  cmd->add_option("--json", a->json, "write the results as JSON to this file");
+  cmd->add_option("--data", a->data, "TUM folder for benchmarks over real frames");
+  cmd->add_option("--filter", a->filter, "only cases whose name contains this");
+  auto* list = cmd->add_flag("--list", "list the benchmarks");
+  cmd->callback([&action, a, list] {
+    action = [a, list] {
+      if (*list || a->name.empty()) {
+        for (auto& [n, info] : bench_registry()) std::printf("%-12s %s\n", n.c_str(), info.description.c_str());
+        return a->name.empty() && !*list ? 2 : 0;
+      }
+      return run_bench(*a);
+    };
+  });
+}
+
+}  // namespace seamless::app
