@@ -6,14 +6,63 @@
 #include "app/commands.hpp"
 #include "app/run_context.hpp"
 #include "config/config.hpp"
+#include "core/error.hpp"
+#include "eval/trajectory_eval.hpp"
 
 namespace seamless::app {
 
+namespace {
+struct EvalArgs {
+  std::vector<std::string> files;
+  double max_dt = 0.02;
+  std::string json, aligned;
+};
+
+int run_eval(const EvalArgs& a) {
+  Trajectory est = read_tum_trajectory(a.files[0]), gt = read_tum_trajectory(a.files[1]);
+  AteResult ate = compute_ate(est, gt, a.max_dt);
+  RpeResult rpe_f = compute_rpe(est, gt, 1, "frames", a.max_dt);
+  double span = est.empty() ? 0 : est.back().timestamp - est.front().timestamp;
+  std::printf("%zu of %zu estimated poses matched ground truth within %.3f s\n", ate.trans.count, est.size(), a.max_dt);
+  std::printf("%-22s %10s %10s %10s %10s\n", "", "rmse", "mean", "median", "max");
+  auto row = [](const char* name, const ErrorStats& s, double scale) {
+    std::printf("%-22s %10.4f %10.4f %10.4f %10.4f\n", name, s.rmse * scale, s.mean * scale, s.median * scale,
+                s.max * scale);
+  };
+  row("ATE (cm)", ate.trans, 100);
+  row("RPE/frame trans (cm)", rpe_f.trans, 100);
+  row("RPE/frame rot (deg)", rpe_f.rot, 1);
+  std::string rpe_s_json;
+  if (span > 1.0) {
+    RpeResult rpe_s = compute_rpe(est, gt, 1.0, "seconds", a.max_dt);
+    row("RPE/s trans (cm)", rpe_s.trans, 100);
+    row("RPE/s rot (deg)", rpe_s.rot, 1);
+    rpe_s_json = ",\n  \"rpe_second_trans_rmse_m\": " + std::to_string(rpe_s.trans.rmse) +
+                 ",\n  \"rpe_second_rot_rmse_deg\": " + std::to_string(rpe_s.rot.rmse);
+  }
+  if (!a.aligned.empty()) write_tum_trajectory(a.aligned, ate.aligned);
+  if (!a.json.empty()) {
+    std::FILE* f = std::fopen(a.json.c_str(), "w");
+    if (!f) throw Error("cannot write " + a.json);
+    std::fprintf(f,
+                 "{\n  \"pairs\": %zu,\n  \"ate_rmse_m\": %.9f,\n  \"ate_mean_m\": %.9f,\n  \"ate_median_m\": %.9f,\n"
+                 "  \"ate_max_m\": %.9f,\n  \"rpe_frame_trans_rmse_m\": %.9f,\n  \"rpe_frame_rot_rmse_deg\": %.9f%s\n}\n",
+                 ate.trans.count, ate.trans.rmse, ate.trans.mean, ate.trans.median, ate.trans.max, rpe_f.trans.rmse,
+                 rpe_f.rot.rmse, rpe_s_json.c_str());
+    std::fclose(f);
+  }
+  return 0;
+}
+}  // namespace
+
 void add_eval_command(CLI::App& app, std::function<int()>& action) {
-  auto files = std::make_shared<std::vector<std::string>>();
+  auto a = std::make_shared<EvalArgs>();
   auto* cmd = app.add_subcommand("eval", "ATE and RPE of an estimated trajectory against ground truth (TUM format)");
-  cmd->add_option("trajectories", *files, "estimate.txt groundtruth.txt")->expected(2)->required();
-  cmd->callback([&action] { action = [] { return not_built("eval", "trajectory evaluation (issue 5) is not built yet"); }; });
+  cmd->add_option("trajectories", a->files, "estimate.txt groundtruth.txt")->expected(2)->required()->check(CLI::ExistingFile);
+  cmd->add_option("--max-dt", a->max_dt, "largest timestamp difference of associated poses, seconds (TUM: 0.02)");
+  cmd->add_option("--json", a->json, "write the figures as JSON");
+  cmd->add_option("--aligned", a->aligned, "write the aligned estimate (TUM format) for plotting");
+  cmd->callback([&action, a] { action = [a] { return run_eval(*a); }; });
 }
 
 void add_record_command(CLI::App& app, std::function<int()>& action) {
