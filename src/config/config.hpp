@@ -7,6 +7,7 @@
 
 #include "config/experiment.hpp"
 #include "config/params_text.hpp"
+#include "core/error.hpp"
 
 namespace seamless {
 

@@ -1,0 +1,207 @@
+// Loading and validation: every kind of bad input must name the file position, the full key
+// path, what was expected, and (for near misses) suggest the intended word.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "config/config.hpp"
+#include "config/params_yaml.hpp"
+#include "seamless/build_config.hpp"
+
+namespace seamless {
+namespace {
+
+using ::testing::HasSubstr;
+
+// The message of the seamless::Error thrown by parsing `yaml`, or "" if nothing was thrown.
+std::string error_of(const std::string& yaml, const std::vector<std::string>& overrides = {}) {
+  try {
+    parse_experiment(yaml, overrides, "test.yaml");
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ConfigLoad, EmptyFileGivesDefaults) {
+  Experiment e = parse_experiment("", {}, "empty.yaml");
+  EXPECT_TRUE(diff_experiments(e, Experiment{}).empty());
+}
+
+TEST(ConfigLoad, MissingKeysKeepTheirDefaults) {
+  Experiment e = parse_experiment("volume:\n  voxel_size: 0.01\noutput:\n", {}, "t.yaml");
+  EXPECT_EQ(e.volume.voxel_size, 0.01f);
+  EXPECT_EQ(e.volume.truncation, VolumeParams{}.truncation);
+  EXPECT_EQ(e.output.dir, OutputParams{}.dir);  // `output:` with nothing under it = defaults
+  EXPECT_EQ(e.tracker.iterations, (std::vector<int>{10, 5, 4}));
+}
+
+TEST(ConfigLoad, ReadsEveryFieldType) {
+  Experiment e = parse_experiment(R"(
+name: "my run: 2"
+frames: 12345678901
+input:
+  synthetic: {seed: 18446744073709551615, noise: off}
+  depth_scale: 1000.5
+volume: {integrate_color: false}
+tracker: {iterations: [3, 2], fixed_gravity: [0, -1, 0.5]}
+spawn:
+  - {kind: cloth, pinned: [0, 3], nx: 5}
+  - kind: rigid
+    position: [1, 2, 3]
+)", {}, "t.yaml");
+  EXPECT_EQ(e.name, "my run: 2");
+  EXPECT_EQ(e.frames, 12345678901LL);
+  EXPECT_EQ(e.input.synthetic.seed, 18446744073709551615ULL);
+  EXPECT_FALSE(e.input.synthetic.noise);
+  EXPECT_EQ(e.input.depth_scale, 1000.5);
+  EXPECT_FALSE(e.volume.integrate_color);
+  EXPECT_EQ(e.tracker.iterations, (std::vector<int>{3, 2}));
+  EXPECT_EQ(e.tracker.fixed_gravity.z, 0.5f);
+  ASSERT_EQ(e.spawn.size(), 2u);
+  EXPECT_EQ(e.spawn[0].kind, "cloth");
+  EXPECT_EQ(e.spawn[0].pinned, (std::vector<int>{0, 3}));
+  EXPECT_EQ(e.spawn[0].nx, 5);
+  EXPECT_EQ(e.spawn[1].kind, "rigid");
+  EXPECT_EQ(e.spawn[1].position.y, 2.f);
+  EXPECT_EQ(e.spawn[1].size.x, SpawnParams{}.size.x);  // element defaults apply per entry
+}
+
+TEST(ConfigErrors, MisspeltKeyGivesPositionPathAndSuggestion) {
+  std::string msg = error_of("name: x\nvolume:\n  voxel_sise: 0.01\n");
+  EXPECT_THAT(msg, HasSubstr("test.yaml:3:3:"));  // 1-based line and column of the key
+  EXPECT_THAT(msg, HasSubstr("volume.voxel_sise"));
+  EXPECT_THAT(msg, HasSubstr("did you mean 'voxel_size'?"));
+  EXPECT_THAT(msg, HasSubstr("keys of 'volume':"));  // what was expected
+}
+
+TEST(ConfigErrors, TranspositionAndCaseAreNearMisses) {
+  EXPECT_THAT(error_of("volume:\n  voxle_size: 1\n"), HasSubstr("did you mean 'voxel_size'?"));
+  EXPECT_THAT(error_of("Volume:\n  voxel_size: 0.01\n"), HasSubstr("did you mean 'volume'?"));
+}
+
+TEST(ConfigErrors, FarOffKeyGetsNoSuggestionButTheKeyList) {
+  std::string msg = error_of("tracker:\n  banana: 1\n");
+  EXPECT_THAT(msg, HasSubstr("tracker.banana"));
+  EXPECT_THAT(msg, ::testing::Not(HasSubstr("did you mean")));
+  EXPECT_THAT(msg, HasSubstr("dist_threshold"));
+}
+
+TEST(ConfigErrors, KeyInTheWrongSectionNamesTheRightOne) {
+  std::string msg = error_of("voxel_size: 0.01\n");
+  EXPECT_THAT(msg, HasSubstr("test.yaml:1:1:"));
+  EXPECT_THAT(msg, HasSubstr("volume.voxel_size"));
+}
+
+TEST(ConfigErrors, WrongType) {
+  std::string msg = error_of("volume:\n  voxel_size: abc\n");
+  EXPECT_THAT(msg, HasSubstr("test.yaml:2:15:"));  // position of the value
+  EXPECT_THAT(msg, HasSubstr("volume.voxel_size"));
+  EXPECT_THAT(msg, HasSubstr("expected a number (float), got 'abc'"));
+
+  EXPECT_THAT(error_of("volume: {integrate_color: 3}"), HasSubstr("expected true or false, got '3'"));
+  EXPECT_THAT(error_of("solver: {iterations: 1.5}"), HasSubstr("expected an integer (int), got '1.5'"));
+  EXPECT_THAT(error_of("solver: {gravity: [0, -9.81]}"),
+              HasSubstr("solver.gravity: expected a list of 3 numbers [x, y, z], got a list of 2"));
+  EXPECT_THAT(error_of("volume: 3"), HasSubstr("volume: expected a section"));
+  EXPECT_THAT(error_of("spawn: {kind: rigid}"), HasSubstr("spawn: expected a list"));
+  EXPECT_THAT(error_of("input: {synthetic: {seed: -1}}"), HasSubstr("non-negative integer"));
+  EXPECT_THAT(error_of("solver: {dt: .nan}"), HasSubstr("solver.dt: expected a number"));
+}
+
+TEST(ConfigErrors, OutOfRange) {
+  std::string msg = error_of("volume:\n  voxel_size: 5\n");
+  EXPECT_THAT(msg, HasSubstr("test.yaml:2:15:"));
+  EXPECT_THAT(msg, HasSubstr("volume.voxel_size: out of range: got '5', expected a value in [0.0005, 1]"));
+  // Ranges apply to each element of a list, and the element's index is part of the path.
+  EXPECT_THAT(error_of("tracker: {iterations: [10, -1]}"), HasSubstr("tracker.iterations.1: out of range"));
+}
+
+TEST(ConfigErrors, BadChoice) {
+  std::string msg = error_of("volume:\n  layout: hsah\n");
+  EXPECT_THAT(msg, HasSubstr("test.yaml:2:11:"));
+  EXPECT_THAT(msg, HasSubstr("volume.layout: got 'hsah', expected one of hash, dense; did you mean 'hash'?"));
+}
+
+TEST(ConfigErrors, ListElementsHaveIndexedPathsAndPositions) {
+  std::string msg = error_of("spawn:\n  - kind: rigid\n  - kind: fluid_blok\n");
+  EXPECT_THAT(msg, HasSubstr("test.yaml:3:11: spawn.1.kind"));
+  EXPECT_THAT(msg, HasSubstr("did you mean 'fluid_block'?"));
+}
+
+TEST(ConfigErrors, AllProblemsAreReportedAtOnce) {
+  std::string msg = error_of("volume:\n  voxel_size: 5\n  layot: hash\nrender: {width: wide}\n");
+  EXPECT_THAT(msg, HasSubstr("3 problems"));
+  EXPECT_THAT(msg, HasSubstr("test.yaml:2:15: volume.voxel_size"));
+  EXPECT_THAT(msg, HasSubstr("test.yaml:3:3: volume.layot"));
+  EXPECT_THAT(msg, HasSubstr("render.width"));
+}
+
+TEST(ConfigErrors, DuplicateKey) {
+  EXPECT_THAT(error_of("volume:\n  voxel_size: 0.01\n  voxel_size: 0.02\n"),
+              HasSubstr("test.yaml:3:3: volume.voxel_size: duplicate key"));
+}
+
+TEST(ConfigErrors, YamlSyntaxErrorHasPosition) {
+  std::string msg = error_of("volume:\n  voxel_size: [0.01\n");
+  EXPECT_THAT(msg, HasSubstr("test.yaml:"));
+  EXPECT_THAT(msg, HasSubstr("YAML syntax error"));
+}
+
+TEST(ConfigErrors, FileErrorsNameTheFile) {
+  auto dir = std::filesystem::path(::testing::TempDir()) / "seamless_config_errors";
+  std::filesystem::create_directories(dir);
+  std::string file = (dir / "bad.yaml").string();
+  std::ofstream(file) << "render:\n  mode: headles\n";
+  try {
+    load_experiment(file);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_THAT(std::string(e.what()), HasSubstr(file + ":2:9: render.mode"));
+    EXPECT_THAT(std::string(e.what()), HasSubstr("did you mean 'headless'?"));
+  }
+  EXPECT_THROW(load_experiment((dir / "missing.yaml").string()), Error);
+}
+
+TEST(ConfigDidYouMean, PicksTheClosestPlausibleWord) {
+  std::vector<std::string> keys{"voxel_size", "truncation", "max_weight", "dt", "nx"};
+  EXPECT_EQ(config::did_you_mean("voxel_sise", keys), "voxel_size");
+  EXPECT_EQ(config::did_you_mean("truncaton", keys), "truncation");
+  EXPECT_EQ(config::did_you_mean("MAX_WEIGHT", keys), "max_weight");
+  EXPECT_EQ(config::did_you_mean("dx", keys), "dt");  // one substitution; "nx" ties, first wins
+  EXPECT_EQ(config::did_you_mean("colour", keys), "");
+}
+
+// Every shipped experiment file must load: a config that rots breaks users first.
+TEST(ConfigFiles, EveryShippedConfigLoads) {
+  std::filesystem::path root = std::filesystem::path(SEAMLESS_SOURCE_DIR) / "configs";
+  int n = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(root)) {
+    auto ext = entry.path().extension();
+    if (ext != ".yaml" && ext != ".yml") continue;
+    SCOPED_TRACE(entry.path().string());
+    EXPECT_NO_THROW({
+      try {
+        load_experiment(entry.path().string());
+      } catch (const Error& e) {
+        ADD_FAILURE() << e.what();
+        throw;
+      }
+    });
+    ++n;
+  }
+  EXPECT_GE(n, 3) << "configs/demo.yaml, tum_fr1.yaml and kinect_live.yaml at least";
+}
+
+TEST(ConfigFiles, DemoSaysWhatItShould) {
+  Experiment e = load_experiment(std::string(SEAMLESS_SOURCE_DIR) + "/configs/demo.yaml");
+  EXPECT_EQ(e.input.source, "synthetic");
+  EXPECT_EQ(e.mode, "scan_then_simulate");
+  EXPECT_EQ(e.spawn.size(), 3u);
+  EXPECT_EQ(e.spawn[1].kind, "cloth");
+}
+
+}  // namespace
+}  // namespace seamless
