@@ -1,1 +1,4 @@
 seamless_kernel_family(recon/preprocess)
+seamless_kernel_family(recon/voxel_hash)
+seamless_kernel_family(recon/tsdf_fusion)
+seamless_kernel_family(recon/tsdf_raycast)

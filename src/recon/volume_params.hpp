@@ -22,6 +22,7 @@ struct VolumeParams {
   float max_depth = 4.0f;            // beyond this depth is too noisy to fuse
   bool integrate_color = true;
   bool remove_empty_blocks = true;
+  bool grow_when_full = true;        // double the hash table / block pool instead of dropping blocks
 
   template <class V> void visit(V& v) {
     v("layout", layout, "volume layout: voxel hashing or dense grid", Choices{"hash", "dense"});
@@ -36,6 +37,8 @@ struct VolumeParams {
     v("max_depth", max_depth, "ignore depth farther than this, metres", Range{0.01, 100.0});
     v("integrate_color", integrate_color, "fuse RGB colour into the voxels");
     v("remove_empty_blocks", remove_empty_blocks, "free blocks whose voxels all became empty");
+    v("grow_when_full", grow_when_full,
+      "when the hash table or block pool runs out, grow it (and retry) instead of dropping blocks with a warning");
   }
 };
 

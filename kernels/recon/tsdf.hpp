@@ -1,0 +1,100 @@
+// TSDF kernels over voxel blocks (voxel hashing after Niessner et al. 2013; fusion after Curless &
+// Levoy 1996 / KinectFusion, Newcombe et al. 2011, section 3.3). The per-element pieces live in
+// voxel_hash.hpp; these are the kernel families, each written once over the executor.
+#pragma once
+#include <cstdint>
+
+#include "core/camera.hpp"
+#include "core/math.hpp"
+#include "core/view.hpp"
+#include "kernels/recon/voxel_hash.hpp"
+
+namespace seamless::kernels {
+
+// --- hash table maintenance (family recon/voxel_hash) ------------------------------------------
+// Empties every slot (keys -> empty, values -> -1).
+template <class Exec>
+void hash_clear(const Exec& ex, HashTableView t);
+// Free list = 0..n-1, all counters zero, free_top = n.
+template <class Exec>
+void pool_reset(const Exec& ex, View<std::int32_t> free_list, HashCounters* counters);
+// Puts blocks first..first+n-1 on the free list (after the pool grew); free_top += n.
+template <class Exec>
+void pool_append(const Exec& ex, View<std::int32_t> free_list, HashCounters* counters, std::int32_t first, std::int32_t n);
+// Zeroes the per-frame fields of the counters (inserted, collisions, failures, visible, removed).
+template <class Exec>
+void reset_frame_counters(const Exec& ex, HashCounters* counters);
+// Concurrent insert of keys (duplicates allowed); slot_out[i] = slot, result_out[i] = InsertResult.
+// A newly inserted key gets values[slot] = value_in[i] (or -1 when value_in is empty).
+template <class Exec>
+void hash_insert(const Exec& ex, HashTableView t, View<const HashKey> keys, View<const std::int32_t> value_in,
+                 View<std::int32_t> slot_out, View<std::int32_t> result_out, HashCounters* counters);
+// slot_out[i] = slot of keys[i] or -1.
+template <class Exec>
+void hash_find(const Exec& ex, HashTableView t, View<const HashKey> keys, View<std::int32_t> slot_out);
+// Tombstones every key present; slot_out[i] = freed slot or -1 (absent, or erased by a duplicate).
+template <class Exec>
+void hash_erase(const Exec& ex, HashTableView t, View<const HashKey> keys, View<std::int32_t> slot_out,
+                HashCounters* counters);
+// Slots holding a live key with a block, in slot order (deterministic); returns how many. flags
+// must hold one int per slot (scratch).
+template <class Exec>
+std::int64_t hash_live_slots(const Exec& ex, HashTableView t, View<std::int32_t> flags, View<std::int32_t> slots_out);
+// Copies (key, value) of the given slots out (for rehashing and host inspection).
+template <class Exec>
+void hash_gather(const Exec& ex, HashTableView t, View<const std::int32_t> slots, View<HashKey> keys_out,
+                 View<std::int32_t> values_out);
+// Copies whole blocks out of / into the pool: out[i*512 + k] = pool[blocks[i]*512 + k] and back
+// (host download, streaming, dense <-> hash conversion).
+template <class Exec>
+void gather_blocks(const Exec& ex, const Voxel* pool, View<const std::int32_t> blocks, View<Voxel> out);
+template <class Exec>
+void scatter_blocks(const Exec& ex, Voxel* pool, View<const std::int32_t> blocks, View<const Voxel> in);
+
+// --- per-frame fusion (family recon/tsdf_fusion) -----------------------------------------------
+struct FrameInput {
+  View2D<const float> depth;   // metres, 0 = no reading
+  View2D<const uchar3> rgb;    // same size as depth, or data == nullptr for none
+  Intrinsics K;
+  SE3 world_T_camera;
+  float min_depth = 0.3f, max_depth = 4.f;
+};
+
+// Inserts every block that the truncation band [d - mu, d + mu] of each depth ray passes through
+// (Niessner section 4.1), popping a block from the pool for each new key; failures are counted.
+template <class Exec>
+void allocate_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list, HashCounters* counters,
+                     FrameInput in, VoxelGeometry geom);
+// Appends to visible_slots every allocated block whose voxels may project into the image
+// (counters->visible is the count). Also clamps free_top after a failed allocation pass.
+template <class Exec>
+void find_visible_blocks(const Exec& ex, HashTableView t, HashCounters* counters, FrameInput in, VoxelGeometry geom,
+                         View<std::int32_t> visible_slots);
+// Fuses one frame into the listed blocks, one thread per voxel.
+template <class Exec>
+void fuse_hash_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
+                      Voxel* voxels, FrameInput in, VoxelGeometry geom, float max_weight, bool color);
+// Fuses one frame into every block of a dense grid.
+template <class Exec>
+void fuse_dense_blocks(const Exec& ex, DenseAccess grid, FrameInput in, float max_weight, bool color);
+// Frees the listed blocks that hold no voxel with weight > 0 and |sdf| < keep_below (metres):
+// zeroes them, tombstones their keys, pushes them on the free list (counters->removed counts).
+template <class Exec>
+void remove_empty_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
+                         Voxel* voxels, View<std::int32_t> free_list, HashCounters* counters, float keep_below);
+
+// --- raycasting (family recon/tsdf_raycast) ----------------------------------------------------
+struct RaycastOutput {
+  View2D<float> depth;    // camera z of the hit, metres; 0 = no hit
+  View2D<vec3> vertex;    // world coordinates; zero where no hit
+  View2D<vec3> normal;    // world coordinates, unit, facing the camera; zero where no hit
+  View2D<uchar3> color;   // fused colour; zero where no hit
+};
+// One ray per pixel from min_depth to max_depth: skips unallocated blocks whole, steps by the
+// TSDF inside allocated ones, refines the +/- zero crossing by regula falsi on the trilinear
+// field and takes the normal from its gradient (KinectFusion section 3.5; Niessner section 4.3).
+template <class Exec, class Acc>
+void raycast(const Exec& ex, Acc a, Intrinsics K, SE3 world_T_camera, float min_depth, float max_depth,
+             RaycastOutput out);
+
+}  // namespace seamless::kernels

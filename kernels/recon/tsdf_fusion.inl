@@ -1,0 +1,209 @@
+// Kernel bodies for per-frame fusion in recon/tsdf.hpp, compiled once per backend.
+#include <cmath>
+
+#include "kernels/recon/tsdf.hpp"
+
+namespace seamless::kernels {
+
+// Claims block b for this frame and gives its key a block from the pool if it has none. The
+// value goes -1 -> -2 (being filled, by exactly one thread) -> block index, or back to -1 when the
+// pool is empty: the key then stays in the table without a block, ignored by every reader, and
+// the retry after growing the pool fills it. (Tombstoning it instead would make every later
+// attempt on the same key claim a fresh slot.)
+SEAMLESS_HD inline void allocate_block(HashTableView t, const std::int32_t* free_list, HashCounters* c, int3 b) {
+  if (!block_in_range(b)) return;
+  std::int32_t slot = -1;
+  int probes = 0;
+  InsertResult r = t.insert(pack_block(b), &slot, &probes);
+  if (r == InsertResult::Full) {
+    atomic_add(&c->probe_failures, 1);
+    return;
+  }
+  if (r == InsertResult::Inserted) {
+    atomic_add(&c->inserted, 1);
+    if (probes > 0) atomic_add(&c->collisions, 1);
+  }
+  if (atomic_load(&t.values[slot]) != -1 || atomic_cas(&t.values[slot], -1, -2) != -1) return;
+  std::int32_t block = pool_pop(c, free_list);
+  atomic_exch(&t.values[slot], block < 0 ? -1 : block);
+  if (block < 0) atomic_add(&c->pool_failures, 1);
+}
+
+// Amanatides & Woo (1987) traversal of the block grid along the segment a -> b (block units):
+// visits every block the segment touches, in order.
+template <class F>
+SEAMLESS_HD inline void traverse_blocks(vec3 a, vec3 b, F visit) {
+  int3 c = floor_to_int(a), e = floor_to_int(b);
+  vec3 d = b - a;
+  const float inf = 1e30f;
+  int sx = d.x > 0 ? 1 : -1, sy = d.y > 0 ? 1 : -1, sz = d.z > 0 ? 1 : -1;
+  float tx = d.x != 0.f ? ((c.x + (sx > 0)) - a.x) / d.x : inf;
+  float ty = d.y != 0.f ? ((c.y + (sy > 0)) - a.y) / d.y : inf;
+  float tz = d.z != 0.f ? ((c.z + (sz > 0)) - a.z) / d.z : inf;
+  float dx = d.x != 0.f ? fabsf(1.f / d.x) : inf, dy = d.y != 0.f ? fabsf(1.f / d.y) : inf,
+        dz = d.z != 0.f ? fabsf(1.f / d.z) : inf;
+  for (int n = 0; n < 64; ++n) {
+    visit(c);
+    if (c == e) return;
+    if (tx <= ty && tx <= tz) {
+      if (tx > 1.f) return;
+      c.x += sx;
+      tx += dx;
+    } else if (ty <= tz) {
+      if (ty > 1.f) return;
+      c.y += sy;
+      ty += dy;
+    } else {
+      if (tz > 1.f) return;
+      c.z += sz;
+      tz += dz;
+    }
+  }
+}
+
+template <class Exec>
+void allocate_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list, HashCounters* counters,
+                     FrameInput in, VoxelGeometry geom) {
+  const int w = in.depth.width;
+  const float mu = geom.truncation;
+  const float to_block = 1.f / (geom.voxel_size * kBlockSide);
+  // Voxel g sits at origin + g*s, and block b holds voxels 8b..8b+7: in block units a world point p
+  // lies in block floor((p - origin)/(8s)).
+  ex.for_each(in.depth.count(), [=] SEAMLESS_HD(std::int64_t i) {
+    int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
+    float d = in.depth(x, y);
+    if (!(d >= in.min_depth && d <= in.max_depth)) return;
+    vec3 p = in.K.unproject(static_cast<float>(x), static_cast<float>(y), d);
+    float r = mu / length(p);  // the band is +-mu along the ray (Niessner section 4.1)
+    vec3 a = (in.world_T_camera * (p * (1.f - r)) - geom.origin) * to_block;
+    vec3 b = (in.world_T_camera * (p * (1.f + r)) - geom.origin) * to_block;
+    traverse_blocks(a, b, [&](int3 blk) { allocate_block(t, free_list.data, counters, blk); });
+  });
+}
+
+// Could any voxel of block b project into the image in front of the camera, within max_depth+mu?
+SEAMLESS_HD inline bool block_maybe_visible(int3 b, const FrameInput& in, const SE3& camera_T_world,
+                                            const VoxelGeometry& geom) {
+  float umin = 1e30f, umax = -1e30f, vmin = 1e30f, vmax = -1e30f, zmin = 1e30f;
+  bool behind = false;
+  for (int k = 0; k < 8; ++k) {
+    int3 g{b.x * 8 + (k & 1) * 7, b.y * 8 + ((k >> 1) & 1) * 7, b.z * 8 + (k >> 2) * 7};
+    vec3 pc = camera_T_world * geom.to_world(to_vec3(g));
+    zmin = fminf(zmin, pc.z);
+    if (pc.z <= 1e-4f) {
+      behind = true;
+      continue;
+    }
+    vec2 uv = in.K.project(pc);
+    umin = fminf(umin, uv.x), umax = fmaxf(umax, uv.x), vmin = fminf(vmin, uv.y), vmax = fmaxf(vmax, uv.y);
+  }
+  if (zmin > in.max_depth + geom.truncation) return false;
+  if (behind) return umax > -1e29f;  // straddles the camera plane: keep if any corner is in front
+  return umax >= -0.5f && umin <= in.depth.width - 0.5f && vmax >= -0.5f && vmin <= in.depth.height - 0.5f;
+}
+
+template <class Exec>
+void find_visible_blocks(const Exec& ex, HashTableView t, HashCounters* counters, FrameInput in, VoxelGeometry geom,
+                         View<std::int32_t> visible_slots) {
+  const SE3 camera_T_world = in.world_T_camera.inverse();
+  ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
+    if (i == 0 && counters->free_top < 0) counters->free_top = 0;  // after failed pops
+    HashKey k = t.keys[i];
+    if (!is_live_key(k) || t.values[i] < 0) return;
+    if (!block_maybe_visible(unpack_block(k), in, camera_T_world, geom)) return;
+    visible_slots[atomic_add(&counters->visible, 1)] = static_cast<std::int32_t>(i);
+  });
+}
+
+// Weighted running average of the truncated signed distance (Curless & Levoy 1996; KinectFusion
+// eq. 11-13) with the weight capped at max_weight so the model can follow change. The distance is
+// projective (along z), as in KinectFusion and Niessner; colour is averaged only near the surface.
+SEAMLESS_HD inline void fuse_voxel(Voxel& v, vec3 p_world, const FrameInput& in, const SE3& camera_T_world, float mu,
+                                   float max_weight, bool color) {
+  vec3 pc = camera_T_world * p_world;
+  if (pc.z <= 0.f) return;
+  vec2 uv = in.K.project(pc);
+  int u = static_cast<int>(floorf(uv.x + 0.5f)), w = static_cast<int>(floorf(uv.y + 0.5f));
+  if (!in.depth.inside(u, w)) return;
+  float d = in.depth(u, w);
+  if (!(d >= in.min_depth && d <= in.max_depth)) return;
+  float sdf = d - pc.z;
+  if (sdf < -mu) return;  // occluded: behind the surface by more than the truncation
+  float tsdf = fminf(sdf, mu);
+  float wt = v.weight;
+  v.sdf = (v.sdf * wt + tsdf) / (wt + 1.f);
+  if (color && in.rgb.data && sdf < mu) {
+    uchar3 c = in.rgb(u, w);
+    auto avg = [&](std::uint8_t old, std::uint8_t obs) {
+      return static_cast<std::uint8_t>(fminf(255.f, (old * wt + obs) / (wt + 1.f) + 0.5f));
+    };
+    v.color = {avg(v.color.x, c.x), avg(v.color.y, c.y), avg(v.color.z, c.z)};
+  }
+  v.weight = fminf(wt + 1.f, max_weight);
+}
+
+template <class Exec>
+void fuse_hash_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
+                      Voxel* voxels, FrameInput in, VoxelGeometry geom, float max_weight, bool color) {
+  const SE3 camera_T_world = in.world_T_camera.inverse();
+  ex.for_each(count * kBlockVoxels, [=] SEAMLESS_HD(std::int64_t i) {
+    std::int32_t slot = slots[i / kBlockVoxels];
+    int li = static_cast<int>(i % kBlockVoxels);
+    std::int32_t block = t.values[slot];
+    if (block < 0) return;
+    int3 b = unpack_block(t.keys[slot]);
+    int3 l = local_coords(li);
+    vec3 g{float(b.x * 8 + l.x), float(b.y * 8 + l.y), float(b.z * 8 + l.z)};
+    fuse_voxel(voxels[static_cast<std::int64_t>(block) * kBlockVoxels + li], geom.to_world(g), in, camera_T_world,
+               geom.truncation, max_weight, color);
+  });
+}
+
+template <class Exec>
+void fuse_dense_blocks(const Exec& ex, DenseAccess grid, FrameInput in, float max_weight, bool color) {
+  const SE3 camera_T_world = in.world_T_camera.inverse();
+  const int n = grid.blocks_per_side;
+  const std::int64_t blocks = static_cast<std::int64_t>(n) * n * n;
+  ex.for_each(blocks * kBlockVoxels, [=] SEAMLESS_HD(std::int64_t i) {
+    std::int64_t block = i / kBlockVoxels;
+    int li = static_cast<int>(i % kBlockVoxels);
+    int3 b{static_cast<int>(block % n), static_cast<int>((block / n) % n), static_cast<int>(block / n / n)};
+    int3 l = local_coords(li);
+    vec3 g{float(b.x * 8 + l.x), float(b.y * 8 + l.y), float(b.z * 8 + l.z)};
+    fuse_voxel(grid.voxels[i], grid.geom.to_world(g), in, camera_T_world, grid.geom.truncation, max_weight, color);
+  });
+}
+
+template <class Exec>
+void remove_empty_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
+                         Voxel* voxels, View<std::int32_t> free_list, HashCounters* counters, float keep_below) {
+  ex.for_each(count, [=] SEAMLESS_HD(std::int64_t i) {
+    std::int32_t slot = slots[i];
+    std::int32_t block = t.values[slot];
+    if (block < 0) return;
+    Voxel* v = voxels + static_cast<std::int64_t>(block) * kBlockVoxels;
+    for (int k = 0; k < kBlockVoxels; ++k)
+      if (v[k].weight > 0.f && fabsf(v[k].sdf) < keep_below) return;  // near a surface: keep
+    for (int k = 0; k < kBlockVoxels; ++k) v[k] = Voxel{0.f, 0.f, {0, 0, 0}, 0};
+    t.values[slot] = -1;
+    atomic_exch(&t.keys[slot], kTombstone);
+    pool_push(counters, free_list.data, block);
+    atomic_add(&counters->tombstones, 1);
+    atomic_add(&counters->removed, 1);
+  });
+}
+
+}  // namespace seamless::kernels
+
+#define SEAMLESS_INSTANTIATE_TSDF_FUSION(EXEC)                                                                    \
+  namespace seamless::kernels {                                                                                   \
+  template void allocate_blocks<EXEC>(const EXEC&, HashTableView, View<const std::int32_t>, HashCounters*,        \
+                                      FrameInput, VoxelGeometry);                                                 \
+  template void find_visible_blocks<EXEC>(const EXEC&, HashTableView, HashCounters*, FrameInput, VoxelGeometry,   \
+                                          View<std::int32_t>);                                                    \
+  template void fuse_hash_blocks<EXEC>(const EXEC&, HashTableView, View<const std::int32_t>, std::int64_t,        \
+                                       Voxel*, FrameInput, VoxelGeometry, float, bool);                           \
+  template void fuse_dense_blocks<EXEC>(const EXEC&, DenseAccess, FrameInput, float, bool);                       \
+  template void remove_empty_blocks<EXEC>(const EXEC&, HashTableView, View<const std::int32_t>, std::int64_t,     \
+                                          Voxel*, View<std::int32_t>, HashCounters*, float);                      \
+  }

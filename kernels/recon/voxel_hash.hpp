@@ -1,0 +1,240 @@
+// Voxel hashing after Niessner, Zollhoefer, Izadi, Stamminger 2013 ("Real-time 3D Reconstruction at
+// Scale using Voxel Hashing"): the scene is a sparse set of 8^3-voxel blocks; a hash table maps
+// integer block coordinates to an index into a pool of blocks. Everything here is per-element and
+// SEAMLESS_HD so that any kernel (fusion, raycast, marching cubes, the physics solver's SDF
+// collisions) can look voxels up on either backend.
+//
+// Table design (see docs/RECONSTRUCTION.md): open addressing with linear probing over a
+// power-of-two array of 64-bit keys plus a parallel array of block indices. A slot's key only ever
+// moves empty -> key -> tombstone, and insertion never reuses tombstones, so concurrent inserts of
+// the same key cannot create duplicates: two threads inserting k walk the same probe sequence and
+// meet at the first slot that was empty, where exactly one compare-and-swap wins. Tombstones are
+// cleared by a rehash between frames.
+#pragma once
+#include <cstdint>
+
+#include "core/atomics.hpp"
+#include "core/math.hpp"
+
+namespace seamless::kernels {
+
+constexpr int kBlockSide = 8;
+constexpr int kBlockVoxels = kBlockSide * kBlockSide * kBlockSide;
+
+// 12 bytes: metric TSDF (truncated to [-mu, mu]), fusion weight (0 = never observed), colour.
+struct Voxel {
+  float sdf;
+  float weight;
+  uchar3 color;
+  std::uint8_t pad;
+};
+
+using HashKey = unsigned long long;  // the type CUDA's 64-bit atomicCAS takes
+constexpr HashKey kEmptyKey = ~0ull;
+constexpr HashKey kTombstone = ~0ull - 1ull;
+// 21 bits per block coordinate, biased: +-2^20 blocks (+-42 km at 5 mm voxels). Packed keys use
+// 63 bits, so the two sentinels (top bit set) can never be a block's key.
+constexpr int kCoordBits = 21;
+constexpr int kCoordBias = 1 << (kCoordBits - 1);
+
+SEAMLESS_HD inline bool block_in_range(int3 b) {
+  return b.x >= -kCoordBias && b.x < kCoordBias && b.y >= -kCoordBias && b.y < kCoordBias && b.z >= -kCoordBias &&
+         b.z < kCoordBias;
+}
+SEAMLESS_HD inline HashKey pack_block(int3 b) {
+  const HashKey m = (1ull << kCoordBits) - 1ull;
+  return ((static_cast<HashKey>(b.x + kCoordBias) & m) << (2 * kCoordBits)) |
+         ((static_cast<HashKey>(b.y + kCoordBias) & m) << kCoordBits) | (static_cast<HashKey>(b.z + kCoordBias) & m);
+}
+SEAMLESS_HD inline int3 unpack_block(HashKey k) {
+  const HashKey m = (1ull << kCoordBits) - 1ull;
+  return {static_cast<int>((k >> (2 * kCoordBits)) & m) - kCoordBias, static_cast<int>((k >> kCoordBits) & m) - kCoordBias,
+          static_cast<int>(k & m) - kCoordBias};
+}
+SEAMLESS_HD inline bool is_live_key(HashKey k) { return k != kEmptyKey && k != kTombstone; }
+
+// MurmurHash3's 64-bit finaliser: linear probing needs neighbouring blocks spread apart, which
+// Niessner's xor of coordinate-times-prime does not guarantee for small coordinates.
+SEAMLESS_HD inline std::uint64_t mix64(std::uint64_t k) {
+  k ^= k >> 33;
+  k *= 0xff51afd7ed558ccdull;
+  k ^= k >> 33;
+  k *= 0xc4ceb9fe1a85ec53ull;
+  k ^= k >> 33;
+  return k;
+}
+
+enum class InsertResult : int { Found = 0, Inserted = 1, Full = 2 };
+
+// Per-table counters that live on the device; the host reads the struct once per frame.
+struct HashCounters {
+  int free_top;        // blocks on the free list (may dip below 0 during a failed allocation pass)
+  int tombstones;      // deleted slots not yet reclaimed by a rehash
+  int inserted;        // keys inserted this frame
+  int collisions;      // inserted keys that did not land in their home slot
+  int probe_failures;  // insertions that found no empty slot within max_probe
+  int pool_failures;   // insertions that found no free block in the pool
+  int visible;         // blocks in the visible list
+  int removed;         // blocks freed by garbage collection
+};
+
+struct HashTableView {
+  HashKey* keys = nullptr;
+  std::int32_t* values = nullptr;  // block index in the pool; -1: none (yet); -2: being assigned
+  std::uint32_t mask = 0;          // slots - 1 (slots is a power of two)
+  int max_probe = 64;
+
+  SEAMLESS_HD std::uint32_t home(HashKey k) const { return static_cast<std::uint32_t>(mix64(k)) & mask; }
+
+  // Slot holding key, or -1. Safe concurrently with insert and erase of other keys.
+  SEAMLESS_HD std::int32_t find(HashKey key) const {
+    std::uint32_t s = home(key);
+    for (int p = 0; p < max_probe; ++p, s = (s + 1) & mask) {
+      HashKey k = atomic_load(&keys[s]);
+      if (k == key) return static_cast<std::int32_t>(s);
+      if (k == kEmptyKey) return -1;
+    }
+    return -1;
+  }
+
+  // Claims a slot for key (or finds the one that holds it). *probes is how far from home it is.
+  SEAMLESS_HD InsertResult insert(HashKey key, std::int32_t* slot, int* probes) const {
+    std::uint32_t s = home(key);
+    for (int p = 0; p < max_probe; ++p, s = (s + 1) & mask) {
+      HashKey k = atomic_load(&keys[s]);
+      if (k == kEmptyKey) k = atomic_cas(&keys[s], kEmptyKey, key);
+      if (k == kEmptyKey || k == key) {
+        *slot = static_cast<std::int32_t>(s);
+        *probes = p;
+        return k == kEmptyKey ? InsertResult::Inserted : InsertResult::Found;
+      }
+    }
+    return InsertResult::Full;
+  }
+
+  // Turns key's slot into a tombstone; returns the slot it held, or -1 if absent.
+  SEAMLESS_HD std::int32_t erase(HashKey key) const {
+    std::int32_t s = find(key);
+    if (s < 0) return -1;
+    return atomic_cas(&keys[s], key, kTombstone) == key ? s : -1;
+  }
+};
+
+// Pops a free block index (-1 when the pool is exhausted). Pops and pushes never share a kernel.
+SEAMLESS_HD inline std::int32_t pool_pop(HashCounters* c, const std::int32_t* free_list) {
+  int top = atomic_add(&c->free_top, -1);
+  return top > 0 ? free_list[top - 1] : -1;
+}
+SEAMLESS_HD inline void pool_push(HashCounters* c, std::int32_t* free_list, std::int32_t block) {
+  int pos = atomic_add(&c->free_top, 1);
+  free_list[pos] = block;
+}
+
+// --- Voxel access shared by the hash volume and the dense grid --------------------------------
+// A "block access" maps a block coordinate to a block index in a pool of 8^3-voxel blocks stored
+// block-major (voxel (x,y,z) of block i at voxels[i*512 + x + 8y + 64z]). Voxel g (integer voxel
+// coordinates) sits at world position origin + g * voxel_size.
+
+struct VoxelGeometry {
+  vec3 origin{0.f, 0.f, 0.f};
+  float voxel_size = 0.005f;
+  float truncation = 0.02f;
+  SEAMLESS_HD vec3 to_voxel(vec3 p) const { return (p - origin) / voxel_size; }
+  SEAMLESS_HD vec3 to_world(vec3 g) const { return origin + g * voxel_size; }
+};
+
+SEAMLESS_HD inline int3 block_of_voxel(int3 g) { return {g.x >> 3, g.y >> 3, g.z >> 3}; }  // floor division
+SEAMLESS_HD inline int local_index(int3 g) { return (g.x & 7) + 8 * (g.y & 7) + 64 * (g.z & 7); }
+SEAMLESS_HD inline int3 local_coords(int i) { return {i & 7, (i >> 3) & 7, i >> 6}; }
+
+// Voxel hashing access: the device view of a VoxelHashVolume that physics kernels may copy.
+struct HashAccess {
+  HashTableView table;
+  Voxel* voxels = nullptr;
+  VoxelGeometry geom;
+  SEAMLESS_HD std::int32_t find_block(int3 b) const {
+    if (!block_in_range(b)) return -1;
+    std::int32_t s = table.find(pack_block(b));
+    return s < 0 ? -1 : table.values[s];
+  }
+};
+
+// Dense grid access: blocks_per_side^3 blocks starting at block (0,0,0); the dense KinectFusion
+// volume stored brick-major so that every kernel below serves both layouts.
+struct DenseAccess {
+  Voxel* voxels = nullptr;
+  int blocks_per_side = 0;
+  VoxelGeometry geom;
+  SEAMLESS_HD std::int32_t find_block(int3 b) const {
+    int n = blocks_per_side;
+    if (b.x < 0 || b.y < 0 || b.z < 0 || b.x >= n || b.y >= n || b.z >= n) return -1;
+    return b.x + n * (b.y + n * b.z);
+  }
+};
+
+// Remembers the last block looked up: neighbouring samples mostly fall in the same block.
+struct BlockCache {
+  int3 block{-2147483647, 0, 0};
+  std::int32_t index = -1;
+};
+
+template <class Acc>
+SEAMLESS_HD inline const Voxel* find_voxel(const Acc& a, int3 g, BlockCache& c) {
+  int3 b = block_of_voxel(g);
+  if (!(b == c.block)) {
+    c.block = b;
+    c.index = a.find_block(b);
+  }
+  return c.index < 0 ? nullptr : a.voxels + static_cast<std::int64_t>(c.index) * kBlockVoxels + local_index(g);
+}
+
+// Trilinear interpolation of the TSDF (metres) and colour at voxel-space point q. False when any of
+// the 8 corners is unallocated or unobserved (weight 0): no value is invented there.
+template <class Acc>
+SEAMLESS_HD inline bool sample_tsdf(const Acc& a, vec3 q, BlockCache& c, float* sdf, vec3* color = nullptr) {
+  int3 g0 = floor_to_int(q);
+  vec3 f = q - to_vec3(g0);
+  float s = 0.f;
+  vec3 col{0.f, 0.f, 0.f};
+  for (int k = 0; k < 8; ++k) {
+    int3 o{k & 1, (k >> 1) & 1, k >> 2};
+    const Voxel* v = find_voxel(a, g0 + o, c);
+    if (!v || !(v->weight > 0.f)) return false;
+    float w = (o.x ? f.x : 1.f - f.x) * (o.y ? f.y : 1.f - f.y) * (o.z ? f.z : 1.f - f.z);
+    s += w * v->sdf;
+    if (color) col += vec3{float(v->color.x), float(v->color.y), float(v->color.z)} * w;
+  }
+  *sdf = s;
+  if (color) *color = col;
+  return true;
+}
+
+// Gradient of the trilinear TSDF at voxel-space q (metres of SDF per voxel) by central differences
+// over +-1 voxel, one-sided (against the value s0 at q) where a neighbour sample is missing.
+template <class Acc>
+SEAMLESS_HD inline vec3 tsdf_gradient(const Acc& a, vec3 q, float s0, BlockCache& c) {
+  float g[3];
+  for (int axis = 0; axis < 3; ++axis) {
+    vec3 e{axis == 0 ? 1.f : 0.f, axis == 1 ? 1.f : 0.f, axis == 2 ? 1.f : 0.f};
+    float sp = 0.f, sm = 0.f;
+    bool okp = sample_tsdf(a, q + e, c, &sp), okm = sample_tsdf(a, q - e, c, &sm);
+    g[axis] = okp && okm ? 0.5f * (sp - sm) : okp ? sp - s0 : okm ? s0 - sm : 0.f;
+  }
+  return {g[0], g[1], g[2]};
+}
+
+// SDF value (metres) and gradient (unit-free, ~unit length near the surface) at world point p, for
+// collisions against the fused scene (DESIGN "Physics": the smoother alternative of the
+// dissertation's section 2.6.4). False where the TSDF is unknown (unallocated or unobserved).
+template <class Acc>
+SEAMLESS_HD inline bool sample_sdf(const Acc& a, vec3 p, float* value, vec3* gradient) {
+  BlockCache c;
+  vec3 q = a.geom.to_voxel(p);
+  float s0;
+  if (!sample_tsdf(a, q, c, &s0)) return false;
+  *value = s0;
+  if (gradient) *gradient = tsdf_gradient(a, q, s0, c) / a.geom.voxel_size;
+  return true;
+}
+
+}  // namespace seamless::kernels

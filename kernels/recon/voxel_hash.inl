@@ -1,0 +1,130 @@
+// Kernel bodies for the hash table maintenance in recon/tsdf.hpp, compiled once per backend.
+#include "kernels/recon/tsdf.hpp"
+
+namespace seamless::kernels {
+
+template <class Exec>
+void hash_clear(const Exec& ex, HashTableView t) {
+  ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
+    t.keys[i] = kEmptyKey;
+    t.values[i] = -1;
+  });
+}
+
+template <class Exec>
+void pool_reset(const Exec& ex, View<std::int32_t> free_list, HashCounters* counters) {
+  ex.for_each(free_list.size, [=] SEAMLESS_HD(std::int64_t i) {
+    // Reversed so that pops hand out blocks 0, 1, 2, ... (cache-friendly, easy to read in tests).
+    free_list[i] = static_cast<std::int32_t>(free_list.size - 1 - i);
+  });
+  const int n = static_cast<int>(free_list.size);
+  ex.for_each(1, [=] SEAMLESS_HD(std::int64_t) { *counters = HashCounters{n, 0, 0, 0, 0, 0, 0, 0}; });
+}
+
+template <class Exec>
+void pool_append(const Exec& ex, View<std::int32_t> free_list, HashCounters* counters, std::int32_t first,
+                 std::int32_t n) {
+  // One thread: reads free_top once, so the appended range is contiguous above it.
+  ex.for_each(1, [=] SEAMLESS_HD(std::int64_t) {
+    int top = counters->free_top < 0 ? 0 : counters->free_top;
+    for (std::int32_t k = 0; k < n; ++k) free_list[top + k] = first + n - 1 - k;
+    counters->free_top = top + n;
+  });
+}
+
+template <class Exec>
+void reset_frame_counters(const Exec& ex, HashCounters* counters) {
+  ex.for_each(1, [=] SEAMLESS_HD(std::int64_t) {
+    HashCounters& c = *counters;
+    c.inserted = c.collisions = c.probe_failures = c.pool_failures = c.visible = c.removed = 0;
+  });
+}
+
+template <class Exec>
+void hash_insert(const Exec& ex, HashTableView t, View<const HashKey> keys, View<const std::int32_t> value_in,
+                 View<std::int32_t> slot_out, View<std::int32_t> result_out, HashCounters* counters) {
+  ex.for_each(keys.size, [=] SEAMLESS_HD(std::int64_t i) {
+    std::int32_t slot = -1;
+    int probes = 0;
+    InsertResult r = t.insert(keys[i], &slot, &probes);
+    slot_out[i] = r == InsertResult::Full ? -1 : slot;
+    result_out[i] = static_cast<std::int32_t>(r);
+    if (r == InsertResult::Full) {
+      atomic_add(&counters->probe_failures, 1);
+    } else if (r == InsertResult::Inserted) {
+      t.values[slot] = value_in.size ? value_in[i] : -1;
+      atomic_add(&counters->inserted, 1);
+      if (probes > 0) atomic_add(&counters->collisions, 1);
+    }
+  });
+}
+
+template <class Exec>
+void hash_find(const Exec& ex, HashTableView t, View<const HashKey> keys, View<std::int32_t> slot_out) {
+  ex.for_each(keys.size, [=] SEAMLESS_HD(std::int64_t i) { slot_out[i] = t.find(keys[i]); });
+}
+
+template <class Exec>
+void hash_erase(const Exec& ex, HashTableView t, View<const HashKey> keys, View<std::int32_t> slot_out,
+                HashCounters* counters) {
+  ex.for_each(keys.size, [=] SEAMLESS_HD(std::int64_t i) {
+    std::int32_t s = t.erase(keys[i]);
+    slot_out[i] = s;
+    if (s >= 0) atomic_add(&counters->tombstones, 1);
+  });
+}
+
+template <class Exec>
+std::int64_t hash_live_slots(const Exec& ex, HashTableView t, View<std::int32_t> flags, View<std::int32_t> slots_out) {
+  const std::int64_t n = static_cast<std::int64_t>(t.mask) + 1;
+  ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) { flags[i] = is_live_key(t.keys[i]) && t.values[i] >= 0 ? 1 : 0; });
+  // flags becomes the exclusive prefix sum: the output position of each live slot.
+  std::int32_t total = ex.exclusive_scan(flags.data, flags.data, n);
+  ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) {
+    if (is_live_key(t.keys[i]) && t.values[i] >= 0) slots_out[flags[i]] = static_cast<std::int32_t>(i);
+  });
+  return total;
+}
+
+template <class Exec>
+void hash_gather(const Exec& ex, HashTableView t, View<const std::int32_t> slots, View<HashKey> keys_out,
+                 View<std::int32_t> values_out) {
+  ex.for_each(slots.size, [=] SEAMLESS_HD(std::int64_t i) {
+    keys_out[i] = t.keys[slots[i]];
+    values_out[i] = t.values[slots[i]];
+  });
+}
+
+template <class Exec>
+void gather_blocks(const Exec& ex, const Voxel* pool, View<const std::int32_t> blocks, View<Voxel> out) {
+  ex.for_each(blocks.size * kBlockVoxels, [=] SEAMLESS_HD(std::int64_t i) {
+    out[i] = pool[static_cast<std::int64_t>(blocks[i / kBlockVoxels]) * kBlockVoxels + i % kBlockVoxels];
+  });
+}
+
+template <class Exec>
+void scatter_blocks(const Exec& ex, Voxel* pool, View<const std::int32_t> blocks, View<const Voxel> in) {
+  ex.for_each(blocks.size * kBlockVoxels, [=] SEAMLESS_HD(std::int64_t i) {
+    pool[static_cast<std::int64_t>(blocks[i / kBlockVoxels]) * kBlockVoxels + i % kBlockVoxels] = in[i];
+  });
+}
+
+}  // namespace seamless::kernels
+
+#define SEAMLESS_INSTANTIATE_VOXEL_HASH(EXEC)                                                                    \
+  namespace seamless::kernels {                                                                                  \
+  template void hash_clear<EXEC>(const EXEC&, HashTableView);                                                    \
+  template void pool_reset<EXEC>(const EXEC&, View<std::int32_t>, HashCounters*);                                \
+  template void pool_append<EXEC>(const EXEC&, View<std::int32_t>, HashCounters*, std::int32_t, std::int32_t);   \
+  template void reset_frame_counters<EXEC>(const EXEC&, HashCounters*);                                          \
+  template void hash_insert<EXEC>(const EXEC&, HashTableView, View<const HashKey>, View<const std::int32_t>,     \
+                                  View<std::int32_t>, View<std::int32_t>, HashCounters*);                        \
+  template void hash_find<EXEC>(const EXEC&, HashTableView, View<const HashKey>, View<std::int32_t>);            \
+  template void hash_erase<EXEC>(const EXEC&, HashTableView, View<const HashKey>, View<std::int32_t>,            \
+                                 HashCounters*);                                                                 \
+  template std::int64_t hash_live_slots<EXEC>(const EXEC&, HashTableView, View<std::int32_t>, View<std::int32_t>); \
+  template void hash_gather<EXEC>(const EXEC&, HashTableView, View<const std::int32_t>, View<HashKey>,          \
+                                  View<std::int32_t>);                                                           \
+  template void gather_blocks<EXEC>(const EXEC&, const Voxel*, View<const std::int32_t>, View<Voxel>);          \
+  template void scatter_blocks<EXEC>(const EXEC&, Voxel*, View<const std::int32_t>, View<const Voxel>);         \
+  }

@@ -1,0 +1,288 @@
+#include "recon/voxel_hash_volume.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <string>
+#include <tuple>
+
+#include "core/error.hpp"
+#include "core/exec.hpp"
+#include "kernels/recon/tsdf.hpp"
+
+namespace seamless {
+
+using kernels::HashCounters;
+using kernels::kBlockVoxels;
+
+namespace {
+constexpr int kMaxProbe = 128;   // linear probing at <= 50% fill rarely probes past 20 slots
+constexpr int kMaxRetries = 4;   // allocation passes after growing, per frame
+
+std::int64_t next_pow2(std::int64_t n) {
+  std::int64_t p = 1;
+  while (p < n) p <<= 1;
+  return p;
+}
+
+// Runs fn inside a timer stage when there is a timer.
+template <class F>
+void staged(StageTimer* timer, const char* stage, F&& fn) {
+  if (!timer) return fn();
+  StageScope s(*timer, stage);
+  fn();
+}
+}  // namespace
+
+VoxelHashVolume::VoxelHashVolume(const VolumeParams& p, Device d) : params_(p), device_(d) {
+  if (p.truncation < 2.f * p.voxel_size)
+    throw Error("volume.truncation (" + std::to_string(p.truncation) + " m) must be at least two voxels (2 * " +
+                "volume.voxel_size = " + std::to_string(2.f * p.voxel_size) +
+                " m): the truncation band must reach the voxels on both sides of the surface");
+  if (p.capacity > (1ll << 30)) throw Error("volume.capacity must be below 2^30 blocks");
+  geom_ = {{0.f, 0.f, 0.f}, p.voxel_size, p.truncation};
+  const std::int64_t slots = next_pow2(std::max<std::int64_t>(p.hash_buckets, 1024));
+  keys_ = Buffer<kernels::HashKey>(slots, d);
+  values_ = Buffer<std::int32_t>(slots, d);
+  scratch_ = Buffer<std::int32_t>(slots, d);
+  voxels_ = Buffer<kernels::Voxel>(p.capacity * kBlockVoxels, d);
+  voxels_.zero();
+  free_list_ = Buffer<std::int32_t>(p.capacity, d);
+  visible_ = Buffer<std::int32_t>(p.capacity, d);
+  counters_ = Buffer<HashCounters>(1, d);
+  with_exec(d, [&](const auto& ex) {
+    kernels::hash_clear(ex, table());
+    kernels::pool_reset(ex, free_list_.view(), counters_.data());
+  });
+  last_ = read_counters();
+}
+
+kernels::HashTableView VoxelHashVolume::table() const {
+  return {keys_.data(), values_.data(), static_cast<std::uint32_t>(keys_.size() - 1), kMaxProbe};
+}
+
+kernels::HashAccess VoxelHashVolume::device_view() const { return {table(), voxels_.data(), geom_}; }
+
+HashCounters VoxelHashVolume::read_counters() const { return counters_.to_host()[0]; }
+
+void VoxelHashVolume::integrate(const Image<float>& depth, const Image<uchar3>& rgb, const Intrinsics& K,
+                                const SE3& world_T_camera, StageTimer* timer) {
+  if (rgb.width() * rgb.height() != 0 && (rgb.width() != depth.width() || rgb.height() != depth.height()))
+    throw Error("integrate: the colour image (" + std::to_string(rgb.width()) + "x" + std::to_string(rgb.height()) +
+                ") must match the depth image (" + std::to_string(depth.width()) + "x" +
+                std::to_string(depth.height()) + "); register colour to depth first");
+  Image<float> dtmp;
+  Image<uchar3> ctmp;
+  const Image<float>& dep = detail::on_device(depth, device_, dtmp);
+  const Image<uchar3>& col = detail::on_device(rgb, device_, ctmp);
+  kernels::FrameInput in{dep.cview(), col.width() ? col.cview() : View2D<const uchar3>{}, K, world_T_camera,
+                         params_.min_depth, params_.max_depth};
+  maybe_rehash();
+  allocate_and_list(in, timer);
+  const std::int64_t n = last_.visible;
+  with_exec(device_, [&](const auto& ex) {
+    staged(timer, "fuse", [&] {
+      kernels::fuse_hash_blocks(ex, table(), visible_.cview(), n, voxels_.data(), in, geom_, params_.max_weight,
+                                params_.integrate_color);
+    });
+    if (params_.remove_empty_blocks)
+      staged(timer, "remove_empty", [&] {
+        kernels::remove_empty_blocks(ex, table(), visible_.cview(), n, voxels_.data(), free_list_.view(),
+                                     counters_.data(), 0.999f * geom_.truncation);
+      });
+  });
+  ++frames_;
+}
+
+// Allocation and the visible list, with the frame's single read of the counters. A pass with
+// failed insertions is repeated after growing what ran out (insertion is idempotent).
+void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTimer* timer) {
+  for (int attempt = 0;; ++attempt) {
+    with_exec(device_, [&](const auto& ex) {
+      kernels::reset_frame_counters(ex, counters_.data());
+      staged(timer, "allocate", [&] {
+        kernels::allocate_blocks(ex, table(), free_list_.cview(), counters_.data(), in, geom_);
+      });
+      staged(timer, "visible", [&] {
+        kernels::find_visible_blocks(ex, table(), counters_.data(), in, geom_, visible_.view());
+      });
+    });
+    last_ = read_counters();
+    failed_ = last_.probe_failures + last_.pool_failures;
+    if (failed_ == 0 || attempt == kMaxRetries || !params_.grow_when_full) break;
+    handle_failures(last_);
+    ++retries_;
+  }
+  if (failed_ > 0)
+    spdlog::warn(
+        "voxel hashing: {} block insertion attempts failed in frame {} ({} found no hash slot within {} probes, "
+        "{} found the pool of {} blocks full); that part of the frame is not fused. Set volume.capacity >= {} and "
+        "volume.hash_buckets >= {}, or volume.grow_when_full: true",
+        failed_, frames_, last_.probe_failures, kMaxProbe, last_.pool_failures, free_list_.size(),
+        2 * free_list_.size(), 2 * keys_.size());
+}
+
+void VoxelHashVolume::handle_failures(const HashCounters& c) {
+  if (c.probe_failures > 0) {
+    spdlog::warn("voxel hashing: hash table of {} slots too crowded ({} insertions failed); rehashing into {} slots "
+                 "(set volume.hash_buckets: {} to avoid this pause)",
+                 keys_.size(), c.probe_failures, 2 * keys_.size(), 2 * keys_.size());
+    rehash(2 * keys_.size());
+  }
+  if (c.pool_failures > 0) {
+    std::int64_t cap = free_list_.size();
+    spdlog::warn("voxel hashing: block pool full ({} blocks, {} insertion attempts failed); growing it to {} blocks (set "
+                 "volume.capacity: {} to avoid this pause)",
+                 cap, c.pool_failures, 2 * cap, 2 * cap);
+    grow_pool(2 * cap);
+  }
+}
+
+// Between frames: clears tombstones and keeps the fill at or below one half, where linear probing
+// stays short (Knuth: expected probes (1 + 1/(1-a)^2)/2 = 2.5 for an unsuccessful search at a = 1/2).
+void VoxelHashVolume::maybe_rehash() {
+  const std::int64_t slots = keys_.size();
+  const std::int64_t live = free_list_.size() - last_.free_top;
+  if (2 * (live + last_.tombstones) <= slots) return;
+  if (4 * live > slots && params_.grow_when_full) return rehash(2 * slots);
+  if (4 * live > slots)
+    spdlog::warn("voxel hashing: {} of {} hash slots hold blocks; insertions may start failing (set "
+                 "volume.hash_buckets: {} or volume.grow_when_full: true)",
+                 live, slots, 2 * slots);
+  rehash(slots);
+}
+
+std::int64_t VoxelHashVolume::live_slots(Buffer<std::int32_t>& slots) const {
+  if (slots.size() < free_list_.size() || slots.device() != device_) slots = Buffer<std::int32_t>(free_list_.size(), device_);
+  return with_exec(device_, [&](const auto& ex) { return kernels::hash_live_slots(ex, table(), scratch_.view(), slots.view()); });
+}
+
+void VoxelHashVolume::rehash(std::int64_t new_slots) {
+  Buffer<std::int32_t> slots;
+  const std::int64_t n = live_slots(slots);
+  Buffer<kernels::HashKey> keys(n, device_);
+  Buffer<std::int32_t> values(n, device_), slot_out(n, device_), result(n, device_);
+  with_exec(device_, [&](const auto& ex) {
+    kernels::hash_gather(ex, table(), View<const std::int32_t>{slots.data(), n}, keys.view(), values.view());
+  });
+  keys_ = Buffer<kernels::HashKey>(new_slots, device_);
+  values_ = Buffer<std::int32_t>(new_slots, device_);
+  scratch_ = Buffer<std::int32_t>(new_slots, device_);
+  HashCounters c = read_counters();
+  c.tombstones = 0;
+  c.probe_failures = 0;
+  counters_.copy_from_host(&c, 1);
+  with_exec(device_, [&](const auto& ex) {
+    kernels::hash_clear(ex, table());
+    kernels::hash_insert(ex, table(), keys.cview(), values.cview(), slot_out.view(), result.view(), counters_.data());
+  });
+  HashCounters after = read_counters();
+  if (after.probe_failures > 0)
+    throw Error("voxel hashing: rehashing " + std::to_string(n) + " blocks into " + std::to_string(new_slots) +
+                " slots failed; set volume.hash_buckets to at least " + std::to_string(4 * n));
+  after.inserted = c.inserted;
+  after.collisions = c.collisions;
+  counters_.copy_from_host(&after, 1);
+  last_.tombstones = 0;
+}
+
+void VoxelHashVolume::grow_pool(std::int64_t blocks) {
+  const std::int64_t old = free_list_.size();
+  if (blocks > (1ll << 30)) throw Error("voxel hashing: the block pool cannot grow beyond 2^30 blocks");
+  Buffer<kernels::Voxel> voxels(blocks * kBlockVoxels, device_);
+  voxels.zero();
+  voxels.copy_from(voxels_);
+  voxels_ = std::move(voxels);
+  Buffer<std::int32_t> free_list(blocks, device_);
+  free_list.copy_from(free_list_);
+  free_list_ = std::move(free_list);
+  visible_ = Buffer<std::int32_t>(blocks, device_);
+  with_exec(device_, [&](const auto& ex) {
+    kernels::pool_append(ex, free_list_.view(), counters_.data(), static_cast<std::int32_t>(old),
+                         static_cast<std::int32_t>(blocks - old));
+  });
+  params_.capacity = blocks;
+}
+
+std::int64_t VoxelHashVolume::remove_empty_blocks() {
+  Buffer<std::int32_t> slots;
+  const std::int64_t n = live_slots(slots);
+  with_exec(device_, [&](const auto& ex) {
+    kernels::reset_frame_counters(ex, counters_.data());
+    kernels::remove_empty_blocks(ex, table(), slots.cview(), n, voxels_.data(), free_list_.view(), counters_.data(),
+                                 0.999f * geom_.truncation);
+  });
+  last_ = read_counters();
+  return last_.removed;
+}
+
+std::vector<int3> VoxelHashVolume::allocated_block_coords() const {
+  Buffer<std::int32_t> slots;
+  const std::int64_t n = live_slots(slots);
+  Buffer<kernels::HashKey> keys(n, device_);
+  Buffer<std::int32_t> values(n, device_);
+  with_exec(device_, [&](const auto& ex) {
+    kernels::hash_gather(ex, table(), View<const std::int32_t>{slots.data(), n}, keys.view(), values.view());
+  });
+  std::vector<int3> out;
+  for (kernels::HashKey k : keys.to_host()) out.push_back(kernels::unpack_block(k));
+  std::sort(out.begin(), out.end(), [](int3 a, int3 b) { return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z); });
+  return out;
+}
+
+std::vector<VoxelHashVolume::HostBlock> VoxelHashVolume::download_blocks() const {
+  Buffer<std::int32_t> slots;
+  const std::int64_t n = live_slots(slots);
+  Buffer<kernels::HashKey> keys(n, device_);
+  Buffer<std::int32_t> values(n, device_);
+  Buffer<kernels::Voxel> vox(n * kBlockVoxels, device_);
+  with_exec(device_, [&](const auto& ex) {
+    kernels::hash_gather(ex, table(), View<const std::int32_t>{slots.data(), n}, keys.view(), values.view());
+    kernels::gather_blocks(ex, voxels_.data(), values.cview(), vox.view());
+  });
+  std::vector<kernels::HashKey> hk = keys.to_host();
+  std::vector<kernels::Voxel> hv = vox.to_host();
+  std::vector<HostBlock> out(static_cast<std::size_t>(n));
+  for (std::int64_t i = 0; i < n; ++i) {
+    out[i].coord = kernels::unpack_block(hk[i]);
+    out[i].voxels.assign(hv.begin() + i * kBlockVoxels, hv.begin() + (i + 1) * kBlockVoxels);
+  }
+  std::sort(out.begin(), out.end(), [](const HostBlock& a, const HostBlock& b) {
+    return std::tie(a.coord.x, a.coord.y, a.coord.z) < std::tie(b.coord.x, b.coord.y, b.coord.z);
+  });
+  return out;
+}
+
+void VoxelHashVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, RaycastMaps& maps, StageTimer* timer) {
+  detail::resize_maps(maps, K, device_);
+  kernels::RaycastOutput out{maps.depth.view(), maps.vertex.view(), maps.normal.view(), maps.color.view()};
+  with_exec(device_, [&](const auto& ex) {
+    staged(timer, "raycast", [&] {
+      kernels::raycast(ex, device_view(), K, world_T_camera, params_.min_depth, params_.max_depth, out);
+    });
+  });
+}
+
+VolumeStats VoxelHashVolume::stats() {
+  HashCounters c = read_counters();
+  VolumeStats s;
+  s.frames = frames_;
+  s.block_capacity = free_list_.size();
+  s.allocated_blocks = s.block_capacity - std::max(c.free_top, 0);
+  s.hash_slots = keys_.size();
+  s.tombstones = c.tombstones;
+  s.hash_fill = double(s.allocated_blocks + s.tombstones) / double(s.hash_slots);
+  s.inserted = last_.inserted;
+  s.collisions = last_.collisions;
+  s.failed_insertions = failed_;
+  s.retries = retries_;
+  s.visible_blocks = last_.visible;
+  s.removed_blocks = c.removed;
+  s.bytes_per_block = sizeof(kernels::Voxel) * kBlockVoxels;
+  s.voxel_bytes = s.bytes_per_block * static_cast<std::size_t>(s.allocated_blocks);
+  s.device_bytes = keys_.bytes() + values_.bytes() + scratch_.bytes() + voxels_.bytes() + free_list_.bytes() +
+                   visible_.bytes() + counters_.bytes();
+  return s;
+}
+
+}  // namespace seamless
