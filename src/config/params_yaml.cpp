@@ -130,6 +130,15 @@ void check_constraint(LoadContext& ctx, const YAML::Node& n, const std::string& 
                          format_number(r.hi) + "]");
 }
 
+void check_constraint(LoadContext& ctx, const YAML::Node& n, const std::string& path, float v, const Range& r) {
+  // Compared in float on purpose. (GCC 12 at -O2 drops a double->float->double round trip of the
+  // bounds when they are passed through a helper, so the rounding must not rely on that.)
+  const float lo = static_cast<float>(r.lo), hi = static_cast<float>(r.hi);
+  if (v >= lo && v <= hi) return;
+  ctx.error(n, path, "out of range: got " + describe(n) + ", expected a value in [" + format_number(r.lo) + ", " +
+                         format_number(r.hi) + "]");
+}
+
 void check_constraint(LoadContext& ctx, const YAML::Node& n, const std::string& path, const std::string& v,
                       const Choices& c) {
   if (std::find(c.values.begin(), c.values.end(), v) != c.values.end()) return;

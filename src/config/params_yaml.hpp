@@ -75,8 +75,12 @@ template <class T> std::string expected_text() {
 }
 
 inline void check_constraint(LoadContext&, const YAML::Node&, const std::string&, double) {}
+inline void check_constraint(LoadContext&, const YAML::Node&, const std::string&, float) {}
 inline void check_constraint(LoadContext&, const YAML::Node&, const std::string&, const std::string&) {}
 void check_constraint(LoadContext& ctx, const YAML::Node& n, const std::string& path, double v, const Range& r);
+// A float field is compared with its bounds rounded to float: `0.1` must pass Range{0, 0.1}
+// although float(0.1) > 0.1 as doubles.
+void check_constraint(LoadContext& ctx, const YAML::Node& n, const std::string& path, float v, const Range& r);
 void check_constraint(LoadContext& ctx, const YAML::Node& n, const std::string& path, const std::string& v,
                       const Choices& c);
 
@@ -122,7 +126,8 @@ bool read_leaf(LoadContext& ctx, const YAML::Node& n, const std::string& path, T
       ctx.error(n, path, "expected " + expected_text<T>() + ", got " + describe(n));
       return false;
     }
-    if constexpr (!std::same_as<T, bool>) check_constraint(ctx, n, path, static_cast<double>(out), c...);
+    if constexpr (std::same_as<T, float>) check_constraint(ctx, n, path, out, c...);
+    else if constexpr (!std::same_as<T, bool>) check_constraint(ctx, n, path, static_cast<double>(out), c...);
     return true;
   }
 }
