@@ -10,15 +10,17 @@ namespace seamless {
 
 // Camera intrinsics: a named preset, or `custom` with fx fy cx cy given here.
 struct IntrinsicsParams {
-  std::string preset = "freiburg1";
+  std::string preset = "auto";
   float fx = 525.f, fy = 525.f, cx = 319.5f, cy = 239.5f;  // used when preset is custom
   int width = 640, height = 480;
 
   template <class V> void visit(V& v) {
     // TUM values from vision.in.tum.de/data/datasets/rgbd-dataset/file_formats; kinect_v1 is the
     // generic 525/319.5/239.5 set the TUM page gives for the default OpenNI calibration.
+    // auto: a TUM folder's calibration.txt (written by `seamless record`), else the freiburg preset
+    // its name contains, else kinect_v1 (also for the synthetic room and a live Kinect).
     v("preset", preset, "intrinsics preset (fx fy cx cy below are used only for custom)",
-      Choices{"freiburg1", "freiburg2", "freiburg3", "kinect_v1", "custom"});
+      Choices{"auto", "freiburg1", "freiburg2", "freiburg3", "kinect_v1", "custom"});
     v("fx", fx, "focal length x, pixels (custom only)", Range{1.0, 1e5});
     v("fy", fy, "focal length y, pixels (custom only)", Range{1.0, 1e5});
     v("cx", cx, "principal point x, pixels (custom only)", Range{-1e4, 1e4});
@@ -28,18 +30,67 @@ struct IntrinsicsParams {
   }
 };
 
+// Kinect v1 sensor model of the synthetic room (kernels/io/render_room.hpp, docs/INPUT.md).
+struct SyntheticNoiseParams {
+  float sigma_disparity = 0.05f;     // pixels, Gaussian disparity noise on top of 1/8-pixel quantisation
+  float min_depth = 0.4f;
+  float max_depth = 4.0f;
+  float max_incidence_deg = 78.f;
+  float edge_jump = 0.05f;
+  bool projector_shadow = true;
+
+  template <class V> void visit(V& v) {
+    v("sigma_disparity", sigma_disparity, "Gaussian disparity noise, pixels (Khoshelham & Elberink 2012)", Range{0.0, 5.0});
+    v("min_depth", min_depth, "nearest measurable depth, metres", Range{0.0, 100.0});
+    v("max_depth", max_depth, "farthest measurable depth, metres", Range{0.0, 100.0});
+    v("max_incidence_deg", max_incidence_deg, "no depth beyond this angle between ray and surface normal, degrees",
+      Range{0.0, 90.0});
+    v("edge_jump", edge_jump, "relative depth jump to a neighbour that drops a pixel as an edge", Range{0.0, 10.0});
+    v("projector_shadow", projector_shadow, "drop pixels the IR projector (7.5 cm to the side) cannot see");
+  }
+};
+
 // The built-in synthetic room (no data needed; ground-truth poses known exactly).
 struct SyntheticParams {
   std::uint64_t seed = 1;
   bool noise = true;
   int frames = 120;
   std::string trajectory = "orbit";
+  double fps = 30.0;
+  float radius = 1.6f;               // orbit: horizontal distance to the desk centre, metres
+  float height = 1.35f;              // camera height above the floor, metres
+  float speed_deg = 15.f;            // orbit: degrees per second around the desk
+  float start_deg = -90.f;           // orbit: start angle (-90: in front of the desk, behind the chair)
+  float shake = 1.f;                 // scale of the hand-held wobble (0 = a perfectly smooth path)
+  SyntheticNoiseParams sensor;
 
   template <class V> void visit(V& v) {
-    v("seed", seed, "random seed for noise and scene jitter");
-    v("noise", noise, "add Kinect-like depth noise and dropouts");
+    v("seed", seed, "random seed for the noise and the hand-held wobble");
+    v("noise", noise, "add Kinect-like depth noise and dropouts (off: exact depth everywhere)");
     v("frames", frames, "number of frames to generate", Range{1, 1000000});
-    v("trajectory", trajectory, "camera path name (see io/synthetic)");
+    v("trajectory", trajectory, "camera path: orbit around the desk, or still (fixed pose)",
+      Choices{"orbit", "still"});
+    v("fps", fps, "frames per second (timestamps and motion speed)", Range{1.0, 1000.0});
+    v("radius", radius, "orbit radius around the desk centre, metres", Range{0.5, 1.8});
+    v("height", height, "camera height above the floor, metres (above the furniture)", Range{1.05, 2.3});
+    v("speed_deg", speed_deg, "orbit speed, degrees per second", Range{-360.0, 360.0});
+    v("start_deg", start_deg, "orbit start angle, degrees", Range{-360.0, 360.0});
+    v("shake", shake, "hand-held wobble scale (0 = smooth)", Range{0.0, 5.0});
+    v("sensor", sensor, "Kinect v1 sensor model used when noise is on");
+  }
+};
+
+// A live Kinect v1 through libfreenect (source: kinect).
+struct KinectParams {
+  int device_index = 0;
+  int queue_size = 4;
+  double timeout_s = 5.0;
+
+  template <class V> void visit(V& v) {
+    v("device_index", device_index, "which Kinect (libfreenect device index)", Range{0, 16});
+    v("queue_size", queue_size, "frames buffered between capture and processing; a full queue drops the oldest",
+      Range{1, 1000});
+    v("timeout_s", timeout_s, "give up when no frame arrives for this long, seconds", Range{0.1, 3600.0});
   }
 };
 
@@ -51,7 +102,10 @@ struct InputParams {
   std::int64_t max_frames = 0;      // 0 = all
   std::int64_t first_frame = 0;
   bool skip_bad_frames = false;
+  bool undistort = true;            // remove lens distortion of presets that have it (freiburg1/2)
+  double max_gt_gap = 0.1;          // seconds: no ground truth across larger motion-capture gaps
   SyntheticParams synthetic;
+  KinectParams kinect;
 
   template <class V> void visit(V& v) {
     v("source", source, "frame source", Choices{"synthetic", "tum", "kinect"});
@@ -61,7 +115,11 @@ struct InputParams {
     v("max_frames", max_frames, "stop after this many frames; 0 = all", Range{0, 1e12});
     v("first_frame", first_frame, "skip frames before this index", Range{0, 1e12});
     v("skip_bad_frames", skip_bad_frames, "skip unreadable frames with a warning instead of stopping");
+    v("undistort", undistort, "undistort images whose intrinsics have lens distortion");
+    v("max_gt_gap", max_gt_gap, "interpolate ground truth only between samples closer than this, seconds",
+      Range{0.0, 10.0});
     v("synthetic", synthetic, "synthetic room settings (source: synthetic)");
+    v("kinect", kinect, "live Kinect v1 settings (source: kinect)");
   }
 };
 

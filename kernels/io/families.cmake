@@ -1,0 +1,3 @@
+# kernels/io: the synthetic room's renderer (and input-side image kernels).
+seamless_kernel_family(io/render_room)
+seamless_kernel_family(io/undistort)

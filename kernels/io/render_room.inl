@@ -1,0 +1,86 @@
+// Kernel bodies for io/render_room.hpp, compiled once per backend.
+#include <cmath>
+
+#include "kernels/io/render_room.hpp"
+#include "kernels/io/synthetic_room.hpp"
+
+namespace seamless::kernels {
+
+namespace render_detail {
+
+// Lambert shading under one fixed light plus ambient, so that colour depends only on the surface
+// (view-independent: a photometric tracker sees the same colour from every pose).
+SEAMLESS_HD inline uchar3 shade(vec3 albedo, vec3 n) {
+  const vec3 light = normalize(vec3{0.3f, -0.4f, 1.f});
+  float s = 0.45f + 0.55f * fmaxf(dot(n, light), 0.f);
+  vec3 c = albedo * s;
+  auto to8 = [](float v) { return static_cast<std::uint8_t>(fminf(fmaxf(v, 0.f), 1.f) * 255.f + 0.5f); };
+  return {to8(c.x), to8(c.y), to8(c.z)};
+}
+
+// True when the projector (offset by the baseline along the camera's x axis) cannot see p.
+SEAMLESS_HD inline bool in_projector_shadow(vec3 p, vec3 n, vec3 projector) {
+  vec3 to = projector - p;
+  float dist = length(to);
+  vec3 o = p + n * 1e-4f;
+  room::Hit h = room::room_raycast(o, to / dist, dist - 2e-4f);
+  return h.t > 0.f;
+}
+
+}  // namespace render_detail
+
+template <class Exec>
+void render_room(const Exec& ex, Intrinsics K, SE3 world_T_camera, DepthNoise noise, std::uint32_t seed,
+                 std::uint32_t frame, View2D<float> scratch, View2D<float> depth, View2D<uchar3> rgb) {
+  const int w = depth.width;
+  const SE3 T = world_T_camera;
+  const vec3 projector = T * vec3{noise.baseline, 0.f, 0.f};
+  // Pass 1: exact first hit. scratch = z (> 0), -z where the sensor cannot measure it (shadow or
+  // grazing incidence; edges need the neighbours and come in pass 2), 0 where the ray hits nothing.
+  ex.for_each(depth.count(), [=] SEAMLESS_HD(std::int64_t i) {
+    int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
+    vec3 dc{(x - K.cx) / K.fx, (y - K.cy) / K.fy, 1.f};
+    float len = length(dc);
+    vec3 dir = T.rotate(dc / len);
+    room::Hit h = room::room_raycast(T.t, dir);
+    if (h.t <= 0.f) {
+      scratch(x, y) = 0.f;
+      rgb(x, y) = {0, 0, 0};
+      return;
+    }
+    vec3 p = T.t + dir * h.t;
+    float z = h.t / len;  // along the optical axis: |dc| = len for the unit-z ray
+    bool lost = noise.enabled && (dot(h.normal, -dir) < noise.min_incidence_cos ||
+                                  (noise.projector_shadow && render_detail::in_projector_shadow(p, h.normal, projector)));
+    scratch(x, y) = lost ? -z : z;
+    rgb(x, y) = render_detail::shade(room::surface_colour(h.id, p), h.normal);
+  });
+  // Pass 2: edges, range, disparity quantisation and noise.
+  const std::int64_t n_pix = depth.count();
+  ex.for_each(n_pix, [=] SEAMLESS_HD(std::int64_t i) {
+    int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
+    float s = scratch(x, y);
+    if (!noise.enabled) {
+      depth(x, y) = fabsf(s);
+      return;
+    }
+    float z = s;
+    for (int dy = -1; dy <= 1 && z > 0.f; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (!scratch.inside(x + dx, y + dy)) continue;
+        float zn = fabsf(scratch(x + dx, y + dy));
+        if (zn == 0.f || fabsf(zn - z) > noise.edge_jump * z) z = 0.f;
+      }
+    if (z < noise.min_depth || z > noise.max_depth) z = 0.f;
+    float g = noise.sigma_disparity > 0.f ? hash_gauss(seed, frame, static_cast<std::uint32_t>(i)) : 0.f;
+    depth(x, y) = z > 0.f ? kinect_quantise(z, K.fx, noise, g) : 0.f;
+  });
+}
+
+}  // namespace seamless::kernels
+
+#define SEAMLESS_INSTANTIATE_RENDER_ROOM(EXEC)                                                        \
+  namespace seamless::kernels {                                                                      \
+  template void render_room<EXEC>(const EXEC&, Intrinsics, SE3, DepthNoise, std::uint32_t, std::uint32_t, \
+                                  View2D<float>, View2D<float>, View2D<uchar3>);                     \
+  }

@@ -1,0 +1,32 @@
+// PNG reading and writing with libpng. Errors (missing file, truncated or corrupt data, a bit depth
+// or colour type other than the one asked for) throw seamless::Error naming the file.
+#pragma once
+#include <cstdint>
+#include <string>
+
+#include "core/buffer.hpp"
+#include "core/math.hpp"
+
+namespace seamless {
+
+struct PngInfo {
+  int width = 0, height = 0;
+  int bit_depth = 0;   // per channel
+  int channels = 0;    // 1 gray, 2 gray+alpha, 3 RGB, 4 RGBA (palette images report 3)
+};
+
+PngInfo png_info(const std::string& path);
+
+// 16-bit grayscale only (TUM depth); an 8-bit image is an error (it cannot hold depth).
+Image<std::uint16_t> read_png_u16(const std::string& path);
+// 8-bit grayscale only.
+Image<std::uint8_t> read_png_u8(const std::string& path);
+// 8-bit colour: RGB, or RGBA / palette / gray converted to RGB.
+Image<uchar3> read_png_rgb(const std::string& path);
+
+// Images are host (Device::CPU) images.
+void write_png_u16(const std::string& path, const Image<std::uint16_t>& image);
+void write_png_u8(const std::string& path, const Image<std::uint8_t>& image);
+void write_png_rgb(const std::string& path, const Image<uchar3>& image);
+
+}  // namespace seamless

@@ -1,0 +1,246 @@
+#include "io/tum_source.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "core/exec.hpp"
+#include "core/log.hpp"
+#include "io/intrinsics_presets.hpp"
+#include "io/png_io.hpp"
+#include "kernels/io/undistort.hpp"
+
+namespace seamless {
+namespace fs = std::filesystem;
+namespace {
+
+std::string where(const std::string& path, int line) { return "'" + path + "' line " + std::to_string(line); }
+
+bool is_comment(const std::string& line) {
+  auto first = line.find_first_not_of(" \t\r");
+  return first == std::string::npos || line[first] == '#';
+}
+
+void check_order(double prev, double t, const std::string& path, int n) {
+  if (t < prev)
+    throw Error("timestamps out of order at " + where(path, n) + " (" + std::to_string(t) + " after " +
+                std::to_string(prev) + "): TUM list files must be sorted by time");
+}
+
+// associations.txt: `t_rgb rgb_file t_depth depth_file` (TUM's associate.py rgb.txt depth.txt);
+// a file written the other way round (depth first) is recognised by its file names.
+std::vector<TumPair> read_associations(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error("cannot open association file '" + path + "': " + std::strerror(errno));
+  std::vector<TumPair> out;
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    if (is_comment(line)) continue;
+    std::istringstream ss(line);
+    TumPair p;
+    if (!(ss >> p.rgb.timestamp >> p.rgb.file >> p.depth.timestamp >> p.depth.file))
+      throw Error("malformed association at " + where(path, n) + ": expected 't_rgb rgb/x.png t_depth depth/y.png', got '" +
+                  line + "'");
+    if (p.rgb.file.find("depth") != std::string::npos && p.depth.file.find("rgb") != std::string::npos)
+      std::swap(p.rgb, p.depth);
+    if (!out.empty()) check_order(out.back().rgb.timestamp, p.rgb.timestamp, path, n);
+    out.push_back(p);
+  }
+  return out;
+}
+
+std::vector<std::pair<double, vec3>> read_accelerometer(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error("cannot open accelerometer file '" + path + "': " + std::strerror(errno));
+  std::vector<std::pair<double, vec3>> out;
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    if (is_comment(line)) continue;
+    std::istringstream ss(line);
+    double t, ax, ay, az;
+    if (!(ss >> t >> ax >> ay >> az))
+      throw Error("malformed accelerometer sample at " + where(path, n) + ": expected 'timestamp ax ay az'");
+    if (!out.empty()) check_order(out.back().first, t, path, n);
+    // The Kinect's accelerometer axes are the camera's turned half a turn about z (x left, y up):
+    // checked against the motion-capture ground truth of freiburg1 (tests/io/test_tum.cpp).
+    out.push_back({t, vec3{static_cast<float>(-ax), static_cast<float>(-ay), static_cast<float>(az)}});
+  }
+  return out;
+}
+
+// Median of the valid depths (every 7th pixel is plenty): a wrong depth_scale shows here first.
+float median_depth(const Image<float>& depth) {
+  std::vector<float> v;
+  const float* d = depth.buffer().data();
+  for (std::int64_t i = 0; i < depth.buffer().size(); i += 7)
+    if (d[i] > 0.f) v.push_back(d[i]);
+  if (v.empty()) return 0.f;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+std::vector<TumListEntry> read_tum_list(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error("cannot open TUM list file '" + path + "': " + std::strerror(errno));
+  std::vector<TumListEntry> out;
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    if (is_comment(line)) continue;
+    std::istringstream ss(line);
+    TumListEntry e;
+    if (!(ss >> e.timestamp >> e.file))
+      throw Error("malformed line at " + where(path, n) + ": expected 'timestamp filename', got '" + line + "'");
+    if (!out.empty()) check_order(out.back().timestamp, e.timestamp, path, n);
+    out.push_back(e);
+  }
+  return out;
+}
+
+std::vector<TumPair> associate(const std::vector<TumListEntry>& rgb, const std::vector<TumListEntry>& depth,
+                               double max_difference) {
+  struct Candidate {
+    double diff;
+    std::size_t r, d;
+  };
+  std::vector<Candidate> cand;
+  for (std::size_t r = 0; r < rgb.size(); ++r) {  // both lists are sorted: a window per rgb entry
+    auto lo = std::lower_bound(depth.begin(), depth.end(), rgb[r].timestamp - max_difference,
+                               [](const TumListEntry& e, double t) { return e.timestamp < t; });
+    for (auto it = lo; it != depth.end() && it->timestamp < rgb[r].timestamp + max_difference; ++it)
+      cand.push_back({std::fabs(it->timestamp - rgb[r].timestamp), r, static_cast<std::size_t>(it - depth.begin())});
+  }
+  std::stable_sort(cand.begin(), cand.end(), [](const Candidate& a, const Candidate& b) { return a.diff < b.diff; });
+  std::vector<char> used_r(rgb.size(), 0), used_d(depth.size(), 0);
+  std::vector<TumPair> out;
+  for (const Candidate& c : cand) {
+    if (used_r[c.r] || used_d[c.d]) continue;
+    used_r[c.r] = used_d[c.d] = 1;
+    out.push_back({rgb[c.r], depth[c.d]});
+  }
+  std::sort(out.begin(), out.end(), [](const TumPair& a, const TumPair& b) { return a.rgb.timestamp < b.rgb.timestamp; });
+  return out;
+}
+
+TumSource::TumSource(const InputParams& params) : params_(params), folder_(params.path) {
+  if (folder_.empty()) throw Error("input.path is empty: set it to a TUM RGB-D folder (source: tum)");
+  if (!fs::is_directory(folder_))
+    throw Error("input.path '" + folder_ + "' is not a folder: download one with datasets/download_tum.sh");
+  K_ = resolve_intrinsics(params.intrinsics, folder_);
+  fs::path dir(folder_);
+  for (const char* assoc : {"associations.txt", "associate.txt"})
+    if (fs::exists(dir / assoc)) {
+      pairs_ = read_associations((dir / assoc).string());
+      break;
+    }
+  if (pairs_.empty() && !fs::exists(dir / "associations.txt") && !fs::exists(dir / "associate.txt"))
+    pairs_ = associate(read_tum_list((dir / "rgb.txt").string()), read_tum_list((dir / "depth.txt").string()));
+  if (pairs_.empty())
+    throw Error("TUM folder '" + folder_ + "' has no rgb/depth pairs (no timestamps within 0.02 s, or empty lists)");
+  std::size_t first = static_cast<std::size_t>(std::min<std::int64_t>(params.first_frame, pairs_.size()));
+  pairs_.erase(pairs_.begin(), pairs_.begin() + first);
+  if (params.max_frames > 0 && pairs_.size() > static_cast<std::size_t>(params.max_frames)) pairs_.resize(params.max_frames);
+  if (pairs_.empty())
+    throw Error("input.first_frame " + std::to_string(params.first_frame) + " is past the end of '" + folder_ + "'");
+  if (fs::exists(dir / "groundtruth.txt")) groundtruth_ = read_tum_trajectory((dir / "groundtruth.txt").string());
+  if (fs::exists(dir / "accelerometer.txt")) accel_ = read_accelerometer((dir / "accelerometer.txt").string());
+}
+
+Intrinsics TumSource::intrinsics() const {
+  Intrinsics K = K_;
+  bool distorted = false;
+  for (float d : K.dist) distorted = distorted || d != 0.f;
+  if (distorted && params_.undistort)
+    for (float& d : K.dist) d = 0.f;
+  return K;
+}
+
+std::optional<vec3> TumSource::accelerometer_at(double t) const {
+  if (accel_.empty()) return std::nullopt;
+  auto it = std::lower_bound(accel_.begin(), accel_.end(), t, [](const auto& a, double v) { return a.first < v; });
+  auto best = it == accel_.end() ? it - 1 : it;
+  if (it != accel_.begin() && std::fabs((it - 1)->first - t) < std::fabs(best->first - t)) best = it - 1;
+  // The Kinect reports about 30 samples a second (TUM logs ~500 Hz with repeats): 0.1 s is near.
+  if (std::fabs(best->first - t) > 0.1) return std::nullopt;
+  return best->second;
+}
+
+void TumSource::load_frame(const TumPair& pair, RgbdFrame& frame) {
+  fs::path dir(folder_);
+  std::string depth_path = (dir / pair.depth.file).string(), rgb_path = (dir / pair.rgb.file).string();
+  Image<std::uint16_t> raw = read_png_u16(depth_path);
+  Image<uchar3> rgb = read_png_rgb(rgb_path);
+  if (raw.width() != K_.width || raw.height() != K_.height)
+    throw Error("depth image '" + depth_path + "' is " + std::to_string(raw.width()) + "x" + std::to_string(raw.height()) +
+                " but input.intrinsics says " + std::to_string(K_.width) + "x" + std::to_string(K_.height));
+  if (rgb.width() != raw.width() || rgb.height() != raw.height())
+    throw Error("colour image '" + rgb_path + "' is " + std::to_string(rgb.width()) + "x" + std::to_string(rgb.height()) +
+                ", its depth image '" + depth_path + "' " + std::to_string(raw.width()) + "x" + std::to_string(raw.height()));
+  Image<float> depth(raw.width(), raw.height(), Device::CPU);
+  const float inv = static_cast<float>(1.0 / params_.depth_scale);
+  for (std::int64_t i = 0; i < depth.buffer().size(); ++i) depth.buffer().data()[i] = raw.buffer().data()[i] * inv;
+  float med = median_depth(depth);
+  if (med > 0.f && (med < 0.2f || med > 10.f))
+    throw Error("depth image '" + depth_path + "': median depth " + std::to_string(med) + " m with input.depth_scale " +
+                std::to_string(params_.depth_scale) + " is implausible for a Kinect (0.2-10 m); TUM uses 5000, " +
+                "millimetre depth needs 1000 (a scale of about " +
+                std::to_string(params_.depth_scale * med / 2.0) + " would put the median at 2 m)");
+  Intrinsics K = intrinsics();
+  if (K.dist[0] == 0.f && K_.dist[0] != 0.f) {  // undistort (on the host: this is input decoding)
+    Image<float> d2(depth.width(), depth.height(), Device::CPU);
+    Image<uchar3> c2(rgb.width(), rgb.height(), Device::CPU);
+    with_exec(Device::CPU, [&](const auto& ex) {
+      if (undistort_map_.width() != depth.width()) {
+        undistort_map_ = Image<vec2>(depth.width(), depth.height(), Device::CPU);
+        kernels::undistort_map(ex, K_, undistort_map_.view());
+      }
+      kernels::remap_depth(ex, undistort_map_.cview(), depth.cview(), d2.view());
+      kernels::remap_rgb(ex, undistort_map_.cview(), rgb.cview(), c2.view());
+    });
+    depth = std::move(d2);
+    rgb = std::move(c2);
+  }
+  frame.depth = std::move(depth);
+  frame.rgb = std::move(rgb);
+  fill_metadata(pair, frame);
+}
+
+void TumSource::fill_metadata(const TumPair& pair, RgbdFrame& frame) const {
+  frame.timestamp = pair.rgb.timestamp;
+  frame.intrinsics = intrinsics();
+  frame.accelerometer = accelerometer_at(pair.rgb.timestamp);
+  frame.ground_truth.reset();
+  if (auto p = interpolate_pose(groundtruth_, pair.rgb.timestamp, params_.max_gt_gap)) frame.ground_truth = p->se3();
+}
+
+RgbdFrame TumSource::metadata(std::size_t i) const {
+  RgbdFrame f;
+  f.index = static_cast<std::int64_t>(i);
+  fill_metadata(pairs_.at(i), f);
+  return f;
+}
+
+bool TumSource::next(RgbdFrame& frame) {
+  while (next_ < pairs_.size()) {
+    const TumPair& pair = pairs_[next_++];
+    try {
+      load_frame(pair, frame);
+      frame.index = delivered_++;
+      return true;
+    } catch (const Error& e) {
+      bool scale_problem = std::string(e.what()).find("input.depth_scale") != std::string::npos;
+      if (!params_.skip_bad_frames || scale_problem) throw;  // a wrong scale is not one bad frame
+      ++skipped_;
+      spdlog::warn("skipping bad frame {} of '{}' ({} skipped so far): {}", next_ - 1, folder_, skipped_, e.what());
+    }
+  }
+  return false;
+}
+
+}  // namespace seamless
