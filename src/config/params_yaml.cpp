@@ -159,7 +159,9 @@ std::string LoadContext::where(const YAML::Node& at, const std::string& path) co
 }
 
 void LoadContext::error(const YAML::Node& at, const std::string& path, const std::string& what) {
-  errors_.push_back(where(at, path) + ": " + path + ": " + what);
+  std::string at_where = where(at, path);
+  long pos = at_where.rfind("(from --set", 0) == 0 || at.Mark().pos < 0 ? 1L << 40 : at.Mark().pos;
+  errors_.push_back({pos, at_where + ": " + path + ": " + what});
 }
 
 void LoadContext::unknown_key(const YAML::Node& key, const std::string& path, const std::vector<std::string>& known) {
@@ -184,10 +186,13 @@ void LoadContext::unknown_key(const YAML::Node& key, const std::string& path, co
 
 void LoadContext::throw_if_errors() const {
   if (errors_.empty()) return;
-  if (errors_.size() == 1) throw Error(errors_[0] + "\n(every key is listed in docs/CONFIG.md)");
+  const char* hint = "\n(every key: `seamless config --list` or docs/CONFIG.md)";
+  if (errors_.size() == 1) throw Error(errors_[0].message + hint);
+  auto sorted = errors_;
+  std::stable_sort(sorted.begin(), sorted.end(), [](const Problem& a, const Problem& b) { return a.order < b.order; });
   std::string msg = std::to_string(errors_.size()) + " problems in the configuration:";
-  for (const auto& e : errors_) msg += "\n  " + e;
-  throw Error(msg + "\n(every key is listed in docs/CONFIG.md)");
+  for (const auto& e : sorted) msg += "\n  " + e.message;
+  throw Error(msg + hint);
 }
 
 // ---- SectionReader ----------------------------------------------------------------------------

@@ -40,7 +40,11 @@ class LoadContext {
   std::string source_;
   std::vector<Override> overrides_;
   std::vector<KeyInfo> schema_;  // for "'x' belongs in section 'y'" hints; may be empty
-  std::vector<std::string> errors_;
+  struct Problem {
+    long order;  // position in the file (overrides after the file), to report in reading order
+    std::string message;
+  };
+  std::vector<Problem> errors_;
 };
 
 // Closest candidate within a small edit distance (optimal string alignment, case-insensitive),

@@ -139,6 +139,18 @@ TEST(ConfigErrors, AllProblemsAreReportedAtOnce) {
   EXPECT_THAT(msg, HasSubstr("render.width"));
 }
 
+TEST(ConfigErrors, ProblemsAreListedInFileOrder) {
+  // The unknown key is found after its section was read, but is listed where it stands.
+  std::string msg = error_of("volume:\n  layot: hash\n  voxel_size: 5\n", {"render.width=0"});
+  auto unknown = msg.find("test.yaml:2:3: volume.layot"), range = msg.find("test.yaml:3:15: volume.voxel_size");
+  auto set = msg.find("(from --set render.width=0): render.width: out of range");
+  ASSERT_NE(unknown, std::string::npos) << msg;
+  ASSERT_NE(range, std::string::npos) << msg;
+  ASSERT_NE(set, std::string::npos) << msg;
+  EXPECT_LT(unknown, range);
+  EXPECT_LT(range, set);  // overrides after the file
+}
+
 TEST(ConfigErrors, DuplicateKey) {
   EXPECT_THAT(error_of("volume:\n  voxel_size: 0.01\n  voxel_size: 0.02\n"),
               HasSubstr("test.yaml:3:3: volume.voxel_size: duplicate key"));
