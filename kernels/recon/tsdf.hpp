@@ -98,3 +98,29 @@ void raycast(const Exec& ex, Acc a, Intrinsics K, SE3 world_T_camera, float min_
              RaycastOutput out);
 
 }  // namespace seamless::kernels
+
+// --- extraction (family recon/tsdf_extract) ----------------------------------------------------
+namespace seamless::kernels {
+
+// Marching cubes (Lorensen & Cline 1987) over the cells of the listed blocks: cell g spans voxels
+// g .. g+(1,1,1), so the cells on a block's upper faces reach into the neighbour blocks and the
+// mesh has no seams. table: 256 rows of kMcRow entries, 3 edge indices per triangle, -1 ended
+// (recon/marching_cubes.cpp generates it). Edge e joins corners kMcEdge[e][0] and [1]; corner k
+// is g + (k&1, (k>>1)&1, k>>2).
+constexpr int kMcRow = 16;
+// counts[i] = triangles of cell i (block i / 512, voxel i % 512); returns the total and turns
+// counts into exclusive offsets.
+template <class Exec, class Acc>
+std::int64_t mesh_count(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,
+                        View<std::int32_t> counts);
+// Writes 3 vertices per triangle at 3 * offsets[i]: position (world), normal (TSDF gradient),
+// colour, and a key naming the voxel edge it lies on (equal keys = the same vertex).
+template <class Exec, class Acc>
+void mesh_emit(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,
+               View<const std::int32_t> offsets, View<vec3> positions, View<vec3> normals, View<uchar3> colors,
+               View<std::uint64_t> edge_keys);
+// Block coordinates of the given hash slots.
+template <class Exec>
+void slot_block_coords(const Exec& ex, HashTableView t, View<const std::int32_t> slots, View<int3> out);
+
+}  // namespace seamless::kernels

@@ -212,12 +212,14 @@ SEAMLESS_HD inline bool sample_tsdf(const Acc& a, vec3 q, BlockCache& c, float* 
 // Gradient of the trilinear TSDF at voxel-space q (metres of SDF per voxel) by central differences
 // over +-1 voxel, one-sided (against the value s0 at q) where a neighbour sample is missing.
 template <class Acc>
-SEAMLESS_HD inline vec3 tsdf_gradient(const Acc& a, vec3 q, float s0, BlockCache& c) {
+SEAMLESS_HD inline vec3 tsdf_gradient(const Acc& a, vec3 q, float s0, BlockCache& c, bool* complete = nullptr) {
   float g[3];
+  if (complete) *complete = true;
   for (int axis = 0; axis < 3; ++axis) {
     vec3 e{axis == 0 ? 1.f : 0.f, axis == 1 ? 1.f : 0.f, axis == 2 ? 1.f : 0.f};
     float sp = 0.f, sm = 0.f;
     bool okp = sample_tsdf(a, q + e, c, &sp), okm = sample_tsdf(a, q - e, c, &sm);
+    if (complete && !(okp && okm)) *complete = false;
     g[axis] = okp && okm ? 0.5f * (sp - sm) : okp ? sp - s0 : okm ? s0 - sm : 0.f;
   }
   return {g[0], g[1], g[2]};

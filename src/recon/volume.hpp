@@ -65,6 +65,8 @@ class Volume {
     raycast(K, world_T_camera, m);
     return m;
   }
+  // Marching-cubes mesh of everything fused so far, with vertex colours and normals.
+  virtual Mesh extract_mesh() = 0;
   virtual VolumeStats stats() = 0;
   virtual Device device() const = 0;
   virtual const VolumeParams& params() const = 0;

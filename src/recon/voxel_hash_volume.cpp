@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "core/exec.hpp"
 #include "kernels/recon/tsdf.hpp"
+#include "recon/marching_cubes.hpp"
 
 namespace seamless {
 
@@ -261,6 +262,16 @@ void VoxelHashVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, Ra
       kernels::raycast(ex, device_view(), K, world_T_camera, params_.min_depth, params_.max_depth, out);
     });
   });
+}
+
+Mesh VoxelHashVolume::extract_mesh() {
+  Buffer<std::int32_t> slots;
+  const std::int64_t n = live_slots(slots);
+  Buffer<int3> coords(n, device_);
+  with_exec(device_, [&](const auto& ex) {
+    kernels::slot_block_coords(ex, table(), View<const std::int32_t>{slots.data(), n}, coords.view());
+  });
+  return marching_cubes(device_, device_view(), coords, n);
 }
 
 VolumeStats VoxelHashVolume::stats() {

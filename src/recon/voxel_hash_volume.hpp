@@ -21,6 +21,7 @@ class VoxelHashVolume final : public Volume {
                  StageTimer* timer = nullptr) override;
   void raycast(const Intrinsics& K, const SE3& world_T_camera, RaycastMaps& maps, StageTimer* timer = nullptr) override;
   using Volume::raycast;
+  Mesh extract_mesh() override;
   VolumeStats stats() override;
   Device device() const override { return device_; }
   const VolumeParams& params() const override { return params_; }

@@ -1,0 +1,3 @@
+#include "core/exec_cpu.hpp"
+#include "kernels/recon/tsdf_extract.inl"
+SEAMLESS_INSTANTIATE_TSDF_EXTRACT(seamless::CpuExec)

@@ -1,0 +1,122 @@
+#include "recon/marching_cubes.hpp"
+
+#include <algorithm>
+#include <unordered_map>
+
+#include "core/error.hpp"
+#include "core/exec.hpp"
+#include "kernels/recon/tsdf.hpp"
+
+namespace seamless {
+
+namespace {
+
+int edge_between(int a, int b) {
+  int diff = a ^ b, axis = diff == 1 ? 0 : diff == 2 ? 1 : 2;
+  int lo = std::min(a, b), j = 0, m = 0;
+  for (int bit = 0; bit < 3; ++bit) {
+    if (bit == axis) continue;
+    if (lo & (1 << bit)) j |= 1 << m;
+    ++m;
+  }
+  return axis * 4 + j;
+}
+
+// Corners of face (axis, side) in counter-clockwise order seen from outside the cube.
+std::vector<int> face_corners(int axis, int side) {
+  int u = (axis + 1) % 3, v = (axis + 2) % 3;  // (u, v, axis) is right-handed
+  int base = side << axis;
+  std::vector<int> c = {base, base | (1 << u), base | (1 << u) | (1 << v), base | (1 << v)};
+  if (side == 0) std::reverse(c.begin(), c.end());
+  return c;
+}
+
+std::vector<std::int8_t> build_table() {
+  std::vector<std::int8_t> table(256 * kernels::kMcRow, -1);
+  for (int cube = 1; cube < 255; ++cube) {
+    auto inside = [&](int k) { return (cube >> k) & 1; };
+    int next[12];
+    std::fill(next, next + 12, -1);
+    // On each face, each run of inside corners (walking counter-clockwise) is cut off by one
+    // segment from the edge where the walk enters the run to the edge where it leaves it. A
+    // crossing edge is entered on one of its two faces and left on the other, so segments chain.
+    for (int axis = 0; axis < 3; ++axis)
+      for (int side = 0; side < 2; ++side) {
+        std::vector<int> c = face_corners(axis, side);
+        for (int i = 0; i < 4; ++i) {
+          if (inside(c[i]) || !inside(c[(i + 1) % 4])) continue;  // find out -> in
+          int entry = edge_between(c[i], c[(i + 1) % 4]);
+          int j = (i + 1) % 4;
+          while (inside(c[(j + 1) % 4])) j = (j + 1) % 4;
+          next[entry] = edge_between(c[j], c[(j + 1) % 4]);
+        }
+      }
+    std::vector<int> tris;
+    bool used[12] = {false};
+    for (int e = 0; e < 12; ++e) {
+      if (next[e] < 0 || used[e]) continue;
+      std::vector<int> loop;
+      for (int k = e; !used[k]; k = next[k]) {
+        used[k] = true;
+        loop.push_back(k);
+        if (next[k] < 0) throw Error("marching cubes table: open loop (internal error)");
+      }
+      for (std::size_t i = 1; i + 1 < loop.size(); ++i) tris.insert(tris.end(), {loop[0], loop[i], loop[i + 1]});
+    }
+    if (static_cast<int>(tris.size()) > kernels::kMcRow)
+      throw Error("marching cubes table: configuration with more than 5 triangles (internal error)");
+    std::copy(tris.begin(), tris.end(), table.begin() + cube * kernels::kMcRow);
+  }
+  return table;
+}
+
+}  // namespace
+
+const std::vector<std::int8_t>& marching_cubes_table() {
+  static const std::vector<std::int8_t> t = build_table();
+  return t;
+}
+
+template <class Acc>
+Mesh marching_cubes(Device d, const Acc& a, const Buffer<int3>& blocks, std::int64_t block_count) {
+  Buffer<std::int8_t> table = Buffer<std::int8_t>::from_host(marching_cubes_table(), d);
+  Mesh mesh;
+  std::unordered_map<std::uint64_t, int> index;  // voxel edge -> vertex
+  constexpr std::int64_t kChunk = 8192;           // blocks per pass: bounds the scratch memory
+  for (std::int64_t first = 0; first < block_count; first += kChunk) {
+    std::int64_t nb = std::min(kChunk, block_count - first);
+    View<const int3> chunk{blocks.data() + first, nb};
+    Buffer<std::int32_t> offsets(nb * kernels::kBlockVoxels, d);
+    std::int64_t tris = with_exec(d, [&](const auto& ex) {
+      return kernels::mesh_count(ex, a, chunk, table.data(), offsets.view());
+    });
+    if (tris == 0) continue;
+    Buffer<vec3> pos(3 * tris, d), nrm(3 * tris, d);
+    Buffer<uchar3> col(3 * tris, d);
+    Buffer<std::uint64_t> keys(3 * tris, d);
+    with_exec(d, [&](const auto& ex) {
+      kernels::mesh_emit(ex, a, chunk, table.data(), offsets.cview(), pos.view(), nrm.view(), col.view(), keys.view());
+    });
+    auto hp = pos.to_host(), hn = nrm.to_host();
+    auto hc = col.to_host();
+    auto hk = keys.to_host();
+    int tri[3];
+    for (std::int64_t v = 0; v < 3 * tris; ++v) {
+      auto [it, fresh] = index.emplace(hk[v], static_cast<int>(mesh.positions.size()));
+      if (fresh) {
+        mesh.positions.push_back(hp[v]);
+        mesh.normals.push_back(hn[v]);
+        mesh.colors.push_back(hc[v]);
+      }
+      tri[v % 3] = it->second;
+      if (v % 3 == 2) mesh.triangles.push_back({tri[0], tri[1], tri[2]});
+    }
+  }
+  return mesh;
+}
+
+template Mesh marching_cubes<kernels::HashAccess>(Device, const kernels::HashAccess&, const Buffer<int3>&, std::int64_t);
+template Mesh marching_cubes<kernels::DenseAccess>(Device, const kernels::DenseAccess&, const Buffer<int3>&,
+                                                   std::int64_t);
+
+}  // namespace seamless
