@@ -28,14 +28,31 @@ struct SolverParams {
   float surface_tension = 0.01f;        // Akinci 2013 curvature term
   std::string scene_collision = "particles";
   float sleep_threshold = 0.f;          // m/s; 0 = never sleep
-  float max_speed = 20.f;               // m/s, clamps blow-ups
+  float max_speed = 4.f;                // m/s: speed limit; sets the substeps (docs/PHYSICS.md)
   int max_neighbours = 64;
+  // Solver details (docs/PHYSICS.md).
+  int stabilization_iterations = 1;     // Macklin 2014 section 4.4 pre-stabilisation passes
+  float relaxation = 1.f;               // SOR factor omega of averaged contacts (Macklin 2014 eq. 11)
+  float tunnel_fraction = 0.5f;         // substeps keep max_speed * dt_sub <= this * diameter
+  float fluid_smoothing = 2.f;          // PBF smoothing radius h in particle diameters
+  float fluid_relaxation = 0.01f;       // PBF epsilon as a fraction of the rest lattice's sum |grad C|^2
+  bool fluid_unilateral = true;         // density constraint only pushes apart (Macklin 2014 7.1)
+  float tensile_k = 0.f;                // PBF s_corr k (eq. 13); 0 = off
+  float tensile_dq = 0.2f;              // PBF s_corr delta q in units of h
+  float solid_density_scale = 1.f;      // weight of solid neighbours in fluid density
+  float drag = 0.f;                     // cloth drag coefficient C_D (Keckeisen 2004)
+  float lift = 0.f;                     // cloth lift coefficient C_L
+  float air_density = 1.2f;             // kg/m^3
+  vec3 wind{0.f, 0.f, 0.f};             // m/s
+  float cloth_relaxation = 2.f;         // cloth constraint averaging: k / max(1, degree / this)
+  int rotation_iterations = 8;          // Mueller 2016 rotation extraction steps per shape match
+  int max_static_neighbours = 64;
 
   template <class V> void visit(V& v) {
     v("particle_diameter", particle_diameter, "particle diameter, metres", Range{0.001, 1.0});
     v("dt", dt, "time step per simulated frame, seconds", Range{1e-5, 1.0});
     v("iterations", iterations, "constraint iterations per substep", Range{1, 1000});
-    v("substeps", substeps, "substeps per time step", Range{1, 1000});
+    v("substeps", substeps, "minimum substeps per time step (more if max_speed needs them)", Range{1, 1000});
     v("gravity", gravity, "gravity in world coordinates, m/s^2");
     v("max_particles", max_particles, "particle capacity", Range{1, 1e9});
     v("static_friction", static_friction, "static friction coefficient", Range{0.0, 10.0});
@@ -49,8 +66,25 @@ struct SolverParams {
     v("scene_collision", scene_collision, "collide against static scene particles or the sampled TSDF",
       Choices{"particles", "sdf"});
     v("sleep_threshold", sleep_threshold, "particles slower than this are frozen, m/s; 0 = off", Range{0.0, 100.0});
-    v("max_speed", max_speed, "speed clamp, m/s", Range{0.0, 1e4});
+    v("max_speed", max_speed, "speed limit, m/s; sets the substeps so that nothing tunnels", Range{0.01, 1e4});
     v("max_neighbours", max_neighbours, "neighbours kept per particle", Range{1, 1024});
+    v("stabilization_iterations", stabilization_iterations, "pre-stabilisation passes on initial contacts",
+      Range{0, 100});
+    v("relaxation", relaxation, "SOR factor of averaged contact corrections", Range{0.1, 2.0});
+    v("tunnel_fraction", tunnel_fraction, "max distance per substep at max_speed, in diameters", Range{0.05, 1.0});
+    v("fluid_smoothing", fluid_smoothing, "fluid smoothing radius h, in particle diameters", Range{1.0, 4.0});
+    v("fluid_relaxation", fluid_relaxation, "PBF constraint relaxation epsilon (relative)", Range{0.0, 100.0});
+    v("fluid_unilateral", fluid_unilateral, "fluid density constraint only pushes particles apart");
+    v("tensile_k", tensile_k, "PBF artificial pressure k; 0 = off", Range{0.0, 1.0});
+    v("tensile_dq", tensile_dq, "PBF artificial pressure delta q, in units of h", Range{0.0, 1.0});
+    v("solid_density_scale", solid_density_scale, "weight of solid neighbours in fluid density", Range{0.0, 10.0});
+    v("drag", drag, "cloth aerodynamic drag coefficient", Range{0.0, 100.0});
+    v("lift", lift, "cloth aerodynamic lift coefficient", Range{0.0, 100.0});
+    v("air_density", air_density, "air density, kg/m^3", Range{0.0, 100.0});
+    v("wind", wind, "wind velocity, m/s");
+    v("cloth_relaxation", cloth_relaxation, "cloth constraint averaging divisor", Range{0.5, 16.0});
+    v("rotation_iterations", rotation_iterations, "rotation extraction iterations", Range{1, 100});
+    v("max_static_neighbours", max_static_neighbours, "scene particles kept per particle", Range{1, 1024});
   }
 };
 
@@ -67,9 +101,13 @@ struct SpawnParams {
   int nx = 32, ny = 32;               // cloth grid
   float spacing = 0.f;                // cloth particle spacing, metres; 0 = particle diameter
   std::vector<int> pinned;            // cloth corners held fixed: 0..3 = (0,0) (nx-1,0) (0,ny-1) (nx-1,ny-1)
-  float stiffness = 1.f;              // cloth stretch stiffness (PBD k)
+  float stiffness = 1.f;              // cloth stretch stiffness (PBD k); rigid: shape matching stiffness
+  float bend_stiffness = 0.1f;        // cloth bending stiffness
+  bool self_collide = false;          // cloth collides with itself
   std::string shape = "box";          // rigid
   std::string mesh;                   // rigid, shape: mesh (OBJ/PLY path)
+  vec3 rotation{0.f, 0.f, 0.f};       // pose: Euler angles about x, y, z (applied in that order), degrees
+  float density = 1000.f;             // kg/m^3: particle mass = density * diameter^3 (fluid: solver.rest_density)
 
   template <class V> void visit(V& v) {
     v("kind", kind, "what to spawn", Choices{"fluid_block", "emitter", "cloth", "rigid"});
@@ -85,7 +123,11 @@ struct SpawnParams {
     v("spacing", spacing, "cloth particle spacing, metres; 0 = particle diameter", Range{0.0, 10.0});
     v("pinned", pinned, "cloth corners held fixed (0..3)", Range{0, 3});
     v("stiffness", stiffness, "cloth stretch stiffness", Range{0.0, 1.0});
+    v("bend_stiffness", bend_stiffness, "cloth bending stiffness", Range{0.0, 1.0});
+    v("self_collide", self_collide, "cloth collides with itself");
     v("shape", shape, "rigid body shape", Choices{"box", "sphere", "mesh"});
+    v("rotation", rotation, "Euler angles about x, y, z, degrees (cloth, rigid)");
+    v("density", density, "material density, kg/m^3 (rigid, cloth)", Range{1.0, 1e5});
     v("mesh", mesh, "rigid body mesh file (shape: mesh)");
   }
 };

@@ -1,0 +1,116 @@
+// What the solver's kernels see: one POD of constants and device pointers, filled by the host
+// (src/physics/solver.cpp) for each substep. Arrays marked "orig" are indexed by particle id (the
+// order the user spawned them in); arrays marked "sorted" are in neighbour-grid cell order, which
+// the solver re-establishes every substep for memory coherence (Green 2010).
+#pragma once
+#include <cstdint>
+
+#include "core/math.hpp"
+#include "kernels/physics/particle_math.hpp"
+#include "kernels/physics/scene_sdf.hpp"
+
+namespace seamless::kernels {
+
+struct Quad {
+  int a, b, c, d;  // bending: a, b = shared edge; c, d = the opposite vertices (Mueller 2007, A)
+};
+
+// Per-chunk partial sums of shape matching: sum of (p - ref) and sum of (p - ref) q^T.
+struct RigidSum {
+  vec3 p;
+  mat3 A;
+};
+SEAMLESS_HD inline RigidSum operator+(const RigidSum& a, const RigidSum& b) { return {a.p + b.p, a.A + b.A}; }
+
+struct SimConstants {
+  float dt = 0.01f, inv_dt = 100.f;
+  vec3 gravity{0.f, -9.81f, 0.f};
+  float radius = 0.02f, diameter = 0.04f;  // contact distance = diameter (one radius per solver)
+  float search_radius = 0.08f;             // neighbour radius = grid cell size
+  float max_speed = 4.f;
+  float omega = 1.f;                       // SOR factor of averaged constraints (Macklin 2014, eq. 11)
+  float static_friction = 0.5f, kinetic_friction = 0.3f, restitution = 0.f;
+  // Position Based Fluids (Macklin & Mueller 2013), in number-density units.
+  float h = 0.08f;                  // smoothing radius
+  float rest_density = 1.f;         // rho_0: kernel sum of the rest lattice
+  float relaxation = 1.f;           // epsilon of eq. 11 (CFM)
+  float scorr_k = 0.f, scorr_inv_wdq = 0.f;  // tensile instability term, eq. 13
+  int unilateral = 1;               // C_i <= 0 only (Macklin 2014, section 7.1)
+  float solid_density_scale = 1.f;  // weight of solid neighbours in fluid density (ibid.)
+  float viscosity = 0.01f, vorticity = 0.f, cohesion = 0.f, surface_tension = 0.f;
+  // cloth aerodynamics (Keckeisen 2004)
+  float drag = 0.f, lift = 0.f, air_density = 1.2f;
+  vec3 wind{0.f, 0.f, 0.f};
+  float sleep_threshold = 0.f;
+  float cloth_self_exclusion = 0.06f;  // same-cloth pairs closer than this at rest never collide
+  int max_neighbors = 64, max_static_neighbors = 64;
+  int rotation_iterations = 8;
+};
+
+struct SimViews {
+  SimConstants c;
+  std::int64_t n = 0;  // active dynamic particles
+
+  // orig: state and per-particle constants
+  vec3* x = nullptr;
+  vec3* v = nullptr;
+  float* w = nullptr;  // inverse mass; 0 = pinned
+  std::uint32_t* phase = nullptr;
+  const vec3* rest = nullptr;  // rigid: offset from the body's rest centre; cloth: rest position
+  const vec4* rsdf = nullptr;  // rigid: body-frame SDF gradient (xyz) and value (w, < 0 inside)
+  vec3* pred = nullptr;        // predicted positions before sorting
+
+  // sort
+  std::uint32_t* key = nullptr;
+  int* order = nullptr;  // sorted slot -> id
+  int* rank = nullptr;   // id -> sorted slot
+
+  // sorted
+  vec3 *sx = nullptr, *sp = nullptr, *sp0 = nullptr, *sv = nullptr, *tmp = nullptr, *vtmp = nullptr;
+  float* sw = nullptr;
+  std::uint32_t* sphase = nullptr;
+  float* lambda = nullptr;
+  float* density = nullptr;
+  int* ncontacts = nullptr;
+  vec3 *vort = nullptr, *cnormal = nullptr;
+
+  // neighbour grid and lists (k-major: list[k * n + i])
+  GridSpec grid{};
+  int *cell_start = nullptr, *cell_end = nullptr;
+  int *nbr = nullptr, *nnbr = nullptr;
+  int *snbr = nullptr, *nsnbr = nullptr;
+  int* counters = nullptr;  // [0] lists over the cap, [1] static lists over the cap, [2] max len, [3] max static len
+
+  // static scene particles, sorted by their own grid at upload
+  std::int64_t ns = 0;
+  const vec3* stat = nullptr;
+  GridSpec sgrid{};
+  const int *scell_start = nullptr, *scell_end = nullptr;
+  SceneSdf sdf{};
+
+  // rigid bodies: particles of body b are ids [body_start[b], body_start[b] + body_count[b])
+  int nbodies = 0;
+  const int *body_start = nullptr, *body_count = nullptr;
+  const int *body_chunk_start = nullptr, *body_chunk_count = nullptr;
+  const float* body_stiffness = nullptr;
+  vec3* body_c = nullptr;  // centre of mass (also the reference point of the next sums)
+  vec3* body_shift = nullptr;  // scratch: new centre minus body_c
+  vec4* body_q = nullptr;
+  mat3* body_R = nullptr;
+  int nchunks = 0;
+  const int *chunk_start = nullptr, *chunk_count = nullptr, *chunk_body = nullptr;
+  RigidSum* chunk_sum = nullptr;
+
+  // cloth, CSR by id: distance constraints (other id, rest length, stiffness already scaled by
+  // the averaging factor), bending constraints and triangles incident to each particle
+  const int *dist_off = nullptr, *dist_other = nullptr;
+  const float *dist_len = nullptr, *dist_k = nullptr;
+  const int *bend_off = nullptr, *bend_list = nullptr;
+  const Quad* bend_ids = nullptr;
+  const float *bend_rest = nullptr, *bend_k = nullptr;
+  const int *tri_off = nullptr, *tri_list = nullptr;
+  const int3* tri_ids = nullptr;
+  int has_cloth_constraints = 0;
+};
+
+}  // namespace seamless::kernels

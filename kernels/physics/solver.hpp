@@ -1,0 +1,73 @@
+// Kernel family of the unified particle solver (Macklin, Mueller, Chentanez, Kim 2014), one
+// substep of the dissertation's Algorithm 1 split into passes. Every pass reads the SimViews the
+// host filled; the host (src/physics/solver.cpp) calls them in this order:
+//
+//   predict -> sort_by_key -> reorder -> clear_cells / cell_ranges -> find_neighbors
+//   -> stabilize (section 4.4)
+//   -> iterations: prepare_constraints, solve_contacts_fluid (swap sp/tmp), shape_match,
+//                  cloth_solve (swap sp/tmp)
+//   -> update_velocity -> velocity_effects (swap sv/vtmp) -> write_back
+#pragma once
+#include <cstdint>
+
+#include "kernels/physics/sim_views.hpp"
+
+namespace seamless::kernels {
+
+// External forces, speed limit, prediction p = x + v dt; cell keys of p; order = identity.
+template <class Exec> void predict(const Exec& ex, const SimViews& S);
+// Stable sort of (key, value) pairs by the low `bits` bits of key (the executor's radix sort).
+template <class Exec> void sort_cells(const Exec& ex, std::uint32_t* keys, int* values, std::int64_t n, int bits);
+// Gathers the sorted arrays after sort_by_key(key, order) and fills rank.
+template <class Exec> void reorder(const Exec& ex, const SimViews& S);
+// Cell ranges of sorted keys: start[k] .. end[k]; cells not present get start = end = 0.
+template <class Exec> void clear_cells(const Exec& ex, int* start, int* end, std::int64_t cells);
+template <class Exec> void cell_ranges(const Exec& ex, const std::uint32_t* keys, std::int64_t n, int* start, int* end);
+// Keys of arbitrary points (static scene particles) and identity values for a sort.
+template <class Exec> void cell_keys(const Exec& ex, const vec3* p, std::int64_t n, GridSpec g, std::uint32_t* keys, int* idx);
+template <class Exec> void gather_vec3(const Exec& ex, const vec3* src, const int* idx, std::int64_t n, vec3* dst);
+// Neighbour lists (dynamic and static) of every particle within search_radius; counts overflow.
+template <class Exec> void find_neighbors(const Exec& ex, const SimViews& S);
+// Pre-stabilisation: contacts on the start positions, applied to x and p alike (uses tmp).
+template <class Exec> void stabilize(const Exec& ex, const SimViews& S);
+// Fluid density and lambda (PBF eqs. 1-11); number of active contacts of every particle.
+template <class Exec> void prepare_constraints(const Exec& ex, const SimViews& S);
+// Contacts (particles, static particles, SDF) with friction, plus the PBF position update
+// (eq. 12/14); writes tmp = sp + correction.
+template <class Exec> void solve_contacts_fluid(const Exec& ex, const SimViews& S);
+// Shape matching of every rigid body (Mueller 2005): per-body sums, rotation, goal positions.
+template <class Exec> void shape_match(const Exec& ex, const SimViews& S);
+// Cloth stretch and bending (Mueller 2007); writes tmp.
+template <class Exec> void cloth_solve(const Exec& ex, const SimViews& S);
+// v = v_pred + (p - p0) / dt (exactly symplectic Euler when nothing acted), restitution, sleeping.
+template <class Exec> void update_velocity(const Exec& ex, const SimViews& S);
+// XSPH viscosity, vorticity confinement, Akinci cohesion and surface tension, cloth
+// aerodynamics; writes vtmp.
+template <class Exec> void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid);
+// x, v back to id order.
+template <class Exec> void write_back(const Exec& ex, const SimViews& S);
+// max |v|^2 over the active particles.
+template <class Exec> float max_speed2(const Exec& ex, const SimViews& S);
+
+}  // namespace seamless::kernels
+
+#define SEAMLESS_INSTANTIATE_PHYSICS_SOLVER(E)                                                              \
+  namespace seamless::kernels {                                                                             \
+  template void predict<E>(const E&, const SimViews&);                                                      \
+  template void reorder<E>(const E&, const SimViews&);                                                      \
+  template void sort_cells<E>(const E&, std::uint32_t*, int*, std::int64_t, int);                           \
+  template void clear_cells<E>(const E&, int*, int*, std::int64_t);                                         \
+  template void cell_ranges<E>(const E&, const std::uint32_t*, std::int64_t, int*, int*);                   \
+  template void cell_keys<E>(const E&, const vec3*, std::int64_t, GridSpec, std::uint32_t*, int*);          \
+  template void gather_vec3<E>(const E&, const vec3*, const int*, std::int64_t, vec3*);                     \
+  template void find_neighbors<E>(const E&, const SimViews&);                                               \
+  template void stabilize<E>(const E&, const SimViews&);                                                    \
+  template void prepare_constraints<E>(const E&, const SimViews&);                                          \
+  template void solve_contacts_fluid<E>(const E&, const SimViews&);                                         \
+  template void shape_match<E>(const E&, const SimViews&);                                                  \
+  template void cloth_solve<E>(const E&, const SimViews&);                                                  \
+  template void update_velocity<E>(const E&, const SimViews&);                                              \
+  template void velocity_effects<E>(const E&, const SimViews&, bool);                                       \
+  template void write_back<E>(const E&, const SimViews&);                                                   \
+  template float max_speed2<E>(const E&, const SimViews&);                                                  \
+  }

@@ -1,0 +1,521 @@
+// Kernel bodies for physics/solver.hpp, compiled once per backend.
+#include "core/atomics.hpp"
+#include "kernels/physics/constraints.hpp"
+#include "kernels/physics/solver.hpp"
+
+namespace seamless::kernels {
+
+namespace detail {
+
+struct MaxF {
+  float v;
+};
+SEAMLESS_HD inline MaxF operator+(MaxF a, MaxF b) { return {fmaxf(a.v, b.v)}; }
+
+// Pairs that never interact are left out of the lists: particles of one rigid body, and
+// particles of one cloth unless it collides with itself (then only pairs that are not already
+// close in the rest shape, which the stretch constraints keep apart anyway).
+SEAMLESS_HD inline bool may_interact(const SimViews& S, std::uint32_t pi, std::uint32_t pj, int si, int sj) {
+  using namespace phase;
+  if (is(pi, kRigid) && is(pj, kRigid) && group(pi) == group(pj)) return false;
+  if (is(pi, kCloth) && is(pj, kCloth) && group(pi) == group(pj)) {
+    if (!is(pi, kSelfCollide)) return false;
+    float e = S.c.cloth_self_exclusion;
+    return length2(S.rest[S.order[si]] - S.rest[S.order[sj]]) >= e * e;
+  }
+  return true;
+}
+
+struct PairGeom {
+  bool hit;
+  vec3 n;  // unit, pushes particle s away from j
+  float depth;
+};
+
+// Contact between dynamic particles s and j at positions P (Macklin 2014, eq. 4.3 of the
+// dissertation). Between two rigid bodies whose particles are both below the surface layer, the
+// bodies have interpenetrated deeply; the stored SDF of the shallower particle then gives the
+// direction and depth (Macklin 2014, section 5), so the bodies separate the short way.
+SEAMLESS_HD inline PairGeom pair_geometry(const SimViews& S, int s, int j, const vec3* P) {
+  const float D = S.c.diameter;
+  vec3 d = P[s] - P[j];
+  float l2 = length2(d);
+  if (l2 >= D * D) return {false, {0.f, 0.f, 0.f}, 0.f};
+  float l = sqrtf(l2);
+  PairGeom g{true, l > 1e-9f ? d / l : vec3{0.f, 1.f, 0.f}, D - l};
+  std::uint32_t pi = S.sphase[s], pj = S.sphase[j];
+  if (phase::is(pi, phase::kRigid) && phase::is(pj, phase::kRigid) && S.rsdf) {
+    const int idi = S.order[s], idj = S.order[j];
+    vec4 gi = S.rsdf[idi], gj = S.rsdf[idj];
+    float ai = fabsf(gi.w), aj = fabsf(gj.w);
+    if (fminf(ai, aj) > D) {
+      // Both particles of the pair must pick the same SDF (ties broken by id), so that their
+      // corrections stay opposite.
+      if (ai < aj || (ai == aj && idi < idj)) g = {true, -(S.body_R[phase::group(pi)] * xyz(gi)), ai};
+      else g = {true, S.body_R[phase::group(pj)] * xyz(gj), aj};
+    }
+  }
+  return g;
+}
+
+SEAMLESS_HD inline bool both_fluid(std::uint32_t a, std::uint32_t b) {
+  return phase::is(a, phase::kFluid) && phase::is(b, phase::kFluid);
+}
+
+// Number of active contacts of particle s at positions P (at least 1: it divides).
+SEAMLESS_HD inline int count_contacts(const SimViews& S, int s, const vec3* P) {
+  const float D2 = S.c.diameter * S.c.diameter;
+  const int m = S.nnbr[s];
+  const vec3 p = P[s];
+  int count = 0;
+  for (int k = 0; k < m; ++k) {
+    int j = S.nbr[k * S.n + s];
+    if (both_fluid(S.sphase[s], S.sphase[j])) continue;
+    if (length2(p - P[j]) < D2) ++count;
+  }
+  for (int k = 0, ms = S.nsnbr[s]; k < ms; ++k)
+    if (length2(p - S.stat[S.snbr[k * S.n + s]]) < D2) ++count;
+  if (S.sdf.active() && scene_sdf(S.sdf, p).d < S.c.radius) ++count;
+  return count > 0 ? count : 1;
+}
+
+// Sum of the contact corrections of s at positions P (start positions X for friction). Each
+// pair's correction is scaled by omega / max(n_s, n_j): averaging as in Macklin 2014 (eq. 11)
+// that keeps every pair's two corrections equal and opposite, so momentum is conserved.
+SEAMLESS_HD inline vec3 contact_sum(const SimViews& S, int s, const vec3* P, const vec3* X, bool friction) {
+  const float D = S.c.diameter, wi = S.sw[s];
+  const std::uint32_t ph = S.sphase[s];
+  const bool fl = phase::is(ph, phase::kFluid);
+  const vec3 p = P[s], dx = p - X[s];
+  const float ni = static_cast<float>(S.ncontacts[s]);
+  const float mus = friction ? S.c.static_friction : 0.f, muk = friction ? S.c.kinetic_friction : 0.f;
+  vec3 acc{0.f, 0.f, 0.f};
+  for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
+    int j = S.nbr[k * S.n + s];
+    std::uint32_t phj = S.sphase[j];
+    if (fl && phase::is(phj, phase::kFluid)) continue;
+    PairGeom g = pair_geometry(S, s, j, P);
+    if (!g.hit) continue;
+    bool any_fluid = fl || phase::is(phj, phase::kFluid);  // fluids slip
+    vec3 rel = dx - (P[j] - X[j]);
+    float scale = S.c.omega / fmaxf(ni, static_cast<float>(S.ncontacts[j]));
+    acc += contact_delta(g.n, g.depth, rel, wi, S.sw[j], any_fluid ? 0.f : mus, any_fluid ? 0.f : muk) * scale;
+  }
+  const float self = S.c.omega / ni;
+  const float smu_s = fl ? 0.f : mus, smu_k = fl ? 0.f : muk;
+  for (int k = 0, m = S.nsnbr[s]; k < m; ++k) {
+    vec3 r = p - S.stat[S.snbr[k * S.n + s]];
+    float l2 = length2(r);
+    if (l2 >= D * D) continue;
+    float l = sqrtf(l2);
+    vec3 n = l > 1e-9f ? r / l : vec3{0.f, 1.f, 0.f};
+    acc += contact_delta(n, D - l, dx, wi, 0.f, smu_s, smu_k) * self;
+  }
+  if (S.sdf.active()) {
+    SdfSample3 q = scene_sdf(S.sdf, p);
+    if (q.d < S.c.radius) acc += contact_delta(q.grad, S.c.radius - q.d, dx, wi, 0.f, smu_s, smu_k) * self;
+  }
+  return acc;
+}
+
+}  // namespace detail
+
+template <class Exec>
+void predict(const Exec& ex, const SimViews& S) {
+  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t i) {
+    vec3 v = S.v[i];
+    if (S.w[i] > 0.f) v = v + S.c.gravity * S.c.dt;
+    float l2 = length2(v);
+    if (l2 > S.c.max_speed * S.c.max_speed) v = v * (S.c.max_speed / sqrtf(l2));
+    vec3 p = S.x[i] + v * S.c.dt;
+    S.v[i] = v;
+    S.pred[i] = p;
+    S.key[i] = S.grid.key(S.grid.cell(p));
+    S.order[i] = static_cast<int>(i);
+  });
+}
+
+template <class Exec>
+void sort_cells(const Exec& ex, std::uint32_t* keys, int* values, std::int64_t n, int bits) {
+  ex.sort_by_key(keys, values, n, bits);
+}
+
+template <class Exec>
+void reorder(const Exec& ex, const SimViews& S) {
+  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
+    int id = S.order[s];
+    S.rank[id] = static_cast<int>(s);
+    S.sx[s] = S.x[id];
+    S.sp[s] = S.pred[id];
+    S.sp0[s] = S.pred[id];
+    S.sv[s] = S.v[id];
+    S.sw[s] = S.w[id];
+    S.sphase[s] = S.phase[id];
+  });
+}
+
+template <class Exec>
+void clear_cells(const Exec& ex, int* start, int* end, std::int64_t cells) {
+  ex.for_each(cells, [=] SEAMLESS_HD(std::int64_t i) {
+    start[i] = 0;
+    end[i] = 0;
+  });
+}
+
+template <class Exec>
+void cell_ranges(const Exec& ex, const std::uint32_t* keys, std::int64_t n, int* start, int* end) {
+  ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) {
+    std::uint32_t k = keys[i];
+    if (i == 0 || keys[i - 1] != k) start[k] = static_cast<int>(i);
+    if (i == n - 1 || keys[i + 1] != k) end[k] = static_cast<int>(i + 1);
+  });
+}
+
+template <class Exec>
+void cell_keys(const Exec& ex, const vec3* p, std::int64_t n, GridSpec g, std::uint32_t* keys, int* idx) {
+  ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) {
+    keys[i] = g.key(g.cell(p[i]));
+    idx[i] = static_cast<int>(i);
+  });
+}
+
+template <class Exec>
+void gather_vec3(const Exec& ex, const vec3* src, const int* idx, std::int64_t n, vec3* dst) {
+  ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) { dst[i] = src[idx[i]]; });
+}
+
+template <class Exec>
+void find_neighbors(const Exec& ex, const SimViews& S) {
+  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t i) {
+    const int s = static_cast<int>(i);
+    const vec3 p = S.sp[s];
+    const float R2 = S.c.search_radius * S.c.search_radius;
+    const std::uint32_t ph = S.sphase[s];
+    int3 c = S.grid.cell(p);
+    int cnt = 0;
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          std::uint32_t k = S.grid.key(c + int3{dx, dy, dz});
+          for (int j = S.cell_start[k], e = S.cell_end[k]; j < e; ++j) {
+            if (j == s || length2(p - S.sp[j]) >= R2) continue;
+            if (!detail::may_interact(S, ph, S.sphase[j], s, j)) continue;
+            if (cnt < S.c.max_neighbors) S.nbr[cnt * S.n + s] = j;
+            ++cnt;
+          }
+        }
+    if (cnt > S.c.max_neighbors) atomic_add(&S.counters[0], 1);
+    atomic_max(&S.counters[2], cnt);
+    S.nnbr[s] = cnt < S.c.max_neighbors ? cnt : S.c.max_neighbors;
+    int scnt = 0;
+    if (S.ns > 0) {
+      int3 cs = S.sgrid.cell(p);
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            std::uint32_t k = S.sgrid.key(cs + int3{dx, dy, dz});
+            for (int j = S.scell_start[k], e = S.scell_end[k]; j < e; ++j) {
+              if (length2(p - S.stat[j]) >= R2) continue;
+              if (scnt < S.c.max_static_neighbors) S.snbr[scnt * S.n + s] = j;
+              ++scnt;
+            }
+          }
+      if (scnt > S.c.max_static_neighbors) atomic_add(&S.counters[1], 1);
+      atomic_max(&S.counters[3], scnt);
+    }
+    S.nsnbr[s] = scnt < S.c.max_static_neighbors ? scnt : S.c.max_static_neighbors;
+  });
+}
+
+// Macklin 2014, section 4.4: contacts that already exist at the start positions are resolved on
+// x and p together, so that they are removed without adding velocity.
+template <class Exec>
+void stabilize(const Exec& ex, const SimViews& S) {
+  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) { S.ncontacts[s] = detail::count_contacts(S, static_cast<int>(s), S.sx); });
+  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
+    S.tmp[s] = S.sw[s] > 0.f ? detail::contact_sum(S, static_cast<int>(s), S.sx, S.sx, false) : vec3{0.f, 0.f, 0.f};
+  });
+  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
+    vec3 d = S.tmp[s];
+    S.sx[s] += d;
+    S.sp[s] += d;
+    S.sp0[s] += d;
+  });
+}
+
+// Density (PBF eq. 2, number density: rho_i = sum_j W_ij, solid neighbours weighted by
+// solid_density_scale, Macklin 2014 section 7.1), constraint C_i = rho_i / rho_0 - 1 (eq. 1,
+// clamped to C_i >= 0 when unilateral) and lambda_i = -C_i / (sum_k |grad_k C_i|^2 + eps)
+// (eqs. 8-11). Only fluid particles are moved by the density constraint.
+template <class Exec>
+void prepare_constraints(const Exec& ex, const SimViews& S) {
+  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t i) {
+    const int s = static_cast<int>(i);
+    S.ncontacts[s] = detail::count_contacts(S, s, S.sp);
+    const std::uint32_t ph = S.sphase[s];
+    if (!phase::is(ph, phase::kFluid)) {
+      S.lambda[s] = 0.f;
+      S.density[s] = S.c.rest_density;
+      return;
+    }
+    const vec3 p = S.sp[s];
+    const float h = S.c.h, inv_rho0 = 1.f / S.c.rest_density, sw = S.c.solid_density_scale;
+    float rho = poly6(0.f, h), sum2 = 0.f;
+    vec3 gi{0.f, 0.f, 0.f};
+    for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
+      int j = S.nbr[k * S.n + s];
+      vec3 r = p - S.sp[j];
+      float wgt = poly6(length2(r), h);
+      vec3 g = spiky_grad(r, h) * inv_rho0;
+      if (phase::is(S.sphase[j], phase::kFluid)) {
+        rho += wgt;
+        gi += g;
+        sum2 += length2(g);
+      } else {
+        rho += sw * wgt;
+        gi += g * sw;
+      }
+    }
+    for (int k = 0, m = S.nsnbr[s]; k < m; ++k) {
+      vec3 r = p - S.stat[S.snbr[k * S.n + s]];
+      rho += sw * poly6(length2(r), h);
+      gi += spiky_grad(r, h) * (sw * inv_rho0);
+    }
+    float C = rho * inv_rho0 - 1.f;
+    if (S.c.unilateral && C < 0.f) C = 0.f;
+    S.lambda[s] = -C / (sum2 + length2(gi) + S.c.relaxation);
+    S.density[s] = rho;
+  });
+}
+
+template <class Exec>
+void solve_contacts_fluid(const Exec& ex, const SimViews& S) {
+  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t i) {
+    const int s = static_cast<int>(i);
+    const vec3 p = S.sp[s];
+    if (!(S.sw[s] > 0.f)) {
+      S.tmp[s] = p;
+      return;
+    }
+    vec3 acc = detail::contact_sum(S, s, S.sp, S.sx, true);
+    if (phase::is(S.sphase[s], phase::kFluid)) {
+      // PBF position update (eq. 12) with the artificial pressure s_corr (eq. 13, n = 4).
+      const float h = S.c.h, li = S.lambda[s], sw = S.c.solid_density_scale;
+      vec3 f{0.f, 0.f, 0.f};
+      for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
+        int j = S.nbr[k * S.n + s];
+        vec3 r = p - S.sp[j];
+        vec3 g = spiky_grad(r, h);
+        if (phase::is(S.sphase[j], phase::kFluid)) {
+          float sc = 0.f;
+          if (S.c.scorr_k > 0.f) {
+            float q = poly6(length2(r), h) * S.c.scorr_inv_wdq;
+            sc = -S.c.scorr_k * q * q * q * q;
+          }
+          f += g * (li + S.lambda[j] + sc);
+        } else {
+          f += g * (li * sw);
+        }
+      }
+      for (int k = 0, m = S.nsnbr[s]; k < m; ++k) f += spiky_grad(p - S.stat[S.snbr[k * S.n + s]], h) * (li * sw);
+      acc += f * (1.f / S.c.rest_density);
+    } else if (S.c.solid_density_scale > 0.f) {
+      // Two-way coupling: the reaction of the density correction a fluid neighbour j received
+      // from this solid particle (equal and opposite momentum: scaled by w_s / w_j).
+      const float h = S.c.h, ws = S.sw[s];
+      vec3 f{0.f, 0.f, 0.f};
+      for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
+        int j = S.nbr[k * S.n + s];
+        if (!phase::is(S.sphase[j], phase::kFluid)) continue;
+        f += spiky_grad(p - S.sp[j], h) * (S.lambda[j] * ws / S.sw[j]);
+      }
+      acc += f * (S.c.solid_density_scale / S.c.rest_density);
+    }
+    S.tmp[s] = p + acc;
+  });
+}
+
+template <class Exec>
+void shape_match(const Exec& ex, const SimViews& S) {
+  if (S.nbodies == 0) return;
+  // Partial sums over fixed-size chunks of each body's particles, then per-body totals: a
+  // deterministic segmented reduction (no float atomics). Offsets are taken from the previous
+  // centre so that sum (p - ref) q^T does not cancel catastrophically far from the origin.
+  ex.for_each(S.nchunks, [=] SEAMLESS_HD(std::int64_t c) {
+    vec3 ref = S.body_c[S.chunk_body[c]];
+    RigidSum sum{{0.f, 0.f, 0.f}, mat3::zero()};
+    for (int id = S.chunk_start[c], e = S.chunk_start[c] + S.chunk_count[c]; id < e; ++id) {
+      vec3 d = S.sp[S.rank[id]] - ref;
+      sum.p += d;
+      sum.A = sum.A + outer(d, S.rest[id]);
+    }
+    S.chunk_sum[c] = sum;
+  });
+  // Mueller 2005: c = mean position (eq. 4.4), A_pq = sum (p - c) q^T = sum (p - ref) q^T because
+  // the rest offsets q sum to zero; R = rotational part of A_pq (eq. 4.5), found on the device.
+  ex.for_each(S.nbodies, [=] SEAMLESS_HD(std::int64_t b) {
+    RigidSum t{{0.f, 0.f, 0.f}, mat3::zero()};
+    for (int c = S.body_chunk_start[b], e = c + S.body_chunk_count[b]; c < e; ++c) t = t + S.chunk_sum[c];
+    vec3 shift = t.p / static_cast<float>(S.body_count[b]);
+    vec4 q = extract_rotation(t.A, S.body_q[b], S.c.rotation_iterations);
+    S.body_q[b] = q;
+    S.body_R[b] = quat_to_mat(q);
+    S.body_shift[b] = shift;
+  });
+  // Goal positions g_i = R q_i + c (eq. 4.6), approached with the body's stiffness. The
+  // correction is formed relative to the reference point, so that its rounding error is relative
+  // to the body's size rather than to the distance from the origin (velocities are corrections
+  // divided by dt: this keeps momentum at float precision).
+  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
+    std::uint32_t ph = S.sphase[s];
+    if (!phase::is(ph, phase::kRigid) || !(S.sw[s] > 0.f)) return;
+    int b = static_cast<int>(phase::group(ph));
+    vec3 local = S.sp[s] - S.body_c[b];
+    vec3 goal = S.body_R[b] * S.rest[S.order[s]] + S.body_shift[b];
+    S.sp[s] += (goal - local) * S.body_stiffness[b];
+  });
+  ex.for_each(S.nbodies, [=] SEAMLESS_HD(std::int64_t b) { S.body_c[b] = S.body_c[b] + S.body_shift[b]; });
+}
+
+template <class Exec>
+void cloth_solve(const Exec& ex, const SimViews& S) {
+  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t i) {
+    const int s = static_cast<int>(i);
+    const vec3 p = S.sp[s];
+    const float wi = S.sw[s];
+    if (!phase::is(S.sphase[s], phase::kCloth) || !(wi > 0.f)) {
+      S.tmp[s] = p;
+      return;
+    }
+    const int id = S.order[s];
+    vec3 acc{0.f, 0.f, 0.f};
+    for (int e = S.dist_off[id], end = S.dist_off[id + 1]; e < end; ++e) {
+      int sj = S.rank[S.dist_other[e]];
+      acc += distance_delta(p, S.sp[sj], wi, S.sw[sj], S.dist_len[e], S.dist_k[e]);
+    }
+    for (int e = S.bend_off[id], end = S.bend_off[id + 1]; e < end; ++e) {
+      int b = S.bend_list[e];
+      Quad q = S.bend_ids[b];
+      int ids[4] = {q.a, q.b, q.c, q.d};
+      vec3 pos[4];
+      float w[4];
+      int which = 0;
+      for (int k = 0; k < 4; ++k) {
+        int sk = S.rank[ids[k]];
+        pos[k] = S.sp[sk];
+        w[k] = S.sw[sk];
+        if (ids[k] == id) which = k;
+      }
+      acc += bending_delta(pos, w, S.bend_rest[b], S.bend_k[b], which);
+    }
+    S.tmp[s] = p + acc;
+  });
+}
+
+template <class Exec>
+void update_velocity(const Exec& ex, const SimViews& S) {
+  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
+    // v_pred + (p - p0)/dt equals (p - x)/dt, but is exactly v_pred when no constraint acted.
+    vec3 v = S.sv[s] + (S.sp[s] - S.sp0[s]) * S.c.inv_dt;
+    if (S.c.sleep_threshold > 0.f && length2(v) < S.c.sleep_threshold * S.c.sleep_threshold) {
+      v = {0.f, 0.f, 0.f};  // Macklin 2014, section 4.5: slow particles keep their position
+      S.sp[s] = S.sx[s];
+    }
+    if (S.c.restitution > 0.f && S.sdf.active()) {
+      // Restitution against the scene SDF: reflect the approach speed of the step's start.
+      SdfSample3 q = scene_sdf(S.sdf, S.sp[s]);
+      float vn0 = dot(S.sv[s], q.grad), vn = dot(v, q.grad);
+      if (q.d < S.c.radius * 1.01f && vn0 < 0.f) v += q.grad * (-S.c.restitution * vn0 - vn);
+    }
+    S.sv[s] = v;
+  });
+}
+
+namespace detail {
+
+// Akinci 2013: cohesion (eq. 1) and curvature (eq. 5) accelerations, with the symmetrising
+// factor K_ij = 2 rho_0 / (rho_i + rho_j) (eq. 6). Masses are volume fractions 1 / rho_0.
+SEAMLESS_HD inline vec3 fluid_forces(const SimViews& S, int s) {
+  const float h = S.c.h, inv_rho0 = 1.f / S.c.rest_density;
+  const vec3 p = S.sp[s], vi = S.sv[s], wi = S.vort[s], ni = S.cnormal[s];
+  vec3 dv_visc{0.f, 0.f, 0.f}, eta{0.f, 0.f, 0.f}, acc{0.f, 0.f, 0.f};
+  for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
+    int j = S.nbr[k * S.n + s];
+    if (!phase::is(S.sphase[j], phase::kFluid)) continue;
+    vec3 r = p - S.sp[j];
+    float l2 = length2(r), l = sqrtf(l2);
+    dv_visc += (S.sv[j] - vi) * (poly6(l2, h) * inv_rho0);  // XSPH, PBF eq. 17
+    eta += spiky_grad(r, h) * (length(S.vort[j]) * inv_rho0);
+    float K = 2.f * S.c.rest_density / (S.density[s] + S.density[j]);
+    vec3 coh = l > 1e-9f ? r * (-S.c.cohesion * inv_rho0 * akinci_spline(l, h) / l) : vec3{0.f, 0.f, 0.f};
+    vec3 curv = (ni - S.cnormal[j]) * (-S.c.surface_tension);
+    acc += (coh + curv) * K;
+  }
+  // Vorticity confinement (PBF eqs. 15-16): f = eps (N x omega), N = eta / |eta|.
+  float el = length(eta);
+  if (el > 1e-9f && S.c.vorticity > 0.f) acc += cross(eta / el, wi) * S.c.vorticity;
+  return dv_visc * S.c.viscosity + acc * S.c.dt;
+}
+
+// Keckeisen 2004 drag and lift of the triangles around cloth particle s, a third each.
+SEAMLESS_HD inline vec3 cloth_aero(const SimViews& S, int s) {
+  const int id = S.order[s];
+  vec3 f{0.f, 0.f, 0.f};
+  for (int e = S.tri_off[id], end = S.tri_off[id + 1]; e < end; ++e) {
+    int3 t = S.tri_ids[S.tri_list[e]];
+    int a = S.rank[t.x], b = S.rank[t.y], c = S.rank[t.z];
+    vec3 vrel = (S.sv[a] + S.sv[b] + S.sv[c]) * (1.f / 3.f) - S.c.wind;
+    f += triangle_aero_force(S.sp[a], S.sp[b], S.sp[c], vrel, S.c.drag, S.c.lift, S.c.air_density) * (1.f / 3.f);
+  }
+  return f * (S.sw[s] * S.c.dt);
+}
+
+}  // namespace detail
+
+template <class Exec>
+void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
+  if (has_fluid) {
+    // Vorticity omega_i = sum_j v_ij x grad_j W_ij (PBF eq. 15) and Akinci's colour-field normal
+    // n_i = h sum_j (1 / rho_j) grad W_ij (Akinci 2013, eq. 4; dissertation eq. 4.21).
+    ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t i) {
+      const int s = static_cast<int>(i);
+      if (!phase::is(S.sphase[s], phase::kFluid)) return;
+      const float h = S.c.h, inv_rho0 = 1.f / S.c.rest_density;
+      vec3 w{0.f, 0.f, 0.f}, n{0.f, 0.f, 0.f};
+      for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
+        int j = S.nbr[k * S.n + s];
+        if (!phase::is(S.sphase[j], phase::kFluid)) continue;
+        vec3 g = spiky_grad(S.sp[s] - S.sp[j], h);
+        w += cross(S.sv[j] - S.sv[s], -g) * inv_rho0;
+        n += g * (h / S.density[j]);
+      }
+      S.vort[s] = w;
+      S.cnormal[s] = n;
+    });
+  }
+  const bool aero = S.has_cloth_constraints && (S.c.drag > 0.f || S.c.lift > 0.f);
+  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t i) {
+    const int s = static_cast<int>(i);
+    std::uint32_t ph = S.sphase[s];
+    vec3 v = S.sv[s];
+    if (has_fluid && phase::is(ph, phase::kFluid)) v += detail::fluid_forces(S, s);
+    if (aero && phase::is(ph, phase::kCloth)) v += detail::cloth_aero(S, s);
+    S.vtmp[s] = v;
+  });
+}
+
+template <class Exec>
+void write_back(const Exec& ex, const SimViews& S) {
+  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
+    int id = S.order[s];
+    S.x[id] = S.sp[s];
+    S.v[id] = S.sv[s];
+  });
+}
+
+template <class Exec>
+float max_speed2(const Exec& ex, const SimViews& S) {
+  return ex.transform_reduce(S.n, detail::MaxF{0.f}, [=] SEAMLESS_HD(std::int64_t i) { return detail::MaxF{length2(S.v[i])}; }).v;
+}
+
+}  // namespace seamless::kernels

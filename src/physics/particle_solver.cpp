@@ -1,0 +1,547 @@
+#include "physics/particle_solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "core/buffer.hpp"
+#include "core/error.hpp"
+#include "core/exec.hpp"
+#include "core/log.hpp"
+#include "kernels/physics/solver.hpp"
+
+namespace seamless {
+
+namespace K = kernels;
+
+namespace {
+
+template <class T>
+void grow(Buffer<T>& b, std::int64_t cap, std::int64_t keep, Device d) {
+  if (b.size() >= cap) return;
+  Buffer<T> nb(cap, d);
+  if (keep > 0) memory::copy(nb.data(), d, b.data(), d, sizeof(T) * static_cast<std::size_t>(keep));
+  b = std::move(nb);
+}
+
+template <class T>
+void upload_at(Buffer<T>& b, std::int64_t offset, const std::vector<T>& v) {
+  if (v.empty()) return;
+  memory::copy(b.data() + offset, b.device(), v.data(), Device::CPU, sizeof(T) * v.size());
+}
+
+// Cells per axis (as bits) so that the grid has about two cells per particle, 8..128 per axis
+// (at least 3 per axis keeps the 27 cells around a particle distinct).
+int grid_bits(std::int64_t n) {
+  int bits = 3;
+  while (bits < 7 && (std::int64_t{1} << (3 * bits)) < 2 * n) ++bits;
+  return bits;
+}
+
+struct Emitter {
+  SpawnParams s;
+  double start = 0.0, distance = 0.0, budget = 0.0;
+};
+
+}  // namespace
+
+struct ParticleSolver::Impl {
+  SolverParams P;
+  Device dev;
+  std::int64_t n = 0, cap = 0;
+  // id order
+  Buffer<vec3> x, v, rest, pred;
+  Buffer<float> w;
+  Buffer<std::uint32_t> phase;
+  Buffer<vec4> rsdf;
+  // sort and sorted scratch
+  Buffer<std::uint32_t> key, sphase;
+  Buffer<int> order, rank, ncontacts, nnbr, nsnbr, nbr, snbr;
+  Buffer<vec3> sx, sp, sp0, sv, tmp, vtmp, vort, cnormal;
+  Buffer<float> sw, lambda, density;
+  Buffer<int> cell_start, cell_end, counters;
+  int bits = 4;
+  // static scene
+  std::vector<vec3> static_host;
+  Buffer<vec3> stat;
+  Buffer<int> scell_start, scell_end;
+  K::GridSpec sgrid{};
+  K::SceneSdf sdf{};
+  Buffer<float> sdf_grid;
+  // rigid bodies
+  std::vector<int> body_start, body_count, body_chunk_start, body_chunk_count, chunk_start, chunk_count, chunk_body;
+  std::vector<float> body_stiffness;
+  Buffer<int> d_body_start, d_body_count, d_body_chunk_start, d_body_chunk_count, d_chunk_start, d_chunk_count,
+      d_chunk_body;
+  Buffer<float> d_body_stiffness;
+  Buffer<vec3> body_c, body_shift;
+  Buffer<vec4> body_q;
+  Buffer<mat3> body_R;
+  Buffer<K::RigidSum> chunk_sum;
+  // cloth (global ids)
+  std::vector<int> edge_a, edge_b;
+  std::vector<float> edge_len, edge_k0;
+  std::vector<K::Quad> bends;
+  std::vector<float> bend_rest, bend_k0;
+  std::vector<int3> tris;
+  Buffer<int> dist_off, dist_other, bend_off, bend_list, tri_off, tri_list;
+  Buffer<float> dist_len, dist_k, d_bend_rest, d_bend_k;
+  Buffer<K::Quad> d_bends;
+  Buffer<int3> d_tris;
+  int cloth_groups = 0;
+  // bookkeeping
+  std::int64_t n_fluid = 0, n_cloth = 0, n_rigid = 0, emitter_dropped = 0;
+  std::vector<SpawnParams> pending;
+  std::vector<Emitter> emitters;
+  double time = 0.0;
+  std::int64_t steps = 0;
+  float rho0 = 1.f, eps = 0.f;
+
+  Impl(const SolverParams& p, Device d) : P(p), dev(d), counters(4, d) {
+    counters.zero();
+    compute_fluid_constants();
+  }
+
+  // rho_0 and the CFM epsilon from the rest lattice (cubic, one diameter spacing), so that a
+  // fluid block spawned on that lattice starts with C_i = 0 in its interior.
+  void compute_fluid_constants() {
+    const float d = P.particle_diameter, h = P.fluid_smoothing * d;
+    int k = static_cast<int>(std::ceil(P.fluid_smoothing)) + 1;
+    double rho = 0.0;
+    for (int z = -k; z <= k; ++z)
+      for (int y = -k; y <= k; ++y)
+        for (int x = -k; x <= k; ++x) rho += K::poly6(float(x * x + y * y + z * z) * d * d, h);
+    rho0 = static_cast<float>(rho);
+    double den = 0.0;
+    for (int z = -k; z <= k; ++z)
+      for (int y = -k; y <= k; ++y)
+        for (int x = -k; x <= k; ++x) den += length2(K::spiky_grad(vec3{float(x), float(y), float(z)} * d, h) / rho0);
+    eps = static_cast<float>(P.fluid_relaxation * den);
+  }
+
+  void ensure_capacity(std::int64_t need) {
+    if (need > P.max_particles)
+      throw Error("particle solver: " + std::to_string(need) + " particles needed, over solver.max_particles = " +
+                  std::to_string(P.max_particles) + "; raise solver.max_particles");
+    if (need <= cap) return;
+    std::int64_t nc = std::min<std::int64_t>(P.max_particles, std::max<std::int64_t>({need, 2 * cap, 1024}));
+    grow(x, nc, n, dev), grow(v, nc, n, dev), grow(w, nc, n, dev), grow(phase, nc, n, dev);
+    grow(rest, nc, n, dev), grow(rsdf, nc, n, dev);
+    for (auto* b : {&pred, &sx, &sp, &sp0, &sv, &tmp, &vtmp, &vort, &cnormal}) b->reserve_discard(nc);
+    for (auto* b : {&order, &rank, &ncontacts, &nnbr, &nsnbr}) b->reserve_discard(nc);
+    for (auto* b : {&sw, &lambda, &density}) b->reserve_discard(nc);
+    key.reserve_discard(nc), sphase.reserve_discard(nc);
+    nbr.reserve_discard(nc * P.max_neighbours);
+    cap = nc;
+  }
+
+  K::SimViews views(float dt) {
+    K::SimViews S;
+    K::SimConstants& c = S.c;
+    const float d = P.particle_diameter;
+    c.dt = dt, c.inv_dt = 1.f / dt, c.gravity = P.gravity;
+    c.radius = 0.5f * d, c.diameter = d;
+    c.h = P.fluid_smoothing * d;
+    c.search_radius = std::max(c.h, 1.5f * d);
+    c.max_speed = P.max_speed, c.omega = P.relaxation;
+    c.static_friction = P.static_friction, c.kinetic_friction = P.kinetic_friction, c.restitution = P.restitution;
+    c.rest_density = rho0, c.relaxation = eps;
+    c.scorr_k = P.tensile_k;
+    float wdq = K::poly6(P.tensile_dq * P.tensile_dq * c.h * c.h, c.h);
+    c.scorr_inv_wdq = wdq > 0.f ? 1.f / wdq : 0.f;
+    c.unilateral = P.fluid_unilateral ? 1 : 0, c.solid_density_scale = P.solid_density_scale;
+    c.viscosity = P.viscosity, c.vorticity = P.vorticity, c.cohesion = P.cohesion, c.surface_tension = P.surface_tension;
+    c.drag = P.drag, c.lift = P.lift, c.air_density = P.air_density, c.wind = P.wind;
+    c.sleep_threshold = P.sleep_threshold;
+    c.cloth_self_exclusion = 1.5f * d;
+    c.max_neighbors = P.max_neighbours, c.max_static_neighbors = P.max_static_neighbours;
+    c.rotation_iterations = P.rotation_iterations;
+    S.n = n;
+    S.x = x.data(), S.v = v.data(), S.w = w.data(), S.phase = phase.data(), S.rest = rest.data();
+    S.rsdf = rsdf.data(), S.pred = pred.data();
+    S.key = key.data(), S.order = order.data(), S.rank = rank.data();
+    S.sx = sx.data(), S.sp = sp.data(), S.sp0 = sp0.data(), S.sv = sv.data(), S.tmp = tmp.data(), S.vtmp = vtmp.data();
+    S.sw = sw.data(), S.sphase = sphase.data(), S.lambda = lambda.data(), S.density = density.data();
+    S.ncontacts = ncontacts.data(), S.vort = vort.data(), S.cnormal = cnormal.data();
+    S.grid = {1.f / c.search_radius, bits};
+    S.cell_start = cell_start.data(), S.cell_end = cell_end.data();
+    S.nbr = nbr.data(), S.nnbr = nnbr.data(), S.snbr = snbr.data(), S.nsnbr = nsnbr.data();
+    S.counters = counters.data();
+    S.ns = static_cast<std::int64_t>(static_host.size());
+    S.stat = stat.data(), S.sgrid = sgrid, S.scell_start = scell_start.data(), S.scell_end = scell_end.data();
+    S.sdf = sdf;
+    S.nbodies = static_cast<int>(body_start.size());
+    S.body_start = d_body_start.data(), S.body_count = d_body_count.data();
+    S.body_chunk_start = d_body_chunk_start.data(), S.body_chunk_count = d_body_chunk_count.data();
+    S.body_stiffness = d_body_stiffness.data();
+    S.body_c = body_c.data(), S.body_shift = body_shift.data(), S.body_q = body_q.data(), S.body_R = body_R.data();
+    S.nchunks = static_cast<int>(chunk_start.size());
+    S.chunk_start = d_chunk_start.data(), S.chunk_count = d_chunk_count.data(), S.chunk_body = d_chunk_body.data();
+    S.chunk_sum = chunk_sum.data();
+    S.dist_off = dist_off.data(), S.dist_other = dist_other.data(), S.dist_len = dist_len.data(), S.dist_k = dist_k.data();
+    S.bend_off = bend_off.data(), S.bend_list = bend_list.data(), S.bend_ids = d_bends.data();
+    S.bend_rest = d_bend_rest.data(), S.bend_k = d_bend_k.data();
+    S.tri_off = tri_off.data(), S.tri_list = tri_list.data(), S.tri_ids = d_tris.data();
+    S.has_cloth_constraints = n_cloth > 0 ? 1 : 0;
+    return S;
+  }
+
+  void prepare_grid() {
+    bits = grid_bits(n);
+    std::int64_t cells = std::int64_t{1} << (3 * bits);
+    cell_start.reserve_discard(cells), cell_end.reserve_discard(cells);
+    if (!static_host.empty()) snbr.reserve_discard(cap * P.max_static_neighbours);
+  }
+
+  // Sort, grid and neighbour lists of the predicted positions (S.pred must be filled).
+  template <class Ex>
+  void build_neighbours(const Ex& ex, const K::SimViews& S) {
+    K::sort_cells(ex, S.key, S.order, n, 3 * bits);
+    K::reorder(ex, S);
+    K::clear_cells(ex, S.cell_start, S.cell_end, std::int64_t{1} << (3 * bits));
+    K::cell_ranges(ex, S.key, n, S.cell_start, S.cell_end);
+    K::find_neighbors(ex, S);
+  }
+
+  // One substep of Algorithm 1 (dissertation section 4.2.2) with Macklin 2014's additions.
+  void substep(float dt) {
+    if (n == 0) return;
+    prepare_grid();
+    K::SimViews S = views(dt);
+    const bool has_fluid = n_fluid > 0, has_cloth = !edge_a.empty() || !bends.empty();
+    const bool effects = has_fluid || (n_cloth > 0 && (P.drag > 0.f || P.lift > 0.f));
+    with_exec(dev, [&](const auto& ex) {
+      K::predict(ex, S);
+      build_neighbours(ex, S);
+      for (int i = 0; i < P.stabilization_iterations; ++i) K::stabilize(ex, S);
+      for (int it = 0; it < P.iterations; ++it) {
+        K::prepare_constraints(ex, S);
+        K::solve_contacts_fluid(ex, S);
+        std::swap(S.sp, S.tmp);
+        K::shape_match(ex, S);
+        if (has_cloth) {
+          K::cloth_solve(ex, S);
+          std::swap(S.sp, S.tmp);
+        }
+      }
+      K::update_velocity(ex, S);
+      if (effects) {
+        K::velocity_effects(ex, S, has_fluid);
+        std::swap(S.sv, S.vtmp);
+      }
+      K::write_back(ex, S);
+    });
+  }
+
+  void upload_bodies(const std::vector<vec3>& c, const std::vector<vec4>& q) {
+    auto up = [&](Buffer<int>& b, const std::vector<int>& h) { b = Buffer<int>::from_host(h, dev); };
+    up(d_body_start, body_start), up(d_body_count, body_count), up(d_body_chunk_start, body_chunk_start);
+    up(d_body_chunk_count, body_chunk_count), up(d_chunk_start, chunk_start), up(d_chunk_count, chunk_count);
+    up(d_chunk_body, chunk_body);
+    d_body_stiffness = Buffer<float>::from_host(body_stiffness, dev);
+    body_c = Buffer<vec3>::from_host(c, dev);
+    body_shift = Buffer<vec3>(static_cast<std::int64_t>(c.size()), dev);
+    body_q = Buffer<vec4>::from_host(q, dev);
+    std::vector<mat3> R;
+    for (vec4 r : q) R.push_back(K::quat_to_mat(r));
+    body_R = Buffer<mat3>::from_host(R, dev);
+    chunk_sum = Buffer<K::RigidSum>(static_cast<std::int64_t>(chunk_start.size()), dev);
+  }
+
+  void add_body(const ParticleBatch& b, std::int64_t first) {
+    std::vector<vec3> c = body_c.to_host();
+    std::vector<vec4> q = body_q.to_host();
+    constexpr int kChunk = 64;
+    int id = static_cast<int>(body_start.size());
+    int m = static_cast<int>(b.size());
+    body_start.push_back(static_cast<int>(first));
+    body_count.push_back(m);
+    body_chunk_start.push_back(static_cast<int>(chunk_start.size()));
+    body_chunk_count.push_back((m + kChunk - 1) / kChunk);
+    for (int k = 0; k < m; k += kChunk) {
+      chunk_start.push_back(static_cast<int>(first) + k);
+      chunk_count.push_back(std::min(kChunk, m - k));
+      chunk_body.push_back(id);
+    }
+    body_stiffness.push_back(b.stiffness);
+    c.push_back(b.centre);
+    q.push_back(b.rotation);
+    upload_bodies(c, q);
+  }
+
+  // CSR by particle id of the cloth constraints. Stiffness is divided by the larger degree of
+  // a constraint's particles over cloth_relaxation (Macklin 2014 eq. 11 averaging, made
+  // symmetric so that a pair's corrections stay equal and opposite).
+  void rebuild_cloth() {
+    const std::size_t N = static_cast<std::size_t>(n);
+    std::vector<int> deg(N, 0), bdeg(N, 0);
+    for (std::size_t e = 0; e < edge_a.size(); ++e) ++deg[edge_a[e]], ++deg[edge_b[e]];
+    for (const K::Quad& q : bends) ++bdeg[q.a], ++bdeg[q.b], ++bdeg[q.c], ++bdeg[q.d];
+    auto scale = [&](int dmax) { return std::min(1.f, P.cloth_relaxation / static_cast<float>(std::max(dmax, 1))); };
+    std::vector<int> off(N + 1, 0), other(2 * edge_a.size());
+    std::vector<float> len(other.size()), k(other.size());
+    for (std::size_t i = 0; i < N; ++i) off[i + 1] = off[i] + deg[i];
+    std::vector<int> fill(off.begin(), off.end() - 1);
+    for (std::size_t e = 0; e < edge_a.size(); ++e) {
+      int a = edge_a[e], b = edge_b[e];
+      float ke = edge_k0[e] * scale(std::max(deg[a], deg[b]));
+      other[fill[a]] = b, len[fill[a]] = edge_len[e], k[fill[a]++] = ke;
+      other[fill[b]] = a, len[fill[b]] = edge_len[e], k[fill[b]++] = ke;
+    }
+    dist_off = Buffer<int>::from_host(off, dev), dist_other = Buffer<int>::from_host(other, dev);
+    dist_len = Buffer<float>::from_host(len, dev), dist_k = Buffer<float>::from_host(k, dev);
+    std::vector<float> bk(bends.size());
+    std::vector<std::vector<int>> inc(N);
+    for (std::size_t i = 0; i < bends.size(); ++i) {
+      const K::Quad& q = bends[i];
+      bk[i] = bend_k0[i] * scale(std::max({bdeg[q.a], bdeg[q.b], bdeg[q.c], bdeg[q.d]}));
+      for (int id : {q.a, q.b, q.c, q.d}) inc[id].push_back(static_cast<int>(i));
+    }
+    upload_csr(inc, bend_off, bend_list);
+    std::vector<std::vector<int>> tinc(N);
+    for (std::size_t i = 0; i < tris.size(); ++i)
+      for (int id : {tris[i].x, tris[i].y, tris[i].z}) tinc[id].push_back(static_cast<int>(i));
+    upload_csr(tinc, tri_off, tri_list);
+    d_bends = Buffer<K::Quad>::from_host(bends, dev), d_bend_rest = Buffer<float>::from_host(bend_rest, dev);
+    d_bend_k = Buffer<float>::from_host(bk, dev), d_tris = Buffer<int3>::from_host(tris, dev);
+  }
+
+  void upload_csr(const std::vector<std::vector<int>>& lists, Buffer<int>& off, Buffer<int>& items) {
+    std::vector<int> o(lists.size() + 1, 0), it;
+    for (std::size_t i = 0; i < lists.size(); ++i) {
+      o[i + 1] = o[i] + static_cast<int>(lists[i].size());
+      it.insert(it.end(), lists[i].begin(), lists[i].end());
+    }
+    if (it.empty()) it.push_back(0);
+    off = Buffer<int>::from_host(o, dev), items = Buffer<int>::from_host(it, dev);
+  }
+
+  std::int64_t add_batch(const ParticleBatch& b) {
+    const std::int64_t m = b.size(), first = n;
+    if (m == 0) return first;
+    ensure_capacity(n + m);
+    std::uint32_t flags = 0;
+    if (b.kind == ParticleBatch::kFluid) flags = K::phase::kFluid;
+    if (b.kind == ParticleBatch::kRigid) {
+      if (body_start.size() >= K::phase::kGroupMask) throw Error("particle solver: too many rigid bodies (max 2^24)");
+      flags = K::phase::kRigid | static_cast<std::uint32_t>(body_start.size());
+    }
+    if (b.kind == ParticleBatch::kCloth)
+      flags = K::phase::kCloth | static_cast<std::uint32_t>(cloth_groups++) | (b.self_collide ? K::phase::kSelfCollide : 0u);
+    upload_at(x, first, b.x), upload_at(v, first, b.v), upload_at(w, first, b.inv_mass);
+    upload_at(phase, first, std::vector<std::uint32_t>(static_cast<std::size_t>(m), flags));
+    if (!b.rest.empty()) upload_at(rest, first, b.rest);
+    if (!b.rsdf.empty()) upload_at(rsdf, first, b.rsdf);
+    n += m;
+    if (b.kind == ParticleBatch::kFluid) n_fluid += m;
+    if (b.kind == ParticleBatch::kRigid) {
+      n_rigid += m;
+      add_body(b, first);
+    }
+    if (b.kind == ParticleBatch::kCloth) {
+      n_cloth += m;
+      const int o = static_cast<int>(first);
+      for (std::size_t e = 0; e < b.edge_a.size(); ++e) {
+        edge_a.push_back(b.edge_a[e] + o), edge_b.push_back(b.edge_b[e] + o);
+        edge_len.push_back(b.edge_len[e]), edge_k0.push_back(b.stretch_k);
+      }
+      for (std::size_t i = 0; i < b.bends.size(); ++i) {
+        const K::Quad& q = b.bends[i];
+        bends.push_back({q.a + o, q.b + o, q.c + o, q.d + o});
+        bend_rest.push_back(b.bend_rest[i]), bend_k0.push_back(b.bend_k);
+      }
+      for (const int3& t : b.tris) tris.push_back({t.x + o, t.y + o, t.z + o});
+      rebuild_cloth();
+    }
+    return first;
+  }
+
+  void run_emitters(float dt) {
+    for (Emitter& e : emitters) {
+      if (e.s.duration > 0.f && time >= e.start + e.s.duration) continue;
+      // A layer leaves the nozzle each time the jet has advanced one diameter, as far as the
+      // rate allows.
+      e.distance += length(e.s.velocity) * dt;
+      e.budget += e.s.rate * dt;
+      ParticleBatch layer = make_emitter_layer(e.s, P);
+      while (e.distance >= P.particle_diameter && e.budget >= static_cast<double>(layer.size())) {
+        e.distance -= P.particle_diameter;
+        e.budget -= static_cast<double>(layer.size());
+        if (n + layer.size() > P.max_particles) {
+          emitter_dropped += layer.size();
+          continue;
+        }
+        // Each layer starts where the previous would be now, so the stream stays evenly spaced.
+        for (vec3& p : layer.x) p += normalize(e.s.velocity) * static_cast<float>(e.distance);
+        add_batch(layer);
+        layer = make_emitter_layer(e.s, P);
+      }
+      // A rate below what the jet speed asks for spaces the layers further apart instead.
+      e.distance = std::min(e.distance, static_cast<double>(P.particle_diameter));
+    }
+  }
+
+  void spawn_due() {
+    std::vector<SpawnParams> later;
+    for (const SpawnParams& s : pending)
+      if (s.time <= time + 1e-9) spawn(s);
+      else later.push_back(s);
+    pending = std::move(later);
+  }
+
+  std::int64_t spawn(const SpawnParams& s) {
+    if (s.kind == "fluid_block") return add_batch(make_fluid_block(s, P));
+    if (s.kind == "cloth") return add_batch(make_cloth(s, P));
+    if (s.kind == "rigid") return add_batch(make_rigid(s, P));
+    if (s.kind == "emitter") {
+      emitters.push_back({s, time, P.particle_diameter, 0.0});
+      return n;
+    }
+    throw Error("spawn: unknown kind '" + s.kind + "' (expected fluid_block, emitter, cloth or rigid)");
+  }
+
+  void rebuild_static() {
+    const std::int64_t ns = static_cast<std::int64_t>(static_host.size());
+    int sb = grid_bits(ns);
+    sgrid = {1.f / std::max(P.fluid_smoothing * P.particle_diameter, 1.5f * P.particle_diameter), sb};
+    std::int64_t cells = std::int64_t{1} << (3 * sb);
+    Buffer<vec3> raw = Buffer<vec3>::from_host(static_host, dev);
+    Buffer<std::uint32_t> keys(ns, dev);
+    Buffer<int> idx(ns, dev);
+    stat = Buffer<vec3>(ns, dev);
+    scell_start = Buffer<int>(cells, dev), scell_end = Buffer<int>(cells, dev);
+    with_exec(dev, [&](const auto& ex) {
+      K::cell_keys(ex, raw.data(), ns, sgrid, keys.data(), idx.data());
+      K::sort_cells(ex, keys.data(), idx.data(), ns, 3 * sb);
+      K::gather_vec3(ex, raw.data(), idx.data(), ns, stat.data());
+      K::clear_cells(ex, scell_start.data(), scell_end.data(), cells);
+      K::cell_ranges(ex, keys.data(), ns, scell_start.data(), scell_end.data());
+    });
+    snbr.reserve_discard(std::max<std::int64_t>(cap, 1) * P.max_static_neighbours);
+  }
+};
+
+ParticleSolver::ParticleSolver(const SolverParams& params, Device device)
+    : impl_(std::make_unique<Impl>(params, device)) {}
+ParticleSolver::~ParticleSolver() = default;
+
+void ParticleSolver::add_static_particles(const std::vector<vec3>& points) {
+  if (points.empty()) return;
+  impl_->static_host.insert(impl_->static_host.end(), points.begin(), points.end());
+  impl_->rebuild_static();
+}
+
+void ParticleSolver::clear_static_particles() { impl_->static_host.clear(); }
+
+void ParticleSolver::set_scene_sdf(const kernels::SceneSdf& sdf) {
+  const float* g = impl_->sdf.grid;
+  int3 dims = impl_->sdf.dims;
+  vec3 origin = impl_->sdf.origin;
+  float voxel = impl_->sdf.voxel;
+  impl_->sdf = sdf;
+  impl_->sdf.grid = g, impl_->sdf.dims = dims, impl_->sdf.origin = origin, impl_->sdf.voxel = voxel;
+}
+
+void ParticleSolver::set_scene_sdf_grid(const std::vector<float>& values, int3 dims, vec3 origin, float voxel) {
+  if (static_cast<std::int64_t>(values.size()) != std::int64_t{dims.x} * dims.y * dims.z || voxel <= 0.f)
+    throw Error("set_scene_sdf_grid: " + std::to_string(values.size()) + " values do not fill a " +
+                std::to_string(dims.x) + "x" + std::to_string(dims.y) + "x" + std::to_string(dims.z) +
+                " grid with a positive voxel size");
+  impl_->sdf_grid = Buffer<float>::from_host(values, impl_->dev);
+  impl_->sdf.grid = impl_->sdf_grid.data(), impl_->sdf.dims = dims, impl_->sdf.origin = origin, impl_->sdf.voxel = voxel;
+}
+
+std::int64_t ParticleSolver::spawn(const SpawnParams& s) { return impl_->spawn(s); }
+
+void ParticleSolver::schedule(const std::vector<SpawnParams>& spawns) {
+  check_spawn_capacity(spawns, impl_->P);
+  impl_->pending.insert(impl_->pending.end(), spawns.begin(), spawns.end());
+}
+
+std::int64_t ParticleSolver::add_batch(const ParticleBatch& b) { return impl_->add_batch(b); }
+
+int ParticleSolver::substeps(float dt) const {
+  const SolverParams& P = impl_->P;
+  if (dt < 0.f) dt = P.dt;
+  double need = std::ceil(P.max_speed * dt / (P.tunnel_fraction * P.particle_diameter) - 1e-6);
+  return std::max(P.substeps, static_cast<int>(std::max(need, 1.0)));
+}
+
+void ParticleSolver::step(float dt) {
+  if (dt < 0.f) dt = impl_->P.dt;
+  impl_->spawn_due();
+  impl_->run_emitters(dt);
+  const int k = substeps(dt);
+  for (int i = 0; i < k; ++i) impl_->substep(dt / static_cast<float>(k));
+  impl_->time += dt;
+  ++impl_->steps;
+}
+
+SolverStats ParticleSolver::stats() const {
+  Impl& I = *impl_;
+  SolverStats s;
+  s.particles = I.n, s.fluid_particles = I.n_fluid, s.cloth_particles = I.n_cloth, s.rigid_particles = I.n_rigid;
+  s.rigid_bodies = static_cast<std::int64_t>(I.body_start.size());
+  s.static_particles = static_cast<std::int64_t>(I.static_host.size());
+  s.substeps = substeps();
+  s.time = I.time, s.steps = I.steps, s.emitter_dropped = I.emitter_dropped;
+  std::vector<int> c = I.counters.to_host();
+  s.neighbour_overflow = c[0], s.static_neighbour_overflow = c[1];
+  s.max_neighbours_seen = c[2], s.max_static_neighbours_seen = c[3];
+  if (I.n > 0) {
+    K::SimViews S = I.views(I.P.dt);
+    float m2 = with_exec(I.dev, [&](const auto& ex) { return K::max_speed2(ex, S); });
+    s.max_speed = std::sqrt(m2);
+  }
+  if (s.neighbour_overflow > 0 || s.static_neighbour_overflow > 0)
+    spdlog::warn("particle solver: {} neighbour lists and {} scene lists exceeded the cap ({} / {}); raise "
+              "solver.max_neighbours / solver.max_static_neighbours",
+              s.neighbour_overflow, s.static_neighbour_overflow, I.P.max_neighbours, I.P.max_static_neighbours);
+  return s;
+}
+
+ParticleState ParticleSolver::download_state() const {
+  Impl& I = *impl_;
+  ParticleState s;
+  auto cut = [&](auto v) {
+    v.resize(static_cast<std::size_t>(I.n));
+    return v;
+  };
+  if (I.n == 0) return s;
+  s.x = cut(I.x.to_host()), s.v = cut(I.v.to_host()), s.inv_mass = cut(I.w.to_host()), s.phase = cut(I.phase.to_host());
+  return s;
+}
+
+std::vector<RigidFrame> ParticleSolver::rigid_frames() const {
+  Impl& I = *impl_;
+  std::vector<RigidFrame> out;
+  std::vector<vec3> c = I.body_c.to_host();
+  std::vector<vec4> q = I.body_q.to_host();
+  for (std::size_t b = 0; b < I.body_start.size(); ++b) out.push_back({c[b], q[b], I.body_start[b], I.body_count[b]});
+  return out;
+}
+
+std::int64_t ParticleSolver::size() const { return impl_->n; }
+const SolverParams& ParticleSolver::params() const { return impl_->P; }
+Device ParticleSolver::device() const { return impl_->dev; }
+float ParticleSolver::fluid_rest_density() const { return impl_->rho0; }
+
+std::vector<float> ParticleSolver::fluid_density_ratio() const {
+  Impl& I = *impl_;
+  if (I.n == 0) return {};
+  I.prepare_grid();
+  K::SimViews S = I.views(I.P.dt);
+  S.c.dt = 0.f, S.c.max_speed = 1e30f;  // predicted = current positions, velocities untouched
+  with_exec(I.dev, [&](const auto& ex) {
+    K::predict(ex, S);
+    I.build_neighbours(ex, S);
+    K::prepare_constraints(ex, S);
+  });
+  std::vector<float> rho = I.density.to_host();
+  std::vector<int> order = I.order.to_host();
+  std::vector<float> out(static_cast<std::size_t>(I.n));
+  for (std::int64_t s = 0; s < I.n; ++s) out[order[s]] = rho[s] / I.rho0;
+  return out;
+}
+
+}  // namespace seamless

@@ -1,0 +1,99 @@
+// The unified particle solver (Macklin, Mueller, Chentanez, Kim 2014) as the host sees it: one
+// object that owns the particle state on one device and steps it with the kernels of
+// kernels/physics/solver.hpp, without host round trips inside a step (docs/PHYSICS.md).
+//
+//   ParticleSolver s(params, Device::CUDA);
+//   s.add_static_particles(scene_points);      // and/or s.set_scene_sdf(...)
+//   s.schedule(experiment.spawn);              // spawned when their time comes
+//   for (...) { s.step(); write_particles_ply(path, s.download_state()); }
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/device.hpp"
+#include "core/math.hpp"
+#include "kernels/physics/scene_sdf.hpp"
+#include "physics/builders.hpp"
+#include "physics/solver_params.hpp"
+
+namespace seamless {
+
+struct SolverStats {
+  std::int64_t particles = 0, fluid_particles = 0, cloth_particles = 0, rigid_particles = 0;
+  std::int64_t rigid_bodies = 0, static_particles = 0;
+  int substeps = 1;
+  double time = 0.0;              // simulated seconds
+  std::int64_t steps = 0;
+  // Neighbour lists over the cap (particles, summed over substeps since the start): each such
+  // particle lost neighbours. Raise solver.max_neighbours if these are not zero.
+  std::int64_t neighbour_overflow = 0, static_neighbour_overflow = 0;
+  int max_neighbours_seen = 0, max_static_neighbours_seen = 0;
+  std::int64_t emitter_dropped = 0;  // particles an emitter could not create (capacity)
+  float max_speed = 0.f;             // m/s, now
+};
+
+// Particle state in id order (ids are given in spawn order and never change).
+struct ParticleState {
+  std::vector<vec3> x, v;
+  std::vector<float> inv_mass;
+  std::vector<std::uint32_t> phase;  // kernels::phase flags and group
+};
+
+// One rigid body's frame: x = R q + c for its rest offsets q.
+struct RigidFrame {
+  vec3 centre;
+  vec4 rotation;  // quaternion (x, y, z, w)
+  std::int64_t first = 0, count = 0;  // particle ids
+};
+
+class ParticleSolver {
+ public:
+  ParticleSolver(const SolverParams& params, Device device);
+  ~ParticleSolver();
+  ParticleSolver(const ParticleSolver&) = delete;
+  ParticleSolver& operator=(const ParticleSolver&) = delete;
+
+  // Static scene particles (appended to those already there); they never move.
+  void add_static_particles(const std::vector<vec3>& points);
+  void clear_static_particles();
+  // Collide against an SDF as well (analytic primitives and/or the synthetic room).
+  void set_scene_sdf(const kernels::SceneSdf& sdf);
+  // Collide against a dense sampled SDF (x fastest), e.g. resampled from the TSDF.
+  void set_scene_sdf_grid(const std::vector<float>& values, int3 dims, vec3 origin, float voxel);
+
+  // Creates the entry's particles now (an emitter starts emitting now). Returns the first id.
+  std::int64_t spawn(const SpawnParams& s);
+  // Entries are spawned at the first step whose start time reaches their `time`. Checks the
+  // capacity of the whole list first (seamless::Error naming the entry).
+  void schedule(const std::vector<SpawnParams>& spawns);
+  // Adds a prepared batch (builders.hpp); returns the first id.
+  std::int64_t add_batch(const ParticleBatch& b);
+
+  // Advances by dt (default: params.dt) in substeps() substeps.
+  void step(float dt = -1.f);
+  // Substeps per step: the most of params.substeps and ceil(max_speed * dt / (tunnel_fraction *
+  // diameter)), so that no particle moves further than tunnel_fraction diameters in a substep.
+  int substeps(float dt = -1.f) const;
+
+  SolverStats stats() const;
+  ParticleState download_state() const;
+  std::vector<RigidFrame> rigid_frames() const;
+  std::int64_t size() const;
+  const SolverParams& params() const;
+  Device device() const;
+  // Rest number density rho_0 of the fluid (kernel sum of the rest lattice), 1/m^3.
+  float fluid_rest_density() const;
+  // Fluid density / rest density of each particle (id order) at the positions now.
+  std::vector<float> fluid_density_ratio() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Writes particles as a binary little-endian PLY (x y z float, vx vy vz float, phase uint).
+void write_particles_ply(const std::string& path, const ParticleState& s);
+
+}  // namespace seamless
