@@ -4,11 +4,8 @@
 #include "io/synthetic_source.hpp"
 #include "io/tum_source.hpp"
 #include "seamless/build_config.hpp"
-#if SEAMLESS_HAS_FREENECT && __has_include("io/kinect_source.hpp")
-#define SEAMLESS_IO_KINECT 1
+#if SEAMLESS_HAS_FREENECT
 #include "io/kinect_source.hpp"
-#else
-#define SEAMLESS_IO_KINECT 0
 #endif
 
 namespace seamless {
@@ -17,7 +14,7 @@ std::unique_ptr<FrameSource> make_source(const InputParams& params, Device devic
   if (params.source == "tum") return std::make_unique<TumSource>(params);
   if (params.source == "synthetic") return std::make_unique<SyntheticSource>(params, device);
   if (params.source == "kinect") {
-#if SEAMLESS_IO_KINECT
+#if SEAMLESS_HAS_FREENECT
     return std::make_unique<KinectSource>(params);
 #else
     throw Error("input.source is kinect but this build has no libfreenect: apt-get install libfreenect-dev, reconfigure");

@@ -1,0 +1,82 @@
+// A live Kinect v1 through libfreenect (only built when SEAMLESS_HAS_FREENECT). Depth registered to
+// the RGB camera (FREENECT_DEPTH_REGISTERED, millimetres), RGB 640x480, accelerometer.
+//
+// libfreenect delivers frames through callbacks from freenect_process_events(), which runs on a
+// capture thread owned by the source. Each depth frame is paired with the latest RGB frame and
+// pushed onto a bounded queue; when the consumer is slower than 30 Hz the queue drops its oldest
+// frame instead of blocking the capture (so the next frame is always recent) and counts the drop.
+// Works unchanged under Debian's fakenect (a replay libfreenect; see write_fakenect_dump()).
+#pragma once
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "io/frame_source.hpp"
+#include "io/input_params.hpp"
+
+struct _freenect_context;
+struct _freenect_device;
+
+namespace seamless {
+
+class KinectSource : public FrameSource {
+ public:
+  // Opens device params.kinect.device_index and starts streaming. Throws seamless::Error when
+  // libfreenect cannot start or no such Kinect is connected.
+  explicit KinectSource(const InputParams& params);
+  ~KinectSource() override;  // stops the streams and the capture thread, closes the device
+  KinectSource(const KinectSource&) = delete;
+  KinectSource& operator=(const KinectSource&) = delete;
+
+  // Waits up to kinect.timeout_s for the next frame. False once the device stopped delivering
+  // (after at least one frame); an error before the first frame throws.
+  bool next(RgbdFrame& frame) override;
+  std::string name() const override { return "kinect:" + std::to_string(params_.kinect.device_index); }
+  Intrinsics intrinsics() const override { return K_; }
+  std::int64_t skipped_frames() const override { return dropped_.load(); }
+  std::int64_t dropped_frames() const { return dropped_.load(); }
+
+ private:
+  struct Raw {
+    double timestamp;
+    std::vector<std::uint16_t> depth_mm;
+    std::vector<std::uint8_t> rgb;
+    bool has_accel;
+    vec3 accel;
+  };
+  static void on_depth(_freenect_device* dev, void* data, std::uint32_t timestamp);
+  static void on_video(_freenect_device* dev, void* data, std::uint32_t timestamp);
+  void capture_loop();
+  void push(Raw&& raw);
+  void close() noexcept;
+  void check_replay_is_millimetres(const std::vector<std::uint16_t>& depth) const;
+
+  InputParams params_;
+  Intrinsics K_;
+  _freenect_context* ctx_ = nullptr;
+  _freenect_device* dev_ = nullptr;
+  std::thread thread_;
+  std::atomic<bool> stop_{false};
+  std::atomic<std::int64_t> dropped_{0};
+  bool replay_ = false;                   // running under fakenect (FAKENECT_PATH set)
+  std::vector<std::uint8_t> latest_rgb_;  // capture thread only (callbacks run there)
+  // Shared with the consumer.
+  std::mutex mutex_;
+  std::condition_variable ready_;
+  std::deque<Raw> queue_;
+  bool ended_ = false;
+  std::string end_reason_;
+  std::int64_t delivered_ = 0;
+};
+
+// Writes frames of `source` as a fakenect recording (the format Debian's libfreenect-bin replays
+// through FAKENECT_PATH): INDEX.txt listing a-<t>-<n>.dump (raw accelerometer state),
+// r-<t>-<n>.ppm (RGB) and d-<t>-<n>.pgm (depth as the registered mode delivers it: millimetres,
+// host byte order, since fakenect hands the bytes over unchanged). Returns the frames written.
+std::int64_t write_fakenect_dump(FrameSource& source, const std::string& dir, std::int64_t max_frames = 0);
+
+}  // namespace seamless
