@@ -124,3 +124,23 @@ template <class Exec>
 void slot_block_coords(const Exec& ex, HashTableView t, View<const std::int32_t> slots, View<int3> out);
 
 }  // namespace seamless::kernels
+
+namespace seamless::kernels {
+
+// Static scene particles (DESIGN "Physics": scene particles come from the hash blocks): the
+// points of the lattice spacing * Z^3 inside the listed blocks whose TSDF lies in
+// [-interior_depth, spacing/2] (the surface band, plus the solid interior to that depth as far as
+// the truncated TSDF knows it). Candidate i is lattice point i % m^3 of block i / m^3 with
+// m = lattice_per_block(...); flags[i] = 1 for a particle. Returns the count; flags become offsets.
+SEAMLESS_HD inline int lattice_per_block(float voxel_size, float spacing) {
+  return static_cast<int>(ceilf(kBlockSide * voxel_size / spacing)) + 1;
+}
+template <class Exec, class Acc>
+std::int64_t scene_particle_count(const Exec& ex, Acc a, View<const int3> blocks, float spacing, float interior_depth,
+                                  View<std::int32_t> flags);
+// Writes position and unit normal (TSDF gradient) of each particle at offsets[i].
+template <class Exec, class Acc>
+void scene_particle_emit(const Exec& ex, Acc a, View<const int3> blocks, float spacing, float interior_depth,
+                         View<const std::int32_t> offsets, View<vec3> positions, View<vec3> normals);
+
+}  // namespace seamless::kernels

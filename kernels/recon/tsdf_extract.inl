@@ -111,6 +111,61 @@ void mesh_emit(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t
   });
 }
 
+// Lattice point of candidate i, or false when it falls outside its block (blocks own the lattice
+// points p with floor((p - origin) / (8 s)) == b; the same float expression decides for both
+// neighbours, so no point is taken twice or lost at a seam).
+template <class Acc>
+SEAMLESS_HD inline bool lattice_point(const Acc& a, View<const int3> blocks, float spacing, std::int64_t i, vec3* p) {
+  const int m = lattice_per_block(a.geom.voxel_size, spacing);
+  const std::int64_t m3 = static_cast<std::int64_t>(m) * m * m;
+  int3 b = blocks[i / m3];
+  int j = static_cast<int>(i % m3);
+  int l[3] = {j % m, (j / m) % m, j / (m * m)}, bb[3] = {b.x, b.y, b.z};
+  float o[3] = {a.geom.origin.x, a.geom.origin.y, a.geom.origin.z}, r[3];
+  const float block = kBlockSide * a.geom.voxel_size;
+  for (int k = 0; k < 3; ++k) {
+    float lo = o[k] + bb[k] * block, hi = lo + block;
+    int first = static_cast<int>(ceilf(lo / spacing)), end = static_cast<int>(ceilf(hi / spacing));
+    if (first + l[k] >= end) return false;
+    r[k] = (first + l[k]) * spacing;
+  }
+  *p = {r[0], r[1], r[2]};
+  return true;
+}
+
+template <class Acc>
+SEAMLESS_HD inline bool is_scene_particle(const Acc& a, vec3 p, float spacing, float interior_depth, float* sdf) {
+  BlockCache c;
+  if (!sample_tsdf(a, a.geom.to_voxel(p), c, sdf)) return false;
+  return *sdf <= 0.5f * spacing && *sdf >= -fmaxf(interior_depth, 0.5f * spacing);
+}
+
+template <class Exec, class Acc>
+std::int64_t scene_particle_count(const Exec& ex, Acc a, View<const int3> blocks, float spacing, float interior_depth,
+                                  View<std::int32_t> flags) {
+  const std::int64_t n = flags.size;
+  ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) {
+    vec3 p;
+    float s;
+    flags[i] = lattice_point(a, blocks, spacing, i, &p) && is_scene_particle(a, p, spacing, interior_depth, &s);
+  });
+  return ex.exclusive_scan(flags.data, flags.data, n);
+}
+
+template <class Exec, class Acc>
+void scene_particle_emit(const Exec& ex, Acc a, View<const int3> blocks, float spacing, float interior_depth,
+                         View<const std::int32_t> offsets, View<vec3> positions, View<vec3> normals) {
+  ex.for_each(offsets.size, [=] SEAMLESS_HD(std::int64_t i) {
+    vec3 p;
+    float s;
+    if (!lattice_point(a, blocks, spacing, i, &p) || !is_scene_particle(a, p, spacing, interior_depth, &s)) return;
+    vec3 g;
+    sample_sdf(a, p, &s, &g);
+    positions[offsets[i]] = p;
+    normals[offsets[i]] = normalize(g);
+  });
+}
+
 template <class Exec>
 void slot_block_coords(const Exec& ex, HashTableView t, View<const std::int32_t> slots, View<int3> out) {
   ex.for_each(slots.size, [=] SEAMLESS_HD(std::int64_t i) { out[i] = unpack_block(t.keys[slots[i]]); });
@@ -125,6 +180,10 @@ void slot_block_coords(const Exec& ex, HashTableView t, View<const std::int32_t>
   template void mesh_emit<EXEC, ACC>(const EXEC&, ACC, View<const int3>, const std::int8_t*,                      \
                                      View<const std::int32_t>, View<vec3>, View<vec3>, View<uchar3>,              \
                                      View<std::uint64_t>);                                                        \
+  template std::int64_t scene_particle_count<EXEC, ACC>(const EXEC&, ACC, View<const int3>, float, float,         \
+                                                        View<std::int32_t>);                                      \
+  template void scene_particle_emit<EXEC, ACC>(const EXEC&, ACC, View<const int3>, float, float,                  \
+                                               View<const std::int32_t>, View<vec3>, View<vec3>);                 \
   }
 #define SEAMLESS_INSTANTIATE_TSDF_EXTRACT(EXEC)                                                                   \
   SEAMLESS_INSTANTIATE_TSDF_EXTRACT_ACC(EXEC, HashAccess)                                                         \

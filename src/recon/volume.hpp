@@ -9,6 +9,7 @@
 #include "core/camera.hpp"
 #include "core/math.hpp"
 #include "core/timing.hpp"
+#include "recon/scene_particles.hpp"
 #include "recon/volume_params.hpp"
 
 namespace seamless {
@@ -67,6 +68,8 @@ class Volume {
   }
   // Marching-cubes mesh of everything fused so far, with vertex colours and normals.
   virtual Mesh extract_mesh() = 0;
+  // Static scene particles for the physics solver (positions and normals on the volume's device).
+  virtual SceneParticles extract_scene_particles(const SceneParticleParams& p) = 0;
   virtual VolumeStats stats() = 0;
   virtual Device device() const = 0;
   virtual const VolumeParams& params() const = 0;

@@ -264,14 +264,26 @@ void VoxelHashVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, Ra
   });
 }
 
-Mesh VoxelHashVolume::extract_mesh() {
+std::int64_t VoxelHashVolume::live_block_coords(Buffer<int3>& coords) const {
   Buffer<std::int32_t> slots;
   const std::int64_t n = live_slots(slots);
-  Buffer<int3> coords(n, device_);
+  coords = Buffer<int3>(n, device_);
   with_exec(device_, [&](const auto& ex) {
     kernels::slot_block_coords(ex, table(), View<const std::int32_t>{slots.data(), n}, coords.view());
   });
+  return n;
+}
+
+Mesh VoxelHashVolume::extract_mesh() {
+  Buffer<int3> coords;
+  const std::int64_t n = live_block_coords(coords);
   return marching_cubes(device_, device_view(), coords, n);
+}
+
+SceneParticles VoxelHashVolume::extract_scene_particles(const SceneParticleParams& p) {
+  Buffer<int3> coords;
+  const std::int64_t n = live_block_coords(coords);
+  return seamless::extract_scene_particles(device_, device_view(), coords, n, p);
 }
 
 VolumeStats VoxelHashVolume::stats() {

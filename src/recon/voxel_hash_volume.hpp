@@ -22,6 +22,7 @@ class VoxelHashVolume final : public Volume {
   void raycast(const Intrinsics& K, const SE3& world_T_camera, RaycastMaps& maps, StageTimer* timer = nullptr) override;
   using Volume::raycast;
   Mesh extract_mesh() override;
+  SceneParticles extract_scene_particles(const SceneParticleParams& p) override;
   VolumeStats stats() override;
   Device device() const override { return device_; }
   const VolumeParams& params() const override { return params_; }
@@ -43,6 +44,8 @@ class VoxelHashVolume final : public Volume {
   std::vector<int3> allocated_block_coords() const;
   // Slots of the live blocks on the device (count returned); the list used by extraction.
   std::int64_t live_slots(Buffer<std::int32_t>& slots) const;
+  // Block coordinates of the allocated blocks on the device (count returned).
+  std::int64_t live_block_coords(Buffer<int3>& coords) const;
 
  private:
   kernels::HashTableView table() const;

@@ -1,0 +1,60 @@
+#include "recon/scene_particles.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <vector>
+
+#include "core/error.hpp"
+#include "core/exec.hpp"
+#include "kernels/recon/tsdf.hpp"
+
+namespace seamless {
+
+template <class Acc>
+SceneParticles extract_scene_particles(Device d, const Acc& a, const Buffer<int3>& blocks, std::int64_t block_count,
+                                       const SceneParticleParams& p) {
+  if (!(p.spacing > 0.f)) throw Error("scene particles: spacing must be positive");
+  if (p.interior_depth > a.geom.truncation)
+    spdlog::warn("scene particles: interior_depth {} m is deeper than the TSDF truncation {} m; the fill stops at the "
+                 "truncation (raise volume.truncation to fill deeper)",
+                 p.interior_depth, a.geom.truncation);
+  const int m = kernels::lattice_per_block(a.geom.voxel_size, p.spacing);
+  const std::int64_t per_block = static_cast<std::int64_t>(m) * m * m;
+  const std::int64_t chunk = std::max<std::int64_t>(1, (std::int64_t(1) << 22) / per_block);  // bounds scratch
+  std::vector<std::pair<Buffer<vec3>, Buffer<vec3>>> parts;
+  SceneParticles out;
+  for (std::int64_t first = 0; first < block_count; first += chunk) {
+    std::int64_t nb = std::min(chunk, block_count - first);
+    View<const int3> part{blocks.data() + first, nb};
+    Buffer<std::int32_t> offsets(nb * per_block, d);
+    std::int64_t n = with_exec(d, [&](const auto& ex) {
+      return kernels::scene_particle_count(ex, a, part, p.spacing, p.interior_depth, offsets.view());
+    });
+    if (n == 0) continue;
+    Buffer<vec3> pos(n, d), nrm(n, d);
+    with_exec(d, [&](const auto& ex) {
+      kernels::scene_particle_emit(ex, a, part, p.spacing, p.interior_depth, offsets.cview(), pos.view(), nrm.view());
+    });
+    out.count += n;
+    parts.emplace_back(std::move(pos), std::move(nrm));
+  }
+  out.positions = Buffer<vec3>(out.count, d);
+  out.normals = Buffer<vec3>(out.count, d);
+  std::int64_t at = 0;
+  for (auto& [pos, nrm] : parts) {
+    memory::copy(out.positions.data() + at, d, pos.data(), d, pos.bytes());
+    memory::copy(out.normals.data() + at, d, nrm.data(), d, nrm.bytes());
+    at += pos.size();
+  }
+  return out;
+}
+
+template SceneParticles extract_scene_particles<kernels::HashAccess>(Device, const kernels::HashAccess&,
+                                                                     const Buffer<int3>&, std::int64_t,
+                                                                     const SceneParticleParams&);
+template SceneParticles extract_scene_particles<kernels::DenseAccess>(Device, const kernels::DenseAccess&,
+                                                                      const Buffer<int3>&, std::int64_t,
+                                                                      const SceneParticleParams&);
+
+}  // namespace seamless

@@ -1,0 +1,36 @@
+// Static scene particles for the physics solver, taken from the fused TSDF (DESIGN "Physics").
+#pragma once
+#include <cstdint>
+
+#include "core/buffer.hpp"
+#include "core/math.hpp"
+#include "core/params.hpp"
+
+namespace seamless {
+
+struct SceneParticleParams {
+  float spacing = 0.04f;        // the solver's particle diameter (dissertation: 4 m / 100)
+  float interior_depth = 0.f;   // also fill the solid this deep below the surface (<= truncation)
+
+  template <class V> void visit(V& v) {
+    v("spacing", spacing, "lattice spacing of the scene particles, metres (the particle diameter)", Range{0.001, 1.0});
+    v("interior_depth", interior_depth, "fill the solid interior this deep below the surface, metres", Range{0.0, 2.0});
+  }
+};
+
+// Particles on the lattice spacing * Z^3 whose TSDF is in [-max(interior_depth, spacing/2),
+// spacing/2], so each lies within half a spacing of the fused surface; normals are the unit TSDF
+// gradient. Both buffers live on the volume's device.
+struct SceneParticles {
+  Buffer<vec3> positions;
+  Buffer<vec3> normals;
+  std::int64_t count = 0;
+};
+
+// Extracts the particles of the given blocks (device block coordinates) through accessor a
+// (kernels::HashAccess or kernels::DenseAccess).
+template <class Acc>
+SceneParticles extract_scene_particles(Device d, const Acc& a, const Buffer<int3>& blocks, std::int64_t block_count,
+                                       const SceneParticleParams& p);
+
+}  // namespace seamless
