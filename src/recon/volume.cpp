@@ -1,12 +1,14 @@
 #include "recon/volume.hpp"
 
 #include "core/error.hpp"
+#include "recon/dense_volume.hpp"
 #include "recon/voxel_hash_volume.hpp"
 
 namespace seamless {
 
 std::unique_ptr<Volume> make_volume(const VolumeParams& params, Device d) {
   if (params.layout == "hash") return std::make_unique<VoxelHashVolume>(params, d);
+  if (params.layout == "dense") return std::make_unique<DenseVolume>(params, d);
   throw Error("volume.layout '" + params.layout + "' is not available (use hash or dense)");
 }
 
