@@ -159,7 +159,7 @@ void scene_particle_emit(const Exec& ex, Acc a, View<const int3> blocks, float s
     vec3 p;
     float s;
     if (!lattice_point(a, blocks, spacing, i, &p) || !is_scene_particle(a, p, spacing, interior_depth, &s)) return;
-    vec3 g;
+    vec3 g{0.f, 0.f, 0.f};
     sample_sdf(a, p, &s, &g);
     positions[offsets[i]] = p;
     normals[offsets[i]] = normalize(g);
