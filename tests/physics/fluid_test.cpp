@@ -1,0 +1,124 @@
+// Position Based Fluids: a fluid at rest keeps its density; a dam break against Martin & Moyce.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "physics/particle_solver.hpp"
+#include "physics_test_util.hpp"
+
+namespace seamless {
+namespace {
+
+struct RestResult {
+  double mean_err = 0, max_err = 0;
+  int interior = 0;
+  int escaped = 0;
+  vec3 escaped_at{0.f, 0.f, 0.f};
+};
+
+// A W x 25 x W block on the cubic rest lattice in an open box of scene particles, settled for
+// 2 s. Interior = at least h from the walls, the floor and the free surface (where the kernel
+// sum is truncated and the unilateral constraint lets density fall below rho_0 by design).
+RestResult fluid_at_rest(int iterations, int W) {
+  SolverParams p;
+  p.iterations = iterations;
+  const float d = p.particle_diameter, h = p.fluid_smoothing * d;
+  const int H = 25;
+  ParticleSolver s(p, Device::CPU);
+  s.add_static_particles(test::static_box({-d, 0.f, -d}, {W * d, (H + 5) * d, W * d}, d));
+  SpawnParams f;
+  f.kind = "fluid_block";
+  f.size = {W * d, H * d, W * d};
+  f.position = {(W - 1) * d / 2, d + (H - 1) * d / 2, (W - 1) * d / 2};
+  s.spawn(f);
+  for (int i = 0; i < 200; ++i) s.step();
+  ParticleState st = s.download_state();
+  std::vector<float> ratio = s.fluid_density_ratio();
+  float top = -1e9f;
+  for (const vec3& x : st.x) top = std::max(top, x.y);
+  RestResult r;
+  for (std::size_t k = 0; k < st.x.size(); ++k) {
+    vec3 x = st.x[k];
+    // Inside the walls' particle centres (at -d and W d) and above the floor's (at 0).
+    if (!(x.x > -d && x.z > -d && x.x < W * d && x.z < W * d && x.y > 0.f && x.y < (H + 5) * d)) {
+      ++r.escaped;
+      r.escaped_at = x;
+    }
+    float lo = h - 0.5f * d, hi = (W - 1) * d - h + 0.5f * d;
+    if (x.x < lo || x.z < lo || x.x > hi || x.z > hi || x.y < d + h || x.y > top - h) continue;
+    double e = std::fabs(ratio[k] - 1.0);
+    r.mean_err += e;
+    r.max_err = std::max(r.max_err, e);
+    ++r.interior;
+  }
+  r.mean_err /= std::max(r.interior, 1);
+  return r;
+}
+
+// Thresholds from the issue (4 iterations): mean interior density error <= 2 %, max <= 5 %.
+TEST(PhysicsFluid, AtRestInBoxKeepsDensity) {
+  RestResult r = fluid_at_rest(4, 8);
+  std::printf("fluid at rest, 4 iterations: interior %d, mean |rho/rho0 - 1| %.4f, max %.4f\n", r.interior,
+              r.mean_err, r.max_err);
+  ASSERT_GT(r.interior, 100);
+  EXPECT_LE(r.mean_err, 0.02);
+  EXPECT_LE(r.max_err, 0.05);
+  EXPECT_EQ(r.escaped, 0) << "e.g. at " << r.escaped_at.x << " " << r.escaped_at.y << " " << r.escaped_at.z;
+  // The dissertation's 2 iterations: reported only (docs/PHYSICS.md).
+  RestResult r2 = fluid_at_rest(2, 8);
+  std::printf("fluid at rest, 2 iterations: interior %d, mean |rho/rho0 - 1| %.4f, max %.4f, %d left the box "
+              "(e.g. at %.3f %.3f %.3f)\n", r2.interior, r2.mean_err, r2.max_err, r2.escaped, r2.escaped_at.x,
+              r2.escaped_at.y, r2.escaped_at.z);
+}
+
+// Martin & Moyce 1952 (plate 2, water column of width a, height 2a): surge front x/a against
+// T = t sqrt(2 g / a).
+const double kMartinMoyce[][2] = {{0.41, 1.11}, {0.84, 1.22}, {1.19, 1.44}, {1.43, 1.67}, {1.63, 1.89},
+                                  {1.83, 2.11}, {1.98, 2.33}, {2.20, 2.56}, {2.32, 2.78}, {2.51, 3.00},
+                                  {2.65, 3.22}, {2.83, 3.44}, {2.98, 3.67}, {3.11, 3.89}, {3.33, 4.11}};
+
+// Column a = 25 diameters (1 m) wide and 2a high in a 2-particle slab between smooth walls (a
+// container SDF: a particle floor's bumps would act as friction the experiment did not have).
+// The front is the leading particle's edge. Tolerance 15 % from the issue, for 1 <= T <= 3.
+TEST(PhysicsFluid, DamBreakFollowsMartinMoyce) {
+  SolverParams p;
+  p.max_speed = 10.f;  // the surge reaches ~6 m/s
+  const float d = p.particle_diameter, a = 25 * d, g = std::fabs(p.gravity.y);
+  const int Z = 2;
+  ParticleSolver s(p, Device::CPU);
+  kernels::SceneSdf sdf;
+  sdf.count = 1;
+  sdf.prims[0] = {kernels::kSdfContainer, {3 * a, 1.5f * a, Z * d / 2}, {3 * a, 1.5f * a, Z * d / 2}, mat3::identity()};
+  s.set_scene_sdf(sdf);
+  SpawnParams f;
+  f.kind = "fluid_block";
+  f.size = {a, 2 * a, Z * d};
+  f.position = {a / 2, a, Z * d / 2};
+  s.spawn(f);
+  const double tscale = std::sqrt(2.0 * g / a);
+  std::vector<double> T{0.0}, X{1.0};
+  while (T.back() < 3.1) {
+    s.step();
+    float front = 0.f;
+    for (const vec3& x : s.download_state().x) front = std::max(front, x.x + 0.5f * d);
+    T.push_back(s.stats().time * tscale);
+    X.push_back(front / a);
+  }
+  int checked = 0;
+  for (const auto& m : kMartinMoyce) {
+    if (m[0] < 1.0 || m[0] > 3.0) continue;
+    auto it = std::lower_bound(T.begin(), T.end(), m[0]);
+    std::size_t i = static_cast<std::size_t>(it - T.begin());
+    double u = (m[0] - T[i - 1]) / (T[i] - T[i - 1]);
+    double x = X[i - 1] + u * (X[i] - X[i - 1]);
+    std::printf("dam break T %.2f: x/a %.3f, Martin & Moyce %.2f (%+.1f %%)\n", m[0], x, m[1], 100 * (x / m[1] - 1));
+    EXPECT_NEAR(x, m[1], 0.15 * m[1]) << "T = " << m[0];
+    ++checked;
+  }
+  EXPECT_EQ(checked, 11);
+}
+
+}  // namespace
+}  // namespace seamless
