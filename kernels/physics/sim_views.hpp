@@ -93,6 +93,7 @@ struct SimViews {
   const int *body_start = nullptr, *body_count = nullptr;
   const int *body_chunk_start = nullptr, *body_chunk_count = nullptr;
   const float* body_stiffness = nullptr;
+  int* body_contacts = nullptr;  // particles of the body touching the scene (this iteration)
   vec3* body_c = nullptr;  // centre of mass (also the reference point of the next sums)
   vec3* body_shift = nullptr;  // scratch: new centre minus body_c
   vec4* body_q = nullptr;

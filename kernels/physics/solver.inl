@@ -7,6 +7,8 @@ namespace seamless::kernels {
 
 namespace detail {
 
+SEAMLESS_HD inline int max(int a, int b) { return a > b ? a : b; }
+
 struct MaxF {
   float v;
 };
@@ -62,7 +64,8 @@ SEAMLESS_HD inline bool both_fluid(std::uint32_t a, std::uint32_t b) {
   return phase::is(a, phase::kFluid) && phase::is(b, phase::kFluid);
 }
 
-// Number of active contacts of particle s at positions P (at least 1: it divides).
+// Number of active contacts of particle s at positions P (at least 1: it divides). A rigid
+// particle touching the scene also counts itself in its body's body_contacts.
 SEAMLESS_HD inline int count_contacts(const SimViews& S, int s, const vec3* P) {
   const float D2 = S.c.diameter * S.c.diameter;
   const int m = S.nnbr[s];
@@ -73,9 +76,12 @@ SEAMLESS_HD inline int count_contacts(const SimViews& S, int s, const vec3* P) {
     if (both_fluid(S.sphase[s], S.sphase[j])) continue;
     if (length2(p - P[j]) < D2) ++count;
   }
+  int scene = 0;
   for (int k = 0, ms = S.nsnbr[s]; k < ms; ++k)
-    if (length2(p - S.stat[S.snbr[k * S.n + s]]) < D2) ++count;
-  if (S.sdf.active() && scene_sdf(S.sdf, p).d < S.c.radius) ++count;
+    if (length2(p - S.stat[S.snbr[k * S.n + s]]) < D2) ++scene;
+  if (S.sdf.active() && scene_sdf(S.sdf, p).d < S.c.radius) ++scene;
+  if (scene > 0 && phase::is(S.sphase[s], phase::kRigid)) atomic_add(&S.body_contacts[phase::group(S.sphase[s])], 1);
+  count += scene;
   return count > 0 ? count : 1;
 }
 
@@ -101,7 +107,15 @@ SEAMLESS_HD inline vec3 contact_sum(const SimViews& S, int s, const vec3* P, con
     float scale = S.c.omega / fmaxf(ni, static_cast<float>(S.ncontacts[j]));
     acc += contact_delta(g.n, g.depth, rel, wi, S.sw[j], any_fluid ? 0.f : mus, any_fluid ? 0.f : muk) * scale;
   }
-  const float self = S.c.omega / ni;
+  // Scene contacts of a rigid particle are scaled by (body particles / body particles touching
+  // the scene): shape matching spreads a particle's correction over the whole body, and without
+  // this a flat face resting on the scene would resolve only a fraction of its contact (and of
+  // its static friction) per iteration, so that resting bodies creep.
+  float self = S.c.omega / ni;
+  if (phase::is(ph, phase::kRigid)) {
+    int b = static_cast<int>(phase::group(ph));
+    self *= static_cast<float>(S.body_count[b]) / static_cast<float>(max(S.body_contacts[b], 1));
+  }
   const float smu_s = fl ? 0.f : mus, smu_k = fl ? 0.f : muk;
   for (int k = 0, m = S.nsnbr[s]; k < m; ++k) {
     vec3 r = p - S.stat[S.snbr[k * S.n + s]];
@@ -231,6 +245,7 @@ void find_neighbors(const Exec& ex, const SimViews& S) {
 // x and p together, so that they are removed without adding velocity.
 template <class Exec>
 void stabilize(const Exec& ex, const SimViews& S) {
+  ex.for_each(S.nbodies, [=] SEAMLESS_HD(std::int64_t b) { S.body_contacts[b] = 0; });
   ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) { S.ncontacts[s] = detail::count_contacts(S, static_cast<int>(s), S.sx); });
   ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
     S.tmp[s] = S.sw[s] > 0.f ? detail::contact_sum(S, static_cast<int>(s), S.sx, S.sx, false) : vec3{0.f, 0.f, 0.f};
@@ -249,6 +264,7 @@ void stabilize(const Exec& ex, const SimViews& S) {
 // (eqs. 8-11). Only fluid particles are moved by the density constraint.
 template <class Exec>
 void prepare_constraints(const Exec& ex, const SimViews& S) {
+  ex.for_each(S.nbodies, [=] SEAMLESS_HD(std::int64_t b) { S.body_contacts[b] = 0; });
   ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t i) {
     const int s = static_cast<int>(i);
     S.ncontacts[s] = detail::count_contacts(S, s, S.sp);

@@ -74,6 +74,7 @@ struct ParticleSolver::Impl {
   Buffer<int> d_body_start, d_body_count, d_body_chunk_start, d_body_chunk_count, d_chunk_start, d_chunk_count,
       d_chunk_body;
   Buffer<float> d_body_stiffness;
+  Buffer<int> body_contacts;
   Buffer<vec3> body_c, body_shift;
   Buffer<vec4> body_q;
   Buffer<mat3> body_R;
@@ -173,7 +174,7 @@ struct ParticleSolver::Impl {
     S.nbodies = static_cast<int>(body_start.size());
     S.body_start = d_body_start.data(), S.body_count = d_body_count.data();
     S.body_chunk_start = d_body_chunk_start.data(), S.body_chunk_count = d_body_chunk_count.data();
-    S.body_stiffness = d_body_stiffness.data();
+    S.body_stiffness = d_body_stiffness.data(), S.body_contacts = body_contacts.data();
     S.body_c = body_c.data(), S.body_shift = body_shift.data(), S.body_q = body_q.data(), S.body_R = body_R.data();
     S.nchunks = static_cast<int>(chunk_start.size());
     S.chunk_start = d_chunk_start.data(), S.chunk_count = d_chunk_count.data(), S.chunk_body = d_chunk_body.data();
@@ -239,6 +240,7 @@ struct ParticleSolver::Impl {
     up(d_body_chunk_count, body_chunk_count), up(d_chunk_start, chunk_start), up(d_chunk_count, chunk_count);
     up(d_chunk_body, chunk_body);
     d_body_stiffness = Buffer<float>::from_host(body_stiffness, dev);
+    body_contacts = Buffer<int>(static_cast<std::int64_t>(body_stiffness.size()), dev);
     body_c = Buffer<vec3>::from_host(c, dev);
     body_shift = Buffer<vec3>(static_cast<std::int64_t>(c.size()), dev);
     body_q = Buffer<vec4>::from_host(q, dev);
