@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <fstream>
 #include <utility>
 
 #include "core/buffer.hpp"
@@ -544,6 +546,21 @@ std::vector<float> ParticleSolver::fluid_density_ratio() const {
   std::vector<float> out(static_cast<std::size_t>(I.n));
   for (std::int64_t s = 0; s < I.n; ++s) out[order[s]] = rho[s] / I.rho0;
   return out;
+}
+
+void write_particles_ply(const std::string& path, const ParticleState& s) {
+  std::ofstream out(path, std::ios::binary);
+  if (!out) throw Error("cannot write particle file '" + path + "'; check that the folder exists and is writable");
+  out << "ply\nformat binary_little_endian 1.0\nelement vertex " << s.x.size()
+      << "\nproperty float x\nproperty float y\nproperty float z\nproperty float vx\nproperty float vy\n"
+         "property float vz\nproperty uint phase\nend_header\n";
+  std::vector<char> buf(s.x.size() * 28);
+  for (std::size_t i = 0; i < s.x.size(); ++i) {
+    float f[6] = {s.x[i].x, s.x[i].y, s.x[i].z, s.v[i].x, s.v[i].y, s.v[i].z};
+    std::memcpy(&buf[i * 28], f, 24);
+    std::memcpy(&buf[i * 28 + 24], &s.phase[i], 4);
+  }
+  out.write(buf.data(), static_cast<std::streamsize>(buf.size()));
 }
 
 }  // namespace seamless
