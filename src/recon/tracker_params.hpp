@@ -17,13 +17,16 @@ struct TrackerParams {
   float angle_threshold_deg = 20.f;
   float photometric_weight = 0.1f;        // rgbd only: weight of the colour term vs geometry
   float min_inlier_ratio = 0.3f;
+  double max_condition = 1e6;             // of the finest level's 6x6 system (see docs/TRACKING.md)
+  float max_intensity_diff = 0.3f;        // rgbd: larger photometric residuals are outliers
+  bool constant_velocity = false;         // start each frame from the last motion instead of the last pose
   float max_translation_jump = 0.3f;      // metres per frame
   float max_rotation_jump_deg = 30.f;     // degrees per frame
   std::string gravity = "auto";
   vec3 fixed_gravity{0.f, 1.f, 0.f};      // camera frame (y down), used when gravity: fixed
 
   template <class V> void visit(V& v) {
-    v("kind", kind, "tracker", Choices{"icp", "rgbd", "ground_truth"});
+    v("kind", kind, "tracker", Choices{"icp", "rgbd", "ground_truth", "opencv_icp", "opencv_rgbd", "pcl_gicp"});
     v("mode", mode, "align to the model raycast or to the previous frame",
       Choices{"frame_to_model", "frame_to_frame"});
     v("iterations", iterations, "ICP iterations per pyramid level, finest first", Range{0, 1000});
@@ -32,6 +35,12 @@ struct TrackerParams {
       Range{0.0, 180.0});
     v("photometric_weight", photometric_weight, "weight of the photometric term (rgbd)", Range{0.0, 1e6});
     v("min_inlier_ratio", min_inlier_ratio, "tracking is lost below this fraction of inliers", Range{0.0, 1.0});
+    v("max_condition", max_condition,
+      "tracking is lost when the condition number of the 6x6 ICP system exceeds this (degenerate geometry)",
+      Range{1.0, 1e30});
+    v("max_intensity_diff", max_intensity_diff, "rgbd: photometric residuals larger than this are outliers",
+      Range{0.0, 1.0});
+    v("constant_velocity", constant_velocity, "predict each pose from the previous motion (else from the last pose)");
     v("max_translation_jump", max_translation_jump, "tracking is lost above this per-frame motion, metres",
       Range{0.0, 100.0});
     v("max_rotation_jump_deg", max_rotation_jump_deg, "tracking is lost above this per-frame rotation, degrees",

@@ -1,0 +1,74 @@
+// Kernel bodies for recon/icp.hpp, compiled once per backend.
+#include <cmath>
+
+#include "kernels/recon/icp.hpp"
+
+namespace seamless::kernels {
+
+template <class Exec>
+IcpSums icp_reduce(const Exec& ex, IcpLevel L) {
+  const int w = L.cur_vertex.width;
+  return ex.transform_reduce(L.cur_vertex.count(), IcpSums{}, [=] SEAMLESS_HD(std::int64_t i) {
+    IcpSums s{};
+    int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
+    if (valid_point(L.cur_vertex(x, y))) s.valid = 1.0;
+    Correspondence c;
+    if (find_correspondence(L, x, y, c)) add_point_to_plane(s, c, 1.f);
+    return s;
+  });
+}
+
+template <class Exec>
+void transform_maps(const Exec& ex, View2D<const vec3> vin, View2D<const vec3> nin, SE3 T, View2D<vec3> vout,
+                    View2D<vec3> nout) {
+  const int w = vin.width;
+  ex.for_each(vin.count(), [=] SEAMLESS_HD(std::int64_t i) {
+    int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
+    vec3 v = vin(x, y), n = nin(x, y);
+    bool ok = length2(v) > 0.f && valid_normal(n);
+    vec3 tv = ok ? T * v : vec3{0.f, 0.f, 0.f};
+    // A point behind the reference camera cannot be seen from it: drop it.
+    if (tv.z <= 0.f) ok = false;
+    vout(x, y) = ok ? tv : vec3{0.f, 0.f, 0.f};
+    nout(x, y) = ok ? T.rotate(n) : vec3{0.f, 0.f, 0.f};
+  });
+}
+
+template <class Exec>
+void pyr_down_maps(const Exec& ex, View2D<const vec3> vin, View2D<const vec3> nin, View2D<vec3> vout,
+                   View2D<vec3> nout, float max_diff) {
+  const int w = vout.width;
+  ex.for_each(vout.count(), [=] SEAMLESS_HD(std::int64_t i) {
+    int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
+    vec3 vs{0.f, 0.f, 0.f}, ns{0.f, 0.f, 0.f};
+    float ref = 0.f;
+    int n = 0;
+    for (int k = 0; k < 4; ++k) {
+      int xx = 2 * x + (k & 1), yy = 2 * y + (k >> 1);
+      if (!vin.inside(xx, yy)) continue;
+      vec3 v = vin(xx, yy), nn = nin(xx, yy);
+      if (!valid_point(v) || !valid_normal(nn)) continue;
+      if (n == 0) ref = v.z;
+      if (fabsf(v.z - ref) <= max_diff) {
+        vs += v;
+        ns += nn;
+        ++n;
+      }
+    }
+    vec3 nm = n ? normalize(ns) : vec3{0.f, 0.f, 0.f};
+    bool ok = n > 0 && valid_normal(nm);
+    vout(x, y) = ok ? vs / static_cast<float>(n) : vec3{0.f, 0.f, 0.f};
+    nout(x, y) = ok ? nm : vec3{0.f, 0.f, 0.f};
+  });
+}
+
+}  // namespace seamless::kernels
+
+#define SEAMLESS_INSTANTIATE_ICP(EXEC)                                                                             \
+  namespace seamless::kernels {                                                                                    \
+  template IcpSums icp_reduce<EXEC>(const EXEC&, IcpLevel);                                                        \
+  template void transform_maps<EXEC>(const EXEC&, View2D<const vec3>, View2D<const vec3>, SE3, View2D<vec3>,      \
+                                     View2D<vec3>);                                                                \
+  template void pyr_down_maps<EXEC>(const EXEC&, View2D<const vec3>, View2D<const vec3>, View2D<vec3>,             \
+                                    View2D<vec3>, float);                                                          \
+  }

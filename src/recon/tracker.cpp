@@ -1,0 +1,212 @@
+#include "recon/tracker.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <limits>
+
+#include "core/error.hpp"
+#include "core/exec.hpp"
+#include "kernels/recon/preprocess.hpp"
+#include "kernels/recon/rgbd.hpp"
+#include "recon/volume.hpp"
+
+namespace seamless {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+
+Eigen::Matrix3d to_eigen(const mat3& R) {
+  Eigen::Matrix3d M;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) M(r, c) = R.m[r][c];
+  return M;
+}
+}  // namespace
+
+const char* to_string(TrackStatus s) {
+  switch (s) {
+    case TrackStatus::ok: return "ok";
+    case TrackStatus::too_few_inliers: return "too_few_inliers";
+    case TrackStatus::implausible_jump: return "implausible_jump";
+    case TrackStatus::degenerate: return "degenerate";
+    case TrackStatus::no_reference: return "no_reference";
+  }
+  return "?";
+}
+
+// ---- ReferenceMaps ------------------------------------------------------------------------------
+
+void ReferenceMaps::resize(const Intrinsics& K, int levels, Device d, bool intensity) {
+  bool same = static_cast<int>(levels_.size()) == levels && !levels_.empty() &&
+              levels_[0].vertices.device() == d && levels_[0].K.width == K.width &&
+              levels_[0].K.height == K.height && has_intensity() == intensity;
+  if (!same) {
+    levels_.clear();
+    for (int l = 0; l < levels; ++l) {
+      Intrinsics k = K.level(l);
+      levels_.push_back({k, Image<vec3>(k.width, k.height, d), Image<vec3>(k.width, k.height, d),
+                         intensity ? Image<float>(k.width, k.height, d) : Image<float>()});
+    }
+  }
+  for (int l = 0; l < levels; ++l) levels_[l].K = K.level(l);
+}
+
+void ReferenceMaps::set_from_frame(const FramePyramid& frame, const SE3& world_T_camera) {
+  const PyramidLevel& l0 = frame.level(0);
+  bool intensity = l0.intensity.width() > 0;
+  resize(l0.K, frame.levels(), frame.device(), intensity);
+  for (int l = 0; l < frame.levels(); ++l) {
+    levels_[l].vertices.buffer().copy_from(frame.level(l).vertices.buffer());
+    levels_[l].normals.buffer().copy_from(frame.level(l).normals.buffer());
+    if (intensity) levels_[l].intensity.buffer().copy_from(frame.level(l).intensity.buffer());
+  }
+  world_T_ref_ = world_T_camera;
+}
+
+void ReferenceMaps::set_from_raycast(const RaycastMaps& maps, const Intrinsics& K, const SE3& world_T_camera,
+                                     int levels, float max_diff) {
+  if (maps.vertex.width() != K.width || maps.vertex.height() != K.height)
+    throw Error("raycast maps are " + std::to_string(maps.vertex.width()) + "x" + std::to_string(maps.vertex.height()) +
+                " but the tracker's intrinsics say " + std::to_string(K.width) + "x" + std::to_string(K.height));
+  bool intensity = maps.color.width() == K.width && maps.color.height() == K.height;
+  Device d = maps.vertex.device();
+  resize(K, levels, d, intensity);
+  const SE3 camera_T_world = world_T_camera.inverse();
+  with_exec(d, [&](const auto& ex) {
+    kernels::transform_maps(ex, maps.vertex.cview(), maps.normal.cview(), camera_T_world, levels_[0].vertices.view(),
+                            levels_[0].normals.view());
+    if (intensity) kernels::rgb_to_intensity(ex, maps.color.cview(), levels_[0].intensity.view());
+    for (int l = 1; l < levels; ++l) {
+      kernels::pyr_down_maps(ex, levels_[l - 1].vertices.cview(), levels_[l - 1].normals.cview(),
+                             levels_[l].vertices.view(), levels_[l].normals.view(), max_diff);
+      if (intensity)
+        kernels::pyr_down_intensity(ex, levels_[l - 1].intensity.cview(), levels_[l].intensity.view());
+    }
+  });
+  world_T_ref_ = world_T_camera;
+}
+
+// ---- host side of a Gauss-Newton step -----------------------------------------------------------
+
+IcpStep solve_icp_step(const kernels::IcpSums& s) {
+  Eigen::Matrix<double, 6, 6> A;
+  Eigen::Matrix<double, 6, 1> b;
+  int k = 0;
+  for (int i = 0; i < 6; ++i) {
+    for (int j = i; j < 6; ++j) A(i, j) = A(j, i) = s.jtj[k++];
+    b(i) = -s.jtr[i];
+  }
+  IcpStep step;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(A, Eigen::EigenvaluesOnly);
+  double lo = eig.eigenvalues()(0), hi = eig.eigenvalues()(5);
+  step.condition = lo > 0 ? hi / lo : std::numeric_limits<double>::infinity();
+  if (!(lo > 0) || !std::isfinite(step.condition)) return step;
+  Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(A);
+  if (ldlt.info() != Eigen::Success) return step;
+  Eigen::Matrix<double, 6, 1> x = ldlt.solve(b);
+  if (!x.allFinite()) return step;
+  for (int i = 0; i < 6; ++i) step.xi[i] = x(i);
+  step.solved = true;
+  return step;
+}
+
+SE3 se3_exp(const double xi[6]) {
+  Eigen::Vector3d w(xi[0], xi[1], xi[2]);
+  double angle = w.norm();
+  Eigen::Matrix3d R = angle > 0 ? Eigen::AngleAxisd(angle, w / angle).toRotationMatrix() : Eigen::Matrix3d::Identity();
+  SE3 T;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) T.R.m[r][c] = static_cast<float>(R(r, c));
+  T.t = {static_cast<float>(xi[3]), static_cast<float>(xi[4]), static_cast<float>(xi[5])};
+  return T;
+}
+
+double rotation_angle_deg(const mat3& R) {
+  double c = 0.5 * (R.m[0][0] + R.m[1][1] + R.m[2][2] - 1.0);
+  return std::acos(std::max(-1.0, std::min(1.0, c))) * 180.0 / kPi;
+}
+
+namespace {
+// Keeps a pose exactly rigid after many float compositions (nearest rotation by SVD).
+SE3 orthonormalize(SE3 T) {
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(to_eigen(T.R), Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d R = svd.matrixU() * svd.matrixV().transpose();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) T.R.m[r][c] = static_cast<float>(R(r, c));
+  return T;
+}
+}  // namespace
+
+// ---- Tracker ------------------------------------------------------------------------------------
+
+Tracker::Tracker(const TrackerParams& params, Device device) : params_(params), device_(device) {
+  if (params_.kind != "icp" && params_.kind != "rgbd")
+    throw Error("tracker.kind '" + params_.kind + "' is not an ICP tracker (the Tracker class runs icp and rgbd)");
+}
+
+bool Tracker::use_photometric(const FramePyramid& frame, const ReferenceMaps& ref) const {
+  return params_.kind == "rgbd" && params_.photometric_weight > 0 && ref.has_intensity() &&
+         frame.level(0).intensity.width() > 0;
+}
+
+kernels::IcpSums Tracker::reduce(const FramePyramid& frame, const ReferenceMaps& ref, int level,
+                                 const SE3& ref_T_cur) const {
+  const PyramidLevel& cur = frame.level(level);
+  const ReferenceLevel& rl = ref.level(level);
+  kernels::IcpLevel L{cur.vertices.cview(), cur.normals.cview(), rl.vertices.cview(), rl.normals.cview(), rl.K,
+                      ref_T_cur, params_.dist_threshold,
+                      static_cast<float>(std::cos(params_.angle_threshold_deg * kPi / 180.0))};
+  return with_exec(device_, [&](const auto& ex) {
+    if (!use_photometric(frame, ref)) return kernels::icp_reduce(ex, L);
+    kernels::RgbdLevel R{L, cur.intensity.cview(), rl.intensity.cview(), 1.f, params_.photometric_weight,
+                         params_.max_intensity_diff};
+    return kernels::rgbd_reduce(ex, R);
+  });
+}
+
+TrackResult Tracker::track(const FramePyramid& frame, const ReferenceMaps& ref,
+                           const SE3& initial_world_T_camera) const {
+  TrackResult r;
+  r.world_T_camera = initial_world_T_camera;
+  if (ref.empty()) return r;
+  const int levels = std::min({frame.levels(), ref.levels(), static_cast<int>(params_.iterations.size())});
+  SE3 ref_T_cur = ref.world_T_ref().inverse() * initial_world_T_camera;
+  bool degenerate = false;
+  for (int l = levels - 1; l >= 0; --l) {
+    for (int it = 0; it < params_.iterations[l]; ++it) {
+      kernels::IcpSums s = reduce(frame, ref, l, ref_T_cur);
+      IcpStep step = solve_icp_step(s);
+      ++r.iterations;
+      if (l == 0) {
+        r.inliers = static_cast<std::int64_t>(s.inliers);
+        r.inlier_ratio = s.valid > 0 ? s.inliers / s.valid : 0.0;
+        r.residual_rms = s.inliers > 0 ? std::sqrt(s.error / s.inliers) : 0.0;
+        r.condition = step.condition;
+        degenerate = !step.solved;
+      }
+      if (!step.solved) break;  // nothing to add at this level; a finer one may still constrain it
+      ref_T_cur = orthonormalize(se3_exp(step.xi) * ref_T_cur);
+    }
+  }
+  r.world_T_camera = ref.world_T_ref() * ref_T_cur;
+  r.status = degenerate ? TrackStatus::degenerate : TrackStatus::ok;
+  check_loss(r, initial_world_T_camera);
+  return r;
+}
+
+void Tracker::check_loss(TrackResult& r, const SE3& initial) const {
+  SE3 delta = initial.inverse() * r.world_T_camera;
+  r.translation_jump = length(delta.t);
+  r.rotation_jump_deg = rotation_angle_deg(delta.R);
+  if (r.status != TrackStatus::ok) return;
+  if (r.inlier_ratio < params_.min_inlier_ratio)
+    r.status = TrackStatus::too_few_inliers;
+  else if (!(r.condition <= params_.max_condition))
+    r.status = TrackStatus::degenerate;
+  else if (r.translation_jump > params_.max_translation_jump || r.rotation_jump_deg > params_.max_rotation_jump_deg)
+    r.status = TrackStatus::implausible_jump;
+}
+
+}  // namespace seamless

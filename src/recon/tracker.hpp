@@ -1,0 +1,110 @@
+// Camera tracking after KinectFusion (Newcombe et al. 2011, section 3.5): point-to-plane ICP with
+// projective data association over a 3-level pyramid, coarse to fine, against a reference view
+// (the model raycast for frame-to-model, the previous frame for frame-to-frame); optionally with a
+// photometric term (RGB-D). Each Gauss-Newton iteration is one device reduction of the 6x6 normal
+// equations (kernels/recon/icp.hpp) and one 6x6 solve here on the host (Eigen LDLT).
+// Tracking loss is detected, not hidden: see TrackStatus. docs/TRACKING.md has the details.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/buffer.hpp"
+#include "core/camera.hpp"
+#include "core/math.hpp"
+#include "kernels/recon/icp.hpp"
+#include "recon/preprocess.hpp"
+#include "recon/tracker_params.hpp"
+
+namespace seamless {
+
+struct RaycastMaps;
+
+// One level of a reference view, in the coordinates of the camera it was seen or rendered from.
+struct ReferenceLevel {
+  Intrinsics K;
+  Image<vec3> vertices;
+  Image<vec3> normals;
+  Image<float> intensity;  // empty when the reference has no colour
+};
+
+// What a frame is aligned to. Owns its images (device of the tracker), so the frame pyramid or
+// raycast it came from can be reused for the next frame.
+class ReferenceMaps {
+ public:
+  // Frame-to-frame: a copy of a frame's pyramid, seen from world_T_camera.
+  void set_from_frame(const FramePyramid& frame, const SE3& world_T_camera);
+  // Frame-to-model: a raycast (world-space maps, full resolution, intrinsics K) rendered from
+  // world_T_camera, moved into that camera's coordinates and subsampled into `levels` levels.
+  // max_diff: largest depth difference averaged by the subsampling, metres.
+  void set_from_raycast(const RaycastMaps& maps, const Intrinsics& K, const SE3& world_T_camera, int levels,
+                        float max_diff = 0.09f);
+  const ReferenceLevel& level(int l) const { return levels_.at(l); }
+  int levels() const { return static_cast<int>(levels_.size()); }
+  bool empty() const { return levels_.empty(); }
+  bool has_intensity() const { return !levels_.empty() && levels_[0].intensity.width() > 0; }
+  const SE3& world_T_ref() const { return world_T_ref_; }
+
+ private:
+  void resize(const Intrinsics& K, int levels, Device d, bool intensity);
+  std::vector<ReferenceLevel> levels_;
+  SE3 world_T_ref_ = SE3::identity();
+};
+
+enum class TrackStatus {
+  ok,
+  too_few_inliers,   // inliers / valid pixels below tracker.min_inlier_ratio
+  implausible_jump,  // more motion than tracker.max_translation_jump / max_rotation_jump_deg
+  degenerate,        // the 6x6 system is singular or worse conditioned than tracker.max_condition
+  no_reference,      // nothing to align to (first frame, or no ground truth for this frame)
+};
+const char* to_string(TrackStatus s);
+
+// Quality of one tracked frame (docs/TRACKING.md, "Per-frame statistics").
+struct TrackResult {
+  SE3 world_T_camera = SE3::identity();  // the estimate; the initial guess when the solve failed
+  TrackStatus status = TrackStatus::no_reference;
+  double residual_rms = 0;     // sqrt(error / inliers) of the last finest-level iteration (metres for ICP)
+  double inlier_ratio = 0;     // finest level: correspondences / pixels with a vertex
+  std::int64_t inliers = 0;
+  double condition = 0;        // eigenvalue ratio of the finest level's J^T J
+  int iterations = 0;          // Gauss-Newton steps taken, all levels
+  double translation_jump = 0; // metres between the initial guess and the estimate
+  double rotation_jump_deg = 0;
+  bool ok() const { return status == TrackStatus::ok; }
+};
+
+class Tracker {
+ public:
+  Tracker(const TrackerParams& params, Device device);
+  // Aligns `frame` to `ref` starting from initial_world_T_camera (coarse to fine, params.iterations
+  // per level, finest first). Checks the result for tracking loss; a lost result still carries
+  // the estimate and its statistics.
+  TrackResult track(const FramePyramid& frame, const ReferenceMaps& ref, const SE3& initial_world_T_camera) const;
+  // The normal equations of one level at ref_T_cur (one reduction; for tests and benchmarks).
+  kernels::IcpSums reduce(const FramePyramid& frame, const ReferenceMaps& ref, int level, const SE3& ref_T_cur) const;
+  const TrackerParams& params() const { return params_; }
+  Device device() const { return device_; }
+
+ private:
+  bool use_photometric(const FramePyramid& frame, const ReferenceMaps& ref) const;
+  void check_loss(TrackResult& r, const SE3& initial) const;
+  TrackerParams params_;
+  Device device_;
+};
+
+// Host side of one Gauss-Newton step (exposed for tests): solves J^T J xi = -J^T r by LDLT and
+// reports the condition number of J^T J (largest / smallest eigenvalue; infinity when singular).
+struct IcpStep {
+  double xi[6] = {0, 0, 0, 0, 0, 0};  // omega (rad), upsilon (m)
+  double condition = 0;
+  bool solved = false;
+};
+IcpStep solve_icp_step(const kernels::IcpSums& s);
+// exp(xi) as a rigid transform: Rodrigues rotation of omega, translation upsilon (the left update of
+// kernels/recon/icp.hpp, first order in xi like KinectFusion eq. 19, then kept exactly rigid).
+SE3 se3_exp(const double xi[6]);
+// Rotation angle of R in degrees.
+double rotation_angle_deg(const mat3& R);
+
+}  // namespace seamless

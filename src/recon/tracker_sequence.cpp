@@ -1,0 +1,225 @@
+#include "recon/tracker_sequence.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+
+#include "core/error.hpp"
+#include "core/exec.hpp"
+#include "core/log.hpp"
+#include "core/timing.hpp"
+#include "kernels/recon/rgbd.hpp"
+#include "seamless/build_config.hpp"
+
+namespace seamless {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+
+// Host time after the device finished: every stage below ends with a download or a sync anyway.
+double ms_since(Clock::time_point t0, Device d) {
+  with_exec(d, [](const auto& ex) { ex.synchronize(); });
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+}  // namespace
+
+// ---- registry -----------------------------------------------------------------------------------
+
+const std::vector<TrackerInfo>& tracker_registry() {
+  static const std::vector<TrackerInfo> r = {
+      {"icp", "point-to-plane ICP, projective association, 3-level pyramid (KinectFusion)", true, ""},
+      {"rgbd", "ICP plus a photometric term in one Gauss-Newton solve", true, ""},
+      {"ground_truth", "the source's ground-truth poses (upper bound for fusion and physics)", true, ""},
+      {"opencv_icp", "OpenCV rgbd::ICPOdometry", false,
+       "OpenCV's rgbd contrib module (libopencv-contrib-dev) is not in this build"},
+      {"opencv_rgbd", "OpenCV rgbd::RgbdICPOdometry", false,
+       "OpenCV's rgbd contrib module (libopencv-contrib-dev) is not in this build"},
+      {"pcl_gicp", "PCL generalized ICP, frame to frame", false, "PCL (libpcl-dev) is not in this build"},
+  };
+  return r;
+}
+
+void require_tracker(const std::string& kind) {
+  for (const TrackerInfo& t : tracker_registry()) {
+    if (t.kind != kind) continue;
+    if (!t.available) throw Error("tracker.kind '" + kind + "' is not available in this build: " + t.missing);
+    return;
+  }
+  std::string known;
+  for (const TrackerInfo& t : tracker_registry()) known += (known.empty() ? "" : ", ") + t.kind;
+  throw Error("tracker.kind '" + kind + "' is unknown; known trackers: " + known);
+}
+
+// ---- TrackingSession ----------------------------------------------------------------------------
+
+TrackingSession::TrackingSession(const TrackSequenceParams& params, Device device, const Intrinsics& K,
+                                 Volume* volume)
+    : p_(params), device_(device), K_(K), volume_(volume), pyr_(device, K, params.preprocess.levels) {
+  require_tracker(p_.tracker.kind);
+  if (p_.tracker.kind != "ground_truth") tracker_ = std::make_unique<Tracker>(p_.tracker, device);
+  if (!volume_ && p_.tracker.mode == "frame_to_model" && p_.tracker.kind != "ground_truth") {
+    own_volume_ = make_volume(p_.volume, device);
+    volume_ = own_volume_.get();
+  }
+}
+
+TrackingSession::~TrackingSession() = default;
+
+bool TrackingSession::uses_volume() const { return volume_ != nullptr; }
+
+void TrackingSession::upload(const RgbdFrame& frame) {
+  if (frame.depth.width() != K_.width || frame.depth.height() != K_.height)
+    throw Error("frame " + std::to_string(frame.index) + " is " + std::to_string(frame.depth.width()) + "x" +
+                std::to_string(frame.depth.height()) + " but the source's intrinsics say " +
+                std::to_string(K_.width) + "x" + std::to_string(K_.height));
+  depth_ = frame.depth.clone(device_);
+  bool colour = frame.rgb.width() == K_.width && frame.rgb.height() == K_.height;
+  rgb_ = colour ? frame.rgb.clone(device_) : Image<uchar3>();
+  const Image<float>* intensity = nullptr;
+  if (colour && p_.tracker.kind == "rgbd") {
+    if (intensity_.width() != K_.width) intensity_ = Image<float>(K_.width, K_.height, device_);
+    with_exec(device_, [&](const auto& ex) { kernels::rgb_to_intensity(ex, rgb_.cview(), intensity_.view()); });
+    intensity = &intensity_;
+  }
+  pyr_.build(depth_, intensity, p_.preprocess);
+}
+
+void TrackingSession::update_reference(const SE3& pose) {
+  if (volume_ && p_.tracker.mode == "frame_to_model") {
+    volume_->raycast(K_, pose, maps_);
+    ref_.set_from_raycast(maps_, K_, pose, pyr_.levels(), p_.preprocess.pyramid_max_diff);
+  } else {
+    ref_.set_from_frame(pyr_, pose);
+  }
+}
+
+void TrackingSession::accept(const RgbdFrame& frame, const SE3& pose, FrameRecord& rec) {
+  (void)frame;
+  auto t0 = Clock::now();
+  if (volume_) {
+    volume_->integrate(depth_, rgb_, K_, pose);
+    rec.fused = true;
+  }
+  if (tracker_) update_reference(pose);
+  rec.fuse_ms = ms_since(t0, device_);
+  prev_good_ = started_ ? last_good_ : pose;
+  last_good_ = pose;
+}
+
+void TrackingSession::first_frame(const RgbdFrame& frame, FrameRecord& rec) {
+  gravity_ = estimate_gravity(p_.tracker, frame.accelerometer, pyr_);
+  if (p_.tracker.gravity != "none" && !gravity_.found)
+    spdlog::warn("tracker.gravity: {} gave no gravity direction; the world frame is the first camera's",
+              p_.tracker.gravity);
+  SE3 world_T_first = gravity_.found ? gravity_aligned_pose(gravity_.down) : SE3::identity();
+  if (frame.ground_truth) world_T_gt_ = world_T_first * frame.ground_truth->inverse();
+  rec.result.world_T_camera = world_T_first;
+  rec.result.status = TrackStatus::ok;  // the first frame defines the world
+  rec.result.inlier_ratio = 1.0;
+}
+
+TrackResult TrackingSession::track_frame(const RgbdFrame& frame) {
+  TrackResult r;
+  r.world_T_camera = last_good_;
+  if (p_.tracker.kind == "ground_truth") {
+    if (frame.ground_truth) {
+      r.world_T_camera = world_T_gt_ * *frame.ground_truth;
+      r.status = TrackStatus::ok;
+      r.inlier_ratio = 1.0;
+    }
+    return r;  // no ground truth for this frame: reported as no_reference
+  }
+  // KinectFusion starts from the last pose; a constant-velocity prediction helps fast motion.
+  SE3 initial = p_.tracker.constant_velocity ? last_good_ * (prev_good_.inverse() * last_good_) : last_good_;
+  r = tracker_->track(pyr_, ref_, initial);
+  if (p_.tracker.constant_velocity && !r.ok()) {
+    // The motion model may have overshot (the camera stopped): retry from the last pose.
+    TrackResult r2 = tracker_->track(pyr_, ref_, last_good_);
+    if (r2.ok()) r = r2;
+  }
+  return r;
+}
+
+FrameRecord TrackingSession::process(const RgbdFrame& frame) {
+  FrameRecord rec;
+  rec.frame = frame.index;
+  rec.timestamp = frame.timestamp;
+  auto t0 = Clock::now();
+  upload(frame);
+  rec.preprocess_ms = ms_since(t0, device_);
+  if (!started_) {
+    first_frame(frame, rec);
+  } else {
+    auto t1 = Clock::now();
+    rec.result = track_frame(frame);
+    rec.track_ms = ms_since(t1, device_);
+  }
+  if (rec.result.ok()) {
+    accept(frame, rec.result.world_T_camera, rec);
+  } else {
+    ++lost_;
+    rec.result.world_T_camera = last_good_;  // the estimate was not trusted: keep the last good pose
+  }
+  started_ = true;
+  rec.frame_ms = ms_since(t0, device_);
+  return rec;
+}
+
+// ---- whole sequences ----------------------------------------------------------------------------
+
+void write_tracking_stats(const std::string& path, const std::vector<FrameRecord>& frames) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) throw Error("cannot write tracking statistics '" + path + "': check that the folder exists and is writable");
+  std::fprintf(f,
+               "frame,timestamp,status,fused,inlier_ratio,inliers,residual_rms,condition,iterations,"
+               "translation_jump_m,rotation_jump_deg,preprocess_ms,track_ms,fuse_ms,frame_ms\n");
+  for (const FrameRecord& r : frames) {
+    const TrackResult& t = r.result;
+    std::fprintf(f, "%lld,%.6f,%s,%d,%.5f,%lld,%.6g,%.6g,%d,%.6f,%.4f,%.3f,%.3f,%.3f,%.3f\n",
+                 static_cast<long long>(r.frame), r.timestamp, to_string(t.status), r.fused ? 1 : 0, t.inlier_ratio,
+                 static_cast<long long>(t.inliers), t.residual_rms, t.condition, t.iterations, t.translation_jump,
+                 t.rotation_jump_deg, r.preprocess_ms, r.track_ms, r.fuse_ms, r.frame_ms);
+  }
+  if (std::fclose(f) != 0) throw Error("error writing tracking statistics '" + path + "' (disk full?)");
+}
+
+TrackSequenceResult track_sequence(FrameSource& source, const TrackSequenceParams& params, Device device,
+                                   const std::string& out_dir, Volume* volume,
+                                   const std::function<void(const RgbdFrame&, const FrameRecord&)>& on_frame) {
+  TrackingSession session(params, device, source.intrinsics(), volume);
+  std::unique_ptr<TrajectoryWriter> writer;
+  if (params.write_files) {
+    std::filesystem::create_directories(out_dir);
+    writer = std::make_unique<TrajectoryWriter>(out_dir + "/trajectory.txt",
+                                                "camera trajectory (world_T_camera) by seamless, tracker " +
+                                                    params.tracker.kind + " " + params.tracker.mode);
+  }
+  TrackSequenceResult out;
+  RgbdFrame frame;
+  std::vector<double> track_ms, frame_ms;
+  while ((params.max_frames <= 0 || static_cast<std::int64_t>(out.frames.size()) < params.max_frames) &&
+         source.next(frame)) {
+    FrameRecord rec = session.process(frame);
+    out.trajectory.push_back(TumPose::from_se3(frame.timestamp, rec.result.world_T_camera));
+    if (writer) writer->write(out.trajectory.back());
+    if (out.frames.size() > 0) track_ms.push_back(rec.track_ms);
+    frame_ms.push_back(rec.frame_ms);
+    if (!rec.result.ok())
+      spdlog::warn("frame {}: tracking lost ({}, inliers {:.2f}, condition {:.3g}, jump {:.3f} m / {:.1f} deg); not fused",
+                rec.frame, to_string(rec.result.status), rec.result.inlier_ratio, rec.result.condition,
+                rec.result.translation_jump, rec.result.rotation_jump_deg);
+    if (on_frame) on_frame(frame, rec);
+    out.frames.push_back(rec);
+  }
+  out.lost_frames = session.lost_frames();
+  out.gravity = session.gravity();
+  out.median_track_ms = median(track_ms);
+  out.median_frame_ms = median(frame_ms);
+  if (params.write_files) write_tracking_stats(out_dir + "/tracking_stats.csv", out.frames);
+  spdlog::info("tracked {} frames with {} ({}), {} lost; median {:.2f} ms tracking, {:.2f} ms a frame",
+            out.frames.size(), params.tracker.kind, params.tracker.mode, out.lost_frames, out.median_track_ms,
+            out.median_frame_ms);
+  return out;
+}
+
+}  // namespace seamless

@@ -1,0 +1,118 @@
+// Tracking a whole sequence: the per-frame loop of KinectFusion (preprocess, track against the
+// reference view, fuse, raycast the next reference) with loss handling, gravity alignment and
+// the outputs trajectory.txt (TUM) and tracking_stats.csv. `seamless track` is a thin wrapper
+// around track_sequence(); `seamless run` can drive TrackingSession frame by frame and share the
+// volume with the physics.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "io/frame_source.hpp"
+#include "io/trajectory.hpp"
+#include "recon/preprocess.hpp"
+#include "recon/tracker.hpp"
+#include "recon/tracker_gravity.hpp"
+#include "recon/volume.hpp"
+
+namespace seamless {
+
+// The sections of an experiment that tracking reads (from Experiment: tracker, preprocess, volume,
+// frames).
+struct TrackSequenceParams {
+  TrackerParams tracker;
+  PreprocessParams preprocess;
+  VolumeParams volume;
+  std::int64_t max_frames = 0;  // 0 = all the source has
+  bool write_files = true;      // trajectory.txt and tracking_stats.csv into out_dir
+};
+
+// One frame's outcome, one row of tracking_stats.csv.
+struct FrameRecord {
+  std::int64_t frame = 0;
+  double timestamp = 0;
+  TrackResult result;          // result.world_T_camera is the pose written for this frame
+  bool fused = false;          // integrated into the volume (never when tracking was lost)
+  double preprocess_ms = 0, track_ms = 0, fuse_ms = 0, frame_ms = 0;
+};
+
+// The per-frame state machine. World frame: the first camera, rotated so that gravity is world -y
+// when tracker.gravity finds it. A lost frame keeps the last good pose, is not fused, and the
+// reference stays the last good view, so the next frames try to recover against it.
+class TrackingSession {
+ public:
+  // volume: the model for frame-to-model tracking. nullptr: the session makes its own from
+  // params.volume when the mode is frame_to_model. A volume that is given is always fused into.
+  TrackingSession(const TrackSequenceParams& params, Device device, const Intrinsics& K, Volume* volume = nullptr);
+  ~TrackingSession();
+  FrameRecord process(const RgbdFrame& frame);
+
+  Volume* volume() const { return volume_; }
+  const GravityEstimate& gravity() const { return gravity_; }
+  std::int64_t lost_frames() const { return lost_; }
+  const ReferenceMaps& reference() const { return ref_; }
+  const FramePyramid& pyramid() const { return pyr_; }
+
+ private:
+  bool uses_volume() const;
+  void upload(const RgbdFrame& frame);
+  void first_frame(const RgbdFrame& frame, FrameRecord& rec);
+  TrackResult track_frame(const RgbdFrame& frame);
+  void accept(const RgbdFrame& frame, const SE3& pose, FrameRecord& rec);
+  void update_reference(const SE3& pose);
+
+  TrackSequenceParams p_;
+  Device device_;
+  Intrinsics K_;
+  std::unique_ptr<Volume> own_volume_;
+  Volume* volume_ = nullptr;
+  std::unique_ptr<Tracker> tracker_;
+  FramePyramid pyr_;
+  ReferenceMaps ref_;
+  RaycastMaps maps_;
+  Image<float> depth_, intensity_;
+  Image<uchar3> rgb_;
+  GravityEstimate gravity_;
+  bool started_ = false;
+  SE3 last_good_ = SE3::identity(), prev_good_ = SE3::identity();
+  SE3 world_T_gt_ = SE3::identity();  // ground_truth tracker: maps the source's poses into our world
+  std::int64_t lost_ = 0;
+};
+
+struct TrackSequenceResult {
+  Trajectory trajectory;             // one pose per frame (a lost frame: the last good pose)
+  std::vector<FrameRecord> frames;
+  std::int64_t lost_frames = 0;
+  GravityEstimate gravity;
+  double median_track_ms = 0;
+  double median_frame_ms = 0;
+};
+
+// Tracks every frame of `source` (up to params.max_frames), writes out_dir/trajectory.txt and
+// out_dir/tracking_stats.csv when params.write_files, and returns both in memory. on_frame, if
+// given, sees each frame after it was processed (progress, rendering).
+TrackSequenceResult track_sequence(FrameSource& source, const TrackSequenceParams& params, Device device,
+                                   const std::string& out_dir, Volume* volume = nullptr,
+                                   const std::function<void(const RgbdFrame&, const FrameRecord&)>& on_frame = {});
+
+// tracking_stats.csv: frame, timestamp, status, fused, inlier_ratio, inliers, residual_rms,
+// condition, iterations, translation_jump_m, rotation_jump_deg, preprocess_ms, track_ms, fuse_ms,
+// frame_ms.
+void write_tracking_stats(const std::string& path, const std::vector<FrameRecord>& frames);
+
+// The trackers this build knows (tracker.kind values): every entry says whether it is available and,
+// if not, why. Adding a tracker (OpenCV's RGB-D odometry, PCL's GICP) is one entry here plus its
+// implementation behind make_pose_tracker-style dispatch in TrackingSession.
+struct TrackerInfo {
+  std::string kind;
+  std::string description;
+  bool available;
+  std::string missing;  // what to install when not available
+};
+const std::vector<TrackerInfo>& tracker_registry();
+// Throws seamless::Error naming the fix when `kind` is unknown or not built in.
+void require_tracker(const std::string& kind);
+
+}  // namespace seamless
