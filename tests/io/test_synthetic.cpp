@@ -224,7 +224,9 @@ TEST(SyntheticRoom, CameraPathStaysInFreeSpaceAndLooksAtTheDesk) {
     vec3 fwd = T.rotate({0, 0, 1});
     vec3 to_desk = normalize(room::desk_centre() - T.t);
     EXPECT_GT(dot(fwd, to_desk), std::cos(10.f * 3.14159f / 180));  // within 10 degrees of the desk
-    if (k) EXPECT_LT(length(T.t - prev), 0.02f);  // smooth: < 2 cm per frame at 30 Hz
+    if (k) {
+      EXPECT_LT(length(T.t - prev), 0.02f);  // smooth: < 2 cm per frame at 30 Hz
+    }
     prev = T.t;
   }
 }
