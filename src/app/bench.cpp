@@ -18,6 +18,11 @@ std::map<std::string, BenchInfo>& bench_registry() {
 void register_benchmarks() {
   bench_registry()["preprocess"] = {"bilateral filter, 3-level depth pyramid, vertex and normal maps at 640x480",
                                     make_preprocess_bench};
+  bench_registry()["recon"] = {"TSDF allocate + fuse + raycast per 640x480 frame (hash 5 mm, dense 1 cm); --data TUM folder",
+                               make_recon_bench};
+  bench_registry()["physics"] = {"one solver step: Table 5.1 scenes (fluid 10k, cloth 40x40, rigid 4x64) and scaled "
+                                 "ones (fluid 1M, cloth 512x512, 4096 cubes); --filter paper|large",
+                                 make_physics_bench};
 }
 
 }  // namespace seamless::app

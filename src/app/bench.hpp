@@ -15,6 +15,7 @@ struct BenchCase {
   std::string name;
   std::function<void()> step;
   std::string detail;  // e.g. "640x480, 3 levels"
+  std::function<std::string()> report = {};  // extra figures after the timing (blocks, counts)
 };
 
 struct BenchOptions {

@@ -4,4 +4,6 @@
 
 namespace seamless::app {
 std::vector<BenchCase> make_preprocess_bench(const BenchOptions& o);
+std::vector<BenchCase> make_recon_bench(const BenchOptions& o);
+std::vector<BenchCase> make_physics_bench(const BenchOptions& o);
 }  // namespace seamless::app

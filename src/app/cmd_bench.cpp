@@ -15,6 +15,7 @@ namespace {
 struct BenchArgs {
   std::string name, device = "auto", json, data, filter;
   int reps = 50, warmup = 5;
+  bool list = false;
 };
 
 void write_json(const std::string& path, const std::string& bench, Device dev, const std::vector<std::string>& rows) {
@@ -50,6 +51,7 @@ int run_bench(const BenchArgs& a) {
     std::snprintf(row, sizeof row, "{\"name\": \"%s\", \"reps\": %d, \"min_ms\": %.6f, \"median_ms\": %.6f, \"max_ms\": %.6f, \"detail\": \"%s\"}",
                   c.name.c_str(), a.reps, lo, med, hi, c.detail.c_str());
     json_rows.push_back(row);
+    if (c.report) std::printf("%-32s %s\n", "", c.report().c_str());
   }
   if (!a.json.empty()) {
     write_json(a.json, a.name, o.device, json_rows);
@@ -69,12 +71,12 @@ void add_bench_command(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--json", a->json, "write the results as JSON to this file");
   cmd->add_option("--data", a->data, "TUM folder for benchmarks over real frames");
   cmd->add_option("--filter", a->filter, "only cases whose name contains this");
-  auto* list = cmd->add_flag("--list", "list the benchmarks");
-  cmd->callback([&action, a, list] {
-    action = [a, list] {
-      if (*list || a->name.empty()) {
+  cmd->add_flag("--list", a->list, "list the benchmarks");
+  cmd->callback([&action, a] {
+    action = [a] {
+      if (a->list || a->name.empty()) {
         for (auto& [n, info] : bench_registry()) std::printf("%-12s %s\n", n.c_str(), info.description.c_str());
-        return a->name.empty() && !*list ? 2 : 0;
+        return a->list ? 0 : 2;
       }
       return run_bench(*a);
     };

@@ -29,6 +29,8 @@ class StageTimer {
     std::string stage;
     double ms;
   };
+  // Appends a stage time measured elsewhere (e.g. by a layer's own timer).
+  void add(std::int64_t frame, const std::string& stage, double ms) { rows_.push_back({frame, stage, ms}); }
   const std::vector<Row>& rows() const { return rows_; }
   void write_csv(const std::string& path) const;  // frame,stage,ms
   // Median ms of a stage over all frames (0 if none).
