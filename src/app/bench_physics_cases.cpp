@@ -2,6 +2,7 @@
 // scaled ones (src/physics/bench_physics.hpp builds them). --filter paper|large picks a set.
 #include "app/bench_cases.hpp"
 #include "physics/bench_physics.hpp"
+#include "physics/particle_solver.hpp"
 
 namespace seamless::app {
 

@@ -65,9 +65,11 @@ class Buffer {
     b.copy_from(*this);
     return b;
   }
-  // Grows (never shrinks) without keeping the contents.
-  void reserve_discard(std::int64_t n) {
-    if (n > size_) *this = Buffer(n, device_);
+  // Makes room for n elements on device d without keeping the contents: reallocates when the
+  // buffer is smaller or lives elsewhere (a default-constructed Buffer is an empty CPU buffer, so
+  // the device must be named here).
+  void reserve_discard(std::int64_t n, Device d) {
+    if (n > size_ || d != device_) *this = Buffer(n, d);
   }
 
  private:

@@ -4,7 +4,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <algorithm>
 #include <map>
+#include <tuple>
 #include <set>
 
 #include "core/error.hpp"
@@ -161,9 +163,28 @@ TEST(TsdfMeshParity, CpuAndCudaMeshesAgree) {
   Mesh a = fused_mesh(s, Device::CPU), b = fused_mesh(s, Device::CUDA);
   ASSERT_EQ(a.triangles.size(), b.triangles.size());
   ASSERT_EQ(a.positions.size(), b.positions.size());
-  // Vertex order follows the block order of the hash table, which is the same on both (slot
-  // order, deterministic): compare position by position.
-  for (std::size_t i = 0; i < a.positions.size(); ++i) EXPECT_LE(length(a.positions[i] - b.positions[i]), 1e-5f);
+  // The vertex order follows the order in which blocks were allocated, which depends on thread
+  // timing on both backends: compare the meshes as point sets. Each CPU vertex must have a CUDA
+  // vertex within 1e-5 m (both interpolate the same TSDF values; float rounding is ~1e-7 m).
+  std::map<std::tuple<int, int, int>, std::vector<vec3>> grid;
+  auto cell = [](vec3 p) {
+    return std::make_tuple(int(std::floor(p.x * 1000)), int(std::floor(p.y * 1000)), int(std::floor(p.z * 1000)));
+  };
+  for (vec3 p : b.positions) grid[cell(p)].push_back(p);
+  int unmatched = 0;
+  for (vec3 p : a.positions) {
+    auto [cx, cy, cz] = cell(p);
+    float best = 1e9f;
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          auto it = grid.find({cx + dx, cy + dy, cz + dz});
+          if (it == grid.end()) continue;
+          for (vec3 q : it->second) best = std::min(best, length(p - q));
+        }
+    if (best > 1e-5f) ++unmatched;
+  }
+  EXPECT_EQ(unmatched, 0);
 }
 
 }  // namespace
