@@ -130,11 +130,11 @@ struct ParticleSolver::Impl {
     std::int64_t nc = std::min<std::int64_t>(P.max_particles, std::max<std::int64_t>({need, 2 * cap, 1024}));
     grow(x, nc, n, dev), grow(v, nc, n, dev), grow(w, nc, n, dev), grow(phase, nc, n, dev);
     grow(rest, nc, n, dev), grow(rsdf, nc, n, dev);
-    for (auto* b : {&pred, &sx, &sp, &sp0, &sv, &tmp, &vtmp, &vort, &cnormal}) b->reserve_discard(nc);
-    for (auto* b : {&order, &rank, &ncontacts, &nnbr, &nsnbr}) b->reserve_discard(nc);
-    for (auto* b : {&sw, &lambda, &density}) b->reserve_discard(nc);
-    key.reserve_discard(nc), sphase.reserve_discard(nc);
-    nbr.reserve_discard(nc * P.max_neighbours);
+    for (auto* b : {&pred, &sx, &sp, &sp0, &sv, &tmp, &vtmp, &vort, &cnormal}) b->reserve_discard(nc, dev);
+    for (auto* b : {&order, &rank, &ncontacts, &nnbr, &nsnbr}) b->reserve_discard(nc, dev);
+    for (auto* b : {&sw, &lambda, &density}) b->reserve_discard(nc, dev);
+    key.reserve_discard(nc, dev), sphase.reserve_discard(nc, dev);
+    nbr.reserve_discard(nc * P.max_neighbours, dev);
     cap = nc;
   }
 
@@ -192,8 +192,8 @@ struct ParticleSolver::Impl {
   void prepare_grid() {
     bits = grid_bits(n);
     std::int64_t cells = std::int64_t{1} << (3 * bits);
-    cell_start.reserve_discard(cells), cell_end.reserve_discard(cells);
-    if (!static_host.empty()) snbr.reserve_discard(cap * P.max_static_neighbours);
+    cell_start.reserve_discard(cells, dev), cell_end.reserve_discard(cells, dev);
+    if (!static_host.empty()) snbr.reserve_discard(cap * P.max_static_neighbours, dev);
   }
 
   // Sort, grid and neighbour lists of the predicted positions (S.pred must be filled).
@@ -421,7 +421,7 @@ struct ParticleSolver::Impl {
       K::clear_cells(ex, scell_start.data(), scell_end.data(), cells);
       K::cell_ranges(ex, keys.data(), ns, scell_start.data(), scell_end.data());
     });
-    snbr.reserve_discard(std::max<std::int64_t>(cap, 1) * P.max_static_neighbours);
+    snbr.reserve_discard(std::max<std::int64_t>(cap, 1) * P.max_static_neighbours, dev);
   }
 };
 
