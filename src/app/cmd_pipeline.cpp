@@ -2,6 +2,8 @@
 #include "app/commands.hpp"
 #include "app/pipeline.hpp"
 #include "app/run_context.hpp"
+#include "core/error.hpp"
+#include "kernels/io/synthetic_room.hpp"
 
 namespace seamless::app {
 
@@ -15,8 +17,6 @@ struct Part {
 
 void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
   static const Part parts[] = {
-      {"simulate", "run the particle solver on a static scene; write particle states or frames",
-       "the unified particle solver (issue 6) is not wired into the command yet"},
       {"render", "render a run's outputs (mesh, particles, fluid) to images or a window",
        "the renderer (issue 7) is not built yet"},
   };
@@ -38,6 +38,23 @@ void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
     action = [trk] {
       RunContext ctx(*trk);
       scan(ctx, false);
+      return 0;
+    };
+  });
+  auto sim = std::make_shared<CommonOptions>();
+  auto* m = app.add_subcommand("simulate", "run the particle solver on the synthetic room's exact SDF (no scan); "
+                                           "write particle states");
+  add_common_options(*m, *sim);
+  m->callback([&action, sim] {
+    action = [sim] {
+      RunContext ctx(*sim);
+      if (ctx.experiment().input.source != "synthetic")
+        throw Error("seamless simulate runs on the synthetic room's analytic scene (input.source: synthetic); to "
+                    "simulate on a scanned scene use `seamless run` with mode: scan_then_simulate");
+      kernels::SceneSdf sdf{};
+      sdf.synthetic_room = 1;
+      ctx.experiment().solver.gravity = kernels::room::gravity();  // the room's world is z up
+      simulate(ctx, {}, &sdf);
       return 0;
     };
   });

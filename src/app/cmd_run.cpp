@@ -5,11 +5,9 @@
 #include <memory>
 
 #include "app/commands.hpp"
+#include "app/pipeline.hpp"
 #include "app/run_context.hpp"
 #include "config/config.hpp"
-#include "core/progress.hpp"
-#include "io/frame_source.hpp"
-#include "recon/preprocess.hpp"
 
 namespace seamless::app {
 
@@ -28,28 +26,17 @@ int run(const CommonOptions& o) {
   if (o.dry_run) return dry_run(o);
   RunContext ctx(o);
   const Experiment& e = ctx.experiment();
-  auto source = make_source(e.input, ctx.device());
-  Intrinsics K = source->intrinsics();
-  FramePyramid pyramid(ctx.device(), K, e.preprocess.levels);
-  spdlog::warn("not built yet, skipped: tracking, TSDF fusion, scene extraction, physics, rendering");
-
-  std::int64_t limit = e.frames > 0 ? e.frames : source->size().value_or(0);
-  Progress progress("frames", limit);
-  RgbdFrame frame;
-  std::int64_t n = 0;
-  while ((limit == 0 || n < limit) && source->next(frame)) {
-    {
-      StageScope s(ctx.timer(), "upload");
-      Image<float> depth = frame.depth.clone(ctx.device());
-      StageScope p(ctx.timer(), "preprocess");
-      pyramid.build(depth, nullptr, e.preprocess);
-    }
-    ctx.timer().end_frame(n);
-    progress.update(++n);
-  }
-  progress.finish();
-  spdlog::info("{} frames from {} ({} skipped); median preprocess {:.3f} ms", n, source->name(),
-               source->skipped_frames(), ctx.timer().median_ms("preprocess"));
+  if (e.mode == "live")
+    spdlog::warn("mode live (simulate while scanning) is not built yet: running scan_then_simulate");
+  ScanResult scan_result = scan(ctx, true);
+  SceneParticleParams sp;
+  sp.spacing = e.solver.particle_diameter;
+  SceneParticles scene = scan_result.volume->extract_scene_particles(sp);
+  std::vector<vec3> points = scene.positions.to_host();
+  points.resize(static_cast<std::size_t>(scene.count));
+  spdlog::info("{} scene particles at {} m spacing", points.size(), sp.spacing);
+  simulate(ctx, points, nullptr);
+  spdlog::warn("not built yet, skipped: rendering (issue 7)");
   spdlog::info("outputs in {}", ctx.out_dir());
   return 0;
 }

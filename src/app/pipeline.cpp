@@ -2,8 +2,11 @@
 
 #include <spdlog/spdlog.h>
 
+#include <cmath>
+
 #include "core/progress.hpp"
 #include "io/frame_source.hpp"
+#include "physics/particle_solver.hpp"
 #include "recon/ply.hpp"
 
 namespace seamless::app {
@@ -58,6 +61,38 @@ ScanResult scan(RunContext& ctx, bool with_volume) {
     }
   }
   return r;
+}
+
+void simulate(RunContext& ctx, const std::vector<vec3>& scene_particles, const kernels::SceneSdf* sdf) {
+  const Experiment& e = ctx.experiment();
+  ParticleSolver solver(e.solver, ctx.device());
+  if (!scene_particles.empty()) solver.add_static_particles(scene_particles);
+  if (sdf) solver.set_scene_sdf(*sdf);
+  solver.schedule(e.spawn);  // checks the particle budget up front
+  const auto steps = static_cast<std::int64_t>(std::ceil(e.duration / e.solver.dt));
+  spdlog::info("simulating {:.2f} s in {} steps of {} s on {} scene particles{}", e.duration, steps, e.solver.dt,
+               scene_particles.size(), sdf ? " and the scene SDF" : "");
+  Progress progress("simulate", steps);
+  for (std::int64_t k = 0; k < steps; ++k) {
+    {
+      StageScope s(ctx.timer(), "physics");
+      solver.step();
+    }
+    ctx.timer().end_frame(k);
+    int every = e.output.particles_every;
+    if (every > 0 && (k + 1) % every == 0)
+      write_particles_ply(ctx.out_path("particles_" + std::to_string(k + 1) + ".ply"), solver.download_state());
+    progress.update(k + 1);
+  }
+  progress.finish();
+  write_particles_ply(ctx.out_path("particles.ply"), solver.download_state());
+  SolverStats st = solver.stats();
+  spdlog::info("physics: {} particles ({} fluid, {} cloth, {} rigid in {} bodies), {} substeps/step, median {:.3f} ms "
+               "per step; neighbour overflow {} / {}",
+               st.particles, st.fluid_particles, st.cloth_particles, st.rigid_particles, st.rigid_bodies, st.substeps,
+               ctx.timer().median_ms("physics"), st.neighbour_overflow, st.static_neighbour_overflow);
+  if (st.neighbour_overflow || st.static_neighbour_overflow)
+    spdlog::warn("some particles had more neighbours than solver.max_neighbours / max_static_neighbours: raise them");
 }
 
 }  // namespace seamless::app

@@ -5,6 +5,7 @@
 #include "app/run_context.hpp"
 #include "recon/tracker_sequence.hpp"
 #include "recon/volume.hpp"
+#include "kernels/physics/scene_sdf.hpp"
 
 namespace seamless::app {
 
@@ -16,5 +17,10 @@ struct ScanResult {
 // Tracks the experiment's input (and fuses it into a new volume when with_volume), writing
 // trajectory.txt, tracking_stats.csv and, with a volume, mesh.ply (output.write_mesh).
 ScanResult scan(RunContext& ctx, bool with_volume);
+
+// Runs the particle solver for experiment.duration seconds on the given static scene (particles
+// and/or an SDF), spawning experiment.spawn, writing particles_<step>.ply every
+// output.particles_every steps and the last state as particles.ply.
+void simulate(RunContext& ctx, const std::vector<vec3>& scene_particles, const kernels::SceneSdf* sdf);
 
 }  // namespace seamless::app

@@ -23,6 +23,7 @@ struct OutputParams {
   bool write_trajectory = true;   // trajectory.txt, TUM format
   bool write_timings = true;      // timings.csv, one row per frame and stage
   bool write_stats = true;        // stats.csv: hash fill, tracking inliers, particle counts
+  int particles_every = 25;       // write particles_<step>.ply every this many solver steps; 0 = only the last
 
   template <class V> void visit(V& v) {
     v("dir", dir, "output folder (created if missing)");
@@ -31,6 +32,8 @@ struct OutputParams {
     v("write_trajectory", write_trajectory, "write the camera trajectory (TUM format) as trajectory.txt");
     v("write_timings", write_timings, "write per-stage timings as timings.csv");
     v("write_stats", write_stats, "write per-frame statistics as stats.csv");
+    v("particles_every", particles_every, "write particles_<step>.ply every this many solver steps; 0 = only the last",
+      Range{0, 1e9});
   }
 };
 
@@ -39,6 +42,7 @@ struct Experiment {
   std::string device = "auto";
   std::string mode = "live";
   std::int64_t frames = 0;        // 0 = as many as the input gives
+  double duration = 3.0;          // simulated seconds after the scan (scan_then_simulate)
   InputParams input;
   PreprocessParams preprocess;
   VolumeParams volume;
@@ -55,6 +59,7 @@ struct Experiment {
     v("mode", mode, "reconstruct and simulate at once, or scan first then simulate",
       Choices{"live", "scan_then_simulate"});
     v("frames", frames, "frames to process; 0 = all the input has", Range{0, 1e12});
+    v("duration", duration, "simulated seconds after the scan (scan_then_simulate mode, and simulate)", Range{0, 1e6});
     v("input", input, "where frames come from");
     v("preprocess", preprocess, "depth filtering, pyramid, vertex and normal maps");
     v("volume", volume, "TSDF volume");
