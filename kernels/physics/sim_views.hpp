@@ -104,7 +104,7 @@ struct SimViews {
 
   // cloth, CSR by id: distance constraints (other id, rest length, stiffness already scaled by
   // the averaging factor), bending constraints and triangles incident to each particle
-  const int *dist_off = nullptr, *dist_other = nullptr;
+  const int *dist_off = nullptr, *dist_other = nullptr, *dist_colour = nullptr;
   const float *dist_len = nullptr, *dist_k = nullptr;
   const int *bend_off = nullptr, *bend_list = nullptr;
   const Quad* bend_ids = nullptr;

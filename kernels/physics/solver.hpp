@@ -5,7 +5,7 @@
 //   predict -> sort_by_key -> reorder -> clear_cells / cell_ranges -> find_neighbors
 //   -> stabilize (section 4.4)
 //   -> iterations: prepare_constraints, solve_contacts_fluid (swap sp/tmp), shape_match,
-//                  cloth_solve (swap sp/tmp)
+//                  cloth_stretch per colour, cloth_bend (each: swap sp/tmp)
 //   -> update_velocity -> velocity_effects (swap sv/vtmp) -> write_back
 #pragma once
 #include <cstdint>
@@ -38,7 +38,8 @@ template <class Exec> void solve_contacts_fluid(const Exec& ex, const SimViews& 
 // Shape matching of every rigid body (Mueller 2005): per-body sums, rotation, goal positions.
 template <class Exec> void shape_match(const Exec& ex, const SimViews& S);
 // Cloth stretch and bending (Mueller 2007); writes tmp.
-template <class Exec> void cloth_solve(const Exec& ex, const SimViews& S);
+template <class Exec> void cloth_stretch(const Exec& ex, const SimViews& S, int colour);
+template <class Exec> void cloth_bend(const Exec& ex, const SimViews& S);
 // v = v_pred + (p - p0) / dt (exactly symplectic Euler when nothing acted), restitution, sleeping.
 template <class Exec> void update_velocity(const Exec& ex, const SimViews& S);
 // XSPH viscosity, vorticity confinement, Akinci cohesion and surface tension, cloth
@@ -65,7 +66,8 @@ template <class Exec> float max_speed2(const Exec& ex, const SimViews& S);
   template void prepare_constraints<E>(const E&, const SimViews&);                                          \
   template void solve_contacts_fluid<E>(const E&, const SimViews&);                                         \
   template void shape_match<E>(const E&, const SimViews&);                                                  \
-  template void cloth_solve<E>(const E&, const SimViews&);                                                  \
+  template void cloth_stretch<E>(const E&, const SimViews&, int);                                           \
+  template void cloth_bend<E>(const E&, const SimViews&);                                                  \
   template void update_velocity<E>(const E&, const SimViews&);                                              \
   template void velocity_effects<E>(const E&, const SimViews&, bool);                                       \
   template void write_back<E>(const E&, const SimViews&);                                                   \

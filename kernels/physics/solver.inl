@@ -393,8 +393,32 @@ void shape_match(const Exec& ex, const SimViews& S) {
   ex.for_each(S.nbodies, [=] SEAMLESS_HD(std::int64_t b) { S.body_c[b] = S.body_c[b] + S.body_shift[b]; });
 }
 
+// Stretch constraints of one colour (Mueller 2007, eq. 4.7/4.8). The host colours the edges so
+// that no particle has two edges of one colour: each colour is then projected fully (Gauss-Seidel
+// over colours, the usual graph colouring of parallel PBD) instead of averaged (Jacobi), which
+// with 8 edges per particle and 2 iterations left hanging cloth stretched by 20 %.
 template <class Exec>
-void cloth_solve(const Exec& ex, const SimViews& S) {
+void cloth_stretch(const Exec& ex, const SimViews& S, int colour) {
+  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t i) {
+    const int s = static_cast<int>(i);
+    const vec3 p = S.sp[s];
+    const float wi = S.sw[s];
+    vec3 acc{0.f, 0.f, 0.f};
+    if (phase::is(S.sphase[s], phase::kCloth) && wi > 0.f) {
+      const int id = S.order[s];
+      for (int e = S.dist_off[id], end = S.dist_off[id + 1]; e < end; ++e) {
+        if (S.dist_colour[e] != colour) continue;
+        int sj = S.rank[S.dist_other[e]];
+        acc += distance_delta(p, S.sp[sj], wi, S.sw[sj], S.dist_len[e], S.dist_k[e]);
+      }
+    }
+    S.tmp[s] = p + acc;
+  });
+}
+
+// Bending constraints (Jacobi, averaged through their stiffness on the host).
+template <class Exec>
+void cloth_bend(const Exec& ex, const SimViews& S) {
   ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t i) {
     const int s = static_cast<int>(i);
     const vec3 p = S.sp[s];
@@ -405,10 +429,6 @@ void cloth_solve(const Exec& ex, const SimViews& S) {
     }
     const int id = S.order[s];
     vec3 acc{0.f, 0.f, 0.f};
-    for (int e = S.dist_off[id], end = S.dist_off[id + 1]; e < end; ++e) {
-      int sj = S.rank[S.dist_other[e]];
-      acc += distance_delta(p, S.sp[sj], wi, S.sw[sj], S.dist_len[e], S.dist_k[e]);
-    }
     for (int e = S.bend_off[id], end = S.bend_off[id + 1]; e < end; ++e) {
       int b = S.bend_list[e];
       Quad q = S.bend_ids[b];

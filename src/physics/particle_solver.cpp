@@ -87,7 +87,8 @@ struct ParticleSolver::Impl {
   std::vector<K::Quad> bends;
   std::vector<float> bend_rest, bend_k0;
   std::vector<int3> tris;
-  Buffer<int> dist_off, dist_other, bend_off, bend_list, tri_off, tri_list;
+  int stretch_colours = 0;
+  Buffer<int> dist_off, dist_other, dist_colour, bend_off, bend_list, tri_off, tri_list;
   Buffer<float> dist_len, dist_k, d_bend_rest, d_bend_k;
   Buffer<K::Quad> d_bends;
   Buffer<int3> d_tris;
@@ -181,7 +182,7 @@ struct ParticleSolver::Impl {
     S.nchunks = static_cast<int>(chunk_start.size());
     S.chunk_start = d_chunk_start.data(), S.chunk_count = d_chunk_count.data(), S.chunk_body = d_chunk_body.data();
     S.chunk_sum = chunk_sum.data();
-    S.dist_off = dist_off.data(), S.dist_other = dist_other.data(), S.dist_len = dist_len.data(), S.dist_k = dist_k.data();
+    S.dist_off = dist_off.data(), S.dist_other = dist_other.data(), S.dist_colour = dist_colour.data(), S.dist_len = dist_len.data(), S.dist_k = dist_k.data();
     S.bend_off = bend_off.data(), S.bend_list = bend_list.data(), S.bend_ids = d_bends.data();
     S.bend_rest = d_bend_rest.data(), S.bend_k = d_bend_k.data();
     S.tri_off = tri_off.data(), S.tri_list = tri_list.data(), S.tri_ids = d_tris.data();
@@ -222,10 +223,7 @@ struct ParticleSolver::Impl {
         K::solve_contacts_fluid(ex, S);
         std::swap(S.sp, S.tmp);
         K::shape_match(ex, S);
-        if (has_cloth) {
-          K::cloth_solve(ex, S);
-          std::swap(S.sp, S.tmp);
-        }
+        if (has_cloth) solve_cloth(ex, S);
       }
       K::update_velocity(ex, S);
       if (effects) {
@@ -234,6 +232,18 @@ struct ParticleSolver::Impl {
       }
       K::write_back(ex, S);
     });
+  }
+
+  template <class Ex>
+  void solve_cloth(const Ex& ex, K::SimViews& S) {
+    for (int c = 0; c < stretch_colours; ++c) {
+      K::cloth_stretch(ex, S, c);
+      std::swap(S.sp, S.tmp);
+    }
+    if (!bends.empty()) {
+      K::cloth_bend(ex, S);
+      std::swap(S.sp, S.tmp);
+    }
   }
 
   void upload_bodies(const std::vector<vec3>& c, const std::vector<vec4>& q) {
@@ -273,25 +283,47 @@ struct ParticleSolver::Impl {
     upload_bodies(c, q);
   }
 
-  // CSR by particle id of the cloth constraints. Stiffness is divided by the larger degree of
-  // a constraint's particles over cloth_relaxation (Macklin 2014 eq. 11 averaging, made
-  // symmetric so that a pair's corrections stay equal and opposite).
+  // Greedy edge colouring: no particle has two edges of one colour, so each colour's
+  // constraints can be projected together at full stiffness (see kernels::cloth_stretch).
+  std::vector<int> colour_edges(std::size_t N) {
+    std::vector<std::uint64_t> used(N, 0);
+    std::vector<int> col(edge_a.size());
+    stretch_colours = 0;
+    for (std::size_t e = 0; e < edge_a.size(); ++e) {
+      std::uint64_t busy = used[edge_a[e]] | used[edge_b[e]];
+      int c = 0;
+      while (c < 64 && (busy >> c & 1u)) ++c;
+      if (c == 64) throw Error("particle solver: a cloth particle has more than 63 stretch constraints");
+      col[e] = c;
+      used[edge_a[e]] |= std::uint64_t{1} << c, used[edge_b[e]] |= std::uint64_t{1} << c;
+      stretch_colours = std::max(stretch_colours, c + 1);
+    }
+    return col;
+  }
+
+  // CSR by particle id of the cloth constraints. Stretch constraints are coloured and keep their
+  // stiffness; bending stiffness is divided by the larger degree of a constraint's particles over
+  // cloth_relaxation (Macklin 2014 eq. 11 averaging, made symmetric so that a pair's corrections
+  // stay equal and opposite).
   void rebuild_cloth() {
     const std::size_t N = static_cast<std::size_t>(n);
     std::vector<int> deg(N, 0), bdeg(N, 0);
     for (std::size_t e = 0; e < edge_a.size(); ++e) ++deg[edge_a[e]], ++deg[edge_b[e]];
     for (const K::Quad& q : bends) ++bdeg[q.a], ++bdeg[q.b], ++bdeg[q.c], ++bdeg[q.d];
     auto scale = [&](int dmax) { return std::min(1.f, P.cloth_relaxation / static_cast<float>(std::max(dmax, 1))); };
-    std::vector<int> off(N + 1, 0), other(2 * edge_a.size());
+    std::vector<int> col = colour_edges(N);
+    std::vector<int> off(N + 1, 0), other(2 * edge_a.size()), ecol(other.size());
     std::vector<float> len(other.size()), k(other.size());
     for (std::size_t i = 0; i < N; ++i) off[i + 1] = off[i] + deg[i];
     std::vector<int> fill(off.begin(), off.end() - 1);
     for (std::size_t e = 0; e < edge_a.size(); ++e) {
       int a = edge_a[e], b = edge_b[e];
-      float ke = edge_k0[e] * scale(std::max(deg[a], deg[b]));
-      other[fill[a]] = b, len[fill[a]] = edge_len[e], k[fill[a]++] = ke;
-      other[fill[b]] = a, len[fill[b]] = edge_len[e], k[fill[b]++] = ke;
+      float ke = edge_k0[e];
+      ecol[fill[a]] = col[e], other[fill[a]] = b, len[fill[a]] = edge_len[e], k[fill[a]++] = ke;
+      ecol[fill[b]] = col[e], other[fill[b]] = a, len[fill[b]] = edge_len[e], k[fill[b]++] = ke;
     }
+    if (other.empty()) other.push_back(0), ecol.push_back(-1), len.push_back(0.f), k.push_back(0.f);
+    dist_colour = Buffer<int>::from_host(ecol, dev);
     dist_off = Buffer<int>::from_host(off, dev), dist_other = Buffer<int>::from_host(other, dev);
     dist_len = Buffer<float>::from_host(len, dev), dist_k = Buffer<float>::from_host(k, dev);
     std::vector<float> bk(bends.size());
