@@ -3,6 +3,7 @@
 // voxel_hash.hpp; these are the kernel families, each written once over the executor.
 #pragma once
 #include <cstdint>
+#include <cstring>
 
 #include "core/camera.hpp"
 #include "core/math.hpp"
@@ -66,22 +67,38 @@ template <class Exec>
 void allocate_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list, HashCounters* counters,
                      FrameInput in, VoxelGeometry geom);
 // Appends to visible_slots every allocated block whose voxels may project into the image
-// (counters->visible is the count). Also clamps free_top after a failed allocation pass.
+// (counters->visible is the count) and zeroes its keep flag (keep may be empty). Also clamps
+// free_top after a failed allocation pass.
 template <class Exec>
 void find_visible_blocks(const Exec& ex, HashTableView t, HashCounters* counters, FrameInput in, VoxelGeometry geom,
-                         View<std::int32_t> visible_slots);
-// Fuses one frame into the listed blocks, one thread per voxel.
+                         View<std::int32_t> visible_slots, View<std::int32_t> keep);
+// Fuses one frame into the listed blocks, one thread per voxel. When keep is not empty, keep[j]
+// becomes 1 if block j still has a voxel near a surface afterwards (voxel_keeps_block), so that
+// finding the empty blocks costs no second pass over the voxels.
 template <class Exec>
 void fuse_hash_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
-                      Voxel* voxels, FrameInput in, VoxelGeometry geom, float max_weight, bool color);
+                      Voxel* voxels, FrameInput in, VoxelGeometry geom, float max_weight, bool color,
+                      View<std::int32_t> keep, float keep_below);
 // Fuses one frame into every block of a dense grid.
 template <class Exec>
 void fuse_dense_blocks(const Exec& ex, DenseAccess grid, FrameInput in, float max_weight, bool color);
-// Frees the listed blocks that hold no voxel with weight > 0 and |sdf| < keep_below (metres):
-// zeroes them, tombstones their keys, pushes them on the free list (counters->removed counts).
+
+// A block is worth keeping while one of its voxels is observed (weight > 0) and near a surface
+// (|sdf| < keep_below, metres); a block of free space or never-observed voxels can go.
+SEAMLESS_HD inline bool voxel_keeps_block(const Voxel& v, float keep_below) {
+  return v.weight > 0.f && fabsf(v.sdf) < keep_below;
+}
+// keep[j] = 1 if listed block j has a voxel that keeps it (the caller zeroes keep), one thread
+// per voxel: the stand-alone version of the marking that fuse_hash_blocks does.
 template <class Exec>
-void remove_empty_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
-                         Voxel* voxels, View<std::int32_t> free_list, HashCounters* counters, float keep_below);
+void mark_kept_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
+                      const Voxel* voxels, View<std::int32_t> keep, float keep_below);
+// Frees the listed blocks whose keep flag is 0: zeroes their voxels, tombstones their keys and
+// pushes them on the free list (counters->removed counts). A few threads per block.
+template <class Exec>
+void remove_unkept_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
+                          View<const std::int32_t> keep, Voxel* voxels, View<std::int32_t> free_list,
+                          HashCounters* counters);
 
 // --- raycasting (family recon/tsdf_raycast) ----------------------------------------------------
 struct RaycastOutput {
@@ -90,12 +107,56 @@ struct RaycastOutput {
   View2D<vec3> normal;    // world coordinates, unit, facing the camera; zero where no hit
   View2D<uchar3> color;   // fused colour; zero where no hit
 };
-// One ray per pixel from min_depth to max_depth: skips unallocated blocks whole, steps by the
-// TSDF inside allocated ones, refines the +/- zero crossing by regula falsi on the trilinear
-// field and takes the normal from its gradient (KinectFusion section 3.5; Niessner section 4.3).
+// Ray intervals (Niessner section 4.3): the image is cut into tile x tile pixel tiles, and each
+// tile holds the camera-depth range [near, far] covered by the blocks whose boxes project onto it,
+// so that a ray marches only from its tile's near to its far depth and a tile without blocks casts
+// no ray at all. Depths are stored as the bits of positive floats, which order like the floats,
+// so integer atomic_min / atomic_max splat them on both backends.
+struct RayIntervals {
+  std::int32_t* bits = nullptr;  // 2 per tile, row-major: [2t] near, [2t+1] far; nullptr: no intervals
+  int tile = 8, tiles_x = 0, tiles_y = 0;
+  SEAMLESS_HD std::int64_t count() const { return static_cast<std::int64_t>(tiles_x) * tiles_y; }
+  SEAMLESS_HD int tile_of(int x, int y) const { return (y / tile) * tiles_x + x / tile; }
+};
+constexpr std::int32_t kEmptyNear = 0x7f800000;  // +infinity
+constexpr std::int32_t kEmptyFar = 0;            // +0: no block splatted
+SEAMLESS_HD inline std::int32_t float_bits(float f) {
+#ifdef __CUDA_ARCH__
+  return __float_as_int(f);
+#else
+  std::int32_t i;
+  std::memcpy(&i, &f, sizeof i);
+  return i;
+#endif
+}
+SEAMLESS_HD inline float bits_float(std::int32_t i) {
+#ifdef __CUDA_ARCH__
+  return __int_as_float(i);
+#else
+  float f;
+  std::memcpy(&f, &i, sizeof f);
+  return f;
+#endif
+}
+// Empties every tile (near = +inf, far = 0).
+template <class Exec>
+void clear_ray_intervals(const Exec& ex, RayIntervals iv);
+// One thread per hash slot: each live block's cell box [8b, 8b+8]^3 (voxel units; every sample a
+// ray can take in the block lies in it), clipped to the depth slab [min_depth, max_depth], is
+// projected, and the tiles under its pixel bounding box take the min / max of its depth range.
+template <class Exec>
+void splat_ray_intervals(const Exec& ex, HashTableView t, VoxelGeometry geom, Intrinsics K, SE3 world_T_camera,
+                         float min_depth, float max_depth, RayIntervals iv);
+
+// One ray per pixel from min_depth to max_depth, or only over its tile's interval when iv.bits is
+// set: skips unallocated blocks whole, steps by the TSDF inside allocated ones, refines the +/-
+// zero crossing by regula falsi on the trilinear field and takes the normal from its gradient
+// (KinectFusion section 3.5; Niessner section 4.3). A ray starting before its tile's near depth is
+// in unallocated blocks up to there, where the full march skips block by block, so both take the
+// same samples from the first block on and hit the same surfaces.
 template <class Exec, class Acc>
 void raycast(const Exec& ex, Acc a, Intrinsics K, SE3 world_T_camera, float min_depth, float max_depth,
-             RaycastOutput out);
+             RaycastOutput out, RayIntervals iv = {});
 
 }  // namespace seamless::kernels
 

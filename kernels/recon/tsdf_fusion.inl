@@ -104,15 +104,22 @@ SEAMLESS_HD inline bool block_maybe_visible(int3 b, const FrameInput& in, const 
 
 template <class Exec>
 void find_visible_blocks(const Exec& ex, HashTableView t, HashCounters* counters, FrameInput in, VoxelGeometry geom,
-                         View<std::int32_t> visible_slots) {
+                         View<std::int32_t> visible_slots, View<std::int32_t> keep) {
   const SE3 camera_T_world = in.world_T_camera.inverse();
   ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
     if (i == 0 && counters->free_top < 0) counters->free_top = 0;  // after failed pops
     HashKey k = t.keys[i];
     if (!is_live_key(k) || t.values[i] < 0) return;
     if (!block_maybe_visible(unpack_block(k), in, camera_T_world, geom)) return;
-    visible_slots[atomic_add(&counters->visible, 1)] = static_cast<std::int32_t>(i);
+    const int j = atomic_add(&counters->visible, 1);
+    visible_slots[j] = static_cast<std::int32_t>(i);
+    if (keep.data) keep[j] = 0;
   });
+}
+
+// Sets a keep flag; the read first spares the atomic when another voxel already set it.
+SEAMLESS_HD inline void set_keep(std::int32_t* flag) {
+  if (atomic_load(flag) == 0) atomic_exch(flag, 1);
 }
 
 // Weighted running average of the truncated signed distance (Curless & Levoy 1996; KinectFusion
@@ -144,18 +151,21 @@ SEAMLESS_HD inline void fuse_voxel(Voxel& v, vec3 p_world, const FrameInput& in,
 
 template <class Exec>
 void fuse_hash_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
-                      Voxel* voxels, FrameInput in, VoxelGeometry geom, float max_weight, bool color) {
+                      Voxel* voxels, FrameInput in, VoxelGeometry geom, float max_weight, bool color,
+                      View<std::int32_t> keep, float keep_below) {
   const SE3 camera_T_world = in.world_T_camera.inverse();
   ex.for_each(count * kBlockVoxels, [=] SEAMLESS_HD(std::int64_t i) {
-    std::int32_t slot = slots[i / kBlockVoxels];
+    const std::int64_t j = i / kBlockVoxels;
+    std::int32_t slot = slots[j];
     int li = static_cast<int>(i % kBlockVoxels);
     std::int32_t block = t.values[slot];
     if (block < 0) return;
     int3 b = unpack_block(t.keys[slot]);
     int3 l = local_coords(li);
     vec3 g{float(b.x * 8 + l.x), float(b.y * 8 + l.y), float(b.z * 8 + l.z)};
-    fuse_voxel(voxels[static_cast<std::int64_t>(block) * kBlockVoxels + li], geom.to_world(g), in, camera_T_world,
-               geom.truncation, max_weight, color);
+    Voxel& v = voxels[static_cast<std::int64_t>(block) * kBlockVoxels + li];
+    fuse_voxel(v, geom.to_world(g), in, camera_T_world, geom.truncation, max_weight, color);
+    if (keep.data && voxel_keeps_block(v, keep_below)) set_keep(&keep[j]);
   });
 }
 
@@ -175,17 +185,36 @@ void fuse_dense_blocks(const Exec& ex, DenseAccess grid, FrameInput in, float ma
 }
 
 template <class Exec>
-void remove_empty_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
-                         Voxel* voxels, View<std::int32_t> free_list, HashCounters* counters, float keep_below) {
-  ex.for_each(count, [=] SEAMLESS_HD(std::int64_t i) {
-    std::int32_t slot = slots[i];
+void mark_kept_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
+                      const Voxel* voxels, View<std::int32_t> keep, float keep_below) {
+  ex.for_each(count * kBlockVoxels, [=] SEAMLESS_HD(std::int64_t i) {
+    const std::int64_t j = i / kBlockVoxels;
+    std::int32_t block = t.values[slots[j]];
+    if (block < 0) return;
+    if (voxel_keeps_block(voxels[static_cast<std::int64_t>(block) * kBlockVoxels + i % kBlockVoxels], keep_below))
+      set_keep(&keep[j]);
+  });
+}
+
+template <class Exec>
+void remove_unkept_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
+                          View<const std::int32_t> keep, Voxel* voxels, View<std::int32_t> free_list,
+                          HashCounters* counters) {
+  // kParts threads per block, each zeroing 512 / kParts voxels: one thread clearing a whole block
+  // (6 KiB) would hold up the kernel. Part 0 also frees the slot and the block; the block is not
+  // handed out again before the next allocation kernel, after this one has finished. The slot's
+  // value is left as it is (as hash_erase does): nobody reads the value of a tombstone.
+  constexpr int kParts = 8, kPerPart = kBlockVoxels / kParts;
+  ex.for_each(count * kParts, [=] SEAMLESS_HD(std::int64_t i) {
+    const std::int64_t j = i / kParts;
+    const int part = static_cast<int>(i % kParts);
+    if (keep[j]) return;
+    std::int32_t slot = slots[j];
     std::int32_t block = t.values[slot];
     if (block < 0) return;
-    Voxel* v = voxels + static_cast<std::int64_t>(block) * kBlockVoxels;
-    for (int k = 0; k < kBlockVoxels; ++k)
-      if (v[k].weight > 0.f && fabsf(v[k].sdf) < keep_below) return;  // near a surface: keep
-    for (int k = 0; k < kBlockVoxels; ++k) v[k] = Voxel{0.f, 0.f, {0, 0, 0}, 0};
-    t.values[slot] = -1;
+    Voxel* v = voxels + static_cast<std::int64_t>(block) * kBlockVoxels + part * kPerPart;
+    for (int k = 0; k < kPerPart; ++k) v[k] = Voxel{0.f, 0.f, {0, 0, 0}, 0};
+    if (part != 0) return;
     atomic_exch(&t.keys[slot], kTombstone);
     pool_push(counters, free_list.data, block);
     atomic_add(&counters->tombstones, 1);
@@ -200,10 +229,13 @@ void remove_empty_blocks(const Exec& ex, HashTableView t, View<const std::int32_
   template void allocate_blocks<EXEC>(const EXEC&, HashTableView, View<const std::int32_t>, HashCounters*,        \
                                       FrameInput, VoxelGeometry);                                                 \
   template void find_visible_blocks<EXEC>(const EXEC&, HashTableView, HashCounters*, FrameInput, VoxelGeometry,   \
-                                          View<std::int32_t>);                                                    \
+                                          View<std::int32_t>, View<std::int32_t>);                                \
   template void fuse_hash_blocks<EXEC>(const EXEC&, HashTableView, View<const std::int32_t>, std::int64_t,        \
-                                       Voxel*, FrameInput, VoxelGeometry, float, bool);                           \
+                                       Voxel*, FrameInput, VoxelGeometry, float, bool, View<std::int32_t>,        \
+                                       float);                                                                    \
   template void fuse_dense_blocks<EXEC>(const EXEC&, DenseAccess, FrameInput, float, bool);                       \
-  template void remove_empty_blocks<EXEC>(const EXEC&, HashTableView, View<const std::int32_t>, std::int64_t,     \
-                                          Voxel*, View<std::int32_t>, HashCounters*, float);                      \
+  template void mark_kept_blocks<EXEC>(const EXEC&, HashTableView, View<const std::int32_t>, std::int64_t,        \
+                                       const Voxel*, View<std::int32_t>, float);                                  \
+  template void remove_unkept_blocks<EXEC>(const EXEC&, HashTableView, View<const std::int32_t>, std::int64_t,    \
+                                           View<const std::int32_t>, Voxel*, View<std::int32_t>, HashCounters*);  \
   }

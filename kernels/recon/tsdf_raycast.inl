@@ -31,9 +31,82 @@ SEAMLESS_HD inline float refine_crossing(const Acc& a, vec3 o, vec3 d, float ta,
   return ta + (tb - ta) * fa / (fa - fb);
 }
 
+// Pixel bounding box and camera-depth range of a block's cell box clipped to the depth slab.
+struct ScreenBounds {
+  float u0 = 1e30f, u1 = -1e30f, v0 = 1e30f, v1 = -1e30f, z0 = 1e30f, z1 = -1e30f;
+  SEAMLESS_HD void add(vec3 p, const Intrinsics& K) {
+    vec2 uv = K.project(p);
+    u0 = fminf(u0, uv.x), u1 = fmaxf(u1, uv.x), v0 = fminf(v0, uv.y), v1 = fmaxf(v1, uv.y);
+    z0 = fminf(z0, p.z), z1 = fmaxf(z1, p.z);
+  }
+};
+
+// Bounds of block b's cell box [8b, 8b+8]^3 (voxel units) seen from the camera, clipped to the
+// slab zn <= z <= zf (zn > 0): the clipped box is convex, and its vertices are the box corners
+// inside the slab and the crossings of the 12 box edges with the two planes. False when empty.
+SEAMLESS_HD inline bool block_screen_bounds(int3 b, const VoxelGeometry& g, const Intrinsics& K,
+                                            const SE3& camera_T_world, float zn, float zf, ScreenBounds* out) {
+  vec3 pc[8];
+  for (int k = 0; k < 8; ++k) {
+    int3 v{8 * (b.x + (k & 1)), 8 * (b.y + ((k >> 1) & 1)), 8 * (b.z + (k >> 2))};
+    pc[k] = camera_T_world * g.to_world(to_vec3(v));
+  }
+  ScreenBounds s;
+  for (int k = 0; k < 8; ++k) {
+    if (pc[k].z >= zn && pc[k].z <= zf) s.add(pc[k], K);
+    for (int axis = 0; axis < 3; ++axis) {  // edge k -> j along axis, each edge once
+      if (k & (1 << axis)) continue;
+      vec3 p = pc[k], q = pc[k | (1 << axis)];
+      const float planes[2] = {zn, zf};
+      for (float plane : planes) {
+        if ((p.z - plane) * (q.z - plane) >= 0.f) continue;
+        vec3 c = p + (q - p) * ((plane - p.z) / (q.z - p.z));
+        c.z = plane;
+        s.add(c, K);
+      }
+    }
+  }
+  *out = s;
+  return s.z0 <= s.z1;
+}
+
+template <class Exec>
+void clear_ray_intervals(const Exec& ex, RayIntervals iv) {
+  ex.for_each(iv.count(), [=] SEAMLESS_HD(std::int64_t t) {
+    iv.bits[2 * t] = kEmptyNear;
+    iv.bits[2 * t + 1] = kEmptyFar;
+  });
+}
+
+template <class Exec>
+void splat_ray_intervals(const Exec& ex, HashTableView t, VoxelGeometry geom, Intrinsics K, SE3 world_T_camera,
+                         float min_depth, float max_depth, RayIntervals iv) {
+  const SE3 camera_T_world = world_T_camera.inverse();
+  const float zn = fmaxf(min_depth, 1e-3f);
+  ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
+    HashKey k = t.keys[i];
+    if (!is_live_key(k) || t.values[i] < 0) return;
+    ScreenBounds s;
+    if (!block_screen_bounds(unpack_block(k), geom, K, camera_T_world, zn, max_depth, &s)) return;
+    // Rays go through pixel centres: pixel x can meet the box only if u0 <= x <= u1. Rounding
+    // outwards keeps the splat conservative.
+    if (s.u1 < 0.f || s.v1 < 0.f || s.u0 > K.width - 1.f || s.v0 > K.height - 1.f) return;
+    const int x0 = static_cast<int>(floorf(fmaxf(s.u0, 0.f))), x1 = static_cast<int>(ceilf(fminf(s.u1, K.width - 1.f)));
+    const int y0 = static_cast<int>(floorf(fmaxf(s.v0, 0.f))), y1 = static_cast<int>(ceilf(fminf(s.v1, K.height - 1.f)));
+    const std::int32_t z_near = float_bits(s.z0), z_far = float_bits(s.z1);
+    for (int ty = y0 / iv.tile; ty <= y1 / iv.tile; ++ty)
+      for (int tx = x0 / iv.tile; tx <= x1 / iv.tile; ++tx) {
+        std::int32_t* tile = iv.bits + 2 * (static_cast<std::int64_t>(ty) * iv.tiles_x + tx);
+        atomic_min(tile, z_near);
+        atomic_max(tile + 1, z_far);
+      }
+  });
+}
+
 template <class Acc>
 SEAMLESS_HD inline void raycast_pixel(const Acc& a, int x, int y, const Intrinsics& K, const SE3& world_T_camera,
-                                      float min_depth, float max_depth, const RaycastOutput& out) {
+                                      float min_depth, float max_depth, const RaycastOutput& out,
+                                      const RayIntervals& iv) {
   out.depth(x, y) = 0.f;
   out.vertex(x, y) = out.normal(x, y) = {0.f, 0.f, 0.f};
   out.color(x, y) = {0, 0, 0};
@@ -44,10 +117,17 @@ SEAMLESS_HD inline void raycast_pixel(const Acc& a, int x, int y, const Intrinsi
   vec3 d = world_T_camera.rotate(dir_c) / g.voxel_size;
   const float dlen = length(d);  // voxels per metre of depth
   const float min_step = 0.5f / dlen;  // half a voxel
+  float z = min_depth, z_end = max_depth;
+  if (iv.bits) {  // march only where blocks are (Niessner section 4.3)
+    const int t = iv.tile_of(x, y);
+    const float z_near = bits_float(iv.bits[2 * t]), z_far = bits_float(iv.bits[2 * t + 1]);
+    if (!(z_far > 0.f)) return;  // no block projects here: nothing to hit
+    z = fmaxf(z, z_near - min_step), z_end = fminf(z_end, z_far + min_step);
+  }
   BlockCache c;
-  float z = min_depth, z_prev = 0.f, f_prev = 0.f;
+  float z_prev = 0.f, f_prev = 0.f;
   bool have_prev = false;
-  for (int it = 0; it < 8192 && z < max_depth; ++it) {
+  for (int it = 0; it < 8192 && z < z_end; ++it) {
     vec3 q = o + d * z;
     int3 b = block_of_voxel(floor_to_int(q));
     if (!(b == c.block)) {
@@ -81,19 +161,22 @@ SEAMLESS_HD inline void raycast_pixel(const Acc& a, int x, int y, const Intrinsi
       return;
     }
     z_prev = z, f_prev = f, have_prev = true;
-    // The TSDF is at most about the distance to the surface (projective distances over-estimate
-    // at grazing angles, hence the 0.8), so stepping that far along the ray (|d| s metres per unit
-    // of z) cannot jump over a zero crossing.
-    z += fmaxf(0.8f * f / (dlen * g.voxel_size), min_step);
+    // |TSDF| is at most about the distance to the nearest zero crossing (projective distances
+    // over-estimate at grazing angles, hence the 0.8), so stepping that far along the ray (|d| s
+    // metres per unit of z) cannot jump over one: truncation-sized steps in the band's free-space
+    // side (and through the back of a surface a ray enters from behind), shrinking to half a
+    // voxel at the surface.
+    z += fmaxf(0.8f * fabsf(f) / (dlen * g.voxel_size), min_step);
   }
 }
 
 template <class Exec, class Acc>
 void raycast(const Exec& ex, Acc a, Intrinsics K, SE3 world_T_camera, float min_depth, float max_depth,
-             RaycastOutput out) {
+             RaycastOutput out, RayIntervals iv) {
   const int w = out.depth.width;
   ex.for_each(out.depth.count(), [=] SEAMLESS_HD(std::int64_t i) {
-    raycast_pixel(a, static_cast<int>(i % w), static_cast<int>(i / w), K, world_T_camera, min_depth, max_depth, out);
+    raycast_pixel(a, static_cast<int>(i % w), static_cast<int>(i / w), K, world_T_camera, min_depth, max_depth, out,
+                  iv);
   });
 }
 
@@ -101,7 +184,11 @@ void raycast(const Exec& ex, Acc a, Intrinsics K, SE3 world_T_camera, float min_
 
 #define SEAMLESS_INSTANTIATE_TSDF_RAYCAST(EXEC)                                                                  \
   namespace seamless::kernels {                                                                                  \
-  template void raycast<EXEC, HashAccess>(const EXEC&, HashAccess, Intrinsics, SE3, float, float, RaycastOutput); \
+  template void raycast<EXEC, HashAccess>(const EXEC&, HashAccess, Intrinsics, SE3, float, float, RaycastOutput,  \
+                                          RayIntervals);                                                         \
   template void raycast<EXEC, DenseAccess>(const EXEC&, DenseAccess, Intrinsics, SE3, float, float,              \
-                                           RaycastOutput);                                                       \
+                                           RaycastOutput, RayIntervals);                                         \
+  template void clear_ray_intervals<EXEC>(const EXEC&, RayIntervals);                                            \
+  template void splat_ray_intervals<EXEC>(const EXEC&, HashTableView, VoxelGeometry, Intrinsics, SE3, float,     \
+                                          float, RayIntervals);                                                  \
   }

@@ -87,15 +87,11 @@ struct HashTableView {
   SEAMLESS_HD std::uint32_t home(HashKey k) const { return static_cast<std::uint32_t>(mix64(k)) & mask; }
 
   // Slot holding key, or -1. Safe concurrently with insert and erase of other keys.
-  SEAMLESS_HD std::int32_t find(HashKey key) const {
-    std::uint32_t s = home(key);
-    for (int p = 0; p < max_probe; ++p, s = (s + 1) & mask) {
-      HashKey k = atomic_load(&keys[s]);
-      if (k == key) return static_cast<std::int32_t>(s);
-      if (k == kEmptyKey) return -1;
-    }
-    return -1;
-  }
+  SEAMLESS_HD std::int32_t find(HashKey key) const { return probe<true>(key); }
+  // The same for kernels during which nobody modifies the table (raycast, extraction, the physics
+  // SDF sampler): plain loads, which the GPU caches in L1, where atomic (volatile) loads go to L2
+  // on every probe.
+  SEAMLESS_HD std::int32_t find_stable(HashKey key) const { return probe<false>(key); }
 
   // Claims a slot for key (or finds the one that holds it). *probes is how far from home it is.
   SEAMLESS_HD InsertResult insert(HashKey key, std::int32_t* slot, int* probes) const {
@@ -110,6 +106,17 @@ struct HashTableView {
       }
     }
     return InsertResult::Full;
+  }
+
+  template <bool Atomic>
+  SEAMLESS_HD std::int32_t probe(HashKey key) const {
+    std::uint32_t s = home(key);
+    for (int p = 0; p < max_probe; ++p, s = (s + 1) & mask) {
+      HashKey k = Atomic ? atomic_load(&keys[s]) : keys[s];
+      if (k == key) return static_cast<std::int32_t>(s);
+      if (k == kEmptyKey) return -1;
+    }
+    return -1;
   }
 
   // Turns key's slot into a tombstone; returns the slot it held, or -1 if absent.
@@ -147,14 +154,15 @@ SEAMLESS_HD inline int3 block_of_voxel(int3 g) { return {g.x >> 3, g.y >> 3, g.z
 SEAMLESS_HD inline int local_index(int3 g) { return (g.x & 7) + 8 * (g.y & 7) + 64 * (g.z & 7); }
 SEAMLESS_HD inline int3 local_coords(int i) { return {i & 7, (i >> 3) & 7, i >> 6}; }
 
-// Voxel hashing access: the device view of a VoxelHashVolume that physics kernels may copy.
+// Voxel hashing access: the device view of a VoxelHashVolume that physics kernels may copy. Only
+// for kernels that run between frames (no concurrent insertion or removal): lookups use plain loads.
 struct HashAccess {
   HashTableView table;
   Voxel* voxels = nullptr;
   VoxelGeometry geom;
   SEAMLESS_HD std::int32_t find_block(int3 b) const {
     if (!block_in_range(b)) return -1;
-    std::int32_t s = table.find(pack_block(b));
+    std::int32_t s = table.find_stable(pack_block(b));
     return s < 0 ? -1 : table.values[s];
   }
 };

@@ -23,6 +23,7 @@ struct VolumeParams {
   bool integrate_color = true;
   bool remove_empty_blocks = true;
   bool grow_when_full = true;        // double the hash table / block pool instead of dropping blocks
+  int raycast_tile = 8;              // pixels per side of a ray-interval tile (Niessner 4.3); 0: none
 
   template <class V> void visit(V& v) {
     v("layout", layout, "volume layout: voxel hashing or dense grid", Choices{"hash", "dense"});
@@ -39,6 +40,10 @@ struct VolumeParams {
     v("remove_empty_blocks", remove_empty_blocks, "free blocks whose voxels all became empty");
     v("grow_when_full", grow_when_full,
       "when the hash table or block pool runs out, grow it (and retry) instead of dropping blocks with a warning");
+    v("raycast_tile", raycast_tile,
+      "hash layout: rays march only over the depth range of the blocks projecting onto their tile of this many "
+      "pixels per side (Niessner 2013, section 4.3); 0 marches every ray from min_depth",
+      Range{0, 256});
   }
 };
 

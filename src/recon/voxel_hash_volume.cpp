@@ -50,6 +50,7 @@ VoxelHashVolume::VoxelHashVolume(const VolumeParams& p, Device d) : params_(p), 
   voxels_.zero();
   free_list_ = Buffer<std::int32_t>(p.capacity, d);
   visible_ = Buffer<std::int32_t>(p.capacity, d);
+  keep_ = Buffer<std::int32_t>(p.capacity, d);
   counters_ = Buffer<HashCounters>(1, d);
   with_exec(d, [&](const auto& ex) {
     kernels::hash_clear(ex, table());
@@ -81,15 +82,18 @@ void VoxelHashVolume::integrate(const Image<float>& depth, const Image<uchar3>& 
   maybe_rehash();
   allocate_and_list(in, timer);
   const std::int64_t n = last_.visible;
+  // Fusion flags the visible blocks that keep a voxel near a surface, so removing the others
+  // needs no second pass over their voxels (one thread per voxel there, not per block).
+  const View<std::int32_t> keep = params_.remove_empty_blocks ? keep_.view() : View<std::int32_t>{};
   with_exec(device_, [&](const auto& ex) {
     staged(timer, "fuse", [&] {
       kernels::fuse_hash_blocks(ex, table(), visible_.cview(), n, voxels_.data(), in, geom_, params_.max_weight,
-                                params_.integrate_color);
+                                params_.integrate_color, keep, keep_below());
     });
     if (params_.remove_empty_blocks)
       staged(timer, "remove_empty", [&] {
-        kernels::remove_empty_blocks(ex, table(), visible_.cview(), n, voxels_.data(), free_list_.view(),
-                                     counters_.data(), 0.999f * geom_.truncation);
+        kernels::remove_unkept_blocks(ex, table(), visible_.cview(), n, keep_.cview(), voxels_.data(),
+                                      free_list_.view(), counters_.data());
       });
   });
   ++frames_;
@@ -105,7 +109,7 @@ void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTime
         kernels::allocate_blocks(ex, table(), free_list_.cview(), counters_.data(), in, geom_);
       });
       staged(timer, "visible", [&] {
-        kernels::find_visible_blocks(ex, table(), counters_.data(), in, geom_, visible_.view());
+        kernels::find_visible_blocks(ex, table(), counters_.data(), in, geom_, visible_.view(), keep_.view());
       });
     });
     last_ = read_counters();
@@ -198,6 +202,7 @@ void VoxelHashVolume::grow_pool(std::int64_t blocks) {
   free_list.copy_from(free_list_);
   free_list_ = std::move(free_list);
   visible_ = Buffer<std::int32_t>(blocks, device_);
+  keep_ = Buffer<std::int32_t>(blocks, device_);
   with_exec(device_, [&](const auto& ex) {
     kernels::pool_append(ex, free_list_.view(), counters_.data(), static_cast<std::int32_t>(old),
                          static_cast<std::int32_t>(blocks - old));
@@ -208,10 +213,14 @@ void VoxelHashVolume::grow_pool(std::int64_t blocks) {
 std::int64_t VoxelHashVolume::remove_empty_blocks() {
   Buffer<std::int32_t> slots;
   const std::int64_t n = live_slots(slots);
+  Buffer<std::int32_t> keep(n, device_);
+  keep.zero();
+  const View<const std::int32_t> listed{slots.data(), n};
   with_exec(device_, [&](const auto& ex) {
     kernels::reset_frame_counters(ex, counters_.data());
-    kernels::remove_empty_blocks(ex, table(), slots.cview(), n, voxels_.data(), free_list_.view(), counters_.data(),
-                                 0.999f * geom_.truncation);
+    kernels::mark_kept_blocks(ex, table(), listed, n, voxels_.data(), keep.view(), keep_below());
+    kernels::remove_unkept_blocks(ex, table(), listed, n, keep.cview(), voxels_.data(), free_list_.view(),
+                                  counters_.data());
   });
   last_ = read_counters();
   return last_.removed;
@@ -257,9 +266,21 @@ std::vector<VoxelHashVolume::HostBlock> VoxelHashVolume::download_blocks() const
 void VoxelHashVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, RaycastMaps& maps, StageTimer* timer) {
   detail::resize_maps(maps, K, device_);
   kernels::RaycastOutput out{maps.depth.view(), maps.vertex.view(), maps.normal.view(), maps.color.view()};
+  kernels::RayIntervals iv;  // empty: every ray marches from min_depth
+  if (params_.raycast_tile > 0) {
+    iv.tile = params_.raycast_tile;
+    iv.tiles_x = (K.width + iv.tile - 1) / iv.tile;
+    iv.tiles_y = (K.height + iv.tile - 1) / iv.tile;
+    intervals_.reserve_discard(2 * iv.count(), device_);
+    iv.bits = intervals_.data();
+  }
   with_exec(device_, [&](const auto& ex) {
     staged(timer, "raycast", [&] {
-      kernels::raycast(ex, device_view(), K, world_T_camera, params_.min_depth, params_.max_depth, out);
+      if (iv.bits) {
+        kernels::clear_ray_intervals(ex, iv);
+        kernels::splat_ray_intervals(ex, table(), geom_, K, world_T_camera, params_.min_depth, params_.max_depth, iv);
+      }
+      kernels::raycast(ex, device_view(), K, world_T_camera, params_.min_depth, params_.max_depth, out, iv);
     });
   });
 }
@@ -304,7 +325,7 @@ VolumeStats VoxelHashVolume::stats() {
   s.bytes_per_block = sizeof(kernels::Voxel) * kBlockVoxels;
   s.voxel_bytes = s.bytes_per_block * static_cast<std::size_t>(s.allocated_blocks);
   s.device_bytes = keys_.bytes() + values_.bytes() + scratch_.bytes() + voxels_.bytes() + free_list_.bytes() +
-                   visible_.bytes() + counters_.bytes();
+                   visible_.bytes() + keep_.bytes() + intervals_.bytes() + counters_.bytes();
   return s;
 }
 

@@ -49,6 +49,8 @@ class VoxelHashVolume final : public Volume {
 
  private:
   kernels::HashTableView table() const;
+  // Blocks with no observed voxel closer to a surface than this (metres) are freed as empty.
+  float keep_below() const { return 0.999f * geom_.truncation; }
   kernels::HashCounters read_counters() const;
   void allocate_and_list(const kernels::FrameInput& in, StageTimer* timer);
   void handle_failures(const kernels::HashCounters& c);
@@ -65,6 +67,8 @@ class VoxelHashVolume final : public Volume {
   Buffer<std::int32_t> free_list_;
   Buffer<kernels::HashCounters> counters_;
   Buffer<std::int32_t> visible_;
+  Buffer<std::int32_t> keep_;             // per visible block: 1 = has a voxel near a surface
+  Buffer<std::int32_t> intervals_;        // ray-interval tiles (kernels::RayIntervals)
   mutable Buffer<std::int32_t> scratch_;  // one int per slot for scans
   kernels::HashCounters last_{};          // counters as read at the end of the last frame
   std::int64_t frames_ = 0, retries_ = 0, failed_ = 0;
