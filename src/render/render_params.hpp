@@ -1,7 +1,9 @@
 // Render section (`render:`): window / headless output, what to draw and what to write.
+// docs/RENDERING.md explains every key and the passes they tune.
 #pragma once
 #include <string>
 
+#include "core/math.hpp"
 #include "core/params.hpp"
 
 namespace seamless {
@@ -15,6 +17,29 @@ struct RenderParams {
   bool write_frames = false;
   bool video = false;
   bool stage_images = false;
+  // Camera of the mesh view (the Kinect view uses the sensor's intrinsics and tracked pose).
+  float fov_y = 60.f;                 // degrees, vertical
+  float znear = 0.05f, zfar = 30.f;   // metres
+  int fps = 30;                       // video frame rate
+  // What is drawn (the window toggles these with keys 1-5).
+  bool show_scene = true, show_fluid = true, show_rigid = true, show_cloth = true;
+  bool show_particles = false;        // every dynamic particle as a sphere impostor (debug view)
+  // Shading.
+  vec3 background{0.12f, 0.13f, 0.15f};  // clear colour of the mesh view, linear 0..1
+  vec3 light_dir{0.3f, -1.f, 0.4f};      // direction the light travels, world coordinates
+  float ambient = 0.3f;                  // fraction of light that is not directional
+  bool light_scene = false;              // the scan's colours already hold the room's lighting
+  vec3 rigid_color{0.85f, 0.3f, 0.2f};
+  vec3 cloth_color{0.9f, 0.75f, 0.3f};
+  // Screen-space fluid rendering (van der Laan, Green, Sainz 2009).
+  int filter_iterations = 2;          // separable bilateral passes (x then y) over the depth
+  float filter_size = 3.f;            // filter half-width in particle radii (world), projected per pixel
+  int filter_max_px = 24;             // ... but at most this many pixels
+  float filter_depth_sigma = 1.f;     // range sigma of the bilateral filter, in particle radii
+  vec3 absorption{6.f, 1.8f, 0.8f};   // Beer-Lambert coefficients per colour channel, 1/m (water-like)
+  float refraction = 0.06f;           // screen-space refraction offset per metre of thickness
+  float fresnel_f0 = 0.02f;           // reflectance at normal incidence (water: ((1-1.33)/(1+1.33))^2)
+  int cube_size = 256;                // cube map face size for reflections in the mesh view
 
   template <class V> void visit(V& v) {
     v("mode", mode, "window, headless (PNGs) or no rendering", Choices{"window", "headless", "none"});
@@ -25,6 +50,29 @@ struct RenderParams {
     v("write_frames", write_frames, "write each rendered frame as PNG into the output folder");
     v("video", video, "encode the frames into a video (needs ffmpeg)");
     v("stage_images", stage_images, "also write the intermediate SSFR stages (depth, blur, thickness)");
+    v("fov_y", fov_y, "vertical field of view of the mesh view camera, degrees", Range{5.0, 170.0});
+    v("znear", znear, "near clipping distance, metres", Range{1e-4, 10.0});
+    v("zfar", zfar, "far clipping distance, metres", Range{0.1, 1e5});
+    v("fps", fps, "frame rate of the encoded video", Range{1, 240});
+    v("show_scene", show_scene, "draw the scene (mesh or Kinect image)");
+    v("show_fluid", show_fluid, "draw fluid particles");
+    v("show_rigid", show_rigid, "draw rigid bodies");
+    v("show_cloth", show_cloth, "draw cloth");
+    v("show_particles", show_particles, "draw every dynamic particle as a sphere (debug)");
+    v("background", background, "clear colour of the mesh view, RGB 0..1");
+    v("light_dir", light_dir, "direction the light travels, world coordinates");
+    v("ambient", ambient, "ambient fraction of the lighting", Range{0.0, 1.0});
+    v("light_scene", light_scene, "also light the scene mesh (its colours already contain lighting)");
+    v("rigid_color", rigid_color, "colour of rigid bodies, RGB 0..1");
+    v("cloth_color", cloth_color, "colour of cloth, RGB 0..1");
+    v("filter_iterations", filter_iterations, "bilateral depth filter passes", Range{0, 16});
+    v("filter_size", filter_size, "depth filter half-width, particle radii", Range{0.0, 50.0});
+    v("filter_max_px", filter_max_px, "depth filter half-width limit, pixels", Range{1, 128});
+    v("filter_depth_sigma", filter_depth_sigma, "bilateral range sigma, particle radii", Range{0.01, 100.0});
+    v("absorption", absorption, "fluid absorption per channel (Beer-Lambert), 1/m");
+    v("refraction", refraction, "refraction offset, screen fraction per metre of thickness", Range{0.0, 10.0});
+    v("fresnel_f0", fresnel_f0, "fluid reflectance at normal incidence", Range{0.0, 1.0});
+    v("cube_size", cube_size, "reflection cube map face size, pixels", Range{16, 4096});
   }
 };
 

@@ -1,0 +1,79 @@
+#include "render/bench_render.hpp"
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+
+#include "kernels/physics/particle_math.hpp"
+#include "recon/volume.hpp"
+
+namespace seamless {
+namespace {
+
+double median_of(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+// A floor of 4 x 4 m at y = 0 as the scene.
+Mesh floor_mesh() {
+  Mesh m;
+  m.positions = {{-2, 0, -2}, {2, 0, -2}, {2, 0, 2}, {-2, 0, 2}};
+  m.normals.assign(4, vec3{0, 1, 0});
+  m.colors.assign(4, uchar3{150, 140, 120});
+  m.triangles = {{0, 1, 2}, {0, 2, 3}};
+  return m;
+}
+
+}  // namespace
+
+RenderBenchResult bench_render(int width, int height, std::int64_t particles, int frames) {
+  RenderParams p;
+  p.width = width, p.height = height;
+  Renderer r(p, width, height);
+  r.set_scene_mesh(floor_mesh());
+  // A cube of fluid on a lattice of one diameter, standing on the floor.
+  const float radius = 0.005f;
+  const int side = static_cast<int>(std::ceil(std::cbrt(static_cast<double>(particles))));
+  std::vector<vec3> x;
+  x.reserve(static_cast<std::size_t>(particles));
+  for (int k = 0; k < side && static_cast<std::int64_t>(x.size()) < particles; ++k)
+    for (int j = 0; j < side && static_cast<std::int64_t>(x.size()) < particles; ++j)
+      for (int i = 0; i < side && static_cast<std::int64_t>(x.size()) < particles; ++i)
+        x.push_back(vec3{(i - side / 2) * 2 * radius, (j + 0.5f) * 2 * radius, (k - side / 2) * 2 * radius});
+  std::vector<std::uint32_t> ph(x.size(), kernels::phase::kFluid);
+  DrawList list;
+  list.positions = x, list.phases = ph, list.particle_radius = radius;
+  const float extent = side * 2 * radius;
+  RenderCamera cam = RenderCamera::look_at({extent * 0.9f, extent * 1.1f, extent * 1.3f}, {0, extent * 0.4f, 0},
+                                           {0, 1, 0}, 60.f, width, height);
+  r.draw(list, cam);  // warm-up: shader compilation, allocation, first upload
+  glFinish();
+  std::vector<double> frame_ms, read_ms;
+  std::map<std::string, std::vector<double>> pass_ms;
+  using clock = std::chrono::steady_clock;
+  for (int f = 0; f < frames; ++f) {
+    auto t0 = clock::now();
+    r.draw(list, cam);
+    glFinish();
+    auto t1 = clock::now();
+    (void)r.read_frame();
+    auto t2 = clock::now();
+    frame_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+    read_ms.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
+    for (const RenderTiming& t : r.timings()) pass_ms[t.pass].push_back(t.ms);
+  }
+  RenderBenchResult res;
+  res.width = width, res.height = height, res.particles = static_cast<std::int64_t>(x.size()), res.frames = frames;
+  res.median_frame_ms = median_of(frame_ms);
+  res.median_readback_ms = median_of(read_ms);
+  for (const RenderTiming& t : r.timings()) res.passes.push_back({t.pass, median_of(pass_ms[t.pass])});
+  res.gl_renderer = r.gl_info().renderer;
+  return res;
+}
+
+}  // namespace seamless

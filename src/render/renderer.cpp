@@ -1,0 +1,387 @@
+// Renderer: programs, targets, the scene (mesh or Kinect view), rigid boxes, cloth, particles.
+// The fluid passes are in renderer_fluid.cpp.
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.hpp"
+#include "kernels/physics/particle_math.hpp"
+#include "recon/volume.hpp"
+#include "render/renderer_impl.hpp"
+
+namespace seamless {
+namespace {
+
+std::vector<float> mat3_cols(const mat3& R) {  // column-major for glUniformMatrix3fv
+  return {R.m[0][0], R.m[1][0], R.m[2][0], R.m[0][1], R.m[1][1], R.m[2][1], R.m[0][2], R.m[1][2], R.m[2][2]};
+}
+
+// Area-weighted vertex normals of a triangle mesh (smooth shading, dissertation eq. 4.23 summed
+// over the triangles around each vertex).
+std::vector<vec3> vertex_normals(const std::vector<vec3>& p, const std::vector<int3>& tris) {
+  std::vector<vec3> n(p.size(), vec3{0.f, 0.f, 0.f});
+  for (const int3& t : tris) {
+    const vec3 c = cross(p[t.y] - p[t.x], p[t.z] - p[t.x]);  // |c| = twice the area
+    n[t.x] += c, n[t.y] += c, n[t.z] += c;
+  }
+  for (vec3& v : n) v = normalize(v);
+  return n;
+}
+
+}  // namespace
+
+void Renderer::Impl::build_programs() {
+  auto vs = [](std::vector<std::string> f) { return ShaderStage{GL_VERTEX_SHADER, std::move(f)}; };
+  auto fs = [](std::vector<std::string> f) { return ShaderStage{GL_FRAGMENT_SHADER, std::move(f)}; };
+  const std::vector<std::string> sphere_fs = {"camera.glsl", "sphere_hit.glsl"};
+  auto with = [](std::vector<std::string> a, const char* f) { a.push_back(f); return a; };
+  mesh_prog = Program("mesh", {vs({"mesh.vert"}), fs({"mesh.frag"})});
+  particle_prog = Program("particles", {vs({"sphere.vert"}), fs(with(sphere_fs, "particle.frag"))});
+  fluid_depth_prog = Program("fluid depth", {vs({"sphere.vert"}), fs(with(sphere_fs, "ssfr_depth.frag"))});
+  fluid_thick_prog = Program("fluid thickness", {vs({"sphere.vert"}), fs(with(sphere_fs, "ssfr_thickness.frag"))});
+  kinect_prog = Program("kinect view", {vs({"fullscreen.vert"}), fs({"camera.glsl", "kinect_bg.frag"})});
+  filter_prog = Program("fluid filter", {vs({"fullscreen.vert"}), fs({"camera.glsl", "ssfr_filter.frag"})});
+  normal_prog = Program("fluid normals", {vs({"fullscreen.vert"}), fs({"camera.glsl", "ssfr_normal.frag"})});
+  composite_prog = Program("fluid composite", {vs({"fullscreen.vert"}), fs({"camera.glsl", "ssfr_composite.frag"})});
+}
+
+void Renderer::Impl::make_targets() {
+  scene_color = make_texture_2d(GL_RGBA8, w, h, GL_LINEAR);
+  scene_depth = make_texture_2d(GL_DEPTH_COMPONENT32F, w, h);
+  scene_fbo = make_framebuffer({scene_color}, scene_depth, "scene");
+  final_color = make_texture_2d(GL_RGBA8, w, h);
+  reflect_color = make_texture_2d(GL_RGBA8, w, h);
+  refract_color = make_texture_2d(GL_RGBA8, w, h);
+  final_fbo = make_framebuffer({final_color, reflect_color, refract_color}, 0, "fluid composite");
+  for (int i = 0; i < 2; ++i) {
+    fluid_depth[i] = make_texture_2d(GL_R32F, w, h);
+    thick[i] = make_texture_2d(GL_R32F, w, h);
+    fluid_filter_fbo[i] = make_framebuffer({fluid_depth[i]}, 0, "fluid filter");
+    thick_fbo[i] = make_framebuffer({thick[i]}, 0, "fluid thickness");
+  }
+  normals = make_texture_2d(GL_RGBA16F, w, h);
+  normal_fbo = make_framebuffer({normals}, 0, "fluid normals");
+  fluid_zbuf = Renderbuffer(new_name(glGenRenderbuffers));
+  glBindRenderbuffer(GL_RENDERBUFFER, fluid_zbuf);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, w, h);
+  fluid_depth_fbo = make_framebuffer({fluid_depth[0]}, 0, "fluid depth");
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, fluid_zbuf);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+// Unit box [-1, 1]^3 with a normal per face (24 vertices), scaled to the body's half extents.
+void Renderer::Impl::make_box() {
+  std::vector<vec3> p, n;
+  std::vector<int3> t;
+  for (int axis = 0; axis < 3; ++axis)
+    for (float s : {-1.f, 1.f}) {
+      vec3 nn{0, 0, 0};
+      (&nn.x)[axis] = s;
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      const int base = static_cast<int>(p.size());
+      for (auto [a, b] : {std::pair{-1.f, -1.f}, {1.f, -1.f}, {1.f, 1.f}, {-1.f, 1.f}}) {
+        vec3 q = nn;
+        (&q.x)[u] = a, (&q.x)[v] = b;
+        p.push_back(q), n.push_back(nn);
+      }
+      t.push_back({base, base + 1, base + 2}), t.push_back({base, base + 2, base + 3});
+    }
+  box.upload(p, n, {}, t, GL_STATIC_DRAW);
+}
+
+vec3 Renderer::Impl::light_eye(const RenderCamera& cam) const {
+  const vec3 to_light = -normalize(p.light_dir);
+  return transpose(cam.world_T_camera.R) * to_light;
+}
+
+void Renderer::Impl::set_camera_uniforms(const Program& prog, const RenderCamera& cam) const {
+  prog.use();
+  glUniform4f(prog.loc("u_K"), cam.K.fx, cam.K.fy, cam.K.cx, cam.K.cy);
+  glUniform2f(prog.loc("u_size"), static_cast<float>(cam.K.width), static_cast<float>(cam.K.height));
+  glUniform2f(prog.loc("u_near_far"), cam.znear, cam.zfar);
+  const Mat4 V = view_matrix(cam.world_T_camera), P = projection_matrix(cam.K, cam.znear, cam.zfar);
+  glUniformMatrix4fv(prog.loc("u_view"), 1, GL_FALSE, V.data());
+  glUniformMatrix4fv(prog.loc("u_proj"), 1, GL_FALSE, P.data());
+  const vec3 l = light_eye(cam);
+  glUniform3f(prog.loc("u_light"), l.x, l.y, l.z);
+  glUniform1f(prog.loc("u_ambient"), p.ambient);
+}
+
+void Renderer::Impl::draw_mesh(const GlMesh& m, const RenderCamera& cam, const Mat4& model, bool vertex_color,
+                               vec3 tint, bool lit) {
+  set_camera_uniforms(mesh_prog, cam);
+  glUniformMatrix4fv(mesh_prog.loc("u_model"), 1, GL_FALSE, model.data());
+  glUniform1i(mesh_prog.loc("u_vertex_color"), vertex_color);
+  glUniform3f(mesh_prog.loc("u_tint"), tint.x, tint.y, tint.z);
+  glUniform1i(mesh_prog.loc("u_lit"), lit);
+  m.draw();
+}
+
+void Renderer::Impl::draw_scene(const RenderCamera& cam) {
+  if (!p.show_scene) return;
+  if (p.view == "kinect" && has_kinect) {
+    // Depth test always passes: the image is the background and sets every pixel's depth.
+    glDepthFunc(GL_ALWAYS);
+    set_camera_uniforms(kinect_prog, cam);
+    glActiveTexture(GL_TEXTURE0), glBindTexture(GL_TEXTURE_2D, kin_rgb);
+    glActiveTexture(GL_TEXTURE1), glBindTexture(GL_TEXTURE_2D, kin_depth);
+    glUniform1i(kinect_prog.loc("u_rgb"), 0);
+    glUniform1i(kinect_prog.loc("u_depth"), 1);
+    glBindVertexArray(empty_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glDepthFunc(GL_LESS);
+  } else if (p.view == "mesh" && has_scene) {
+    draw_mesh(scene, cam, model_matrix(SE3::identity()), true, {0.7f, 0.7f, 0.7f}, p.light_scene);
+  }
+}
+
+void Renderer::Impl::upload_particles(const DrawList& list) {
+  const auto n = static_cast<std::int64_t>(list.positions.size());
+  if (!list.phases.empty() && static_cast<std::int64_t>(list.phases.size()) != n)
+    throw Error("render: DrawList has " + std::to_string(n) + " positions but " +
+                std::to_string(list.phases.size()) + " phases; give one phase per particle (or none: all fluid)");
+  if (n > part_capacity) {
+    part_capacity = std::max<std::int64_t>(n, 2 * part_capacity);
+    glBindBuffer(GL_ARRAY_BUFFER, part_pos);
+    glBufferData(GL_ARRAY_BUFFER, part_capacity * static_cast<GLsizeiptr>(sizeof(vec3)), nullptr, GL_STREAM_DRAW);
+    glBindBuffer(GL_ARRAY_BUFFER, part_phase);
+    glBufferData(GL_ARRAY_BUFFER, part_capacity * static_cast<GLsizeiptr>(sizeof(std::uint32_t)), nullptr, GL_STREAM_DRAW);
+  }
+  fluid_count = list.phases.empty() ? n : 0;
+  for (std::uint32_t ph : list.phases) fluid_count += kernels::phase::is(ph, kernels::phase::kFluid) ? 1 : 0;
+  if (n == 0) return;
+  glBindBuffer(GL_ARRAY_BUFFER, part_pos);
+  glBufferSubData(GL_ARRAY_BUFFER, 0, n * static_cast<GLsizeiptr>(sizeof(vec3)), list.positions.data());
+  glBindBuffer(GL_ARRAY_BUFFER, part_phase);
+  if (list.phases.empty()) {
+    std::vector<std::uint32_t> fluid(static_cast<std::size_t>(n), kernels::phase::kFluid);
+    glBufferSubData(GL_ARRAY_BUFFER, 0, n * static_cast<GLsizeiptr>(sizeof(std::uint32_t)), fluid.data());
+  } else {
+    glBufferSubData(GL_ARRAY_BUFFER, 0, n * static_cast<GLsizeiptr>(sizeof(std::uint32_t)), list.phases.data());
+  }
+}
+
+void Renderer::Impl::draw_spheres(const Program& prog, std::int64_t n, std::uint32_t mask, float radius,
+                                  const RenderCamera& cam) {
+  set_camera_uniforms(prog, cam);
+  glUniform1f(prog.loc("u_radius"), radius);
+  glUniform1f(prog.loc("u_fmax"), std::max(cam.K.fx, cam.K.fy));
+  glUniform1ui(prog.loc("u_phase_mask"), mask);
+  glBindVertexArray(part_vao);
+  glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(n));
+  glBindVertexArray(0);
+}
+
+void Renderer::Impl::draw_objects(const DrawList& list, std::int64_t n, const RenderCamera& cam) {
+  if (p.show_rigid)
+    for (const RigidDraw& r : list.rigids)
+      draw_mesh(box, cam, model_matrix(r.world_T_body, r.half_extents), false, p.rigid_color, true);
+  if (p.show_cloth && !list.positions.empty())
+    for (const ClothDraw& c : list.cloths) {
+      if (c.triangles.empty()) continue;
+      // The sheet's particles are one id range (spawn order): upload only that range.
+      int lo = c.triangles[0].x, hi = lo;
+      for (const int3& t : c.triangles) lo = std::min({lo, t.x, t.y, t.z}), hi = std::max({hi, t.x, t.y, t.z});
+      if (lo < 0 || hi >= static_cast<int>(list.positions.size()))
+        throw Error("render: cloth triangle index " + std::to_string(lo < 0 ? lo : hi) + " is outside the " +
+                    std::to_string(list.positions.size()) + " particles of the DrawList");
+      std::vector<vec3> pos(list.positions.begin() + lo, list.positions.begin() + hi + 1);
+      std::vector<int3> tris(c.triangles);
+      for (int3& t : tris) t = {t.x - lo, t.y - lo, t.z - lo};
+      cloth.upload(pos, vertex_normals(pos, tris), {}, tris, GL_STREAM_DRAW);
+      draw_mesh(cloth, cam, model_matrix(SE3::identity()), false, p.cloth_color, true);
+    }
+  const bool fluid_as_particles = p.show_fluid && p.fluid == "particles";
+  if (n > 0 && (p.show_particles || fluid_as_particles)) {
+    const std::uint32_t mask = p.show_particles ? 0u : kernels::phase::kFluid;
+    draw_spheres(particle_prog, n, mask, list.particle_radius, cam);
+  }
+}
+
+void Renderer::Impl::draw_frame(const DrawList& list, std::int64_t n, const RenderCamera& cam) {
+  timer.begin_frame();
+  stages.clear();
+  glViewport(0, 0, w, h);
+  glBindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
+  const vec3 bg = p.background;
+  glClearColor(bg.x, bg.y, bg.z, 1.f);
+  glClearDepth(1.0);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_BLEND);
+  glEnable(GL_PROGRAM_POINT_SIZE);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  draw_scene(cam);
+  timer.mark("scene");
+  draw_objects(list, n, cam);
+  timer.mark("objects");
+  last_has_fluid = p.show_fluid && p.fluid == "ssfr" && n > 0 && draw_fluid(n, list.particle_radius, cam);
+  if (last_has_fluid && p.stage_images) capture_stages();
+  timings = timer.resolve();
+}
+
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+void init(Renderer::Impl& m, const RenderParams& params, int width, int height) {
+  if (width < 1 || height < 1)
+    throw Error("render: framebuffer size " + std::to_string(width) + "x" + std::to_string(height) +
+                " is not positive (render.width / render.height)");
+  m.p = params;
+  m.w = width, m.h = height;
+  m.build_programs();
+  m.empty_vao = VertexArray(new_name(glGenVertexArrays));
+  m.make_targets();
+  m.make_box();
+  m.part_vao = VertexArray(new_name(glGenVertexArrays));
+  m.part_pos = GlBuffer(new_name(glGenBuffers));
+  m.part_phase = GlBuffer(new_name(glGenBuffers));
+  glBindVertexArray(m.part_vao);
+  glBindBuffer(GL_ARRAY_BUFFER, m.part_pos);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+  glBindBuffer(GL_ARRAY_BUFFER, m.part_phase);
+  glEnableVertexAttribArray(1);
+  glVertexAttribIPointer(1, 1, GL_UNSIGNED_INT, 0, nullptr);
+  glBindVertexArray(0);
+}
+
+}  // namespace
+
+Renderer::Renderer(const RenderParams& params, int width, int height) : impl_(std::make_unique<Impl>()) {
+  impl_->ctx = std::make_unique<HeadlessContext>();
+  impl_->info = impl_->ctx->info();
+  init(*impl_, params, width, height);
+}
+
+Renderer::Renderer(const RenderParams& params, int width, int height, UseCurrentContext)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->info.vendor = reinterpret_cast<const char*>(glGetString(GL_VENDOR));
+  impl_->info.renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  impl_->info.version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
+  init(*impl_, params, width, height);
+}
+
+Renderer::~Renderer() = default;
+
+int Renderer::width() const { return impl_->w; }
+int Renderer::height() const { return impl_->h; }
+RenderParams& Renderer::params() { return impl_->p; }
+const GlInfo& Renderer::gl_info() const { return impl_->info; }
+const std::vector<StageImage>& Renderer::stage_images() const { return impl_->stages; }
+const std::vector<RenderTiming>& Renderer::timings() const { return impl_->timings; }
+unsigned Renderer::particle_position_buffer() const { return impl_->part_pos; }
+unsigned Renderer::particle_phase_buffer() const { return impl_->part_phase; }
+
+void Renderer::resize(int width, int height) {
+  if (width == impl_->w && height == impl_->h) return;
+  if (width < 1 || height < 1) return;  // a minimised window
+  impl_->w = width, impl_->h = height;
+  impl_->make_targets();
+}
+
+void Renderer::set_scene_mesh(const Mesh& mesh) {
+  Impl& m = *impl_;
+  if (mesh.normals.size() != mesh.positions.size())
+    throw Error("render: scene mesh has " + std::to_string(mesh.positions.size()) + " positions but " +
+                std::to_string(mesh.normals.size()) + " normals");
+  m.scene.upload(mesh.positions, mesh.normals, mesh.colors, mesh.triangles, GL_STATIC_DRAW);
+  m.has_scene = !mesh.triangles.empty();
+  m.scene_lo = m.scene_hi = mesh.positions.empty() ? vec3{0, 0, 0} : mesh.positions[0];
+  for (const vec3& q : mesh.positions) m.scene_lo = vmin(m.scene_lo, q), m.scene_hi = vmax(m.scene_hi, q);
+  m.render_cube_map();
+}
+
+void Renderer::set_kinect_view(const Image<uchar3>& rgb, const Image<float>& depth, const Intrinsics& K,
+                               const SE3& world_T_camera) {
+  Impl& m = *impl_;
+  if (rgb.device() != Device::CPU || depth.device() != Device::CPU)
+    throw Error("render: set_kinect_view takes host images (download them first)");
+  if (rgb.width() != K.width || rgb.height() != K.height || depth.width() != K.width || depth.height() != K.height)
+    throw Error("render: Kinect view images (rgb " + std::to_string(rgb.width()) + "x" + std::to_string(rgb.height()) +
+                ", depth " + std::to_string(depth.width()) + "x" + std::to_string(depth.height()) +
+                ") must both match the intrinsics' " + std::to_string(K.width) + "x" + std::to_string(K.height) +
+                " (depth registered to rgb)");
+  if (!m.kin_rgb || m.kin_K.width != K.width || m.kin_K.height != K.height) {
+    m.kin_rgb = make_texture_2d(GL_RGB8, K.width, K.height, GL_LINEAR);
+    m.kin_depth = make_texture_2d(GL_R32F, K.width, K.height, GL_NEAREST);  // never blend depths
+  }
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  const std::vector<uchar3> c = rgb.to_host();
+  const std::vector<float> d = depth.to_host();
+  glBindTexture(GL_TEXTURE_2D, m.kin_rgb);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, K.width, K.height, GL_RGB, GL_UNSIGNED_BYTE, c.data());
+  glBindTexture(GL_TEXTURE_2D, m.kin_depth);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, K.width, K.height, GL_RED, GL_FLOAT, d.data());
+  m.kin_K = K;
+  m.kin_pose = world_T_camera;
+  m.has_kinect = true;
+}
+
+RenderCamera Renderer::kinect_camera() const {
+  const Impl& m = *impl_;
+  RenderCamera c;
+  c.K = scale_intrinsics(m.has_kinect ? m.kin_K : Intrinsics{}, m.w, m.h);
+  c.world_T_camera = m.kin_pose;
+  c.znear = m.p.znear, c.zfar = m.p.zfar;
+  return c;
+}
+
+namespace {
+// The camera actually used: Kinect view overrides; a free camera's intrinsics must fit the target.
+RenderCamera effective_camera(const Renderer& r, const RenderParams& p, const RenderCamera& cam) {
+  if (p.view == "kinect") return r.kinect_camera();
+  if (cam.K.width != r.width() || cam.K.height != r.height()) {
+    RenderCamera c = cam;
+    c.K = scale_intrinsics(cam.K, r.width(), r.height());
+    return c;
+  }
+  return cam;
+}
+}  // namespace
+
+void Renderer::draw(const DrawList& list, const RenderCamera& camera) {
+  impl_->upload_particles(list);
+  impl_->draw_frame(list, static_cast<std::int64_t>(list.positions.size()), effective_camera(*this, impl_->p, camera));
+}
+
+void Renderer::draw_device_particles(const DrawList& list, std::int64_t n, const RenderCamera& camera) {
+  if (n > impl_->part_capacity)
+    throw Error("render: " + std::to_string(n) + " device particles but the interop buffers hold " +
+                std::to_string(impl_->part_capacity) + " (call reserve_particles first)");
+  impl_->fluid_count = -1;
+  impl_->draw_frame(list, n, effective_camera(*this, impl_->p, camera));
+}
+
+void Renderer::reserve_particles(std::int64_t n) {
+  DrawList none;
+  if (n <= impl_->part_capacity) return;
+  std::vector<vec3> zeros(static_cast<std::size_t>(n), vec3{0, 0, 0});
+  std::vector<std::uint32_t> ph(static_cast<std::size_t>(n), 0u);
+  none.positions = zeros;
+  none.phases = ph;
+  impl_->upload_particles(none);
+}
+
+Image<uchar3> Renderer::read_frame() {
+  const Impl& m = *impl_;
+  return read_rgb8(m.last_has_fluid ? m.final_fbo : m.scene_fbo, 0, m.w, m.h);
+}
+
+Image<uchar3> Renderer::render(const DrawList& list, const RenderCamera& camera) {
+  draw(list, camera);
+  return read_frame();
+}
+
+void Renderer::blit_to(unsigned framebuffer, int w, int h) {
+  const Impl& m = *impl_;
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, m.last_has_fluid ? m.final_fbo : m.scene_fbo);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, framebuffer);
+  glBlitFramebuffer(0, 0, m.w, m.h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+}  // namespace seamless

@@ -1,0 +1,98 @@
+// One renderer, two front ends (docs/RENDERING.md). It draws into its own framebuffer objects:
+// the headless front end reads frames back (PNG, video), the window blits them to the screen.
+//
+//   Renderer r(params, 640, 480);                 // creates a headless EGL context
+//   r.set_scene_mesh(mesh);                       // or r.set_kinect_view(rgb, depth, K, pose)
+//   r.draw(make_draw_list(state, frames, radius), camera);
+//   Image<uchar3> img = r.read_frame();
+//
+// Passes: scene (mesh or Kinect image + depth), rigid boxes, cloth, debug particle spheres,
+// then screen-space fluid rendering (van der Laan, Green, Sainz 2009) over the result.
+#pragma once
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/buffer.hpp"
+#include "core/camera.hpp"
+#include "core/math.hpp"
+#include "render/camera.hpp"
+#include "render/draw_list.hpp"
+#include "render/gl_context.hpp"
+#include "render/render_params.hpp"
+
+namespace seamless {
+
+struct Mesh;
+
+// An intermediate image of the fluid renderer, made viewable (depth as grey, normals as colour).
+struct StageImage {
+  std::string name;  // "1_depth", "2_depth_filtered", "3_normals", "4_thickness", ...
+  Image<uchar3> image;
+};
+
+struct RenderTiming {
+  std::string pass;
+  double ms;
+};
+
+class Renderer {
+ public:
+  struct UseCurrentContext {};
+  // Creates and owns a headless EGL context (throws seamless::Error if none can be made).
+  Renderer(const RenderParams& params, int width, int height);
+  // Uses the context current on this thread (the window front end's).
+  Renderer(const RenderParams& params, int width, int height, UseCurrentContext);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  int width() const;
+  int height() const;
+  void resize(int width, int height);
+  RenderParams& params();
+  const GlInfo& gl_info() const;  // vendor/renderer (EGL path empty when not owned)
+
+  // The reconstructed scene (mesh view). Also renders the reflection cube map from the centre
+  // of the mesh's bounding box (dissertation 4.3.5: a camera in the middle of the scene).
+  void set_scene_mesh(const Mesh& mesh);
+  // The Kinect's point of view: RGB image and its registered depth (metres, 0 = none) with the
+  // exact intrinsics of both and the tracked pose (x right, y down, z forward).
+  void set_kinect_view(const Image<uchar3>& rgb, const Image<float>& depth, const Intrinsics& K,
+                       const SE3& world_T_camera);
+  // The camera the Kinect view draws with: K scaled to the framebuffer, the tracked pose.
+  RenderCamera kinect_camera() const;
+
+  // Draws one frame. In the Kinect view (params().view == "kinect") `camera` is ignored and
+  // kinect_camera() is used, so that the virtual objects line up with the image.
+  void draw(const DrawList& list, const RenderCamera& camera);
+  // The last frame, rows top to bottom.
+  Image<uchar3> read_frame();
+  // draw + read_frame.
+  Image<uchar3> render(const DrawList& list, const RenderCamera& camera);
+  // Fluid stages of the last draw when params().stage_images is set (empty without fluid).
+  const std::vector<StageImage>& stage_images() const;
+  // GPU time of each pass of the last draw.
+  const std::vector<RenderTiming>& timings() const;
+  // Copies the last frame to the bound draw framebuffer (0 = the window), scaled to w x h.
+  void blit_to(unsigned framebuffer, int w, int h);
+  // The particle position/phase buffers for CUDA-OpenGL interop (render/cuda_interop.hpp).
+  unsigned particle_position_buffer() const;
+  unsigned particle_phase_buffer() const;
+  // Makes the particle buffers hold at least n particles (before registering them for interop).
+  void reserve_particles(std::int64_t n);
+  // Draws with particles already in particle_*_buffer() (n of them) instead of list.positions.
+  void draw_device_particles(const DrawList& list, std::int64_t n, const RenderCamera& camera);
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+// Turns a float image into grey (min..max of the non-zero values to 0..255; zero stays black),
+// as the stage images do. Exposed for tests.
+Image<uchar3> float_to_grey(const std::vector<float>& v, int width, int height);
+
+}  // namespace seamless

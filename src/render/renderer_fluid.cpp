@@ -1,0 +1,193 @@
+// Screen-space fluid rendering (van der Laan, Green, Sainz 2009), the reflection cube map and the
+// stage images (the dissertation's Figure 4.5).
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.hpp"
+#include "kernels/physics/particle_math.hpp"
+#include "render/renderer_impl.hpp"
+
+namespace seamless {
+namespace {
+
+// GL cube map faces +X, -X, +Y, -Y, +Z, -Z as cameras (x right, y down, z forward): the face's
+// s coordinate grows along camera x and its t coordinate against camera y (GL 4.5 spec, table
+// 8.19: e.g. +X has s_c = -r_z, t_c = -r_y), so rendering with these fills the face as sampled.
+constexpr float kFaceAxes[6][3][3] = {
+    {{0, 0, -1}, {0, 1, 0}, {1, 0, 0}},  {{0, 0, 1}, {0, 1, 0}, {-1, 0, 0}},
+    {{1, 0, 0}, {0, 0, -1}, {0, 1, 0}},  {{1, 0, 0}, {0, 0, 1}, {0, -1, 0}},
+    {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}},   {{-1, 0, 0}, {0, 1, 0}, {0, 0, -1}}};
+
+RenderCamera face_camera(int face, vec3 centre, int size, float znear, float zfar) {
+  RenderCamera c = RenderCamera::from_fov(90.f, size, size, znear, zfar);
+  for (int axis = 0; axis < 3; ++axis)
+    for (int r = 0; r < 3; ++r) c.world_T_camera.R.m[r][axis] = kFaceAxes[face][axis][r];
+  c.world_T_camera.t = centre;
+  return c;
+}
+
+std::vector<uchar3> flip_rows(const std::vector<uchar3>& v, int w, int h) {
+  std::vector<uchar3> out(v.size());
+  for (int y = 0; y < h; ++y)
+    std::copy_n(v.begin() + static_cast<std::ptrdiff_t>(y) * w, w, out.begin() + static_cast<std::ptrdiff_t>(h - 1 - y) * w);
+  return out;
+}
+
+// Eye-space normals as colours (n * 0.5 + 0.5), black where there is no fluid.
+Image<uchar3> normals_to_rgb(const std::vector<float>& v, int w, int h) {
+  std::vector<uchar3> out(static_cast<std::size_t>(w) * h, uchar3{0, 0, 0});
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    if (v[4 * i + 3] <= 0.f) continue;
+    auto c = [&](int k) { return static_cast<std::uint8_t>(std::clamp(v[4 * i + k] * 127.5f + 127.5f, 0.f, 255.f)); };
+    out[i] = {c(0), c(1), c(2)};
+  }
+  return Image<uchar3>::from_host(flip_rows(out, w, h), w, h, Device::CPU);
+}
+
+}  // namespace
+
+Image<uchar3> float_to_grey(const std::vector<float>& v, int w, int h) {
+  float lo = INFINITY, hi = -INFINITY;
+  for (float x : v)
+    if (x > 0.f) lo = std::min(lo, x), hi = std::max(hi, x);
+  std::vector<uchar3> out(v.size(), uchar3{0, 0, 0});
+  const float span = hi > lo ? hi - lo : 1.f;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (v[i] <= 0.f) continue;
+    const auto g = static_cast<std::uint8_t>(40.f + 215.f * (v[i] - lo) / span);  // 40: visible above black
+    out[i] = {g, g, g};
+  }
+  return Image<uchar3>::from_host(flip_rows(out, w, h), w, h, Device::CPU);
+}
+
+void Renderer::Impl::render_cube_map() {
+  const int s = p.cube_size;
+  cube = Texture(new_name(glGenTextures));
+  glBindTexture(GL_TEXTURE_CUBE_MAP, cube);
+  glTexStorage2D(GL_TEXTURE_CUBE_MAP, 1, GL_RGBA8, s, s);
+  glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
+  Renderbuffer z(new_name(glGenRenderbuffers));
+  glBindRenderbuffer(GL_RENDERBUFFER, z);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, s, s);
+  Framebuffer fbo(new_name(glGenFramebuffers));
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, z);
+  glViewport(0, 0, s, s);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_CULL_FACE);
+  const vec3 centre = (scene_lo + scene_hi) * 0.5f;
+  for (int f = 0; f < 6; ++f) {
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, cube, 0);
+    glClearColor(p.background.x, p.background.y, p.background.z, 1.f);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    draw_mesh(scene, face_camera(f, centre, s, p.znear, p.zfar), model_matrix(SE3::identity()), true,
+              {0.7f, 0.7f, 0.7f}, p.light_scene);
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  has_cube = true;
+}
+
+namespace {
+void bind_tex(int unit, GLenum target, GLuint tex) {
+  glActiveTexture(GL_TEXTURE0 + static_cast<GLenum>(unit));
+  glBindTexture(target, tex);
+}
+}  // namespace
+
+// Returns false when no fluid particle is drawn.
+bool Renderer::Impl::draw_fluid(std::int64_t n, float radius, const RenderCamera& cam) {
+  if (fluid_count == 0) return false;
+  const std::uint32_t fluid = kernels::phase::kFluid;
+  // 1. Nearest sphere depth per pixel, in front of the scene.
+  glBindFramebuffer(GL_FRAMEBUFFER, fluid_depth_fbo);
+  glClearColor(0.f, 0.f, 0.f, 0.f);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  bind_tex(0, GL_TEXTURE_2D, scene_depth);
+  fluid_depth_prog.use();
+  glUniform1i(fluid_depth_prog.loc("u_scene_depth"), 0);
+  draw_spheres(fluid_depth_prog, n, fluid, radius, cam);
+  timer.mark("fluid_depth");
+  if (p.stage_images) stages.push_back({"1_depth", float_to_grey(read_float(fluid_depth_fbo, 0, GL_RED, 1, w, h), w, h)});
+  // 2. Thickness: every sphere's chord, added up.
+  glDisable(GL_DEPTH_TEST);
+  glBindFramebuffer(GL_FRAMEBUFFER, thick_fbo[0]);
+  glClear(GL_COLOR_BUFFER_BIT);
+  glEnable(GL_BLEND);
+  glBlendFunc(GL_ONE, GL_ONE);
+  fluid_thick_prog.use();
+  glUniform1i(fluid_thick_prog.loc("u_scene_depth"), 0);
+  draw_spheres(fluid_thick_prog, n, fluid, radius, cam);
+  glDisable(GL_BLEND);
+  timer.mark("fluid_thickness");
+  // 3. Separable filters: depth (bilateral, world-sized), thickness (small Gaussian).
+  set_camera_uniforms(filter_prog, cam);
+  glBindVertexArray(empty_vao);
+  auto pass = [&](GLuint src, GLuint dst_fbo, int dx, int dy) {
+    glBindFramebuffer(GL_FRAMEBUFFER, dst_fbo);
+    bind_tex(0, GL_TEXTURE_2D, src);
+    glUniform1i(filter_prog.loc("u_src"), 0);
+    glUniform2i(filter_prog.loc("u_dir"), dx, dy);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+  };
+  glUniform1f(filter_prog.loc("u_world_radius"), p.filter_size * radius);
+  glUniform1i(filter_prog.loc("u_max_px"), p.filter_max_px);
+  glUniform1f(filter_prog.loc("u_range_sigma"), p.filter_depth_sigma * radius);
+  glUniform1i(filter_prog.loc("u_skip_empty"), 1);
+  for (int it = 0; it < p.filter_iterations; ++it) {
+    pass(fluid_depth[0], fluid_filter_fbo[1], 1, 0);
+    pass(fluid_depth[1], fluid_filter_fbo[0], 0, 1);
+  }
+  glUniform1i(filter_prog.loc("u_max_px"), 3);
+  glUniform1f(filter_prog.loc("u_range_sigma"), 0.f);
+  glUniform1i(filter_prog.loc("u_skip_empty"), 0);
+  pass(thick[0], thick_fbo[1], 1, 0);
+  pass(thick[1], thick_fbo[0], 0, 1);
+  timer.mark("fluid_filter");
+  // 4. Normals from the filtered depth.
+  glBindFramebuffer(GL_FRAMEBUFFER, normal_fbo);
+  set_camera_uniforms(normal_prog, cam);
+  bind_tex(0, GL_TEXTURE_2D, fluid_depth[0]);
+  glUniform1i(normal_prog.loc("u_depth"), 0);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  timer.mark("fluid_normals");
+  // 5. Shading over the scene.
+  glBindFramebuffer(GL_FRAMEBUFFER, final_fbo);
+  set_camera_uniforms(composite_prog, cam);
+  bind_tex(0, GL_TEXTURE_2D, scene_color);
+  bind_tex(1, GL_TEXTURE_2D, fluid_depth[0]);
+  bind_tex(2, GL_TEXTURE_2D, normals);
+  bind_tex(3, GL_TEXTURE_2D, thick[0]);
+  bind_tex(4, GL_TEXTURE_CUBE_MAP, cube);
+  const char* samplers[] = {"u_scene_color", "u_fluid_depth", "u_normal", "u_thickness", "u_cube"};
+  for (int i = 0; i < 5; ++i) glUniform1i(composite_prog.loc(samplers[i]), i);
+  const bool use_cube = has_cube && p.view == "mesh";
+  glUniform1i(composite_prog.loc("u_use_cube"), use_cube);
+  const std::vector<float> R = {cam.world_T_camera.R.m[0][0], cam.world_T_camera.R.m[1][0], cam.world_T_camera.R.m[2][0],
+                                cam.world_T_camera.R.m[0][1], cam.world_T_camera.R.m[1][1], cam.world_T_camera.R.m[2][1],
+                                cam.world_T_camera.R.m[0][2], cam.world_T_camera.R.m[1][2], cam.world_T_camera.R.m[2][2]};
+  glUniformMatrix3fv(composite_prog.loc("u_world_R_eye"), 1, GL_FALSE, R.data());
+  glUniform3f(composite_prog.loc("u_absorption"), p.absorption.x, p.absorption.y, p.absorption.z);
+  glUniform1f(composite_prog.loc("u_refraction"), p.refraction);
+  glUniform1f(composite_prog.loc("u_f0"), p.fresnel_f0);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindVertexArray(0);
+  glEnable(GL_DEPTH_TEST);
+  timer.mark("fluid_composite");
+  return true;
+}
+
+void Renderer::Impl::capture_stages() {
+  stages.push_back({"2_depth_filtered", float_to_grey(read_float(fluid_filter_fbo[0], 0, GL_RED, 1, w, h), w, h)});
+  stages.push_back({"3_normals", normals_to_rgb(read_float(normal_fbo, 0, GL_RGBA, 4, w, h), w, h)});
+  stages.push_back({"4_thickness", float_to_grey(read_float(thick_fbo[0], 0, GL_RED, 1, w, h), w, h)});
+  stages.push_back({"5_reflection", read_rgb8(final_fbo, 1, w, h)});
+  stages.push_back({"6_refraction", read_rgb8(final_fbo, 2, w, h)});
+  stages.push_back({"7_composite", read_rgb8(final_fbo, 0, w, h)});
+}
+
+}  // namespace seamless

@@ -1,0 +1,139 @@
+// Internal to src/render: GL object handles and the renderer's state, shared by renderer.cpp
+// (scene, objects, frame) and renderer_fluid.cpp (screen-space fluid passes).
+#pragma once
+#include <epoxy/gl.h>
+
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "render/renderer.hpp"
+#include "render/shader.hpp"
+
+namespace seamless {
+
+// Move-only owner of one GL name; Del is the glDelete* function for it.
+template <void (*Del)(GLuint)>
+class GlName {
+ public:
+  GlName() = default;
+  explicit GlName(GLuint id) : id_(id) {}
+  ~GlName() { if (id_) Del(id_); }
+  GlName(GlName&& o) noexcept : id_(std::exchange(o.id_, 0u)) {}
+  GlName& operator=(GlName&& o) noexcept {
+    if (this != &o) { if (id_) Del(id_); id_ = std::exchange(o.id_, 0u); }
+    return *this;
+  }
+  GLuint get() const { return id_; }
+  operator GLuint() const { return id_; }
+
+ private:
+  GLuint id_ = 0;
+};
+
+void gl_delete_texture(GLuint id);
+void gl_delete_buffer(GLuint id);
+void gl_delete_framebuffer(GLuint id);
+void gl_delete_renderbuffer(GLuint id);
+void gl_delete_vertex_array(GLuint id);
+using Texture = GlName<gl_delete_texture>;
+using GlBuffer = GlName<gl_delete_buffer>;
+using Framebuffer = GlName<gl_delete_framebuffer>;
+using Renderbuffer = GlName<gl_delete_renderbuffer>;
+using VertexArray = GlName<gl_delete_vertex_array>;
+
+Texture make_texture_2d(GLenum internal, int w, int h, GLenum filter = GL_NEAREST);
+GLuint new_name(void (*gen)(GLsizei, GLuint*));
+// Framebuffer with the given colour textures (attachments 0..n-1) and optional depth texture.
+Framebuffer make_framebuffer(const std::vector<GLuint>& colors, GLuint depth, const char* what);
+// Reads one channel layout of a colour attachment: rows bottom to top as GL stores them.
+std::vector<float> read_float(GLuint fbo, int attachment, GLenum format, int channels, int w, int h);
+Image<uchar3> read_rgb8(GLuint fbo, int attachment, int w, int h);
+
+// A triangle mesh in GL buffers: positions, normals, colours (normalised bytes), indices.
+struct GlMesh {
+  VertexArray vao;
+  GlBuffer pos, nrm, col, idx;
+  GLsizei index_count = 0;
+  void upload(const std::vector<vec3>& p, const std::vector<vec3>& n, const std::vector<uchar3>& c,
+              const std::vector<int3>& tris, GLenum usage);
+  void draw() const;
+};
+
+// Per-pass GPU times from timestamp queries between passes, resolved at the end of a frame.
+class PassTimer {
+ public:
+  void begin_frame();
+  void mark(const char* pass);  // the pass that just ended
+  std::vector<RenderTiming> resolve();
+  ~PassTimer();
+
+ private:
+  std::vector<GLuint> queries_;
+  std::vector<std::string> names_;
+  std::size_t used_ = 0;
+};
+
+struct Renderer::Impl {
+  RenderParams p;
+  int w = 0, h = 0;
+  std::unique_ptr<HeadlessContext> ctx;
+  GlInfo info;
+
+  Program mesh_prog, particle_prog, kinect_prog;
+  Program fluid_depth_prog, fluid_thick_prog, filter_prog, normal_prog, composite_prog;
+  VertexArray empty_vao;
+
+  // Framebuffer-sized targets (re-made by resize).
+  Texture scene_color, scene_depth;
+  Framebuffer scene_fbo;
+  Texture final_color, reflect_color, refract_color;
+  Framebuffer final_fbo;
+  Texture fluid_depth[2], thick[2], normals;
+  Renderbuffer fluid_zbuf;
+  Framebuffer fluid_depth_fbo, fluid_filter_fbo[2], thick_fbo[2], normal_fbo;
+  bool last_has_fluid = false;
+  int last_fluid_read = 0;  // which fluid_depth[] holds the filtered depth
+  int last_thick_read = 0;
+
+  // Scene.
+  GlMesh scene;
+  bool has_scene = false;
+  vec3 scene_lo{0, 0, 0}, scene_hi{0, 0, 0};
+  Texture cube;
+  bool has_cube = false;
+  Texture kin_rgb, kin_depth;
+  Intrinsics kin_K;
+  SE3 kin_pose = SE3::identity();
+  bool has_kinect = false;
+
+  // Objects.
+  GlMesh box, cloth;
+  VertexArray part_vao;
+  GlBuffer part_pos, part_phase;
+  std::int64_t part_capacity = 0;
+  std::int64_t fluid_count = -1;  // fluid particles of the last upload; -1: unknown (device data)
+
+  std::vector<StageImage> stages;
+  std::vector<RenderTiming> timings;
+  PassTimer timer;
+
+  void build_programs();
+  void make_targets();
+  void make_box();
+  void upload_particles(const DrawList& list);
+  void draw_frame(const DrawList& list, std::int64_t n, const RenderCamera& cam);
+  void draw_scene(const RenderCamera& cam);
+  void draw_objects(const DrawList& list, std::int64_t n, const RenderCamera& cam);
+  void draw_mesh(const GlMesh& m, const RenderCamera& cam, const Mat4& model, bool vertex_color, vec3 tint, bool lit);
+  void draw_spheres(const Program& prog, std::int64_t n, std::uint32_t mask, float radius, const RenderCamera& cam);
+  void render_cube_map();
+  // renderer_fluid.cpp
+  bool draw_fluid(std::int64_t n, float radius, const RenderCamera& cam);
+  void capture_stages();
+  void set_camera_uniforms(const Program& prog, const RenderCamera& cam) const;
+  vec3 light_eye(const RenderCamera& cam) const;
+};
+
+}  // namespace seamless

@@ -1,0 +1,22 @@
+// Pinhole camera helpers shared by the screen-space passes (x right, y down, z forward; see
+// render/camera.hpp for the projection these invert).
+uniform vec4 u_K;         // fx, fy, cx, cy in framebuffer pixels
+uniform vec2 u_size;      // framebuffer width, height
+uniform vec2 u_near_far;  // znear, zfar
+
+// Image pixel (u right, v down) of this fragment.
+vec2 frag_pixel() { return vec2(gl_FragCoord.x - 0.5, u_size.y - gl_FragCoord.y - 0.5); }
+
+// Ray through a pixel with z = 1, so that a point at depth z is z * pixel_ray(p).
+vec3 pixel_ray(vec2 p) { return vec3((p.x - u_K.z) / u_K.x, (p.y - u_K.w) / u_K.y, 1.0); }
+
+float window_depth(float z) {
+  float n = u_near_far.x, f = u_near_far.y;
+  float ndc = (f + n) / (f - n) - 2.0 * f * n / ((f - n) * z);
+  return 0.5 * ndc + 0.5;
+}
+
+float eye_depth(float w) {
+  float n = u_near_far.x, f = u_near_far.y;
+  return -2.0 * f * n / ((f - n) * ((2.0 * w - 1.0) - (f + n) / (f - n)));
+}

@@ -1,0 +1,37 @@
+// SSFR smoothing (van der Laan et al. 2009, section 4.2, with the bilateral filter they list as
+// the cheaper alternative to curvature flow), one axis per pass: run along x, then along y.
+// Depth: the half-width is a world size projected at this pixel's depth, the range weight keeps
+// depth edges between separate bodies of fluid, and empty pixels neither change nor contribute.
+// Thickness: a plain Gaussian of fixed pixel width (u_range_sigma <= 0, u_skip_empty false).
+uniform sampler2D u_src;
+uniform ivec2 u_dir;            // (1, 0) or (0, 1)
+uniform float u_world_radius;   // metres
+uniform int u_max_px;
+uniform float u_range_sigma;    // metres; <= 0 disables the range weight
+uniform bool u_skip_empty;
+
+layout(location = 0) out float o_value;
+
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  float c = texelFetch(u_src, p, 0).r;
+  if (u_skip_empty && c <= 0.0) { o_value = 0.0; return; }
+  float f = u_dir.x != 0 ? u_K.x : u_K.y;
+  int r = u_skip_empty ? int(min(float(u_max_px), u_world_radius * f / c)) : u_max_px;
+  if (r < 1) { o_value = c; return; }
+  float inv2s2 = 2.0 / float(r * r);  // spatial sigma = r / 2
+  ivec2 hi = textureSize(u_src, 0) - 1;
+  float sum = 0.0, wsum = 0.0;
+  for (int i = -r; i <= r; ++i) {
+    float s = texelFetch(u_src, clamp(p + i * u_dir, ivec2(0), hi), 0).r;
+    if (u_skip_empty && s <= 0.0) continue;
+    float w = exp(-float(i * i) * inv2s2);
+    if (u_range_sigma > 0.0) {
+      float dz = (s - c) / u_range_sigma;
+      w *= exp(-0.5 * dz * dz);
+    }
+    sum += s * w;
+    wsum += w;
+  }
+  o_value = sum / wsum;
+}

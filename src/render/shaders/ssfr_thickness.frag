@@ -1,0 +1,14 @@
+// SSFR thickness (van der Laan et al. 2009, section 4.3): the length of the pixel's ray inside
+// each sphere, summed by additive blending over all particles (no depth test), cut at the scene.
+uniform sampler2D u_scene_depth;
+
+layout(location = 0) out float o_thickness;  // metres
+
+void main() {
+  float z_in, z_out;
+  if (!hit_sphere(z_in, z_out)) discard;
+  float z_scene = eye_depth(texelFetch(u_scene_depth, ivec2(gl_FragCoord.xy), 0).r);
+  float len = (min(z_out, z_scene) - z_in) * length(pixel_ray(frag_pixel()));
+  if (len <= 0.0) discard;
+  o_thickness = len;
+}
