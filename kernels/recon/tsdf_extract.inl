@@ -28,9 +28,9 @@ SEAMLESS_HD inline int mc_cube(const Acc& a, int3 g, BlockCache& c, const Voxel*
   int cube = 0;
   bool truncated = false;
   const float trunc = 0.999f * a.geom.truncation;
+  if (!cell_voxels(a, g, c, v)) return -1;
   for (int k = 0; k < 8; ++k) {
-    v[k] = find_voxel(a, g + mc_corner(k), c);
-    if (!v[k] || !(v[k]->weight > 0.f)) return -1;
+    if (!(v[k]->weight > 0.f)) return -1;
     if (v[k]->sdf < 0.f) cube |= 1 << k;
     if (fabsf(v[k]->sdf) >= trunc) truncated = true;
   }

@@ -130,11 +130,7 @@ SEAMLESS_HD inline void raycast_pixel(const Acc& a, int x, int y, const Intrinsi
   for (int it = 0; it < 8192 && z < z_end; ++it) {
     vec3 q = o + d * z;
     int3 b = block_of_voxel(floor_to_int(q));
-    if (!(b == c.block)) {
-      c.block = b;
-      c.index = a.find_block(b);
-    }
-    if (c.index < 0) {  // empty space: skip the whole block (Niessner section 4.3)
+    if (cached_block(a, b, c) < 0) {  // empty space: skip the whole block (Niessner section 4.3)
       z = fmaxf(block_exit(o, d, b), z) + min_step * 0.1f;
       have_prev = false;
       continue;

@@ -180,20 +180,57 @@ struct DenseAccess {
   }
 };
 
-// Remembers the last block looked up: neighbouring samples mostly fall in the same block.
+// Remembers the last two blocks looked up (most recent first): neighbouring samples mostly fall
+// in the same block, and a cell on a block face reads two blocks, which one entry would look up
+// in turn for every corner.
 struct BlockCache {
   int3 block{-2147483647, 0, 0};
   std::int32_t index = -1;
+  int3 block2{-2147483647, 0, 0};
+  std::int32_t index2 = -1;
 };
+
+// Block index of b (-1: none) through the cache.
+template <class Acc>
+SEAMLESS_HD inline std::int32_t cached_block(const Acc& a, int3 b, BlockCache& c) {
+  if (b == c.block) return c.index;
+  const int3 old_block = c.block;
+  const std::int32_t old_index = c.index;
+  c.block = b;
+  c.index = b == c.block2 ? c.index2 : a.find_block(b);
+  c.block2 = old_block, c.index2 = old_index;
+  return c.index;
+}
 
 template <class Acc>
 SEAMLESS_HD inline const Voxel* find_voxel(const Acc& a, int3 g, BlockCache& c) {
-  int3 b = block_of_voxel(g);
-  if (!(b == c.block)) {
-    c.block = b;
-    c.index = a.find_block(b);
+  std::int32_t index = cached_block(a, block_of_voxel(g), c);
+  return index < 0 ? nullptr : a.voxels + static_cast<std::int64_t>(index) * kBlockVoxels + local_index(g);
+}
+
+// The 8 corner voxels of cell g0 (corner k at g0 + (k&1, (k>>1)&1, k>>2)), each block looked up
+// once: the cell reaches into the next block only along the axes where g0 is a block's last
+// voxel. False when a corner's block is missing.
+template <class Acc>
+SEAMLESS_HD inline bool cell_voxels(const Acc& a, int3 g0, BlockCache& c, const Voxel* v[8]) {
+  const int3 b0 = block_of_voxel(g0);
+  const bool ex = (g0.x & 7) == 7, ey = (g0.y & 7) == 7, ez = (g0.z & 7) == 7;
+  // i[k]: block of corner k, i.e. of b0 + (k&1 & ex, (k>>1)&1 & ey, k>>2 & ez).
+  std::int32_t i[8];
+  i[0] = cached_block(a, b0, c);
+  i[1] = ex ? cached_block(a, b0 + int3{1, 0, 0}, c) : i[0];
+  i[2] = ey ? cached_block(a, b0 + int3{0, 1, 0}, c) : i[0];
+  i[3] = ex && ey ? cached_block(a, b0 + int3{1, 1, 0}, c) : ex ? i[1] : i[2];
+  i[4] = ez ? cached_block(a, b0 + int3{0, 0, 1}, c) : i[0];
+  i[5] = ex && ez ? cached_block(a, b0 + int3{1, 0, 1}, c) : ex ? i[1] : i[4];
+  i[6] = ey && ez ? cached_block(a, b0 + int3{0, 1, 1}, c) : ey ? i[2] : i[4];
+  i[7] = ex && ey && ez ? cached_block(a, b0 + int3{1, 1, 1}, c) : !ex ? i[6] : !ey ? i[5] : i[3];
+  for (int k = 0; k < 8; ++k) {
+    if (i[k] < 0) return false;
+    int3 g = g0 + int3{k & 1, (k >> 1) & 1, k >> 2};
+    v[k] = a.voxels + static_cast<std::int64_t>(i[k]) * kBlockVoxels + local_index(g);
   }
-  return c.index < 0 ? nullptr : a.voxels + static_cast<std::int64_t>(c.index) * kBlockVoxels + local_index(g);
+  return true;
 }
 
 // Trilinear interpolation of the TSDF (metres) and colour at voxel-space point q. False when any of
@@ -202,15 +239,16 @@ template <class Acc>
 SEAMLESS_HD inline bool sample_tsdf(const Acc& a, vec3 q, BlockCache& c, float* sdf, vec3* color = nullptr) {
   int3 g0 = floor_to_int(q);
   vec3 f = q - to_vec3(g0);
+  const Voxel* v[8];
+  if (!cell_voxels(a, g0, c, v)) return false;
   float s = 0.f;
   vec3 col{0.f, 0.f, 0.f};
   for (int k = 0; k < 8; ++k) {
+    if (!(v[k]->weight > 0.f)) return false;
     int3 o{k & 1, (k >> 1) & 1, k >> 2};
-    const Voxel* v = find_voxel(a, g0 + o, c);
-    if (!v || !(v->weight > 0.f)) return false;
     float w = (o.x ? f.x : 1.f - f.x) * (o.y ? f.y : 1.f - f.y) * (o.z ? f.z : 1.f - f.z);
-    s += w * v->sdf;
-    if (color) col += vec3{float(v->color.x), float(v->color.y), float(v->color.z)} * w;
+    s += w * v[k]->sdf;
+    if (color) col += vec3{float(v[k]->color.x), float(v[k]->color.y), float(v[k]->color.z)} * w;
   }
   *sdf = s;
   if (color) *color = col;
