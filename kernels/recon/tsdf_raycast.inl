@@ -103,28 +103,12 @@ void splat_ray_intervals(const Exec& ex, HashTableView t, VoxelGeometry geom, In
   });
 }
 
+// Marches the ray o + d z (voxel units, z = camera depth) from z to z_end; on a +/- zero crossing
+// returns true with its refined depth in *hit and the block cache left near it.
 template <class Acc>
-SEAMLESS_HD inline void raycast_pixel(const Acc& a, int x, int y, const Intrinsics& K, const SE3& world_T_camera,
-                                      float min_depth, float max_depth, const RaycastOutput& out,
-                                      const RayIntervals& iv) {
-  out.depth(x, y) = 0.f;
-  out.vertex(x, y) = out.normal(x, y) = {0.f, 0.f, 0.f};
-  out.color(x, y) = {0, 0, 0};
-  const VoxelGeometry& g = a.geom;
-  // Ray in voxel units, parametrised by camera depth z: point(z) = o + d z.
-  vec3 dir_c = K.unproject(static_cast<float>(x), static_cast<float>(y), 1.f);
-  vec3 o = g.to_voxel(world_T_camera.t);
-  vec3 d = world_T_camera.rotate(dir_c) / g.voxel_size;
-  const float dlen = length(d);  // voxels per metre of depth
+SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z_end, BlockCache& c, float* hit) {
+  const float dlen = length(d);        // voxels per metre of depth
   const float min_step = 0.5f / dlen;  // half a voxel
-  float z = min_depth, z_end = max_depth;
-  if (iv.bits) {  // march only where blocks are (Niessner section 4.3)
-    const int t = iv.tile_of(x, y);
-    const float z_near = bits_float(iv.bits[2 * t]), z_far = bits_float(iv.bits[2 * t + 1]);
-    if (!(z_far > 0.f)) return;  // no block projects here: nothing to hit
-    z = fmaxf(z, z_near - min_step), z_end = fminf(z_end, z_far + min_step);
-  }
-  BlockCache c;
   float z_prev = 0.f, f_prev = 0.f;
   bool have_prev = false;
   for (int it = 0; it < 8192 && z < z_end; ++it) {
@@ -142,19 +126,8 @@ SEAMLESS_HD inline void raycast_pixel(const Acc& a, int x, int y, const Intrinsi
       continue;
     }
     if (have_prev && f_prev > 0.f && f <= 0.f) {
-      float zh = refine_crossing(a, o, d, z_prev, f_prev, z, f, c);
-      vec3 qh = o + d * zh;
-      vec3 col{0.f, 0.f, 0.f};
-      float fh = 0.f;
-      sample_tsdf(a, qh, c, &fh, &col);
-      // The normal is the TSDF gradient (voxel and world axes are parallel, spacing isotropic).
-      vec3 nw = normalize(tsdf_gradient(a, qh, fh, c));
-      out.depth(x, y) = zh;
-      out.vertex(x, y) = g.to_world(qh);
-      out.normal(x, y) = nw;
-      out.color(x, y) = {static_cast<std::uint8_t>(col.x + 0.5f), static_cast<std::uint8_t>(col.y + 0.5f),
-                         static_cast<std::uint8_t>(col.z + 0.5f)};
-      return;
+      *hit = refine_crossing(a, o, d, z_prev, f_prev, z, f, c);
+      return true;
     }
     z_prev = z, f_prev = f, have_prev = true;
     // |TSDF| is at most about the distance to the nearest zero crossing (projective distances
@@ -162,17 +135,60 @@ SEAMLESS_HD inline void raycast_pixel(const Acc& a, int x, int y, const Intrinsi
     // metres per unit of z) cannot jump over one: truncation-sized steps in the band's free-space
     // side (and through the back of a surface a ray enters from behind), shrinking to half a
     // voxel at the surface.
-    z += fmaxf(0.8f * fabsf(f) / (dlen * g.voxel_size), min_step);
+    z += fmaxf(0.8f * fabsf(f) / (dlen * a.geom.voxel_size), min_step);
   }
+  return false;
 }
+
+template <class Acc>
+SEAMLESS_HD inline void raycast_pixel(const Acc& a, int x, int y, const Intrinsics& K, const SE3& world_T_camera,
+                                      float min_depth, float max_depth, const RaycastOutput& out,
+                                      const RayIntervals& iv) {
+  const VoxelGeometry& g = a.geom;
+  // Ray in voxel units, parametrised by camera depth z: point(z) = o + d z.
+  vec3 dir_c = K.unproject(static_cast<float>(x), static_cast<float>(y), 1.f);
+  vec3 o = g.to_voxel(world_T_camera.t);
+  vec3 d = world_T_camera.rotate(dir_c) / g.voxel_size;
+  const float min_step = 0.5f / length(d);  // half a voxel
+  float z = min_depth, z_end = max_depth;
+  if (iv.bits) {  // march only where blocks are (Niessner section 4.3); no block here: no ray
+    const int t = iv.tile_of(x, y);
+    const float z_near = bits_float(iv.bits[2 * t]), z_far = bits_float(iv.bits[2 * t + 1]);
+    z = fmaxf(z, z_near - min_step), z_end = z_far > 0.f ? fminf(z_end, z_far + min_step) : 0.f;
+  }
+  BlockCache c;
+  float zh = 0.f, fh = 0.f;
+  vec3 col{0.f, 0.f, 0.f}, nw{0.f, 0.f, 0.f}, vw{0.f, 0.f, 0.f};
+  if (march_ray(a, o, d, z, z_end, c, &zh)) {
+    vec3 qh = o + d * zh;
+    sample_tsdf(a, qh, c, &fh, &col);
+    // The normal is the TSDF gradient (voxel and world axes are parallel, spacing isotropic).
+    nw = normalize(tsdf_gradient(a, qh, fh, c));
+    vw = g.to_world(qh);
+  }
+  out.depth(x, y) = zh;  // each output written once; zero where no hit
+  out.vertex(x, y) = vw;
+  out.normal(x, y) = nw;
+  out.color(x, y) = {static_cast<std::uint8_t>(col.x + 0.5f), static_cast<std::uint8_t>(col.y + 0.5f),
+                     static_cast<std::uint8_t>(col.z + 0.5f)};
+}
+
+// Threads take pixels in 8 x 4 groups (one CUDA warp each), which stay inside one interval tile
+// and see neighbouring surface points: the rays of a warp march alike instead of diverging along
+// a 32-pixel row.
+constexpr int kRayGroupW = 8, kRayGroupH = 4;
 
 template <class Exec, class Acc>
 void raycast(const Exec& ex, Acc a, Intrinsics K, SE3 world_T_camera, float min_depth, float max_depth,
              RaycastOutput out, RayIntervals iv) {
-  const int w = out.depth.width;
-  ex.for_each(out.depth.count(), [=] SEAMLESS_HD(std::int64_t i) {
-    raycast_pixel(a, static_cast<int>(i % w), static_cast<int>(i / w), K, world_T_camera, min_depth, max_depth, out,
-                  iv);
+  const int w = out.depth.width, h = out.depth.height;
+  const int groups_x = (w + kRayGroupW - 1) / kRayGroupW, groups_y = (h + kRayGroupH - 1) / kRayGroupH;
+  ex.for_each(static_cast<std::int64_t>(groups_x) * groups_y * kRayGroupW * kRayGroupH, [=] SEAMLESS_HD(std::int64_t i) {
+    const std::int64_t group = i / (kRayGroupW * kRayGroupH);
+    const int lane = static_cast<int>(i % (kRayGroupW * kRayGroupH));
+    const int x = static_cast<int>(group % groups_x) * kRayGroupW + lane % kRayGroupW;
+    const int y = static_cast<int>(group / groups_x) * kRayGroupH + lane / kRayGroupW;
+    if (x < w && y < h) raycast_pixel(a, x, y, K, world_T_camera, min_depth, max_depth, out, iv);
   });
 }
 
