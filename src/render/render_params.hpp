@@ -32,6 +32,10 @@ struct RenderParams {
   vec3 rigid_color{0.85f, 0.3f, 0.2f};
   vec3 cloth_color{0.9f, 0.75f, 0.3f};
   // Screen-space fluid rendering (van der Laan, Green, Sainz 2009).
+  // Spheres of the fluid passes are drawn this much larger than the particle radius: at rest the
+  // particles sit about one diameter apart, and on a cubic lattice seen face-on the gaps between
+  // four touching spheres close only above sqrt(2) (the gap centre is sqrt(2) r from each).
+  float fluid_radius_scale = 1.5f;
   int filter_iterations = 2;          // separable bilateral passes (x then y) over the depth
   float filter_size = 3.f;            // filter half-width in particle radii (world), projected per pixel
   int filter_max_px = 24;             // ... but at most this many pixels
@@ -65,6 +69,8 @@ struct RenderParams {
     v("light_scene", light_scene, "also light the scene mesh (its colours already contain lighting)");
     v("rigid_color", rigid_color, "colour of rigid bodies, RGB 0..1");
     v("cloth_color", cloth_color, "colour of cloth, RGB 0..1");
+    v("fluid_radius_scale", fluid_radius_scale, "fluid sphere size in the SSFR passes, particle radii",
+      Range{0.5, 4.0});
     v("filter_iterations", filter_iterations, "bilateral depth filter passes", Range{0, 16});
     v("filter_size", filter_size, "depth filter half-width, particle radii", Range{0.0, 50.0});
     v("filter_max_px", filter_max_px, "depth filter half-width limit, pixels", Range{1, 128});

@@ -78,12 +78,15 @@ void Renderer::Impl::make_box() {
       (&nn.x)[axis] = s;
       const int u = (axis + 1) % 3, v = (axis + 2) % 3;
       const int base = static_cast<int>(p.size());
+      // Corners run counter-clockwise about e_u x e_v = e_axis; reversed on the negative face, so
+      // that every face winds counter-clockwise seen from outside (its normal's side).
       for (auto [a, b] : {std::pair{-1.f, -1.f}, {1.f, -1.f}, {1.f, 1.f}, {-1.f, 1.f}}) {
         vec3 q = nn;
         (&q.x)[u] = a, (&q.x)[v] = b;
         p.push_back(q), n.push_back(nn);
       }
-      t.push_back({base, base + 1, base + 2}), t.push_back({base, base + 2, base + 3});
+      if (s > 0) t.push_back({base, base + 1, base + 2}), t.push_back({base, base + 2, base + 3});
+      else t.push_back({base, base + 2, base + 1}), t.push_back({base, base + 3, base + 2});
     }
   box.upload(p, n, {}, t, GL_STATIC_DRAW);
 }
@@ -107,12 +110,13 @@ void Renderer::Impl::set_camera_uniforms(const Program& prog, const RenderCamera
 }
 
 void Renderer::Impl::draw_mesh(const GlMesh& m, const RenderCamera& cam, const Mat4& model, bool vertex_color,
-                               vec3 tint, bool lit) {
+                               vec3 tint, bool lit, bool two_sided) {
   set_camera_uniforms(mesh_prog, cam);
   glUniformMatrix4fv(mesh_prog.loc("u_model"), 1, GL_FALSE, model.data());
   glUniform1i(mesh_prog.loc("u_vertex_color"), vertex_color);
   glUniform3f(mesh_prog.loc("u_tint"), tint.x, tint.y, tint.z);
   glUniform1i(mesh_prog.loc("u_lit"), lit);
+  glUniform1i(mesh_prog.loc("u_two_sided"), two_sided);
   m.draw();
 }
 
@@ -188,7 +192,7 @@ void Renderer::Impl::draw_objects(const DrawList& list, std::int64_t n, const Re
       std::vector<int3> tris(c.triangles);
       for (int3& t : tris) t = {t.x - lo, t.y - lo, t.z - lo};
       cloth.upload(pos, vertex_normals(pos, tris), {}, tris, GL_STREAM_DRAW);
-      draw_mesh(cloth, cam, model_matrix(SE3::identity()), false, p.cloth_color, true);
+      draw_mesh(cloth, cam, model_matrix(SE3::identity()), false, p.cloth_color, true, true);
     }
   const bool fluid_as_particles = p.show_fluid && p.fluid == "particles";
   if (n > 0 && (p.show_particles || fluid_as_particles)) {

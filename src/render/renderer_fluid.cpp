@@ -103,6 +103,7 @@ void bind_tex(int unit, GLenum target, GLuint tex) {
 bool Renderer::Impl::draw_fluid(std::int64_t n, float radius, const RenderCamera& cam) {
   if (fluid_count == 0) return false;
   const std::uint32_t fluid = kernels::phase::kFluid;
+  const float s = p.fluid_radius_scale, sphere_r = radius * s;
   // 1. Nearest sphere depth per pixel, in front of the scene.
   glBindFramebuffer(GL_FRAMEBUFFER, fluid_depth_fbo);
   glClearColor(0.f, 0.f, 0.f, 0.f);
@@ -110,7 +111,7 @@ bool Renderer::Impl::draw_fluid(std::int64_t n, float radius, const RenderCamera
   bind_tex(0, GL_TEXTURE_2D, scene_depth);
   fluid_depth_prog.use();
   glUniform1i(fluid_depth_prog.loc("u_scene_depth"), 0);
-  draw_spheres(fluid_depth_prog, n, fluid, radius, cam);
+  draw_spheres(fluid_depth_prog, n, fluid, sphere_r, cam);
   timer.mark("fluid_depth");
   if (p.stage_images) stages.push_back({"1_depth", float_to_grey(read_float(fluid_depth_fbo, 0, GL_RED, 1, w, h), w, h)});
   // 2. Thickness: every sphere's chord, added up.
@@ -121,7 +122,8 @@ bool Renderer::Impl::draw_fluid(std::int64_t n, float radius, const RenderCamera
   glBlendFunc(GL_ONE, GL_ONE);
   fluid_thick_prog.use();
   glUniform1i(fluid_thick_prog.loc("u_scene_depth"), 0);
-  draw_spheres(fluid_thick_prog, n, fluid, radius, cam);
+  glUniform1f(fluid_thick_prog.loc("u_thickness_scale"), 6.f / (kernels::kPi * s * s * s));
+  draw_spheres(fluid_thick_prog, n, fluid, sphere_r, cam);
   glDisable(GL_BLEND);
   timer.mark("fluid_thickness");
   // 3. Separable filters: depth (bilateral, world-sized), thickness (small Gaussian).

@@ -126,7 +126,8 @@ struct Renderer::Impl {
   void draw_frame(const DrawList& list, std::int64_t n, const RenderCamera& cam);
   void draw_scene(const RenderCamera& cam);
   void draw_objects(const DrawList& list, std::int64_t n, const RenderCamera& cam);
-  void draw_mesh(const GlMesh& m, const RenderCamera& cam, const Mat4& model, bool vertex_color, vec3 tint, bool lit);
+  void draw_mesh(const GlMesh& m, const RenderCamera& cam, const Mat4& model, bool vertex_color, vec3 tint, bool lit,
+                 bool two_sided = false);
   void draw_spheres(const Program& prog, std::int64_t n, std::uint32_t mask, float radius, const RenderCamera& cam);
   void render_cube_map();
   // renderer_fluid.cpp

@@ -16,6 +16,10 @@ extern const char* const kShaderTexts[];
 extern const int kShaderCount;
 }  // namespace detail
 
+namespace {
+constexpr long kLinesPerFile = 100000;  // see assemble()
+}  // namespace
+
 const std::string& shader_source(const std::string& name) {
   static const std::map<std::string, std::string> table = [] {
     std::map<std::string, std::string> t;
@@ -28,19 +32,17 @@ const std::string& shader_source(const std::string& name) {
 }
 
 std::string map_shader_log(const std::string& log, const std::vector<std::string>& files) {
-  // Mesa: "2:17(5): error: ..."; NVIDIA: "2(17) : error C1008: ...". Group 1/3 = string, 2/4 = line.
-  static const std::regex loc(R"((\d+):(\d+)\(\d+\)|(\d+)\((\d+)\))");
+  // Mesa: "0:100017(5): error: ..."; NVIDIA: "0(100017) : error C1008: ...". Group 1 / 2 = line.
+  static const std::regex loc(R"(\d+:(\d+)\(\d+\)|\d+\((\d+)\))");
   std::string out;
-  auto begin = std::sregex_iterator(log.begin(), log.end(), loc);
   std::size_t last = 0;
-  for (auto it = begin; it != std::sregex_iterator(); ++it) {
+  for (auto it = std::sregex_iterator(log.begin(), log.end(), loc); it != std::sregex_iterator(); ++it) {
     const std::smatch& m = *it;
-    const bool mesa = m[1].matched;
-    const int str = std::stoi(mesa ? m[1].str() : m[3].str());
-    const std::string line = mesa ? m[2].str() : m[4].str();
+    const long line = std::stol(m[1].matched ? m[1].str() : m[2].str());
+    const long file = line / kLinesPerFile - 1;
     out += log.substr(last, static_cast<std::size_t>(m.position()) - last);
-    if (str >= 1 && str <= static_cast<int>(files.size()))
-      out += files[static_cast<std::size_t>(str - 1)] + ":" + line;
+    if (file >= 0 && file < static_cast<long>(files.size()))
+      out += files[static_cast<std::size_t>(file)] + ":" + std::to_string(line % kLinesPerFile);
     else
       out += m.str();
     last = static_cast<std::size_t>(m.position() + m.length());
@@ -52,12 +54,13 @@ namespace {
 
 using Sources = std::vector<std::pair<std::string, std::string>>;  // file name, text
 
-// "#version" first, then each file behind a "#line 1 <n>" so that the driver reports lines of
-// the file itself under source string number n (GLSL 4.10 spec, section 3.4).
+// "#version" first, then file i behind "#line (i + 1) * kLinesPerFile + 1" (GLSL 4.10 spec,
+// section 3.4), so that a reported line says both the file and its own line. (The source-string
+// number of #line would be the natural carrier, but Mesa reports it as 0.)
 std::string assemble(const Sources& src) {
   std::string s = "#version 410 core\n";
   for (std::size_t i = 0; i < src.size(); ++i)
-    s += "#line 1 " + std::to_string(i + 1) + "\n" + src[i].second + "\n";
+    s += "#line " + std::to_string((static_cast<long>(i) + 1) * kLinesPerFile + 1) + "\n" + src[i].second + "\n";
   return s;
 }
 

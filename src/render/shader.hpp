@@ -39,8 +39,8 @@ class Program {
   unsigned id_ = 0;
 };
 
-// Rewrites a driver's info log so that each "<string>:<line>" (Mesa "0:12(5)", NVIDIA "0(12)")
-// names the file and its own line. files[i] is GLSL source string i + 1 (string 0 is #version).
+// Rewrites a driver's info log so that each location (Mesa "0:200012(5)", NVIDIA "0(200012)")
+// names the file and its own line: file i is numbered from (i + 1) * 100000 + 1 by #line.
 std::string map_shader_log(const std::string& log, const std::vector<std::string>& files);
 
 }  // namespace seamless

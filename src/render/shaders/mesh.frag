@@ -4,6 +4,7 @@ in vec3 v_color;
 uniform vec3 u_light;     // unit direction towards the light, eye space
 uniform float u_ambient;
 uniform bool u_lit;
+uniform bool u_two_sided;  // cloth; closed meshes and the scan keep their outward normals
 
 layout(location = 0) out vec4 o_color;
 
@@ -11,7 +12,7 @@ void main() {
   vec3 n = normalize(v_normal);
   // Two-sided surfaces (cloth) are one mesh: the normal is turned towards the side being seen,
   // so the back face is lit like the front instead of drawing a second, offset copy.
-  if (!gl_FrontFacing) n = -n;
+  if (u_two_sided && !gl_FrontFacing) n = -n;
   float diffuse = max(dot(n, u_light), 0.0);
   vec3 c = u_lit ? v_color * (u_ambient + (1.0 - u_ambient) * diffuse) : v_color;
   o_color = vec4(c, 1.0);

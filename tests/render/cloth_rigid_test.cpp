@@ -1,0 +1,123 @@
+// Cloth is one two-sided mesh lit on whichever side is seen; rigid bodies are boxes in their
+// shape-matching frames.
+#include <cmath>
+
+#include "kernels/physics/particle_math.hpp"
+#include "physics/particle_solver.hpp"
+#include "render_test_util.hpp"
+
+namespace seamless::test {
+namespace {
+
+// An n x n sheet in the plane z = 2, side 1 m; `flip` reverses the triangles' winding, so the
+// camera sees the other face of the same sheet.
+struct Sheet {
+  std::vector<vec3> x;
+  std::vector<std::uint32_t> ph;
+  ClothDraw cloth;
+  Sheet(int n, bool flip) {
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        x.push_back(vec3{-0.5f + static_cast<float>(i) / (n - 1), -0.5f + static_cast<float>(j) / (n - 1), 2.f});
+    ph.assign(x.size(), kernels::phase::kCloth);
+    for (int j = 0; j + 1 < n; ++j)
+      for (int i = 0; i + 1 < n; ++i) {
+        const int a = j * n + i, b = a + 1, c = a + n + 1, d = a + n;
+        cloth.triangles.push_back(flip ? int3{a, c, b} : int3{a, b, c});
+        cloth.triangles.push_back(flip ? int3{a, d, c} : int3{a, c, d});
+      }
+  }
+  DrawList list() const {
+    DrawList l;
+    l.positions = x, l.phases = ph, l.particle_radius = 0.01f, l.cloths = {cloth};
+    return l;
+  }
+};
+
+// Light travelling along the view direction (from the camera onto the sheet): with the normal
+// turned to the visible side, diffuse = n . l = 1 at the centre, so the colour is the full cloth
+// colour on either face. Without the turn the back face would get the ambient part only (0.2 of
+// it). Tolerance: 8-bit rounding, 2 levels.
+TEST(RenderCloth, BothFacesAreLit) {
+  SEAMLESS_REQUIRE_EGL();
+  RenderParams p;
+  p.light_dir = {0.f, 0.f, 1.f};
+  p.ambient = 0.2f;
+  p.cloth_color = {200 / 255.f, 150 / 255.f, 50 / 255.f};
+  const Intrinsics K = intrinsics(100.f, 79.5f, 59.5f, 160, 120);
+  Renderer r(p, K.width, K.height);
+  for (bool flip : {false, true}) {
+    Sheet s(9, flip);
+    Pixels img(r.render(s.list(), camera(K)));
+    const uchar3 c = img.at(80, 60);
+    EXPECT_LE(max_diff(c, uchar3{200, 150, 50}), 2) << (flip ? "back" : "front") << " face: " << int(c.x) << " "
+                                                      << int(c.y) << " " << int(c.z);
+  }
+}
+
+// Light from behind the sheet: whichever face is seen, it faces away from the light and shows
+// the ambient part only, on both faces alike (one mesh, one rule).
+TEST(RenderCloth, LightFromBehindGivesAmbientOnBothFaces) {
+  SEAMLESS_REQUIRE_EGL();
+  RenderParams p;
+  p.light_dir = {0.f, 0.f, -1.f};
+  p.ambient = 0.5f;
+  p.cloth_color = {200 / 255.f, 150 / 255.f, 50 / 255.f};
+  const Intrinsics K = intrinsics(100.f, 79.5f, 59.5f, 160, 120);
+  Renderer r(p, K.width, K.height);
+  for (bool flip : {false, true}) {
+    Pixels img(r.render(Sheet(9, flip).list(), camera(K)));
+    EXPECT_LE(max_diff(img.at(80, 60), uchar3{100, 75, 25}), 2) << (flip ? "back" : "front");
+  }
+}
+
+// A box 0.4 x 0.2 x 0.2 m (half extents 0.2, 0.1, 0.1) at (0, 0, 2), facing the camera: its
+// front face z = 1.9 covers [fx x / 1.9 + cx] x [fy y / 1.9 + cy]; a one-pixel margin as for
+// the mesh view. The front face's normal points at the camera and the light comes from it, so
+// the face has the full rigid colour.
+TEST(RenderRigid, BoxCoversItsProjection) {
+  SEAMLESS_REQUIRE_EGL();
+  RenderParams p;
+  p.light_dir = {0.f, 0.f, 1.f};
+  p.rigid_color = {180 / 255.f, 60 / 255.f, 40 / 255.f};
+  p.background = {0.f, 0.f, 0.f};
+  const Intrinsics K = intrinsics(100.f, 79.5f, 59.5f, 160, 120);
+  Renderer r(p, K.width, K.height);
+  DrawList l;
+  l.rigids.push_back(RigidDraw{SE3{mat3::identity(), {0.f, 0.f, 2.f}}, {0.2f, 0.1f, 0.1f}});
+  Pixels img(r.render(l, camera(K)));
+  const float u0 = 100.f * -0.2f / 1.9f + 79.5f, u1 = 100.f * 0.2f / 1.9f + 79.5f;
+  const float v0 = 100.f * -0.1f / 1.9f + 59.5f, v1 = 100.f * 0.1f / 1.9f + 59.5f;
+  for (int v = 0; v < img.h; ++v)
+    for (int u = 0; u < img.w; ++u) {
+      if (u > u0 + 1 && u < u1 - 1 && v > v0 + 1 && v < v1 - 1)
+        EXPECT_LE(max_diff(img.at(u, v), uchar3{180, 60, 40}), 2) << u << "," << v;
+      if (u < u0 - 1 || u > u1 + 1 || v < v0 - 1 || v > v1 + 1)
+        EXPECT_TRUE(same(img.at(u, v), uchar3{0, 0, 0})) << u << "," << v;
+    }
+}
+
+// make_draw_list: a body's box is its particles' extent in the body frame plus one radius.
+TEST(RenderRigid, DrawListBoxesFromShapeMatchingFrames) {
+  ParticleState st;
+  const mat3 R = rotation({0.f, 0.f, 1.f}, 0.5f);
+  const vec3 c{1.f, 2.f, 3.f};
+  for (vec3 q : {vec3{-0.3f, -0.1f, -0.05f}, vec3{0.3f, 0.1f, 0.05f}, vec3{0.3f, -0.1f, 0.f}}) {
+    st.x.push_back(R * q + c);
+    st.phase.push_back(kernels::phase::kRigid);
+  }
+  RigidFrame f;
+  f.centre = c;
+  const float s = std::sin(0.25f);
+  f.rotation = {0.f, 0.f, s, std::cos(0.25f)};  // 0.5 rad about z
+  f.first = 0, f.count = 3;
+  const DrawList d = make_draw_list(st, {f}, 0.02f);
+  ASSERT_EQ(d.rigids.size(), 1u);
+  EXPECT_NEAR(d.rigids[0].half_extents.x, 0.32f, 1e-5f);
+  EXPECT_NEAR(d.rigids[0].half_extents.y, 0.12f, 1e-5f);
+  EXPECT_NEAR(d.rigids[0].half_extents.z, 0.07f, 1e-5f);
+  EXPECT_EQ(d.positions.size(), 3u);
+}
+
+}  // namespace
+}  // namespace seamless::test
