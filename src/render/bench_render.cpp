@@ -53,7 +53,7 @@ RenderBenchResult bench_render(int width, int height, std::int64_t particles, in
                                            {0, 1, 0}, 60.f, width, height);
   r.draw(list, cam);  // warm-up: shader compilation, allocation, first upload
   glFinish();
-  std::vector<double> frame_ms, read_ms;
+  std::vector<double> frame_ms, read_ms, draw_ms;
   std::map<std::string, std::vector<double>> pass_ms;
   using clock = std::chrono::steady_clock;
   for (int f = 0; f < frames; ++f) {
@@ -66,11 +66,16 @@ RenderBenchResult bench_render(int width, int height, std::int64_t particles, in
     frame_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
     read_ms.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
     for (const RenderTiming& t : r.timings()) pass_ms[t.pass].push_back(t.ms);
+    auto t3 = clock::now();
+    r.draw_device_particles(DrawList{}, static_cast<std::int64_t>(x.size()), cam);
+    glFinish();
+    draw_ms.push_back(std::chrono::duration<double, std::milli>(clock::now() - t3).count());
   }
   RenderBenchResult res;
   res.width = width, res.height = height, res.particles = static_cast<std::int64_t>(x.size()), res.frames = frames;
   res.median_frame_ms = median_of(frame_ms);
   res.median_readback_ms = median_of(read_ms);
+  res.median_draw_ms = median_of(draw_ms);
   for (const RenderTiming& t : r.timings()) res.passes.push_back({t.pass, median_of(pass_ms[t.pass])});
   res.gl_renderer = r.gl_info().renderer;
   return res;

@@ -15,7 +15,9 @@ struct RenderBenchResult {
   int width = 0, height = 0;
   std::int64_t particles = 0;
   int frames = 0;
-  double median_frame_ms = 0.0;   // draw + glFinish (no readback), wall clock
+  double median_frame_ms = 0.0;   // upload from host + draw + glFinish (no readback), wall clock
+  double median_draw_ms = 0.0;    // draw + glFinish with the particles already in GL buffers
+                                  // (the CUDA-OpenGL interop path: no host upload)
   double median_readback_ms = 0.0;
   std::vector<RenderTiming> passes;  // GPU time per pass, median over the frames
   std::string gl_renderer;
