@@ -41,12 +41,23 @@ void hash_erase(const Exec& ex, HashTableView t, View<const HashKey> keys, View<
 // must hold one int per slot (scratch).
 template <class Exec>
 std::int64_t hash_live_slots(const Exec& ex, HashTableView t, View<std::int32_t> flags, View<std::int32_t> slots_out);
+// Slots of the live blocks whose centre lies farther than radius from center (both in voxel
+// units), in slot order; returns how many (streaming out, Niessner section 5). flags as above.
+template <class Exec>
+std::int64_t hash_slots_beyond(const Exec& ex, HashTableView t, vec3 center, float radius, View<std::int32_t> flags,
+                               View<std::int32_t> slots_out);
+// Inserts each key (distinct, absent) with a block popped from the pool: blocks_out[i] = the block,
+// or -1 when the key was already present or no slot (probe_failures) or block (pool_failures)
+// was left; a key left without a block is tombstoned again, so it can be inserted later.
+template <class Exec>
+void insert_with_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list, HashCounters* counters,
+                        View<const HashKey> keys, View<std::int32_t> blocks_out);
 // Copies (key, value) of the given slots out (for rehashing and host inspection).
 template <class Exec>
 void hash_gather(const Exec& ex, HashTableView t, View<const std::int32_t> slots, View<HashKey> keys_out,
                  View<std::int32_t> values_out);
 // Copies whole blocks out of / into the pool: out[i*512 + k] = pool[blocks[i]*512 + k] and back
-// (host download, streaming, dense <-> hash conversion).
+// (host download, streaming, dense <-> hash conversion); scatter skips blocks[i] < 0.
 template <class Exec>
 void gather_blocks(const Exec& ex, const Voxel* pool, View<const std::int32_t> blocks, View<Voxel> out);
 template <class Exec>

@@ -74,16 +74,61 @@ void hash_erase(const Exec& ex, HashTableView t, View<const HashKey> keys, View<
   });
 }
 
-template <class Exec>
-std::int64_t hash_live_slots(const Exec& ex, HashTableView t, View<std::int32_t> flags, View<std::int32_t> slots_out) {
+// Writes the slots for which keep(slot) holds to slots_out, in slot order; returns how many.
+// flags (one int per slot) becomes the exclusive prefix sum: the output position of each slot.
+template <class Exec, class Pred>
+std::int64_t compact_slots(const Exec& ex, HashTableView t, View<std::int32_t> flags, View<std::int32_t> slots_out,
+                           Pred keep) {
   const std::int64_t n = static_cast<std::int64_t>(t.mask) + 1;
-  ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) { flags[i] = is_live_key(t.keys[i]) && t.values[i] >= 0 ? 1 : 0; });
-  // flags becomes the exclusive prefix sum: the output position of each live slot.
+  ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) { flags[i] = keep(i) ? 1 : 0; });
   std::int32_t total = ex.exclusive_scan(flags.data, flags.data, n);
   ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) {
-    if (is_live_key(t.keys[i]) && t.values[i] >= 0) slots_out[flags[i]] = static_cast<std::int32_t>(i);
+    if (keep(i)) slots_out[flags[i]] = static_cast<std::int32_t>(i);
   });
   return total;
+}
+
+template <class Exec>
+std::int64_t hash_live_slots(const Exec& ex, HashTableView t, View<std::int32_t> flags, View<std::int32_t> slots_out) {
+  return compact_slots(ex, t, flags, slots_out,
+                       [=] SEAMLESS_HD(std::int64_t i) { return is_live_key(t.keys[i]) && t.values[i] >= 0; });
+}
+
+template <class Exec>
+std::int64_t hash_slots_beyond(const Exec& ex, HashTableView t, vec3 center, float radius, View<std::int32_t> flags,
+                               View<std::int32_t> slots_out) {
+  const float r2 = radius * radius;
+  return compact_slots(ex, t, flags, slots_out, [=] SEAMLESS_HD(std::int64_t i) {
+    HashKey k = t.keys[i];
+    if (!is_live_key(k) || t.values[i] < 0) return false;
+    int3 b = unpack_block(k);
+    vec3 c{b.x * 8.f + 3.5f, b.y * 8.f + 3.5f, b.z * 8.f + 3.5f};  // centre of voxels 8b .. 8b+7
+    return length2(c - center) > r2;
+  });
+}
+
+template <class Exec>
+void insert_with_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list, HashCounters* counters,
+                        View<const HashKey> keys, View<std::int32_t> blocks_out) {
+  ex.for_each(keys.size, [=] SEAMLESS_HD(std::int64_t i) {
+    blocks_out[i] = -1;
+    std::int32_t slot = -1;
+    int probes = 0;
+    InsertResult r = t.insert(keys[i], &slot, &probes);
+    if (r == InsertResult::Full) atomic_add(&counters->probe_failures, 1);
+    if (r != InsertResult::Inserted) return;  // Found: the key was already there (the caller checks)
+    std::int32_t block = pool_pop(counters, free_list.data);
+    if (block < 0) {  // no block: give the slot up so that a later attempt can insert the key again
+      atomic_add(&counters->pool_failures, 1);
+      atomic_exch(&t.keys[slot], kTombstone);
+      atomic_add(&counters->tombstones, 1);
+      return;
+    }
+    atomic_exch(&t.values[slot], block);
+    atomic_add(&counters->inserted, 1);
+    if (probes > 0) atomic_add(&counters->collisions, 1);
+    blocks_out[i] = block;
+  });
 }
 
 template <class Exec>
@@ -105,7 +150,8 @@ void gather_blocks(const Exec& ex, const Voxel* pool, View<const std::int32_t> b
 template <class Exec>
 void scatter_blocks(const Exec& ex, Voxel* pool, View<const std::int32_t> blocks, View<const Voxel> in) {
   ex.for_each(blocks.size * kBlockVoxels, [=] SEAMLESS_HD(std::int64_t i) {
-    pool[static_cast<std::int64_t>(blocks[i / kBlockVoxels]) * kBlockVoxels + i % kBlockVoxels] = in[i];
+    const std::int32_t block = blocks[i / kBlockVoxels];
+    if (block >= 0) pool[static_cast<std::int64_t>(block) * kBlockVoxels + i % kBlockVoxels] = in[i];
   });
 }
 
@@ -123,6 +169,10 @@ void scatter_blocks(const Exec& ex, Voxel* pool, View<const std::int32_t> blocks
   template void hash_erase<EXEC>(const EXEC&, HashTableView, View<const HashKey>, View<std::int32_t>,            \
                                  HashCounters*);                                                                 \
   template std::int64_t hash_live_slots<EXEC>(const EXEC&, HashTableView, View<std::int32_t>, View<std::int32_t>); \
+  template std::int64_t hash_slots_beyond<EXEC>(const EXEC&, HashTableView, vec3, float, View<std::int32_t>,     \
+                                                View<std::int32_t>);                                             \
+  template void insert_with_blocks<EXEC>(const EXEC&, HashTableView, View<const std::int32_t>, HashCounters*,    \
+                                         View<const HashKey>, View<std::int32_t>);                               \
   template void hash_gather<EXEC>(const EXEC&, HashTableView, View<const std::int32_t>, View<HashKey>,          \
                                   View<std::int32_t>);                                                           \
   template void gather_blocks<EXEC>(const EXEC&, const Voxel*, View<const std::int32_t>, View<Voxel>);          \

@@ -49,6 +49,10 @@ struct VolumeStats {
   std::size_t bytes_per_block = 0;    // voxel payload of one 8^3 block
   std::size_t voxel_bytes = 0;        // allocated_blocks * bytes_per_block
   std::size_t device_bytes = 0;       // everything the volume holds on its device
+  std::int64_t host_blocks = 0;       // blocks streamed out to host memory (Niessner section 5)
+  std::size_t host_bytes = 0;         // their voxel payload
+  std::int64_t streamed_out = 0;      // blocks moved to the host, total
+  std::int64_t streamed_in = 0;       // blocks moved back to the device, total
 };
 
 class Volume {

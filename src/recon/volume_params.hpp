@@ -24,6 +24,8 @@ struct VolumeParams {
   bool remove_empty_blocks = true;
   bool grow_when_full = true;        // double the hash table / block pool instead of dropping blocks
   int raycast_tile = 8;              // pixels per side of a ray-interval tile (Niessner 4.3); 0: none
+  float stream_radius = 0.f;         // blocks beyond this distance from the camera go to host memory; 0: off
+  float stream_step = 0.25f;         // camera travel (metres) between two streaming passes
 
   template <class V> void visit(V& v) {
     v("layout", layout, "volume layout: voxel hashing or dense grid", Choices{"hash", "dense"});
@@ -44,6 +46,13 @@ struct VolumeParams {
       "hash layout: rays march only over the depth range of the blocks projecting onto their tile of this many "
       "pixels per side (Niessner 2013, section 4.3); 0 marches every ray from min_depth",
       Range{0, 256});
+    v("stream_radius", stream_radius,
+      "hash layout: blocks whose centre is farther than this from the camera are moved to host memory and brought "
+      "back when the camera returns (Niessner 2013, section 5), metres; 0 keeps everything on the device. Must "
+      "exceed the farthest point a frame can touch plus stream_step (checked; about max_depth * 1.26 + 0.4 for a "
+      "Kinect)",
+      Range{0.0, 1e4});
+    v("stream_step", stream_step, "camera travel between two streaming passes, metres", Range{0.01, 100.0});
   }
 };
 

@@ -79,7 +79,8 @@ void VoxelHashVolume::integrate(const Image<float>& depth, const Image<uchar3>& 
   const Image<uchar3>& col = detail::on_device(rgb, device_, ctmp);
   kernels::FrameInput in{dep.cview(), col.width() ? col.cview() : View2D<const uchar3>{}, K, world_T_camera,
                          params_.min_depth, params_.max_depth};
-  maybe_rehash();
+  if (params_.stream_radius > 0.f) staged(timer, "stream", [&] { maybe_stream(K, world_T_camera.t); });
+  maybe_rehash(last_);
   allocate_and_list(in, timer);
   const std::int64_t n = last_.visible;
   // Fusion flags the visible blocks that keep a voxel near a surface, so removing the others
@@ -145,11 +146,12 @@ void VoxelHashVolume::handle_failures(const HashCounters& c) {
 
 // Between frames: clears tombstones and keeps the fill at or below one half, where linear probing
 // stays short (Knuth: expected probes (1 + 1/(1-a)^2)/2 = 2.5 for an unsuccessful search at a = 1/2).
-void VoxelHashVolume::maybe_rehash() {
+// extra: keys about to be inserted besides allocation (streaming in).
+void VoxelHashVolume::maybe_rehash(const HashCounters& c, std::int64_t extra) {
   const std::int64_t slots = keys_.size();
-  const std::int64_t live = free_list_.size() - last_.free_top;
-  if (2 * (live + last_.tombstones) <= slots) return;
-  if (4 * live > slots && params_.grow_when_full) return rehash(2 * slots);
+  const std::int64_t live = free_list_.size() - std::max(c.free_top, 0) + extra;
+  if (2 * (live + c.tombstones) <= slots) return;
+  if (4 * live > slots && params_.grow_when_full) return rehash(next_pow2(4 * live));
   if (4 * live > slots)
     spdlog::warn("voxel hashing: {} of {} hash slots hold blocks; insertions may start failing (set "
                  "volume.hash_buckets: {} or volume.grow_when_full: true)",
@@ -326,6 +328,10 @@ VolumeStats VoxelHashVolume::stats() {
   s.voxel_bytes = s.bytes_per_block * static_cast<std::size_t>(s.allocated_blocks);
   s.device_bytes = keys_.bytes() + values_.bytes() + scratch_.bytes() + voxels_.bytes() + free_list_.bytes() +
                    visible_.bytes() + keep_.bytes() + intervals_.bytes() + counters_.bytes();
+  s.host_blocks = host_count_;
+  s.host_bytes = s.bytes_per_block * static_cast<std::size_t>(host_count_);
+  s.streamed_out = streamed_out_;
+  s.streamed_in = streamed_in_;
   return s;
 }
 

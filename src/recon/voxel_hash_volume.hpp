@@ -1,6 +1,7 @@
 // The voxel-hashed TSDF volume (Niessner, Zollhoefer, Izadi, Stamminger 2013). Design, memory and
 // failure handling: docs/RECONSTRUCTION.md.
 #pragma once
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -47,6 +48,18 @@ class VoxelHashVolume final : public Volume {
   // Block coordinates of the allocated blocks on the device (count returned).
   std::int64_t live_block_coords(Buffer<int3>& coords) const;
 
+  // Streaming to host memory (Niessner section 5; design in docs/RECONSTRUCTION.md). With
+  // params.stream_radius > 0, integrate() runs a pass whenever the camera has moved stream_step
+  // since the last one. A pass moves every block whose centre is farther than stream_radius from
+  // camera_position into the host store, then brings every stored block within it back. A block
+  // is never on both sides. The accessors above (download, mesh, particles, raycast) see only the
+  // blocks on the device: call stream_in_all() first for the whole model.
+  void stream(const vec3& camera_position);
+  // Brings every stored block back to the device, growing the pool if allowed (else what does not
+  // fit stays on the host, with a warning).
+  void stream_in_all();
+  std::int64_t host_block_count() const { return host_count_; }
+
  private:
   kernels::HashTableView table() const;
   // Blocks with no observed voxel closer to a surface than this (metres) are freed as empty.
@@ -54,9 +67,23 @@ class VoxelHashVolume final : public Volume {
   kernels::HashCounters read_counters() const;
   void allocate_and_list(const kernels::FrameInput& in, StageTimer* timer);
   void handle_failures(const kernels::HashCounters& c);
-  void maybe_rehash();
+  void maybe_rehash(const kernels::HashCounters& c, std::int64_t extra = 0);
   void rehash(std::int64_t slots);
   void grow_pool(std::int64_t blocks);
+
+  // Host store of streamed-out blocks, by chunk of kChunkBlocks^3 blocks (Niessner's chunk grid).
+  struct HostChunk {
+    std::vector<kernels::HashKey> keys;
+    std::vector<kernels::Voxel> voxels;  // 512 per key
+  };
+  static constexpr int kChunkShift = 3;  // chunks of 8^3 blocks (32 cm at 5 mm voxels)
+  void maybe_stream(const Intrinsics& K, const vec3& camera_position);
+  void stream_out(const vec3& camera_position);
+  void take_from_host(const vec3& camera_position, bool all, std::vector<kernels::HashKey>& keys,
+                      std::vector<kernels::Voxel>& voxels);
+  void put_on_host(const kernels::HashKey* keys, const kernels::Voxel* voxels, std::int64_t n);
+  void upload(std::vector<kernels::HashKey>& keys, std::vector<kernels::Voxel>& voxels);
+  bool beyond_radius(kernels::HashKey key, const vec3& camera_position) const;
 
   VolumeParams params_;
   Device device_;
@@ -72,6 +99,10 @@ class VoxelHashVolume final : public Volume {
   mutable Buffer<std::int32_t> scratch_;  // one int per slot for scans
   kernels::HashCounters last_{};          // counters as read at the end of the last frame
   std::int64_t frames_ = 0, retries_ = 0, failed_ = 0;
+  std::unordered_map<kernels::HashKey, HostChunk> host_;
+  std::int64_t host_count_ = 0, streamed_out_ = 0, streamed_in_ = 0;
+  vec3 stream_pos_{0.f, 0.f, 0.f};
+  bool streamed_ = false;  // a pass has run (stream_pos_ is set)
 };
 
 }  // namespace seamless
