@@ -278,10 +278,12 @@ void VoxelHashVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, Ra
   }
   with_exec(device_, [&](const auto& ex) {
     staged(timer, "raycast", [&] {
-      if (iv.bits) {
-        kernels::clear_ray_intervals(ex, iv);
-        kernels::splat_ray_intervals(ex, table(), geom_, K, world_T_camera, params_.min_depth, params_.max_depth, iv);
-      }
+      if (iv.bits)
+        staged(timer, "raycast_splat", [&] {  // part of "raycast"
+          kernels::clear_ray_intervals(ex, iv);
+          kernels::splat_ray_intervals(ex, table(), geom_, K, world_T_camera, params_.min_depth, params_.max_depth,
+                                       iv);
+        });
       kernels::raycast(ex, device_view(), K, world_T_camera, params_.min_depth, params_.max_depth, out, iv);
     });
   });
