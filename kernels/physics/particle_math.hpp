@@ -23,47 +23,137 @@ SEAMLESS_HD inline bool is(std::uint32_t ph, std::uint32_t flag) { return (ph & 
 
 constexpr float kPi = 3.14159265358979f;
 
-// Poly6 kernel (Mueller 2003, used for density in Macklin & Mueller 2013, eq. 2).
-SEAMLESS_HD inline float poly6(float r2, float h) {
-  if (r2 >= h * h) return 0.f;
-  float h2 = h * h, t = h2 - r2;
-  return 315.f / (64.f * kPi * h2 * h2 * h2 * h2 * h) * t * t * t;
-}
+// SPH kernels of smoothing radius h with their normalising constants computed once (the
+// constants cost two divisions per call otherwise, and the kernels run for every neighbour pair
+// several times per iteration). Same expressions, same float results as evaluating them inline.
+struct SphKernel {
+  float h = 0.f, h2 = 0.f;
+  float poly6_c = 0.f;   // 315 / (64 pi h^9)
+  float spiky_c = 0.f;   // -45 / (pi h^6)
+  float akinci_c = 0.f;  // 32 / (pi h^9)
+  float h6_64 = 0.f;     // h^6 / 64
 
-// Gradient of the spiky kernel with respect to p_i for r = p_i - p_j (Mueller 2003; PBF eq. 8).
-SEAMLESS_HD inline vec3 spiky_grad(vec3 r, float h) {
-  float l = length(r);
-  if (l >= h || l <= 1e-12f) return {0.f, 0.f, 0.f};
-  float t = h - l;
-  return r * (-45.f / (kPi * h * h * h * h * h * h) * t * t / l);
-}
+  SEAMLESS_HD static SphKernel make(float h) {
+    SphKernel k;
+    float h2 = h * h;
+    k.h = h, k.h2 = h2;
+    k.poly6_c = 315.f / (64.f * kPi * h2 * h2 * h2 * h2 * h);
+    k.spiky_c = -45.f / (kPi * h * h * h * h * h * h);
+    k.akinci_c = 32.f / (kPi * h * h * h * h * h * h * h * h * h);
+    k.h6_64 = h * h * h * h * h * h / 64.f;
+    return k;
+  }
 
-// Akinci 2013 cohesion spline C(r) (eq. 2 there), zero beyond h.
-SEAMLESS_HD inline float akinci_spline(float r, float h) {
-  if (r >= h || r <= 0.f) return 0.f;
-  float k = 32.f / (kPi * h * h * h * h * h * h * h * h * h);
-  float a = (h - r) * (h - r) * (h - r) * r * r * r;
-  if (2.f * r > h) return k * a;
-  float h6 = h * h * h * h * h * h;
-  return k * (2.f * a - h6 / 64.f);
-}
+  // Poly6 (Mueller 2003, used for density in Macklin & Mueller 2013, eq. 2).
+  SEAMLESS_HD float poly6(float r2) const {
+    if (r2 >= h2) return 0.f;
+    float t = h2 - r2;
+    return poly6_c * t * t * t;
+  }
+
+  // Gradient of the spiky kernel with respect to p_i for r = p_i - p_j (Mueller 2003; PBF eq. 8).
+  SEAMLESS_HD vec3 spiky_grad(vec3 r) const {
+    float l = length(r);
+    if (l >= h || l <= 1e-12f) return {0.f, 0.f, 0.f};
+    float t = h - l;
+    return r * (spiky_c * t * t / l);
+  }
+
+  // Akinci 2013 cohesion spline C(r) (eq. 2 there), zero beyond h.
+  SEAMLESS_HD float akinci(float r) const {
+    if (r >= h || r <= 0.f) return 0.f;
+    float a = (h - r) * (h - r) * (h - r) * r * r * r;
+    if (2.f * r > h) return akinci_c * a;
+    return akinci_c * (2.f * a - h6_64);
+  }
+};
+
+SEAMLESS_HD inline float poly6(float r2, float h) { return SphKernel::make(h).poly6(r2); }
+SEAMLESS_HD inline vec3 spiky_grad(vec3 r, float h) { return SphKernel::make(h).spiky_grad(r); }
+SEAMLESS_HD inline float akinci_spline(float r, float h) { return SphKernel::make(h).akinci(r); }
 
 // ---- neighbour grid -------------------------------------------------------------------------
+// floor as an int without a libm call on the CPU (x86-64 without SSE4.1 calls floorf); equal to
+// static_cast<int>(floorf(x)) wherever that is defined.
+SEAMLESS_HD inline int floor_int(float x) {
+  int i = static_cast<int>(x);
+  return static_cast<float>(i) > x ? i - 1 : i;
+}
+
 // A periodic uniform grid of 2^bits cells per axis: cell coordinates wrap, so the grid covers all
-// of space, and with at least 3 cells per axis the 27 cells around a particle are 27 distinct
-// buckets (no particle is visited twice). Far-apart particles may share a bucket; the distance
-// test removes them.
+// of space, and with at least 2 * reach + 1 cells per axis the cells around a particle are
+// distinct buckets (no particle is visited twice). Far-apart particles may share a bucket; the
+// distance test removes them. Cells are half the search radius (reach 2): the rows of cells
+// searched then hug the search sphere (see for_each_in_radius), about 100 candidates per particle
+// at the fluid rest spacing instead of the 216 of 27 cells of one search radius.
 struct GridSpec {
   float inv_cell;  // 1 / cell size
   int bits;        // cells per axis = 1 << bits
+  float cell;      // cell size
+  int reach;       // cells searched on each side: ceil(search radius / cell)
   SEAMLESS_HD std::uint32_t key(int3 c) const {
     std::uint32_t m = (1u << bits) - 1u;
     return (static_cast<std::uint32_t>(c.x) & m) | ((static_cast<std::uint32_t>(c.y) & m) << bits) |
            ((static_cast<std::uint32_t>(c.z) & m) << (2 * bits));
   }
-  SEAMLESS_HD int3 cell(vec3 p) const { return floor_to_int(p * inv_cell); }
+  SEAMLESS_HD int3 cell_of(vec3 p) const {
+    return {floor_int(p.x * inv_cell), floor_int(p.y * inv_cell), floor_int(p.z * inv_cell)};
+  }
   SEAMLESS_HD std::int64_t cells() const { return std::int64_t{1} << (3 * bits); }
+  // Grid of cells of half the search radius R.
+  static GridSpec for_radius(float R, int bits) { return {2.f / R, bits, 0.5f * R, 2}; }
 };
+
+// Distance along one axis from coordinate v to cell i's slab [i cs, (i + 1) cs), made smaller by
+// pad so that rounding never drops a cell that holds a neighbour.
+SEAMLESS_HD inline float slab_gap(float v, int i, float cs, float pad) {
+  float lo = static_cast<float>(i) * cs, hi = lo + cs;
+  float g = v < lo ? lo - v : (v > hi ? v - hi : 0.f);
+  return g > pad ? g - pad : 0.f;
+}
+
+// Calls fn(j) for every grid entry j in the cells that can hold a point within R of p. For each
+// row of cells along x (fixed y, z within reach) only the x range that the sphere of radius R
+// crosses at the row's nearest y-z distance is visited. Keys run along x within a row, so that
+// range is one run of the sorted entries, [start[first cell], start[last cell + 1]) (start[k] =
+// number of entries with key < k, k in [0, cells]), or two where it wraps around the grid.
+// Candidates still need the distance test.
+template <class F>
+SEAMLESS_HD inline void for_each_in_radius(const GridSpec& g, const int* start, vec3 p, float R, F&& fn) {
+  const int3 c = g.cell_of(p);
+  const float R2 = R * R, pad = 1e-3f * g.cell;
+  const std::uint32_t m = (1u << g.bits) - 1u;
+  for (int dz = -g.reach; dz <= g.reach; ++dz) {
+    const float ez = slab_gap(p.z, c.z + dz, g.cell, pad);
+    for (int dy = -g.reach; dy <= g.reach; ++dy) {
+      const float ey = slab_gap(p.y, c.y + dy, g.cell, pad), d2 = ey * ey + ez * ez;
+      if (d2 >= R2) continue;
+      const float rx = sqrtf(R2 - d2) + pad;
+      const int lo = floor_int((p.x - rx) * g.inv_cell), hi = floor_int((p.x + rx) * g.inv_cell);
+      const std::uint32_t x0 = static_cast<std::uint32_t>(lo > c.x - g.reach ? lo : c.x - g.reach) & m;
+      const std::uint32_t x1 = static_cast<std::uint32_t>(hi < c.x + g.reach ? hi : c.x + g.reach) & m;
+      const std::uint32_t row = ((static_cast<std::uint32_t>(c.y + dy) & m) << g.bits) |
+                                ((static_cast<std::uint32_t>(c.z + dz) & m) << (2 * g.bits));
+      if (x0 <= x1) {
+        for (int j = start[row | x0], e = start[(row | x1) + 1]; j < e; ++j) fn(j);
+      } else {  // the x range wraps: [x0, m] and [0, x1]
+        for (int j = start[row | x0], e = start[(row | m) + 1]; j < e; ++j) fn(j);
+        for (int j = start[row], e = start[(row | x1) + 1]; j < e; ++j) fn(j);
+      }
+    }
+  }
+}
+
+// start[k] for the sorted keys: the number of keys below k (lower bound), k in [0, cells].
+SEAMLESS_HD inline int lower_bound_key(const std::uint32_t* keys, int n, std::uint32_t k) {
+  int lo = 0, hi = n;
+  while (lo < hi) {
+    int mid = (lo + hi) >> 1;
+    if (keys[mid] < k) lo = mid + 1;
+    else hi = mid;
+  }
+  return lo;
+}
 
 // ---- quaternions (x, y, z, w) ------------------------------------------------------------------
 SEAMLESS_HD inline vec4 quat_mul(vec4 a, vec4 b) {

@@ -32,6 +32,7 @@ struct SimConstants {
   float static_friction = 0.5f, kinetic_friction = 0.3f, restitution = 0.f;
   // Position Based Fluids (Macklin & Mueller 2013), in number-density units.
   float h = 0.08f;                  // smoothing radius
+  SphKernel W = SphKernel::make(0.08f);  // kernels of radius h (host: SphKernel::make(h))
   float rest_density = 1.f;         // rho_0: kernel sum of the rest lattice
   float relaxation = 1.f;           // epsilon of eq. 11 (CFM)
   float scorr_k = 0.f, scorr_inv_wdq = 0.f;  // tensile instability term, eq. 13
@@ -73,19 +74,27 @@ struct SimViews {
   float* density = nullptr;
   int* ncontacts = nullptr;
   vec3 *vort = nullptr, *cnormal = nullptr;
+  vec4* sdf_at = nullptr;  // scene SDF gradient (xyz) and distance (w) at the last counted positions
 
-  // neighbour grid and lists (k-major: list[k * n + i])
+  // Neighbour grid and lists. Entry k of particle s's list is list[s * row + k * col]: the layout
+  // is the executor's choice (the host sets the strides). A CPU thread walks one particle's list,
+  // which should be contiguous (row-major: row = cap, col = 1); a GPU warp reads entry k of 32
+  // particles at once, which should be contiguous (column-major: row = 1, col = n).
   GridSpec grid{};
-  int *cell_start = nullptr, *cell_end = nullptr;
+  int* cell_start = nullptr;  // cells + 1 offsets (kernels::cell_starts)
   int *nbr = nullptr, *nnbr = nullptr;
   int *snbr = nullptr, *nsnbr = nullptr;
+  std::int64_t nbr_row = 0, nbr_col = 0, snbr_row = 0, snbr_col = 0;
+  int* nsolid = nullptr;  // list entries of s that are not fluid-fluid pairs (contacts, solid coupling)
+  SEAMLESS_HD const int* nbrs(int s) const { return nbr + s * nbr_row; }
+  SEAMLESS_HD const int* snbrs(int s) const { return snbr + s * snbr_row; }
   int* counters = nullptr;  // [0] lists over the cap, [1] static lists over the cap, [2] max len, [3] max static len
 
   // static scene particles, sorted by their own grid at upload
   std::int64_t ns = 0;
   const vec3* stat = nullptr;
   GridSpec sgrid{};
-  const int *scell_start = nullptr, *scell_end = nullptr;
+  const int* scell_start = nullptr;
   SceneSdf sdf{};
 
   // rigid bodies: particles of body b are ids [body_start[b], body_start[b] + body_count[b])

@@ -2,7 +2,7 @@
 // substep of the dissertation's Algorithm 1 split into passes. Every pass reads the SimViews the
 // host filled; the host (src/physics/solver.cpp) calls them in this order:
 //
-//   predict -> sort_by_key -> reorder -> clear_cells / cell_ranges -> find_neighbors
+//   predict -> sort_by_key -> reorder -> cell_starts -> find_neighbors
 //   -> stabilize (section 4.4)
 //   -> iterations: prepare_constraints, solve_contacts_fluid (swap sp/tmp), shape_match,
 //                  cloth_stretch per colour, cloth_bend (each: swap sp/tmp)
@@ -20,9 +20,9 @@ template <class Exec> void predict(const Exec& ex, const SimViews& S);
 template <class Exec> void sort_cells(const Exec& ex, std::uint32_t* keys, int* values, std::int64_t n, int bits);
 // Gathers the sorted arrays after sort_by_key(key, order) and fills rank.
 template <class Exec> void reorder(const Exec& ex, const SimViews& S);
-// Cell ranges of sorted keys: start[k] .. end[k]; cells not present get start = end = 0.
-template <class Exec> void clear_cells(const Exec& ex, int* start, int* end, std::int64_t cells);
-template <class Exec> void cell_ranges(const Exec& ex, const std::uint32_t* keys, std::int64_t n, int* start, int* end);
+// Cell offsets of sorted keys: start[k] = number of keys below k, k in [0, cells] (cells + 1
+// entries), so that cell k holds entries [start[k], start[k + 1]) and a run of cells one range.
+template <class Exec> void cell_starts(const Exec& ex, const std::uint32_t* keys, std::int64_t n, int* start, std::int64_t cells);
 // Keys of arbitrary points (static scene particles) and identity values for a sort.
 template <class Exec> void cell_keys(const Exec& ex, const vec3* p, std::int64_t n, GridSpec g, std::uint32_t* keys, int* idx);
 template <class Exec> void gather_vec3(const Exec& ex, const vec3* src, const int* idx, std::int64_t n, vec3* dst);
@@ -57,8 +57,7 @@ template <class Exec> float max_speed2(const Exec& ex, const SimViews& S);
   template void predict<E>(const E&, const SimViews&);                                                      \
   template void reorder<E>(const E&, const SimViews&);                                                      \
   template void sort_cells<E>(const E&, std::uint32_t*, int*, std::int64_t, int);                           \
-  template void clear_cells<E>(const E&, int*, int*, std::int64_t);                                         \
-  template void cell_ranges<E>(const E&, const std::uint32_t*, std::int64_t, int*, int*);                   \
+  template void cell_starts<E>(const E&, const std::uint32_t*, std::int64_t, int*, std::int64_t);           \
   template void cell_keys<E>(const E&, const vec3*, std::int64_t, GridSpec, std::uint32_t*, int*);          \
   template void gather_vec3<E>(const E&, const vec3*, const int*, std::int64_t, vec3*);                     \
   template void find_neighbors<E>(const E&, const SimViews&);                                               \

@@ -9,6 +9,10 @@ namespace detail {
 
 SEAMLESS_HD inline int max(int a, int b) { return a > b ? a : b; }
 
+SEAMLESS_HD inline bool both_fluid(std::uint32_t a, std::uint32_t b) {
+  return phase::is(a, phase::kFluid) && phase::is(b, phase::kFluid);
+}
+
 struct MaxF {
   float v;
 };
@@ -60,32 +64,38 @@ SEAMLESS_HD inline PairGeom pair_geometry(const SimViews& S, int s, int j, const
   return g;
 }
 
-SEAMLESS_HD inline bool both_fluid(std::uint32_t a, std::uint32_t b) {
-  return phase::is(a, phase::kFluid) && phase::is(b, phase::kFluid);
-}
-
 // Number of active contacts of particle s at positions P (at least 1: it divides). A rigid
 // particle touching the scene also counts itself in its body's body_contacts.
 SEAMLESS_HD inline int count_contacts(const SimViews& S, int s, const vec3* P) {
   const float D2 = S.c.diameter * S.c.diameter;
-  const int m = S.nnbr[s];
+  // A fluid particle whose list holds only fluid has no particle contacts (fluids meet through
+  // the density constraint), so the loop is skipped.
+  const bool fl = phase::is(S.sphase[s], phase::kFluid);
+  const int m = fl && S.nsolid[s] == 0 ? 0 : S.nnbr[s];
   const vec3 p = P[s];
   int count = 0;
   for (int k = 0; k < m; ++k) {
-    int j = S.nbr[k * S.n + s];
+    int j = S.nbrs(s)[k * S.nbr_col];
     if (both_fluid(S.sphase[s], S.sphase[j])) continue;
     if (length2(p - P[j]) < D2) ++count;
   }
   int scene = 0;
   for (int k = 0, ms = S.nsnbr[s]; k < ms; ++k)
-    if (length2(p - S.stat[S.snbr[k * S.n + s]]) < D2) ++scene;
-  if (S.sdf.active() && scene_sdf(S.sdf, p).d < S.c.radius) ++scene;
+    if (length2(p - S.stat[S.snbrs(s)[k * S.snbr_col]]) < D2) ++scene;
+  if (S.sdf.active()) {
+    // Kept for contact_sum, which runs next at the same positions (the SDF costs more than the
+    // rest of a fluid particle's contact work).
+    SdfSample3 q = scene_sdf(S.sdf, p);
+    S.sdf_at[s] = vec4{q.grad.x, q.grad.y, q.grad.z, q.d};
+    if (q.d < S.c.radius) ++scene;
+  }
   if (scene > 0 && phase::is(S.sphase[s], phase::kRigid)) atomic_add(&S.body_contacts[phase::group(S.sphase[s])], 1);
   count += scene;
   return count > 0 ? count : 1;
 }
 
-// Sum of the contact corrections of s at positions P (start positions X for friction). Each
+// Sum of the contact corrections of s at positions P (start positions X for friction); runs after
+// count_contacts at the same positions (it reuses the SDF sample stored there). Each
 // pair's correction is scaled by omega / max(n_s, n_j): averaging as in Macklin 2014 (eq. 11)
 // that keeps every pair's two corrections equal and opposite, so momentum is conserved.
 SEAMLESS_HD inline vec3 contact_sum(const SimViews& S, int s, const vec3* P, const vec3* X, bool friction) {
@@ -96,8 +106,8 @@ SEAMLESS_HD inline vec3 contact_sum(const SimViews& S, int s, const vec3* P, con
   const float ni = static_cast<float>(S.ncontacts[s]);
   const float mus = friction ? S.c.static_friction : 0.f, muk = friction ? S.c.kinetic_friction : 0.f;
   vec3 acc{0.f, 0.f, 0.f};
-  for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
-    int j = S.nbr[k * S.n + s];
+  for (int k = 0, m = fl && S.nsolid[s] == 0 ? 0 : S.nnbr[s]; k < m; ++k) {
+    int j = S.nbrs(s)[k * S.nbr_col];
     std::uint32_t phj = S.sphase[j];
     if (fl && phase::is(phj, phase::kFluid)) continue;
     PairGeom g = pair_geometry(S, s, j, P);
@@ -118,7 +128,7 @@ SEAMLESS_HD inline vec3 contact_sum(const SimViews& S, int s, const vec3* P, con
   }
   const float smu_s = fl ? 0.f : mus, smu_k = fl ? 0.f : muk;
   for (int k = 0, m = S.nsnbr[s]; k < m; ++k) {
-    vec3 r = p - S.stat[S.snbr[k * S.n + s]];
+    vec3 r = p - S.stat[S.snbrs(s)[k * S.snbr_col]];
     float l2 = length2(r);
     if (l2 >= D * D) continue;
     float l = sqrtf(l2);
@@ -126,8 +136,8 @@ SEAMLESS_HD inline vec3 contact_sum(const SimViews& S, int s, const vec3* P, con
     acc += contact_delta(n, D - l, dx, wi, 0.f, smu_s, smu_k) * self;
   }
   if (S.sdf.active()) {
-    SdfSample3 q = scene_sdf(S.sdf, p);
-    if (q.d < S.c.radius) acc += contact_delta(q.grad, S.c.radius - q.d, dx, wi, 0.f, smu_s, smu_k) * self;
+    const vec4 q = S.sdf_at[s];  // scene_sdf(S.sdf, p), stored by count_contacts
+    if (q.w < S.c.radius) acc += contact_delta(xyz(q), S.c.radius - q.w, dx, wi, 0.f, smu_s, smu_k) * self;
   }
   return acc;
 }
@@ -144,7 +154,7 @@ void predict(const Exec& ex, const SimViews& S) {
     vec3 p = S.x[i] + v * S.c.dt;
     S.v[i] = v;
     S.pred[i] = p;
-    S.key[i] = S.grid.key(S.grid.cell(p));
+    S.key[i] = S.grid.key(S.grid.cell_of(p));
     S.order[i] = static_cast<int>(i);
   });
 }
@@ -169,26 +179,17 @@ void reorder(const Exec& ex, const SimViews& S) {
 }
 
 template <class Exec>
-void clear_cells(const Exec& ex, int* start, int* end, std::int64_t cells) {
-  ex.for_each(cells, [=] SEAMLESS_HD(std::int64_t i) {
-    start[i] = 0;
-    end[i] = 0;
-  });
-}
-
-template <class Exec>
-void cell_ranges(const Exec& ex, const std::uint32_t* keys, std::int64_t n, int* start, int* end) {
-  ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) {
-    std::uint32_t k = keys[i];
-    if (i == 0 || keys[i - 1] != k) start[k] = static_cast<int>(i);
-    if (i == n - 1 || keys[i + 1] != k) end[k] = static_cast<int>(i + 1);
+void cell_starts(const Exec& ex, const std::uint32_t* keys, std::int64_t n, int* start, std::int64_t cells) {
+  // One binary search per cell: parallel over cells on both backends, no atomics, no host sync.
+  ex.for_each(cells + 1, [=] SEAMLESS_HD(std::int64_t k) {
+    start[k] = lower_bound_key(keys, static_cast<int>(n), static_cast<std::uint32_t>(k));
   });
 }
 
 template <class Exec>
 void cell_keys(const Exec& ex, const vec3* p, std::int64_t n, GridSpec g, std::uint32_t* keys, int* idx) {
   ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) {
-    keys[i] = g.key(g.cell(p[i]));
+    keys[i] = g.key(g.cell_of(p[i]));
     idx[i] = static_cast<int>(i);
   });
 }
@@ -203,39 +204,35 @@ void find_neighbors(const Exec& ex, const SimViews& S) {
   ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t i) {
     const int s = static_cast<int>(i);
     const vec3 p = S.sp[s];
-    const float R2 = S.c.search_radius * S.c.search_radius;
+    const float R = S.c.search_radius, R2 = R * R;
     const std::uint32_t ph = S.sphase[s];
-    int3 c = S.grid.cell(p);
-    int cnt = 0;
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          std::uint32_t k = S.grid.key(c + int3{dx, dy, dz});
-          for (int j = S.cell_start[k], e = S.cell_end[k]; j < e; ++j) {
-            if (j == s || length2(p - S.sp[j]) >= R2) continue;
-            if (!detail::may_interact(S, ph, S.sphase[j], s, j)) continue;
-            if (cnt < S.c.max_neighbors) S.nbr[cnt * S.n + s] = j;
-            ++cnt;
-          }
-        }
+    int* list = S.nbr + s * S.nbr_row;
+    int cnt = 0, solid = 0;
+    for_each_in_radius(S.grid, S.cell_start, p, R, [&](int j) {
+      if (j == s || length2(p - S.sp[j]) >= R2) return;
+      const std::uint32_t phj = S.sphase[j];
+      if (!detail::may_interact(S, ph, phj, s, j)) return;
+      if (cnt < S.c.max_neighbors) {
+        list[cnt * S.nbr_col] = j;
+        solid += detail::both_fluid(ph, phj) ? 0 : 1;
+      }
+      ++cnt;
+    });
     if (cnt > S.c.max_neighbors) atomic_add(&S.counters[0], 1);
-    atomic_max(&S.counters[2], cnt);
+    // Read first: the shared maximum rarely changes, so most particles only load it.
+    if (cnt > atomic_load(&S.counters[2])) atomic_max(&S.counters[2], cnt);
     S.nnbr[s] = cnt < S.c.max_neighbors ? cnt : S.c.max_neighbors;
+    S.nsolid[s] = solid;
     int scnt = 0;
     if (S.ns > 0) {
-      int3 cs = S.sgrid.cell(p);
-      for (int dz = -1; dz <= 1; ++dz)
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            std::uint32_t k = S.sgrid.key(cs + int3{dx, dy, dz});
-            for (int j = S.scell_start[k], e = S.scell_end[k]; j < e; ++j) {
-              if (length2(p - S.stat[j]) >= R2) continue;
-              if (scnt < S.c.max_static_neighbors) S.snbr[scnt * S.n + s] = j;
-              ++scnt;
-            }
-          }
+      int* slist = S.snbr + s * S.snbr_row;
+      for_each_in_radius(S.sgrid, S.scell_start, p, R, [&](int j) {
+        if (length2(p - S.stat[j]) >= R2) return;
+        if (scnt < S.c.max_static_neighbors) slist[scnt * S.snbr_col] = j;
+        ++scnt;
+      });
       if (scnt > S.c.max_static_neighbors) atomic_add(&S.counters[1], 1);
-      atomic_max(&S.counters[3], scnt);
+      if (scnt > atomic_load(&S.counters[3])) atomic_max(&S.counters[3], scnt);
     }
     S.nsnbr[s] = scnt < S.c.max_static_neighbors ? scnt : S.c.max_static_neighbors;
   });
@@ -276,13 +273,13 @@ void prepare_constraints(const Exec& ex, const SimViews& S) {
     }
     const vec3 p = S.sp[s];
     const float h = S.c.h, inv_rho0 = 1.f / S.c.rest_density, sw = S.c.solid_density_scale;
-    float rho = poly6(0.f, h), sum2 = 0.f;
+    float rho = S.c.W.poly6(0.f), sum2 = 0.f;
     vec3 gi{0.f, 0.f, 0.f};
     for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
-      int j = S.nbr[k * S.n + s];
+      int j = S.nbrs(s)[k * S.nbr_col];
       vec3 r = p - S.sp[j];
-      float wgt = poly6(length2(r), h);
-      vec3 g = spiky_grad(r, h) * inv_rho0;
+      float wgt = S.c.W.poly6(length2(r));
+      vec3 g = S.c.W.spiky_grad(r) * inv_rho0;
       if (phase::is(S.sphase[j], phase::kFluid)) {
         rho += wgt;
         gi += g;
@@ -293,9 +290,9 @@ void prepare_constraints(const Exec& ex, const SimViews& S) {
       }
     }
     for (int k = 0, m = S.nsnbr[s]; k < m; ++k) {
-      vec3 r = p - S.stat[S.snbr[k * S.n + s]];
-      rho += sw * poly6(length2(r), h);
-      gi += spiky_grad(r, h) * (sw * inv_rho0);
+      vec3 r = p - S.stat[S.snbrs(s)[k * S.snbr_col]];
+      rho += sw * S.c.W.poly6(length2(r));
+      gi += S.c.W.spiky_grad(r) * (sw * inv_rho0);
     }
     float C = rho * inv_rho0 - 1.f;
     if (S.c.unilateral && C < 0.f) C = 0.f;
@@ -319,13 +316,13 @@ void solve_contacts_fluid(const Exec& ex, const SimViews& S) {
       const float h = S.c.h, li = S.lambda[s], sw = S.c.solid_density_scale;
       vec3 f{0.f, 0.f, 0.f};
       for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
-        int j = S.nbr[k * S.n + s];
+        int j = S.nbrs(s)[k * S.nbr_col];
         vec3 r = p - S.sp[j];
-        vec3 g = spiky_grad(r, h);
+        vec3 g = S.c.W.spiky_grad(r);
         if (phase::is(S.sphase[j], phase::kFluid)) {
           float sc = 0.f;
           if (S.c.scorr_k > 0.f) {
-            float q = poly6(length2(r), h) * S.c.scorr_inv_wdq;
+            float q = S.c.W.poly6(length2(r)) * S.c.scorr_inv_wdq;
             sc = -S.c.scorr_k * q * q * q * q;
           }
           f += g * (li + S.lambda[j] + sc);
@@ -333,7 +330,7 @@ void solve_contacts_fluid(const Exec& ex, const SimViews& S) {
           f += g * (li * sw);
         }
       }
-      for (int k = 0, m = S.nsnbr[s]; k < m; ++k) f += spiky_grad(p - S.stat[S.snbr[k * S.n + s]], h) * (li * sw);
+      for (int k = 0, m = S.nsnbr[s]; k < m; ++k) f += S.c.W.spiky_grad(p - S.stat[S.snbrs(s)[k * S.snbr_col]]) * (li * sw);
       acc += f * (1.f / S.c.rest_density);
     } else if (S.c.solid_density_scale > 0.f) {
       // Two-way coupling: the reaction of the density correction a fluid neighbour j received
@@ -341,9 +338,9 @@ void solve_contacts_fluid(const Exec& ex, const SimViews& S) {
       const float h = S.c.h, ws = S.sw[s];
       vec3 f{0.f, 0.f, 0.f};
       for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
-        int j = S.nbr[k * S.n + s];
+        int j = S.nbrs(s)[k * S.nbr_col];
         if (!phase::is(S.sphase[j], phase::kFluid)) continue;
-        f += spiky_grad(p - S.sp[j], h) * (S.lambda[j] * ws / S.sw[j]);
+        f += S.c.W.spiky_grad(p - S.sp[j]) * (S.lambda[j] * ws / S.sw[j]);
       }
       acc += f * (S.c.solid_density_scale / S.c.rest_density);
     }
@@ -476,14 +473,14 @@ SEAMLESS_HD inline vec3 fluid_forces(const SimViews& S, int s) {
   const vec3 p = S.sp[s], vi = S.sv[s], wi = S.vort[s], ni = S.cnormal[s];
   vec3 dv_visc{0.f, 0.f, 0.f}, eta{0.f, 0.f, 0.f}, acc{0.f, 0.f, 0.f};
   for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
-    int j = S.nbr[k * S.n + s];
+    int j = S.nbrs(s)[k * S.nbr_col];
     if (!phase::is(S.sphase[j], phase::kFluid)) continue;
     vec3 r = p - S.sp[j];
     float l2 = length2(r), l = sqrtf(l2);
-    dv_visc += (S.sv[j] - vi) * (poly6(l2, h) * inv_rho0);  // XSPH, PBF eq. 17
-    eta += spiky_grad(r, h) * (length(S.vort[j]) * inv_rho0);
+    dv_visc += (S.sv[j] - vi) * (S.c.W.poly6(l2) * inv_rho0);  // XSPH, PBF eq. 17
+    eta += S.c.W.spiky_grad(r) * (length(S.vort[j]) * inv_rho0);
     float K = 2.f * S.c.rest_density / (S.density[s] + S.density[j]);
-    vec3 coh = l > 1e-9f ? r * (-S.c.cohesion * inv_rho0 * akinci_spline(l, h) / l) : vec3{0.f, 0.f, 0.f};
+    vec3 coh = l > 1e-9f ? r * (-S.c.cohesion * inv_rho0 * S.c.W.akinci(l) / l) : vec3{0.f, 0.f, 0.f};
     vec3 curv = (ni - S.cnormal[j]) * (-S.c.surface_tension);
     acc += (coh + curv) * K;
   }
@@ -519,9 +516,9 @@ void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
       const float h = S.c.h, inv_rho0 = 1.f / S.c.rest_density;
       vec3 w{0.f, 0.f, 0.f}, n{0.f, 0.f, 0.f};
       for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
-        int j = S.nbr[k * S.n + s];
+        int j = S.nbrs(s)[k * S.nbr_col];
         if (!phase::is(S.sphase[j], phase::kFluid)) continue;
-        vec3 g = spiky_grad(S.sp[s] - S.sp[j], h);
+        vec3 g = S.c.W.spiky_grad(S.sp[s] - S.sp[j]);
         w += cross(S.sv[j] - S.sv[s], -g) * inv_rho0;
         n += g * (h / S.density[j]);
       }

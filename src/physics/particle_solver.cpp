@@ -33,7 +33,7 @@ void upload_at(Buffer<T>& b, std::int64_t offset, const std::vector<T>& v) {
 }
 
 // Cells per axis (as bits) so that the grid has about two cells per particle, 8..128 per axis
-// (at least 3 per axis keeps the 27 cells around a particle distinct).
+// (at least 5 per axis keeps the cells searched around a particle distinct, GridSpec).
 int grid_bits(std::int64_t n) {
   int bits = 3;
   while (bits < 7 && (std::int64_t{1} << (3 * bits)) < 2 * n) ++bits;
@@ -55,18 +55,18 @@ struct ParticleSolver::Impl {
   Buffer<vec3> x, v, rest, pred;
   Buffer<float> w;
   Buffer<std::uint32_t> phase;
-  Buffer<vec4> rsdf;
+  Buffer<vec4> rsdf, sdf_at;
   // sort and sorted scratch
   Buffer<std::uint32_t> key, sphase;
-  Buffer<int> order, rank, ncontacts, nnbr, nsnbr, nbr, snbr;
+  Buffer<int> order, rank, ncontacts, nnbr, nsnbr, nsolid, nbr, snbr;
   Buffer<vec3> sx, sp, sp0, sv, tmp, vtmp, vort, cnormal;
   Buffer<float> sw, lambda, density;
-  Buffer<int> cell_start, cell_end, counters;
+  Buffer<int> cell_start, counters;
   int bits = 4;
   // static scene
   std::vector<vec3> static_host;
   Buffer<vec3> stat;
-  Buffer<int> scell_start, scell_end;
+  Buffer<int> scell_start;
   K::GridSpec sgrid{};
   K::SceneSdf sdf{};
   Buffer<float> sdf_grid;
@@ -132,9 +132,9 @@ struct ParticleSolver::Impl {
     grow(x, nc, n, dev), grow(v, nc, n, dev), grow(w, nc, n, dev), grow(phase, nc, n, dev);
     grow(rest, nc, n, dev), grow(rsdf, nc, n, dev);
     for (auto* b : {&pred, &sx, &sp, &sp0, &sv, &tmp, &vtmp, &vort, &cnormal}) b->reserve_discard(nc, dev);
-    for (auto* b : {&order, &rank, &ncontacts, &nnbr, &nsnbr}) b->reserve_discard(nc, dev);
+    for (auto* b : {&order, &rank, &ncontacts, &nnbr, &nsnbr, &nsolid}) b->reserve_discard(nc, dev);
     for (auto* b : {&sw, &lambda, &density}) b->reserve_discard(nc, dev);
-    key.reserve_discard(nc, dev), sphase.reserve_discard(nc, dev);
+    key.reserve_discard(nc, dev), sphase.reserve_discard(nc, dev), sdf_at.reserve_discard(nc, dev);
     nbr.reserve_discard(nc * P.max_neighbours, dev);
     cap = nc;
   }
@@ -146,6 +146,7 @@ struct ParticleSolver::Impl {
     c.dt = dt, c.inv_dt = 1.f / dt, c.gravity = P.gravity;
     c.radius = 0.5f * d, c.diameter = d;
     c.h = P.fluid_smoothing * d;
+    c.W = K::SphKernel::make(c.h);
     c.search_radius = std::max(c.h, 1.5f * d);
     c.max_speed = P.max_speed, c.omega = P.relaxation;
     c.static_friction = P.static_friction, c.kinetic_friction = P.kinetic_friction, c.restitution = P.restitution;
@@ -166,13 +167,17 @@ struct ParticleSolver::Impl {
     S.key = key.data(), S.order = order.data(), S.rank = rank.data();
     S.sx = sx.data(), S.sp = sp.data(), S.sp0 = sp0.data(), S.sv = sv.data(), S.tmp = tmp.data(), S.vtmp = vtmp.data();
     S.sw = sw.data(), S.sphase = sphase.data(), S.lambda = lambda.data(), S.density = density.data();
-    S.ncontacts = ncontacts.data(), S.vort = vort.data(), S.cnormal = cnormal.data();
-    S.grid = {1.f / c.search_radius, bits};
-    S.cell_start = cell_start.data(), S.cell_end = cell_end.data();
-    S.nbr = nbr.data(), S.nnbr = nnbr.data(), S.snbr = snbr.data(), S.nsnbr = nsnbr.data();
+    S.ncontacts = ncontacts.data(), S.vort = vort.data(), S.cnormal = cnormal.data(), S.sdf_at = sdf_at.data();
+    S.grid = K::GridSpec::for_radius(c.search_radius, bits);
+    S.cell_start = cell_start.data();
+    S.nbr = nbr.data(), S.nnbr = nnbr.data(), S.snbr = snbr.data(), S.nsnbr = nsnbr.data(), S.nsolid = nsolid.data();
+    // List layout per backend (kernels/physics/sim_views.hpp): a particle's list contiguous on
+    // the CPU (one thread walks it), entry k of consecutive particles contiguous on the GPU.
+    if (dev == Device::CUDA) S.nbr_row = 1, S.nbr_col = n, S.snbr_row = 1, S.snbr_col = n;
+    else S.nbr_row = P.max_neighbours, S.nbr_col = 1, S.snbr_row = P.max_static_neighbours, S.snbr_col = 1;
     S.counters = counters.data();
     S.ns = static_cast<std::int64_t>(static_host.size());
-    S.stat = stat.data(), S.sgrid = sgrid, S.scell_start = scell_start.data(), S.scell_end = scell_end.data();
+    S.stat = stat.data(), S.sgrid = sgrid, S.scell_start = scell_start.data();
     S.sdf = sdf;
     S.nbodies = static_cast<int>(body_start.size());
     S.body_start = d_body_start.data(), S.body_count = d_body_count.data();
@@ -193,7 +198,7 @@ struct ParticleSolver::Impl {
   void prepare_grid() {
     bits = grid_bits(n);
     std::int64_t cells = std::int64_t{1} << (3 * bits);
-    cell_start.reserve_discard(cells, dev), cell_end.reserve_discard(cells, dev);
+    cell_start.reserve_discard(cells + 1, dev);
     if (!static_host.empty()) snbr.reserve_discard(cap * P.max_static_neighbours, dev);
   }
 
@@ -202,8 +207,7 @@ struct ParticleSolver::Impl {
   void build_neighbours(const Ex& ex, const K::SimViews& S) {
     K::sort_cells(ex, S.key, S.order, n, 3 * bits);
     K::reorder(ex, S);
-    K::clear_cells(ex, S.cell_start, S.cell_end, std::int64_t{1} << (3 * bits));
-    K::cell_ranges(ex, S.key, n, S.cell_start, S.cell_end);
+    K::cell_starts(ex, S.key, n, S.cell_start, std::int64_t{1} << (3 * bits));
     K::find_neighbors(ex, S);
   }
 
@@ -439,19 +443,18 @@ struct ParticleSolver::Impl {
   void rebuild_static() {
     const std::int64_t ns = static_cast<std::int64_t>(static_host.size());
     int sb = grid_bits(ns);
-    sgrid = {1.f / std::max(P.fluid_smoothing * P.particle_diameter, 1.5f * P.particle_diameter), sb};
+    sgrid = K::GridSpec::for_radius(std::max(P.fluid_smoothing * P.particle_diameter, 1.5f * P.particle_diameter), sb);
     std::int64_t cells = std::int64_t{1} << (3 * sb);
     Buffer<vec3> raw = Buffer<vec3>::from_host(static_host, dev);
     Buffer<std::uint32_t> keys(ns, dev);
     Buffer<int> idx(ns, dev);
     stat = Buffer<vec3>(ns, dev);
-    scell_start = Buffer<int>(cells, dev), scell_end = Buffer<int>(cells, dev);
+    scell_start = Buffer<int>(cells + 1, dev);
     with_exec(dev, [&](const auto& ex) {
       K::cell_keys(ex, raw.data(), ns, sgrid, keys.data(), idx.data());
       K::sort_cells(ex, keys.data(), idx.data(), ns, 3 * sb);
       K::gather_vec3(ex, raw.data(), idx.data(), ns, stat.data());
-      K::clear_cells(ex, scell_start.data(), scell_end.data(), cells);
-      K::cell_ranges(ex, keys.data(), ns, scell_start.data(), scell_end.data());
+      K::cell_starts(ex, keys.data(), ns, scell_start.data(), cells);
     });
     snbr.reserve_discard(std::max<std::int64_t>(cap, 1) * P.max_static_neighbours, dev);
   }
