@@ -179,6 +179,42 @@ TEST(TsdfFusion, RemovingEmptyBlocksFreesThem) {
     EXPECT_TRUE(std::find(blocks_back.begin(), blocks_back.end(), b) != blocks_back.end());
 }
 
+// The stand-alone pass over all blocks frees exactly the blocks without an observed voxel within
+// the truncation of a surface (the predicate fusion flags per frame), and keeps the rest intact.
+TEST(TsdfFusion, StandaloneRemovalFreesExactlyTheEmptyBlocks) {
+  VolumeParams p = small_params();
+  p.max_weight = 1.f;
+  p.remove_empty_blocks = false;  // leave the emptied band of the old wall in place
+  VoxelHashVolume vol(p, Device::CPU);
+  Intrinsics K = test::camera(80, 60, 70.f);
+  Scene near;
+  near.sphere = false;
+  Scene far = near;
+  far.wall_z = 2.4f;
+  fuse(vol, near, K, {SE3::identity()});
+  fuse(vol, far, K, std::vector<SE3>(14, SE3::identity()));
+  const auto before = vol.download_blocks();
+  std::vector<int3> expect_kept;
+  for (const auto& blk : before) {
+    bool keep = false;
+    for (const kernels::Voxel& v : blk.voxels) keep |= v.weight > 0.f && std::fabs(v.sdf) < 0.999f * p.truncation;
+    if (keep) expect_kept.push_back(blk.coord);
+  }
+  ASSERT_LT(expect_kept.size(), before.size());  // the old band emptied
+  ASSERT_GT(expect_kept.size(), 0u);
+  const std::int64_t removed = vol.remove_empty_blocks();
+  EXPECT_EQ(removed, static_cast<std::int64_t>(before.size() - expect_kept.size()));
+  const auto after = vol.download_blocks();
+  ASSERT_EQ(after.size(), expect_kept.size());
+  std::size_t j = 0;
+  for (const auto& blk : before) {  // both sorted by coordinate
+    if (j == after.size() || !(blk.coord == after[j].coord)) continue;
+    for (int k = 0; k < kernels::kBlockVoxels; ++k) ASSERT_EQ(blk.voxels[k].sdf, after[j].voxels[k].sdf);
+    ++j;
+  }
+  EXPECT_EQ(j, after.size());
+  EXPECT_EQ(vol.allocated_block_coords(), expect_kept);
+}
 
 TEST(TsdfFusion, FullPoolGrowsAndRetriesOrReports) {
   Intrinsics K = test::camera(160, 120, 140.f);

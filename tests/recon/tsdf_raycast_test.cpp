@@ -76,7 +76,9 @@ void expect_same_surfaces(const RaycastMaps& plain, const RaycastMaps& tiled, co
   }
   EXPECT_EQ(hit_mismatch, 0) << what;
   EXPECT_LE(not_identical, hits / 50) << what;
-  if (sees_front) EXPECT_GT(hits, static_cast<int>(dp.size()) / 4) << what << ": the view must see the model";
+  if (sees_front) {
+    EXPECT_GT(hits, static_cast<int>(dp.size()) / 4) << what << ": the view must see the model";
+  }
   ::testing::Test::RecordProperty(what + "_not_identical", std::to_string(not_identical));
 }
 
