@@ -16,7 +16,8 @@ struct TrackerParams {
   float dist_threshold = 0.1f;            // metres
   float angle_threshold_deg = 20.f;
   float photometric_weight = 0.1f;        // rgbd only: weight of the colour term vs geometry
-  float min_inlier_ratio = 0.3f;
+  float min_inlier_ratio = 0.15f;         // see docs/TRACKING.md, "Tracking loss"
+  float min_inlier_ratio_vs_last = 0.5f;  // a sudden drop below this fraction of the last good frame's ratio
   double max_condition = 1e6;             // of the finest level's 6x6 system (see docs/TRACKING.md)
   float max_intensity_diff = 0.3f;        // rgbd: larger photometric residuals are outliers
   bool constant_velocity = false;         // start each frame from the last motion instead of the last pose
@@ -35,6 +36,9 @@ struct TrackerParams {
       Range{0.0, 180.0});
     v("photometric_weight", photometric_weight, "weight of the photometric term (rgbd)", Range{0.0, 1e6});
     v("min_inlier_ratio", min_inlier_ratio, "tracking is lost below this fraction of inliers", Range{0.0, 1.0});
+    v("min_inlier_ratio_vs_last", min_inlier_ratio_vs_last,
+      "tracking is lost when the inlier ratio falls below this fraction of the last good frame's (a cut)",
+      Range{0.0, 1.0});
     v("max_condition", max_condition,
       "tracking is lost when the condition number of the 6x6 ICP system exceeds this (degenerate geometry)",
       Range{1.0, 1e30});

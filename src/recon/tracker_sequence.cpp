@@ -72,9 +72,13 @@ void TrackingSession::upload(const RgbdFrame& frame) {
     throw Error("frame " + std::to_string(frame.index) + " is " + std::to_string(frame.depth.width()) + "x" +
                 std::to_string(frame.depth.height()) + " but the source's intrinsics say " +
                 std::to_string(K_.width) + "x" + std::to_string(K_.height));
-  depth_ = frame.depth.clone(device_);
+  // Persistent device images: one host-to-device copy a frame, no allocation.
+  if (depth_.width() != K_.width) depth_ = Image<float>(K_.width, K_.height, device_);
+  depth_.buffer().copy_from(frame.depth.buffer());
   bool colour = frame.rgb.width() == K_.width && frame.rgb.height() == K_.height;
-  rgb_ = colour ? frame.rgb.clone(device_) : Image<uchar3>();
+  if (colour && rgb_.width() != K_.width) rgb_ = Image<uchar3>(K_.width, K_.height, device_);
+  if (colour) rgb_.buffer().copy_from(frame.rgb.buffer());
+  if (!colour) rgb_ = Image<uchar3>();
   const Image<float>* intensity = nullptr;
   if (colour && p_.tracker.kind == "rgbd") {
     if (intensity_.width() != K_.width) intensity_ = Image<float>(K_.width, K_.height, device_);
@@ -137,6 +141,11 @@ TrackResult TrackingSession::track_frame(const RgbdFrame& frame) {
     TrackResult r2 = tracker_->track(pyr_, ref_, last_good_);
     if (r2.ok()) r = r2;
   }
+  // The overlap of consecutive views changes gradually with motion; a sudden collapse of the inlier
+  // ratio means the view changed place (a cut), even if some floor or wall still fits.
+  if (r.ok() && r.inlier_ratio < p_.tracker.min_inlier_ratio_vs_last * last_inlier_ratio_)
+    r.status = TrackStatus::too_few_inliers;
+  if (r.ok()) last_inlier_ratio_ = r.inlier_ratio;
   return r;
 }
 

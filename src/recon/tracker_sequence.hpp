@@ -79,6 +79,7 @@ class TrackingSession {
   SE3 last_good_ = SE3::identity(), prev_good_ = SE3::identity();
   SE3 world_T_gt_ = SE3::identity();  // ground_truth tracker: maps the source's poses into our world
   std::int64_t lost_ = 0;
+  double last_inlier_ratio_ = 0;  // of the last frame tracked (not the first), 0 before
 };
 
 struct TrackSequenceResult {
