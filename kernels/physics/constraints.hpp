@@ -35,13 +35,14 @@ SEAMLESS_HD inline vec3 distance_delta(vec3 pi, vec3 pj, float wi, float wj, flo
 }
 
 // Dihedral bending constraint (Mueller 2007, eq. 4.9 and appendix A): p[0], p[1] share the edge,
-// p[2], p[3] are the opposite vertices; phi0 is the rest angle. Writes the correction of vertex
-// `which` (0..3).
-SEAMLESS_HD inline vec3 bending_delta(const vec3* p, const float* w, float phi0, float k, int which) {
+// p[2], p[3] are the opposite vertices; phi0 is the rest angle. Writes the corrections of all
+// four vertices to out[0..3].
+SEAMLESS_HD inline void bending_deltas(const vec3* p, const float* w, float phi0, float k, vec3* out) {
+  for (int i = 0; i < 4; ++i) out[i] = {0.f, 0.f, 0.f};
   vec3 p2 = p[1] - p[0], p3 = p[2] - p[0], p4 = p[3] - p[0];
   vec3 c23 = cross(p2, p3), c24 = cross(p2, p4);
   float l23 = length(c23), l24 = length(c24);
-  if (l23 < 1e-12f || l24 < 1e-12f) return {0.f, 0.f, 0.f};
+  if (l23 < 1e-12f || l24 < 1e-12f) return;
   vec3 n1 = c23 / l23, n2 = c24 / l24;
   float d = fminf(fmaxf(dot(n1, n2), -1.f), 1.f);
   vec3 q[4];
@@ -51,9 +52,9 @@ SEAMLESS_HD inline vec3 bending_delta(const vec3* p, const float* w, float phi0,
   q[0] = -q[1] - q[2] - q[3];
   float den = 0.f;
   for (int i = 0; i < 4; ++i) den += w[i] * length2(q[i]);
-  if (den < 1e-12f) return {0.f, 0.f, 0.f};
+  if (den < 1e-12f) return;
   float s = sqrtf(fmaxf(1.f - d * d, 0.f)) * (acosf(d) - phi0) / den;
-  return q[which] * (-k * w[which] * s);
+  for (int i = 0; i < 4; ++i) out[i] = q[i] * (-k * w[i] * s);
 }
 
 // Aerodynamic force on one triangle (Keckeisen 2004; dissertation eqs. 4.10-4.11), to be shared

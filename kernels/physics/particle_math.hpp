@@ -107,9 +107,9 @@ struct GridSpec {
 // Distance along one axis from coordinate v to cell i's slab [i cs, (i + 1) cs), made smaller by
 // pad so that rounding never drops a cell that holds a neighbour.
 SEAMLESS_HD inline float slab_gap(float v, int i, float cs, float pad) {
-  float lo = static_cast<float>(i) * cs, hi = lo + cs;
-  float g = v < lo ? lo - v : (v > hi ? v - hi : 0.f);
-  return g > pad ? g - pad : 0.f;
+  float lo = static_cast<float>(i) * cs, a = lo - v, b = v - (lo + cs);  // at most one is > 0
+  float g = (a > b ? a : b) - pad;  // max, without a branch
+  return g > 0.f ? g : 0.f;
 }
 
 // Calls fn(j) for every grid entry j in the cells that can hold a point within R of p. For each
@@ -123,17 +123,20 @@ SEAMLESS_HD inline void for_each_in_radius(const GridSpec& g, const int* start, 
   const int3 c = g.cell_of(p);
   const float R2 = R * R, pad = 1e-3f * g.cell;
   const std::uint32_t m = (1u << g.bits) - 1u;
+  const std::uint32_t xa = static_cast<std::uint32_t>(c.x - g.reach) & m, xb = static_cast<std::uint32_t>(c.x + g.reach) & m;
   for (int dz = -g.reach; dz <= g.reach; ++dz) {
     const float ez = slab_gap(p.z, c.z + dz, g.cell, pad);
     for (int dy = -g.reach; dy <= g.reach; ++dy) {
+      const std::uint32_t row = ((static_cast<std::uint32_t>(c.y + dy) & m) << g.bits) |
+                                ((static_cast<std::uint32_t>(c.z + dz) & m) << (2 * g.bits));
+      // Rows with no entry in reach (most of them, in sparse scenes) cost two loads.
+      if (xa <= xb && start[row | xa] == start[(row | xb) + 1]) continue;
       const float ey = slab_gap(p.y, c.y + dy, g.cell, pad), d2 = ey * ey + ez * ez;
       if (d2 >= R2) continue;
       const float rx = sqrtf(R2 - d2) + pad;
       const int lo = floor_int((p.x - rx) * g.inv_cell), hi = floor_int((p.x + rx) * g.inv_cell);
       const std::uint32_t x0 = static_cast<std::uint32_t>(lo > c.x - g.reach ? lo : c.x - g.reach) & m;
       const std::uint32_t x1 = static_cast<std::uint32_t>(hi < c.x + g.reach ? hi : c.x + g.reach) & m;
-      const std::uint32_t row = ((static_cast<std::uint32_t>(c.y + dy) & m) << g.bits) |
-                                ((static_cast<std::uint32_t>(c.z + dz) & m) << (2 * g.bits));
       if (x0 <= x1) {
         for (int j = start[row | x0], e = start[(row | x1) + 1]; j < e; ++j) fn(j);
       } else {  // the x range wraps: [x0, m] and [0, x1]
@@ -145,12 +148,14 @@ SEAMLESS_HD inline void for_each_in_radius(const GridSpec& g, const int* start, 
 }
 
 // start[k] for the sorted keys: the number of keys below k (lower bound), k in [0, cells].
+// Branch-free (the comparison selects the half arithmetically): its outcome is random.
 SEAMLESS_HD inline int lower_bound_key(const std::uint32_t* keys, int n, std::uint32_t k) {
-  int lo = 0, hi = n;
-  while (lo < hi) {
-    int mid = (lo + hi) >> 1;
-    if (keys[mid] < k) lo = mid + 1;
-    else hi = mid;
+  int lo = 0, len = n;
+  while (len > 0) {
+    int half = len >> 1;
+    int right = keys[lo + half] < k;
+    lo += right * (half + 1);
+    len = half + right * (len - 2 * half - 1);
   }
   return lo;
 }

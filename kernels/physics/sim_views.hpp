@@ -79,7 +79,8 @@ struct SimViews {
   // Neighbour grid and lists. Entry k of particle s's list is list[s * row + k * col]: the layout
   // is the executor's choice (the host sets the strides). A CPU thread walks one particle's list,
   // which should be contiguous (row-major: row = cap, col = 1); a GPU warp reads entry k of 32
-  // particles at once, which should be contiguous (column-major: row = 1, col = n).
+  // particles at once, which should be contiguous (column-major: row = 1, col = n). Each list has
+  // cap + 1 slots: find_neighbors writes rejected candidates to the spare slot past the last kept.
   GridSpec grid{};
   int* cell_start = nullptr;  // cells + 1 offsets (kernels::cell_starts)
   int *nbr = nullptr, *nnbr = nullptr;
@@ -118,6 +119,8 @@ struct SimViews {
   const int *bend_off = nullptr, *bend_list = nullptr;
   const Quad* bend_ids = nullptr;
   const float *bend_rest = nullptr, *bend_k = nullptr;
+  std::int64_t nbends = 0;
+  vec3* bend_delta = nullptr;  // scratch: 4 corrections per bending constraint
   const int *tri_off = nullptr, *tri_list = nullptr;
   const int3* tri_ids = nullptr;
   int has_cloth_constraints = 0;

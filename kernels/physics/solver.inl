@@ -180,9 +180,18 @@ void reorder(const Exec& ex, const SimViews& S) {
 
 template <class Exec>
 void cell_starts(const Exec& ex, const std::uint32_t* keys, std::int64_t n, int* start, std::int64_t cells) {
-  // One binary search per cell: parallel over cells on both backends, no atomics, no host sync.
-  ex.for_each(cells + 1, [=] SEAMLESS_HD(std::int64_t k) {
-    start[k] = lower_bound_key(keys, static_cast<int>(n), static_cast<std::uint32_t>(k));
+  // Each task fills a block of 32 cells: one binary search for the first, then a merge walk along
+  // the sorted keys (work per task: 32 cells plus the entries in them). Parallel on both backends,
+  // no atomics, no host sync, and no task fills a long run of empty cells alone.
+  constexpr std::int64_t kBlock = 32;
+  const std::int64_t total = cells + 1;
+  ex.for_each((total + kBlock - 1) / kBlock, [=] SEAMLESS_HD(std::int64_t b) {
+    const std::int64_t k0 = b * kBlock, k1 = k0 + kBlock < total ? k0 + kBlock : total;
+    int pos = lower_bound_key(keys, static_cast<int>(n), static_cast<std::uint32_t>(k0));
+    for (std::int64_t k = k0; k < k1; ++k) {
+      while (pos < n && keys[pos] < static_cast<std::uint32_t>(k)) ++pos;
+      start[k] = pos;
+    }
   });
 }
 
@@ -207,16 +216,18 @@ void find_neighbors(const Exec& ex, const SimViews& S) {
     const float R = S.c.search_radius, R2 = R * R;
     const std::uint32_t ph = S.sphase[s];
     int* list = S.nbr + s * S.nbr_row;
+    const int cap = S.c.max_neighbors;
     int cnt = 0, solid = 0;
+    // Branch-free acceptance: about half the candidates fail the distance test at random, which a
+    // branch mispredicts. Every candidate is written to slot min(cnt, cap) (slot cap is a spare
+    // that nothing reads) and kept by advancing cnt.
     for_each_in_radius(S.grid, S.cell_start, p, R, [&](int j) {
-      if (j == s || length2(p - S.sp[j]) >= R2) return;
       const std::uint32_t phj = S.sphase[j];
-      if (!detail::may_interact(S, ph, phj, s, j)) return;
-      if (cnt < S.c.max_neighbors) {
-        list[cnt * S.nbr_col] = j;
-        solid += detail::both_fluid(ph, phj) ? 0 : 1;
-      }
-      ++cnt;
+      const bool ok = (j != s) & (length2(p - S.sp[j]) < R2) & detail::may_interact(S, ph, phj, s, j);
+      const bool kept = ok & (cnt < cap);
+      list[(cnt < cap ? cnt : cap) * S.nbr_col] = j;
+      solid += kept & !detail::both_fluid(ph, phj);
+      cnt += ok;
     });
     if (cnt > S.c.max_neighbors) atomic_add(&S.counters[0], 1);
     // Read first: the shared maximum rarely changes, so most particles only load it.
@@ -226,10 +237,10 @@ void find_neighbors(const Exec& ex, const SimViews& S) {
     int scnt = 0;
     if (S.ns > 0) {
       int* slist = S.snbr + s * S.snbr_row;
+      const int scap = S.c.max_static_neighbors;
       for_each_in_radius(S.sgrid, S.scell_start, p, R, [&](int j) {
-        if (length2(p - S.stat[j]) >= R2) return;
-        if (scnt < S.c.max_static_neighbors) slist[scnt * S.snbr_col] = j;
-        ++scnt;
+        slist[(scnt < scap ? scnt : scap) * S.snbr_col] = j;
+        scnt += length2(p - S.stat[j]) < R2;
       });
       if (scnt > S.c.max_static_neighbors) atomic_add(&S.counters[1], 1);
       if (scnt > atomic_load(&S.counters[3])) atomic_max(&S.counters[3], scnt);
@@ -413,14 +424,27 @@ void cloth_stretch(const Exec& ex, const SimViews& S, int colour) {
   });
 }
 
-// Bending constraints (Jacobi, averaged through their stiffness on the host).
+// Bending constraints (Jacobi, averaged through their stiffness on the host): each constraint's
+// four corrections once (bend_delta[4 b + vertex]), then every particle gathers its own, in the
+// order of its incidence list (no float atomics).
 template <class Exec>
 void cloth_bend(const Exec& ex, const SimViews& S) {
+  ex.for_each(S.nbends, [=] SEAMLESS_HD(std::int64_t b) {
+    Quad q = S.bend_ids[b];
+    int ids[4] = {q.a, q.b, q.c, q.d};
+    vec3 pos[4];
+    float w[4];
+    for (int k = 0; k < 4; ++k) {
+      int sk = S.rank[ids[k]];
+      pos[k] = S.sp[sk];
+      w[k] = S.sw[sk];
+    }
+    bending_deltas(pos, w, S.bend_rest[b], S.bend_k[b], S.bend_delta + 4 * b);
+  });
   ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t i) {
     const int s = static_cast<int>(i);
     const vec3 p = S.sp[s];
-    const float wi = S.sw[s];
-    if (!phase::is(S.sphase[s], phase::kCloth) || !(wi > 0.f)) {
+    if (!phase::is(S.sphase[s], phase::kCloth) || !(S.sw[s] > 0.f)) {
       S.tmp[s] = p;
       return;
     }
@@ -429,17 +453,8 @@ void cloth_bend(const Exec& ex, const SimViews& S) {
     for (int e = S.bend_off[id], end = S.bend_off[id + 1]; e < end; ++e) {
       int b = S.bend_list[e];
       Quad q = S.bend_ids[b];
-      int ids[4] = {q.a, q.b, q.c, q.d};
-      vec3 pos[4];
-      float w[4];
-      int which = 0;
-      for (int k = 0; k < 4; ++k) {
-        int sk = S.rank[ids[k]];
-        pos[k] = S.sp[sk];
-        w[k] = S.sw[sk];
-        if (ids[k] == id) which = k;
-      }
-      acc += bending_delta(pos, w, S.bend_rest[b], S.bend_k[b], which);
+      int which = q.a == id ? 0 : q.b == id ? 1 : q.c == id ? 2 : 3;
+      acc += S.bend_delta[4 * b + which];
     }
     S.tmp[s] = p + acc;
   });

@@ -32,11 +32,14 @@ void upload_at(Buffer<T>& b, std::int64_t offset, const std::vector<T>& v) {
   memory::copy(b.data() + offset, b.device(), v.data(), Device::CPU, sizeof(T) * v.size());
 }
 
-// Cells per axis (as bits) so that the grid has about two cells per particle, 8..128 per axis
-// (at least 5 per axis keeps the cells searched around a particle distinct, GridSpec).
+// Cells per axis (as bits) so that the grid has about 16 cells per particle, 8..128 per axis (at
+// least 5 per axis keeps the cells searched around a particle distinct, GridSpec). Cells are half
+// the search radius, so a particle at the fluid rest spacing fills about one; the spare cells make
+// the periodic grid wide enough that spread-out scenes (a sheet of cloth, bodies far apart) do not
+// fold many far-away particles into the cells searched.
 int grid_bits(std::int64_t n) {
   int bits = 3;
-  while (bits < 7 && (std::int64_t{1} << (3 * bits)) < 2 * n) ++bits;
+  while (bits < 7 && (std::int64_t{1} << (3 * bits)) < 16 * n) ++bits;
   return bits;
 }
 
@@ -91,6 +94,7 @@ struct ParticleSolver::Impl {
   Buffer<int> dist_off, dist_other, dist_colour, bend_off, bend_list, tri_off, tri_list;
   Buffer<float> dist_len, dist_k, d_bend_rest, d_bend_k;
   Buffer<K::Quad> d_bends;
+  Buffer<vec3> bend_delta;
   Buffer<int3> d_tris;
   int cloth_groups = 0;
   // bookkeeping
@@ -135,7 +139,7 @@ struct ParticleSolver::Impl {
     for (auto* b : {&order, &rank, &ncontacts, &nnbr, &nsnbr, &nsolid}) b->reserve_discard(nc, dev);
     for (auto* b : {&sw, &lambda, &density}) b->reserve_discard(nc, dev);
     key.reserve_discard(nc, dev), sphase.reserve_discard(nc, dev), sdf_at.reserve_discard(nc, dev);
-    nbr.reserve_discard(nc * P.max_neighbours, dev);
+    nbr.reserve_discard(nc * (P.max_neighbours + 1), dev);  // + 1: the spare slot (sim_views.hpp)
     cap = nc;
   }
 
@@ -174,7 +178,7 @@ struct ParticleSolver::Impl {
     // List layout per backend (kernels/physics/sim_views.hpp): a particle's list contiguous on
     // the CPU (one thread walks it), entry k of consecutive particles contiguous on the GPU.
     if (dev == Device::CUDA) S.nbr_row = 1, S.nbr_col = n, S.snbr_row = 1, S.snbr_col = n;
-    else S.nbr_row = P.max_neighbours, S.nbr_col = 1, S.snbr_row = P.max_static_neighbours, S.snbr_col = 1;
+    else S.nbr_row = P.max_neighbours + 1, S.nbr_col = 1, S.snbr_row = P.max_static_neighbours + 1, S.snbr_col = 1;
     S.counters = counters.data();
     S.ns = static_cast<std::int64_t>(static_host.size());
     S.stat = stat.data(), S.sgrid = sgrid, S.scell_start = scell_start.data();
@@ -190,6 +194,7 @@ struct ParticleSolver::Impl {
     S.dist_off = dist_off.data(), S.dist_other = dist_other.data(), S.dist_colour = dist_colour.data(), S.dist_len = dist_len.data(), S.dist_k = dist_k.data();
     S.bend_off = bend_off.data(), S.bend_list = bend_list.data(), S.bend_ids = d_bends.data();
     S.bend_rest = d_bend_rest.data(), S.bend_k = d_bend_k.data();
+    S.nbends = static_cast<std::int64_t>(bends.size()), S.bend_delta = bend_delta.data();
     S.tri_off = tri_off.data(), S.tri_list = tri_list.data(), S.tri_ids = d_tris.data();
     S.has_cloth_constraints = n_cloth > 0 ? 1 : 0;
     return S;
@@ -199,7 +204,7 @@ struct ParticleSolver::Impl {
     bits = grid_bits(n);
     std::int64_t cells = std::int64_t{1} << (3 * bits);
     cell_start.reserve_discard(cells + 1, dev);
-    if (!static_host.empty()) snbr.reserve_discard(cap * P.max_static_neighbours, dev);
+    if (!static_host.empty()) snbr.reserve_discard(cap * (P.max_static_neighbours + 1), dev);
   }
 
   // Sort, grid and neighbour lists of the predicted positions (S.pred must be filled).
@@ -344,6 +349,7 @@ struct ParticleSolver::Impl {
     upload_csr(tinc, tri_off, tri_list);
     d_bends = Buffer<K::Quad>::from_host(bends, dev), d_bend_rest = Buffer<float>::from_host(bend_rest, dev);
     d_bend_k = Buffer<float>::from_host(bk, dev), d_tris = Buffer<int3>::from_host(tris, dev);
+    bend_delta = Buffer<vec3>(std::max<std::int64_t>(1, 4 * static_cast<std::int64_t>(bends.size())), dev);
   }
 
   void upload_csr(const std::vector<std::vector<int>>& lists, Buffer<int>& off, Buffer<int>& items) {
@@ -456,7 +462,7 @@ struct ParticleSolver::Impl {
       K::gather_vec3(ex, raw.data(), idx.data(), ns, stat.data());
       K::cell_starts(ex, keys.data(), ns, scell_start.data(), cells);
     });
-    snbr.reserve_discard(std::max<std::int64_t>(cap, 1) * P.max_static_neighbours, dev);
+    snbr.reserve_discard(std::max<std::int64_t>(cap, 1) * (P.max_static_neighbours + 1), dev);
   }
 };
 
