@@ -72,6 +72,8 @@ struct SimViews {
   std::uint32_t* sphase = nullptr;
   float* lambda = nullptr;
   float* density = nullptr;
+  float* h_rho = nullptr;     // h / density
+  float* vort_len = nullptr;  // |vort|
   int* ncontacts = nullptr;
   vec3 *vort = nullptr, *cnormal = nullptr;
   vec4* sdf_at = nullptr;  // scene SDF gradient (xyz) and distance (w) at the last counted positions

@@ -280,6 +280,7 @@ void prepare_constraints(const Exec& ex, const SimViews& S) {
     if (!phase::is(ph, phase::kFluid)) {
       S.lambda[s] = 0.f;
       S.density[s] = S.c.rest_density;
+      S.h_rho[s] = S.c.h / S.c.rest_density;
       return;
     }
     const vec3 p = S.sp[s];
@@ -309,6 +310,7 @@ void prepare_constraints(const Exec& ex, const SimViews& S) {
     if (S.c.unilateral && C < 0.f) C = 0.f;
     S.lambda[s] = -C / (sum2 + length2(gi) + S.c.relaxation);
     S.density[s] = rho;
+    S.h_rho[s] = h / rho;  // once here instead of once per neighbour pair in velocity_effects
   });
 }
 
@@ -324,7 +326,7 @@ void solve_contacts_fluid(const Exec& ex, const SimViews& S) {
     vec3 acc = detail::contact_sum(S, s, S.sp, S.sx, true);
     if (phase::is(S.sphase[s], phase::kFluid)) {
       // PBF position update (eq. 12) with the artificial pressure s_corr (eq. 13, n = 4).
-      const float h = S.c.h, li = S.lambda[s], sw = S.c.solid_density_scale;
+      const float li = S.lambda[s], sw = S.c.solid_density_scale;
       vec3 f{0.f, 0.f, 0.f};
       for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
         int j = S.nbrs(s)[k * S.nbr_col];
@@ -346,7 +348,7 @@ void solve_contacts_fluid(const Exec& ex, const SimViews& S) {
     } else if (S.c.solid_density_scale > 0.f) {
       // Two-way coupling: the reaction of the density correction a fluid neighbour j received
       // from this solid particle (equal and opposite momentum: scaled by w_s / w_j).
-      const float h = S.c.h, ws = S.sw[s];
+      const float ws = S.sw[s];
       vec3 f{0.f, 0.f, 0.f};
       for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
         int j = S.nbrs(s)[k * S.nbr_col];
@@ -484,7 +486,7 @@ namespace detail {
 // Akinci 2013: cohesion (eq. 1) and curvature (eq. 5) accelerations, with the symmetrising
 // factor K_ij = 2 rho_0 / (rho_i + rho_j) (eq. 6). Masses are volume fractions 1 / rho_0.
 SEAMLESS_HD inline vec3 fluid_forces(const SimViews& S, int s) {
-  const float h = S.c.h, inv_rho0 = 1.f / S.c.rest_density;
+  const float inv_rho0 = 1.f / S.c.rest_density;
   const vec3 p = S.sp[s], vi = S.sv[s], wi = S.vort[s], ni = S.cnormal[s];
   vec3 dv_visc{0.f, 0.f, 0.f}, eta{0.f, 0.f, 0.f}, acc{0.f, 0.f, 0.f};
   for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
@@ -493,7 +495,7 @@ SEAMLESS_HD inline vec3 fluid_forces(const SimViews& S, int s) {
     vec3 r = p - S.sp[j];
     float l2 = length2(r), l = sqrtf(l2);
     dv_visc += (S.sv[j] - vi) * (S.c.W.poly6(l2) * inv_rho0);  // XSPH, PBF eq. 17
-    eta += S.c.W.spiky_grad(r) * (length(S.vort[j]) * inv_rho0);
+    eta += S.c.W.spiky_grad(r) * (S.vort_len[j] * inv_rho0);
     float K = 2.f * S.c.rest_density / (S.density[s] + S.density[j]);
     vec3 coh = l > 1e-9f ? r * (-S.c.cohesion * inv_rho0 * S.c.W.akinci(l) / l) : vec3{0.f, 0.f, 0.f};
     vec3 curv = (ni - S.cnormal[j]) * (-S.c.surface_tension);
@@ -528,16 +530,17 @@ void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
     ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t i) {
       const int s = static_cast<int>(i);
       if (!phase::is(S.sphase[s], phase::kFluid)) return;
-      const float h = S.c.h, inv_rho0 = 1.f / S.c.rest_density;
+      const float inv_rho0 = 1.f / S.c.rest_density;
       vec3 w{0.f, 0.f, 0.f}, n{0.f, 0.f, 0.f};
       for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
         int j = S.nbrs(s)[k * S.nbr_col];
         if (!phase::is(S.sphase[j], phase::kFluid)) continue;
         vec3 g = S.c.W.spiky_grad(S.sp[s] - S.sp[j]);
         w += cross(S.sv[j] - S.sv[s], -g) * inv_rho0;
-        n += g * (h / S.density[j]);
+        n += g * S.h_rho[j];
       }
       S.vort[s] = w;
+      S.vort_len[s] = length(w);  // read by every neighbour in fluid_forces
       S.cnormal[s] = n;
     });
   }

@@ -63,7 +63,7 @@ struct ParticleSolver::Impl {
   Buffer<std::uint32_t> key, sphase;
   Buffer<int> order, rank, ncontacts, nnbr, nsnbr, nsolid, nbr, snbr;
   Buffer<vec3> sx, sp, sp0, sv, tmp, vtmp, vort, cnormal;
-  Buffer<float> sw, lambda, density;
+  Buffer<float> sw, lambda, density, h_rho, vort_len;
   Buffer<int> cell_start, counters;
   int bits = 4;
   // static scene
@@ -137,7 +137,7 @@ struct ParticleSolver::Impl {
     grow(rest, nc, n, dev), grow(rsdf, nc, n, dev);
     for (auto* b : {&pred, &sx, &sp, &sp0, &sv, &tmp, &vtmp, &vort, &cnormal}) b->reserve_discard(nc, dev);
     for (auto* b : {&order, &rank, &ncontacts, &nnbr, &nsnbr, &nsolid}) b->reserve_discard(nc, dev);
-    for (auto* b : {&sw, &lambda, &density}) b->reserve_discard(nc, dev);
+    for (auto* b : {&sw, &lambda, &density, &h_rho, &vort_len}) b->reserve_discard(nc, dev);
     key.reserve_discard(nc, dev), sphase.reserve_discard(nc, dev), sdf_at.reserve_discard(nc, dev);
     nbr.reserve_discard(nc * (P.max_neighbours + 1), dev);  // + 1: the spare slot (sim_views.hpp)
     cap = nc;
@@ -170,7 +170,7 @@ struct ParticleSolver::Impl {
     S.rsdf = rsdf.data(), S.pred = pred.data();
     S.key = key.data(), S.order = order.data(), S.rank = rank.data();
     S.sx = sx.data(), S.sp = sp.data(), S.sp0 = sp0.data(), S.sv = sv.data(), S.tmp = tmp.data(), S.vtmp = vtmp.data();
-    S.sw = sw.data(), S.sphase = sphase.data(), S.lambda = lambda.data(), S.density = density.data();
+    S.sw = sw.data(), S.sphase = sphase.data(), S.lambda = lambda.data(), S.density = density.data(), S.h_rho = h_rho.data(), S.vort_len = vort_len.data();
     S.ncontacts = ncontacts.data(), S.vort = vort.data(), S.cnormal = cnormal.data(), S.sdf_at = sdf_at.data();
     S.grid = K::GridSpec::for_radius(c.search_radius, bits);
     S.cell_start = cell_start.data();
