@@ -29,6 +29,9 @@ using BenchFactory = std::function<std::vector<BenchCase>(const BenchOptions&)>;
 struct BenchInfo {
   std::string description;
   BenchFactory factory;
+  // A benchmark that times itself (e.g. with GL timer queries) prints its own table instead; it
+  // gets the repetition count and the JSON path ("" = none).
+  std::function<int(const BenchOptions&, int reps, const std::string& json)> custom = {};
 };
 
 std::map<std::string, BenchInfo>& bench_registry();

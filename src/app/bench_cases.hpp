@@ -6,4 +6,6 @@ namespace seamless::app {
 std::vector<BenchCase> make_preprocess_bench(const BenchOptions& o);
 std::vector<BenchCase> make_recon_bench(const BenchOptions& o);
 std::vector<BenchCase> make_physics_bench(const BenchOptions& o);
+std::vector<BenchCase> make_tracking_bench(const BenchOptions& o);
+int run_render_bench(const BenchOptions& o, int reps, const std::string& json);
 }  // namespace seamless::app

@@ -67,7 +67,7 @@ std::vector<BenchCase> make_recon_bench(const BenchOptions& o) {
     auto report = [timer, vol] {
       VolumeStats s = vol->stats();
       std::string r = "stage medians (ms):";
-      for (const char* st : {"allocate", "visible", "fuse", "remove_empty", "raycast"})
+      for (const char* st : {"allocate", "visible", "fuse", "remove_empty", "raycast_splat", "raycast"})
         if (double m = timer->median_ms(st); m > 0) r += std::string(" ") + st + " " + std::to_string(m);
       return r + "; blocks " + std::to_string(s.allocated_blocks) + ", " + std::to_string(s.bytes_per_block) +
              " bytes/block";

@@ -36,6 +36,7 @@ int run_bench(const BenchArgs& a) {
     return 1;
   }
   BenchOptions o{resolve_device(a.device), a.data, a.filter};
+  if (it->second.custom) return it->second.custom(o, a.reps, a.json);
   spdlog::info("bench {} on {} {}", a.name, device_name(o.device), cuda_device_description());
   std::vector<std::string> json_rows;
   std::printf("%-32s %10s %10s %10s  %s\n", "case", "min ms", "median ms", "max ms", "detail");

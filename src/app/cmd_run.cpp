@@ -2,12 +2,17 @@
 // are named in the log and skipped; nothing is faked (README, section Status).
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
+#include <optional>
 
 #include "app/commands.hpp"
 #include "app/pipeline.hpp"
+#include "app/render_stage.hpp"
 #include "app/run_context.hpp"
 #include "config/config.hpp"
+#include "physics/particle_solver.hpp"
 
 namespace seamless::app {
 
@@ -22,12 +27,39 @@ int dry_run(const CommonOptions& o) {
   return 0;
 }
 
+// The floor as an infinite plane: parts of the floor the camera never saw (under and in front of
+// the desk, say) have no scene particles, and objects would fall through them. The plane sits at
+// the height below which 2% of the scene particles lie, if at least 5% of them are within 5 cm of
+// it (a floor is there); nullopt otherwise.
+std::optional<kernels::SceneSdf> floor_plane(const std::vector<vec3>& points, vec3 gravity) {
+  if (points.size() < 100 || length(gravity) == 0.f) return std::nullopt;
+  vec3 up = -normalize(gravity);
+  std::vector<float> h;
+  for (vec3 p : points) h.push_back(dot(p, up));
+  std::vector<float> sorted = h;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 50, sorted.end());
+  float floor_h = sorted[sorted.size() / 50];
+  auto near = std::count_if(h.begin(), h.end(), [&](float v) { return std::fabs(v - floor_h) < 0.05f; });
+  if (near < static_cast<std::ptrdiff_t>(points.size() / 20)) return std::nullopt;
+  kernels::SceneSdf sdf{};
+  sdf.count = 1;
+  sdf.prims[0].kind = kernels::kSdfHalfSpace;
+  sdf.prims[0].a = up;
+  sdf.prims[0].b = {floor_h, 0.f, 0.f};
+  sdf.prims[0].R = mat3::identity();
+  return sdf;
+}
+
 int run(const CommonOptions& o) {
   if (o.dry_run) return dry_run(o);
   RunContext ctx(o);
   const Experiment& e = ctx.experiment();
-  if (e.mode == "live")
-    spdlog::warn("mode live (simulate while scanning) is not built yet: running scan_then_simulate");
+  auto renderer = RunRenderer::make(ctx);
+  if (e.mode == "live") {
+    live(ctx, renderer.get());
+    spdlog::info("outputs in {}", ctx.out_dir());
+    return 0;
+  }
   ScanResult scan_result = scan(ctx, true);
   SceneParticleParams sp;
   sp.spacing = e.solver.particle_diameter;
@@ -35,8 +67,20 @@ int run(const CommonOptions& o) {
   std::vector<vec3> points = scene.positions.to_host();
   points.resize(static_cast<std::size_t>(scene.count));
   spdlog::info("{} scene particles at {} m spacing", points.size(), sp.spacing);
-  simulate(ctx, points, nullptr);
-  spdlog::warn("not built yet, skipped: rendering (issue 7)");
+  ParticleState scene_state;
+  scene_state.x = points;
+  scene_state.v.assign(points.size(), vec3{0.f, 0.f, 0.f});
+  scene_state.inv_mass.assign(points.size(), 0.f);
+  scene_state.phase.assign(points.size(), 0u);
+  write_particles_ply(ctx.out_path("scene_particles.ply"), scene_state);
+  if (renderer) {
+    const Trajectory& tr = scan_result.tracking.trajectory;
+    renderer->set_scene(scan_result.mesh, tr.empty() ? SE3::identity() : tr.front().se3());
+  }
+  std::optional<kernels::SceneSdf> floor;
+  if (e.floor_plane) floor = floor_plane(points, e.solver.gravity);
+  if (floor) spdlog::info("floor plane at height {:.3f} m along -gravity", floor->prims[0].b.x);
+  simulate(ctx, points, floor ? &*floor : nullptr, renderer.get());
   spdlog::info("outputs in {}", ctx.out_dir());
   return 0;
 }

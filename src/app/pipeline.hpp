@@ -12,15 +12,24 @@ namespace seamless::app {
 struct ScanResult {
   std::unique_ptr<Volume> volume;  // null when tracking only
   TrackSequenceResult tracking;
+  Mesh mesh;                       // marching cubes of the volume (empty when tracking only)
 };
+
+class RunRenderer;
 
 // Tracks the experiment's input (and fuses it into a new volume when with_volume), writing
 // trajectory.txt, tracking_stats.csv and, with a volume, mesh.ply (output.write_mesh).
 ScanResult scan(RunContext& ctx, bool with_volume);
 
+// Live mode (dissertation, section 5.2): track, fuse and simulate every frame; the scene particles
+// are re-extracted from the volume every experiment.reextract_every fused frames.
+void live(RunContext& ctx, RunRenderer* renderer);
+
 // Runs the particle solver for experiment.duration seconds on the given static scene (particles
 // and/or an SDF), spawning experiment.spawn, writing particles_<step>.ply every
 // output.particles_every steps and the last state as particles.ply.
-void simulate(RunContext& ctx, const std::vector<vec3>& scene_particles, const kernels::SceneSdf* sdf);
+// With a renderer, draws a frame every 1 / (render.fps * solver.dt) steps.
+void simulate(RunContext& ctx, const std::vector<vec3>& scene_particles, const kernels::SceneSdf* sdf,
+              RunRenderer* renderer = nullptr);
 
 }  // namespace seamless::app

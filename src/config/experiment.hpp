@@ -43,6 +43,8 @@ struct Experiment {
   std::string mode = "live";
   std::int64_t frames = 0;        // 0 = as many as the input gives
   double duration = 3.0;          // simulated seconds after the scan (scan_then_simulate)
+  bool floor_plane = true;        // scan_then_simulate: an infinite floor under the scanned floor
+  int reextract_every = 10;       // live mode: scene particles re-extracted every this many fused frames
   InputParams input;
   PreprocessParams preprocess;
   VolumeParams volume;
@@ -59,6 +61,10 @@ struct Experiment {
     v("mode", mode, "reconstruct and simulate at once, or scan first then simulate",
       Choices{"live", "scan_then_simulate"});
     v("frames", frames, "frames to process; 0 = all the input has", Range{0, 1e12});
+    v("floor_plane", floor_plane, "collide with an infinite plane at the scanned floor's height (unseen floor "
+      "would otherwise let objects fall through)");
+    v("reextract_every", reextract_every, "live mode: re-extract the scene particles every this many fused frames",
+      Range{1, 1e6});
     v("duration", duration, "simulated seconds after the scan (scan_then_simulate mode, and simulate)", Range{0, 1e6});
     v("input", input, "where frames come from");
     v("preprocess", preprocess, "depth filtering, pyramid, vertex and normal maps");
