@@ -22,6 +22,16 @@ struct RigidSum {
 };
 SEAMLESS_HD inline RigidSum operator+(const RigidSum& a, const RigidSum& b) { return {a.p + b.p, a.A + b.A}; }
 
+// Per-chunk sums of a body's particles touching the scene (kernels::body_static_friction):
+// tangential displacement over the step now and as predicted, normal correction in the step, count.
+struct SlipSum {
+  vec3 t, free;
+  float push, count;
+};
+SEAMLESS_HD inline SlipSum operator+(const SlipSum& a, const SlipSum& b) {
+  return {a.t + b.t, a.free + b.free, a.push + b.push, a.count + b.count};
+}
+
 struct SimConstants {
   float dt = 0.01f, inv_dt = 100.f;
   vec3 gravity{0.f, -9.81f, 0.f};
@@ -113,6 +123,8 @@ struct SimViews {
   int nchunks = 0;
   const int *chunk_start = nullptr, *chunk_count = nullptr, *chunk_body = nullptr;
   RigidSum* chunk_sum = nullptr;
+  SlipSum* chunk_slip = nullptr;
+  vec3* scene_n = nullptr;  // sum of the scene contact normals at the last count (count_contacts)
 
   // cloth, CSR by id: distance constraints (other id, rest length, stiffness already scaled by
   // the averaging factor), bending constraints and triangles incident to each particle

@@ -80,15 +80,23 @@ SEAMLESS_HD inline int count_contacts(const SimViews& S, int s, const vec3* P) {
     if (length2(p - P[j]) < D2) ++count;
   }
   int scene = 0;
-  for (int k = 0, ms = S.nsnbr[s]; k < ms; ++k)
-    if (length2(p - S.stat[S.snbrs(s)[k * S.snbr_col]]) < D2) ++scene;
+  vec3 sn{0.f, 0.f, 0.f};  // sum of the scene contact normals
+  for (int k = 0, ms = S.nsnbr[s]; k < ms; ++k) {
+    vec3 r = p - S.stat[S.snbrs(s)[k * S.snbr_col]];
+    float l2 = length2(r);
+    if (l2 < D2) {
+      ++scene;
+      if (l2 > 1e-18f) sn += r / sqrtf(l2);
+    }
+  }
   if (S.sdf.active()) {
     // Kept for contact_sum, which runs next at the same positions (the SDF costs more than the
     // rest of a fluid particle's contact work).
     SdfSample3 q = scene_sdf(S.sdf, p);
     S.sdf_at[s] = vec4{q.grad.x, q.grad.y, q.grad.z, q.d};
-    if (q.d < S.c.radius) ++scene;
+    if (q.d < S.c.radius) ++scene, sn += q.grad;
   }
+  S.scene_n[s] = sn;
   if (scene > 0 && phase::is(S.sphase[s], phase::kRigid)) atomic_add(&S.body_contacts[phase::group(S.sphase[s])], 1);
   count += scene;
   return count > 0 ? count : 1;
@@ -361,6 +369,49 @@ void solve_contacts_fluid(const Exec& ex, const SimViews& S) {
   });
 }
 
+// Static friction of a rigid body as a whole (Macklin 2014, section 6.1, applied to the body):
+// shape matching moves the particles touching the scene after their contacts removed their
+// tangential displacement (it turns the body a little under the friction torque at its base), and
+// by the next iteration their contacts are resolved, so the static-friction bound mu_s * depth of
+// the particle contacts is near zero and nothing removes that slip again: a body held by static
+// friction crept down an incline. Here, after shape matching, the mean tangential displacement t
+// over the step of the body's touching particles (tangential to each particle's scene normal) is
+// removed by moving the whole body back by t, where static friction holds: where the tangential
+// displacement the prediction asked for (sp0 - x, before any correction) is below mu_s times the
+// mean normal correction in the step (eq. 24's condition, for the body's contact patch). The
+// contact points then stay put on average, without a torque (the body may still turn about them).
+// Otherwise the particles' kinetic friction acts alone.
+template <class Exec>
+void body_static_friction(const Exec& ex, const SimViews& S) {
+  ex.for_each(S.nchunks, [=] SEAMLESS_HD(std::int64_t c) {
+    SlipSum sum{{0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}, 0.f, 0.f};
+    for (int id = S.chunk_start[c], e = S.chunk_start[c] + S.chunk_count[c]; id < e; ++id) {
+      const int s = S.rank[id];
+      const vec3 sn = S.scene_n[s];
+      const float l = length(sn);
+      if (!(l > 0.f)) continue;
+      const vec3 n = sn / l, dx = S.sp[s] - S.sx[s], free = S.sp0[s] - S.sx[s];
+      sum.t += dx - n * dot(dx, n);
+      sum.free += free - n * dot(free, n);
+      sum.push += fmaxf(dot(n, S.sp[s] - S.sp0[s]), 0.f);
+      sum.count += 1.f;
+    }
+    S.chunk_slip[c] = sum;
+  });
+  ex.for_each(S.nbodies, [=] SEAMLESS_HD(std::int64_t b) {
+    SlipSum t{{0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}, 0.f, 0.f};
+    for (int c = S.body_chunk_start[b], e = c + S.body_chunk_count[b]; c < e; ++c) t = t + S.chunk_slip[c];
+    vec3 back{0.f, 0.f, 0.f};
+    if (t.count > 0.f && length(t.free) < S.c.static_friction * t.push) back = -t.t / t.count;
+    S.body_shift[b] = back;
+    S.body_c[b] = S.body_c[b] + back;
+  });
+  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
+    std::uint32_t ph = S.sphase[s];
+    if (phase::is(ph, phase::kRigid) && S.sw[s] > 0.f) S.sp[s] += S.body_shift[phase::group(ph)];
+  });
+}
+
 template <class Exec>
 void shape_match(const Exec& ex, const SimViews& S) {
   if (S.nbodies == 0) return;
@@ -401,6 +452,7 @@ void shape_match(const Exec& ex, const SimViews& S) {
     S.sp[s] += (goal - local) * S.body_stiffness[b];
   });
   ex.for_each(S.nbodies, [=] SEAMLESS_HD(std::int64_t b) { S.body_c[b] = S.body_c[b] + S.body_shift[b]; });
+  if (S.c.static_friction > 0.f) body_static_friction(ex, S);
 }
 
 // Stretch constraints of one colour (Mueller 2007, eq. 4.7/4.8). The host colours the edges so

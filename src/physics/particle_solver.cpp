@@ -62,7 +62,7 @@ struct ParticleSolver::Impl {
   // sort and sorted scratch
   Buffer<std::uint32_t> key, sphase;
   Buffer<int> order, rank, ncontacts, nnbr, nsnbr, nsolid, nbr, snbr;
-  Buffer<vec3> sx, sp, sp0, sv, tmp, vtmp, vort, cnormal;
+  Buffer<vec3> sx, sp, sp0, sv, tmp, vtmp, vort, cnormal, scene_n;
   Buffer<float> sw, lambda, density, h_rho, vort_len;
   Buffer<int> cell_start, counters;
   int bits = 4;
@@ -84,6 +84,7 @@ struct ParticleSolver::Impl {
   Buffer<vec4> body_q;
   Buffer<mat3> body_R;
   Buffer<K::RigidSum> chunk_sum;
+  Buffer<K::SlipSum> chunk_slip;
   // cloth (global ids)
   std::vector<int> edge_a, edge_b;
   std::vector<float> edge_len, edge_k0;
@@ -135,7 +136,7 @@ struct ParticleSolver::Impl {
     std::int64_t nc = std::min<std::int64_t>(P.max_particles, std::max<std::int64_t>({need, 2 * cap, 1024}));
     grow(x, nc, n, dev), grow(v, nc, n, dev), grow(w, nc, n, dev), grow(phase, nc, n, dev);
     grow(rest, nc, n, dev), grow(rsdf, nc, n, dev);
-    for (auto* b : {&pred, &sx, &sp, &sp0, &sv, &tmp, &vtmp, &vort, &cnormal}) b->reserve_discard(nc, dev);
+    for (auto* b : {&pred, &sx, &sp, &sp0, &sv, &tmp, &vtmp, &vort, &cnormal, &scene_n}) b->reserve_discard(nc, dev);
     for (auto* b : {&order, &rank, &ncontacts, &nnbr, &nsnbr, &nsolid}) b->reserve_discard(nc, dev);
     for (auto* b : {&sw, &lambda, &density, &h_rho, &vort_len}) b->reserve_discard(nc, dev);
     key.reserve_discard(nc, dev), sphase.reserve_discard(nc, dev), sdf_at.reserve_discard(nc, dev);
@@ -171,7 +172,7 @@ struct ParticleSolver::Impl {
     S.key = key.data(), S.order = order.data(), S.rank = rank.data();
     S.sx = sx.data(), S.sp = sp.data(), S.sp0 = sp0.data(), S.sv = sv.data(), S.tmp = tmp.data(), S.vtmp = vtmp.data();
     S.sw = sw.data(), S.sphase = sphase.data(), S.lambda = lambda.data(), S.density = density.data(), S.h_rho = h_rho.data(), S.vort_len = vort_len.data();
-    S.ncontacts = ncontacts.data(), S.vort = vort.data(), S.cnormal = cnormal.data(), S.sdf_at = sdf_at.data();
+    S.ncontacts = ncontacts.data(), S.vort = vort.data(), S.cnormal = cnormal.data(), S.sdf_at = sdf_at.data(), S.scene_n = scene_n.data();
     S.grid = K::GridSpec::for_radius(c.search_radius, bits);
     S.cell_start = cell_start.data();
     S.nbr = nbr.data(), S.nnbr = nnbr.data(), S.snbr = snbr.data(), S.nsnbr = nsnbr.data(), S.nsolid = nsolid.data();
@@ -190,7 +191,7 @@ struct ParticleSolver::Impl {
     S.body_c = body_c.data(), S.body_shift = body_shift.data(), S.body_q = body_q.data(), S.body_R = body_R.data();
     S.nchunks = static_cast<int>(chunk_start.size());
     S.chunk_start = d_chunk_start.data(), S.chunk_count = d_chunk_count.data(), S.chunk_body = d_chunk_body.data();
-    S.chunk_sum = chunk_sum.data();
+    S.chunk_sum = chunk_sum.data(), S.chunk_slip = chunk_slip.data();
     S.dist_off = dist_off.data(), S.dist_other = dist_other.data(), S.dist_colour = dist_colour.data(), S.dist_len = dist_len.data(), S.dist_k = dist_k.data();
     S.bend_off = bend_off.data(), S.bend_list = bend_list.data(), S.bend_ids = d_bends.data();
     S.bend_rest = d_bend_rest.data(), S.bend_k = d_bend_k.data();
@@ -269,6 +270,7 @@ struct ParticleSolver::Impl {
     for (vec4 r : q) R.push_back(K::quat_to_mat(r));
     body_R = Buffer<mat3>::from_host(R, dev);
     chunk_sum = Buffer<K::RigidSum>(static_cast<std::int64_t>(chunk_start.size()), dev);
+    chunk_slip = Buffer<K::SlipSum>(static_cast<std::int64_t>(chunk_start.size()), dev);
   }
 
   void add_body(const ParticleBatch& b, std::int64_t first) {
