@@ -100,7 +100,8 @@ TEST(PhysicsCloth, DroppedOnBoxStaysOutside) {
 // stays green; run with --gtest_also_run_disabled_tests): with 2 iterations and coloured
 // Gauss-Seidel stretch constraints the peak is 26 % at impact and 12 % at rest, at the box's top
 // corners, where the contacts (projected before the cloth in each iteration) and the stretch
-// constraints fight; 4 iterations give 18 %. docs/PHYSICS.md, known limitations.
+// constraints fight; 4 iterations give 18 %. docs/PHYSICS.md, known limitations, lists what else
+// was tried (re-projected contacts, heavier contact particles, more passes, long-range limits).
 TEST(PhysicsCloth, DISABLED_DroppedOnBoxEdgeStrainAtMostTenPercent) {
   DrapeRun r = drape();
   EXPECT_LE(r.worst_strain, 0.10);
