@@ -22,6 +22,7 @@ struct BenchOptions {
   Device device = Device::CPU;
   std::string data_dir;  // TUM folder for benchmarks on real frames ("" = synthetic input)
   std::string filter;    // run only cases whose name contains this
+  std::string scale = "all";  // benchmarks with sized scenes: paper (the dissertation's), large, all
 };
 
 using BenchFactory = std::function<std::vector<BenchCase>(const BenchOptions&)>;

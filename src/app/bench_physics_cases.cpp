@@ -1,5 +1,5 @@
 // `seamless bench physics`: one solver step of the dissertation's Table 5.1 scenes and of the
-// scaled ones (src/physics/bench_physics.hpp builds them). --filter paper|large picks a set.
+// scaled ones (src/physics/bench_physics.hpp builds them). --scale paper|large picks a set.
 #include "app/bench_cases.hpp"
 #include "physics/bench_physics.hpp"
 #include "physics/particle_solver.hpp"
@@ -7,9 +7,8 @@
 namespace seamless::app {
 
 std::vector<BenchCase> make_physics_bench(const BenchOptions& o) {
-  std::string scale = o.filter == "paper" || o.filter == "large" ? o.filter : "all";
   std::vector<BenchCase> cases;
-  for (PhysicsBenchCase& c : physics_bench_cases(o.device, scale)) {
+  for (PhysicsBenchCase& c : physics_bench_cases(o.device, o.scale)) {
     auto solver = c.solver;
     cases.push_back({c.name, c.step, c.detail, [solver] {
                        auto s = solver->stats();

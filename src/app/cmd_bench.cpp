@@ -13,7 +13,7 @@ namespace seamless::app {
 
 namespace {
 struct BenchArgs {
-  std::string name, device = "auto", json, data, filter;
+  std::string name, device = "auto", json, data, filter, scale = "all";
   int reps = 50, warmup = 5;
   bool list = false;
 };
@@ -35,7 +35,7 @@ int run_bench(const BenchArgs& a) {
     spdlog::error("no benchmark named '{}'; this build has:{}", a.name, names);
     return 1;
   }
-  BenchOptions o{resolve_device(a.device), a.data, a.filter};
+  BenchOptions o{resolve_device(a.device), a.data, a.filter, a.scale};
   if (it->second.custom) return it->second.custom(o, a.reps, a.json);
   spdlog::info("bench {} on {} {}", a.name, device_name(o.device), cuda_device_description());
   std::vector<std::string> json_rows;
@@ -72,6 +72,8 @@ void add_bench_command(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--json", a->json, "write the results as JSON to this file");
   cmd->add_option("--data", a->data, "TUM folder for benchmarks over real frames");
   cmd->add_option("--filter", a->filter, "only cases whose name contains this");
+  cmd->add_option("--scale", a->scale, "scene sizes for `physics`: paper (Table 5.1), large or all")
+      ->check(CLI::IsMember({"paper", "large", "all"}));
   cmd->add_flag("--list", a->list, "list the benchmarks");
   cmd->callback([&action, a] {
     action = [a] {
