@@ -22,7 +22,7 @@ struct OutputParams {
   bool write_mesh = true;         // mesh.ply (marching cubes, with colour)
   bool write_trajectory = true;   // trajectory.txt, TUM format
   bool write_timings = true;      // timings.csv, one row per frame and stage
-  bool write_stats = true;        // stats.csv: hash fill, tracking inliers, particle counts
+  bool write_stats = true;        // tracking_stats.csv: per-frame residual, inliers, timings
   int particles_every = 25;       // write particles_<step>.ply every this many solver steps; 0 = only the last
 
   template <class V> void visit(V& v) {
@@ -31,7 +31,7 @@ struct OutputParams {
     v("write_mesh", write_mesh, "write the reconstructed mesh as mesh.ply");
     v("write_trajectory", write_trajectory, "write the camera trajectory (TUM format) as trajectory.txt");
     v("write_timings", write_timings, "write per-stage timings as timings.csv");
-    v("write_stats", write_stats, "write per-frame statistics as stats.csv");
+    v("write_stats", write_stats, "write per-frame tracking statistics as tracking_stats.csv");
     v("particles_every", particles_every, "write particles_<step>.ply every this many solver steps; 0 = only the last",
       Range{0, 1e9});
   }
