@@ -64,6 +64,11 @@ class Cli(unittest.TestCase):
                 p = os.path.join(out, f)
                 self.assertTrue(os.path.isfile(p), f)
                 self.assertGreater(os.path.getsize(p), 0, f)
+            # With the renderer built (it is in CI: Mesa's EGL), the demo's headless frames exist too.
+            if "render" in seamless("bench", "--list").stdout:
+                frames = glob.glob(os.path.join(out, "frames", "*.png"))
+                self.assertGreater(len(frames), 0)
+                self.assertTrue(all(os.path.getsize(f) > 0 for f in frames))
             with open(os.path.join(out, "trajectory.txt")) as t:
                 poses = [l for l in t if l.strip() and not l.startswith("#")]
             self.assertEqual(len(poses), 6)
