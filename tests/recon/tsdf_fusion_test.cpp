@@ -16,17 +16,6 @@ namespace {
 
 using test::Scene;
 
-VolumeParams small_params() {
-  VolumeParams p;
-  p.voxel_size = 0.01f;
-  p.truncation = 0.03f;
-  p.hash_buckets = 1 << 14;
-  p.capacity = 4096;
-  p.min_depth = 0.2f;
-  p.max_depth = 3.f;
-  return p;
-}
-
 // Camera translations only (no rotation), so that the projective distance to the fronto-parallel
 // wall equals the true distance.
 std::vector<SE3> translations() {
@@ -49,7 +38,7 @@ void fuse(Volume& vol, const Scene& s, const Intrinsics& K, const std::vector<SE
 }
 
 TEST(TsdfFusion, WallVoxelsHoldTheTruncatedDistance) {
-  VolumeParams p = small_params();
+  VolumeParams p = test::small_volume_params();
   VoxelHashVolume vol(p, Device::CPU);
   Scene s;
   Intrinsics K = test::camera(160, 120, 140.f);
@@ -79,7 +68,7 @@ TEST(TsdfFusion, WallVoxelsHoldTheTruncatedDistance) {
 }
 
 TEST(TsdfFusion, RaycastDepthAndNormalsMatchAnalyticScene) {
-  VolumeParams p = small_params();
+  VolumeParams p = test::small_volume_params();
   VoxelHashVolume vol(p, Device::CPU);
   Scene s;
   Intrinsics K = test::camera(320, 240, 280.f);
@@ -142,7 +131,7 @@ TEST(TsdfFusion, RaycastDepthAndNormalsMatchAnalyticScene) {
 }
 
 TEST(TsdfFusion, RemovingEmptyBlocksFreesThem) {
-  VolumeParams p = small_params();
+  VolumeParams p = test::small_volume_params();
   p.max_weight = 1.f;  // the model follows the newest frame: the moved wall empties the old band
   std::size_t before = memory::bytes_in_use(Device::CPU);
   VoxelHashVolume vol(p, Device::CPU);
@@ -182,7 +171,7 @@ TEST(TsdfFusion, RemovingEmptyBlocksFreesThem) {
 // The stand-alone pass over all blocks frees exactly the blocks without an observed voxel within
 // the truncation of a surface (the predicate fusion flags per frame), and keeps the rest intact.
 TEST(TsdfFusion, StandaloneRemovalFreesExactlyTheEmptyBlocks) {
-  VolumeParams p = small_params();
+  VolumeParams p = test::small_volume_params();
   p.max_weight = 1.f;
   p.remove_empty_blocks = false;  // leave the emptied band of the old wall in place
   VoxelHashVolume vol(p, Device::CPU);
@@ -219,11 +208,11 @@ TEST(TsdfFusion, StandaloneRemovalFreesExactlyTheEmptyBlocks) {
 TEST(TsdfFusion, FullPoolGrowsAndRetriesOrReports) {
   Intrinsics K = test::camera(160, 120, 140.f);
   Scene s;
-  VolumeParams big = small_params();
+  VolumeParams big = test::small_volume_params();
   VoxelHashVolume ref(big, Device::CPU);
   fuse(ref, s, K, {SE3::identity()});
 
-  VolumeParams tiny = small_params();
+  VolumeParams tiny = test::small_volume_params();
   tiny.capacity = 64;
   tiny.hash_buckets = 1024;
   VoxelHashVolume grown(tiny, Device::CPU);
@@ -244,7 +233,7 @@ TEST(TsdfFusion, FullPoolGrowsAndRetriesOrReports) {
 }
 
 TEST(TsdfFusion, RejectsTruncationBelowTwoVoxels) {
-  VolumeParams p = small_params();
+  VolumeParams p = test::small_volume_params();
   p.truncation = 0.015f;
   EXPECT_THROW((VoxelHashVolume{p, Device::CPU}), Error);
 }
@@ -257,7 +246,7 @@ TEST(TsdfParity, SameBlocksAndValues) {
   Scene s;
   std::vector<SE3> poses = translations();
   poses.push_back(test::pose({0.03f, 0.f, 0.f}, 0.05f, 0.f));
-  VoxelHashVolume cpu(small_params(), Device::CPU), gpu(small_params(), Device::CUDA);
+  VoxelHashVolume cpu(test::small_volume_params(), Device::CPU), gpu(test::small_volume_params(), Device::CUDA);
   fuse(cpu, s, K, poses, true);
   fuse(gpu, s, K, poses, true);
   auto a = cpu.download_blocks(), b = gpu.download_blocks();

@@ -21,19 +21,8 @@ namespace {
 
 using test::Scene;
 
-VolumeParams params() {
-  VolumeParams p;
-  p.voxel_size = 0.01f;
-  p.truncation = 0.03f;
-  p.hash_buckets = 1 << 14;
-  p.capacity = 4096;
-  p.min_depth = 0.2f;
-  p.max_depth = 3.f;
-  return p;
-}
-
 Mesh fused_mesh(const Scene& s, Device d = Device::CPU) {
-  VoxelHashVolume vol(params(), d);
+  VoxelHashVolume vol(test::small_volume_params(), d);
   Intrinsics K = test::camera(320, 240, 280.f);
   for (SE3 T : {test::pose({0.f, 0.f, 0.f}), test::pose({0.04f, 0.f, 0.f}), test::pose({-0.04f, 0.02f, 0.f}),
                 test::pose({0.f, -0.03f, 0.05f})}) {

@@ -7,6 +7,7 @@
 #include "core/buffer.hpp"
 #include "core/camera.hpp"
 #include "core/math.hpp"
+#include "recon/volume_params.hpp"
 
 namespace seamless::test {
 
@@ -108,6 +109,18 @@ inline Intrinsics camera(int w, int h, float f) {
 inline uchar3 colour_of(vec3 n) {
   return {static_cast<std::uint8_t>(127.5f + 127.f * n.x), static_cast<std::uint8_t>(127.5f + 127.f * n.y),
           static_cast<std::uint8_t>(127.5f + 127.f * n.z)};
+}
+
+// A small volume for these scenes: 1 cm voxels, 3 cm truncation, room for the wall and sphere.
+inline VolumeParams small_volume_params() {
+  VolumeParams p;
+  p.voxel_size = 0.01f;
+  p.truncation = 0.03f;
+  p.hash_buckets = 1 << 14;
+  p.capacity = 4096;
+  p.min_depth = 0.2f;
+  p.max_depth = 3.f;
+  return p;
 }
 
 }  // namespace seamless::test

@@ -10,12 +10,8 @@ namespace seamless {
 namespace {
 
 TEST(VolumeBench, ReportsEveryStageOfEveryFrame) {
-  VolumeParams p;
-  p.voxel_size = 0.01f;
-  p.truncation = 0.03f;
-  p.hash_buckets = 1 << 14;
-  p.capacity = 4096;
-  p.min_depth = 0.2f;
+  VolumeParams p = test::small_volume_params();
+  p.max_depth = 4.f;  // the default: this test never limited it
   test::Scene s;
   Intrinsics K = test::camera(80, 60, 70.f);
   std::vector<ReconFrame> frames;

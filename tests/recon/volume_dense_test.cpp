@@ -10,12 +10,8 @@ namespace seamless {
 namespace {
 
 TEST(VolumeDense, MatchesTheHashedVolume) {
-  VolumeParams p;
-  p.voxel_size = 0.01f;
-  p.truncation = 0.03f;
-  p.hash_buckets = 1 << 14;
-  p.capacity = 4096;
-  p.min_depth = 0.2f;
+  VolumeParams p = test::small_volume_params();
+  p.max_depth = 4.f;  // the default: this test never limited it
   p.dense_resolution = 128;                 // 1.28 m cube
   p.dense_origin = {-0.64f, -0.64f, 0.8f};  // holds the sphere and the wall's centre
   test::Scene s;
