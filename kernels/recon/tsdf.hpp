@@ -215,4 +215,10 @@ template <class Exec, class Acc>
 void scene_particle_emit(const Exec& ex, Acc a, View<const int3> blocks, float spacing, float interior_depth,
                          View<const std::int32_t> offsets, View<vec3> positions, View<vec3> normals);
 
+// Samples the SDF (sample_sdf) on a regular grid, x fastest: out[(z * dims.y + y) * dims.x + x] at
+// origin + voxel * (x, y, z). Unknown points (unobserved or outside the band) get `unknown`.
+// For collisions against the TSDF through a dense grid (the solver's scene_collision: sdf).
+template <class Exec, class Acc>
+void sample_sdf_grid(const Exec& ex, Acc a, vec3 origin, int3 dims, float voxel, float unknown, View<float> out);
+
 }  // namespace seamless::kernels

@@ -166,6 +166,17 @@ void scene_particle_emit(const Exec& ex, Acc a, View<const int3> blocks, float s
   });
 }
 
+template <class Exec, class Acc>
+void sample_sdf_grid(const Exec& ex, Acc a, vec3 origin, int3 dims, float voxel, float unknown, View<float> out) {
+  ex.for_each(out.size, [=] SEAMLESS_HD(std::int64_t i) {
+    const std::int64_t plane = static_cast<std::int64_t>(dims.x) * dims.y;
+    int z = static_cast<int>(i / plane), y = static_cast<int>((i % plane) / dims.x), x = static_cast<int>(i % dims.x);
+    vec3 p = origin + vec3{float(x), float(y), float(z)} * voxel;
+    float v;
+    out[i] = sample_sdf(a, p, &v, nullptr) ? v : unknown;
+  });
+}
+
 template <class Exec>
 void slot_block_coords(const Exec& ex, HashTableView t, View<const std::int32_t> slots, View<int3> out) {
   ex.for_each(slots.size, [=] SEAMLESS_HD(std::int64_t i) { out[i] = unpack_block(t.keys[slots[i]]); });
@@ -184,6 +195,7 @@ void slot_block_coords(const Exec& ex, HashTableView t, View<const std::int32_t>
                                                         View<std::int32_t>);                                      \
   template void scene_particle_emit<EXEC, ACC>(const EXEC&, ACC, View<const int3>, float, float,                  \
                                                View<const std::int32_t>, View<vec3>, View<vec3>);                 \
+  template void sample_sdf_grid<EXEC, ACC>(const EXEC&, ACC, vec3, int3, float, float, View<float>);              \
   }
 #define SEAMLESS_INSTANTIATE_TSDF_EXTRACT(EXEC)                                                                   \
   SEAMLESS_INSTANTIATE_TSDF_EXTRACT_ACC(EXEC, HashAccess)                                                         \

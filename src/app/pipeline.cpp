@@ -65,15 +65,17 @@ ScanResult scan(RunContext& ctx, bool with_volume) {
 }
 
 void simulate(RunContext& ctx, const std::vector<vec3>& scene_particles, const kernels::SceneSdf* sdf,
-              RunRenderer* renderer) {
+              RunRenderer* renderer, const SdfGrid* grid) {
   const Experiment& e = ctx.experiment();
   ParticleSolver solver(e.solver, ctx.device());
   if (!scene_particles.empty()) solver.add_static_particles(scene_particles);
   if (sdf) solver.set_scene_sdf(*sdf);
+  if (grid) solver.set_scene_sdf_grid(grid->values, grid->dims, grid->origin, grid->voxel);
   solver.schedule(e.spawn);  // checks the particle budget up front
   const auto steps = static_cast<std::int64_t>(std::ceil(e.duration / e.solver.dt));
-  spdlog::info("simulating {:.2f} s in {} steps of {} s on {} scene particles{}", e.duration, steps, e.solver.dt,
-               scene_particles.size(), sdf ? " and the scene SDF" : "");
+  spdlog::info("simulating {:.2f} s in {} steps of {} s on {} scene particles{}{}", e.duration, steps, e.solver.dt,
+               scene_particles.size(), sdf ? ", analytic SDF primitives" : "",
+               grid ? ", the TSDF sampled on a grid" : "");
   const auto render_every = std::max<std::int64_t>(1, std::llround(1.0 / (e.render.fps * e.solver.dt)));
   Progress progress("simulate", steps);
   for (std::int64_t k = 0; k < steps; ++k) {

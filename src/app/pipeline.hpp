@@ -28,8 +28,16 @@ void live(RunContext& ctx, RunRenderer* renderer);
 // Runs the particle solver for experiment.duration seconds on the given static scene (particles
 // and/or an SDF), spawning experiment.spawn, writing particles_<step>.ply every
 // output.particles_every steps and the last state as particles.ply.
+// A sampled SDF of the scene (x fastest), for solver.scene_collision: sdf.
+struct SdfGrid {
+  std::vector<float> values;
+  int3 dims{0, 0, 0};
+  vec3 origin{0, 0, 0};
+  float voxel = 0.f;
+};
+
 // With a renderer, draws a frame every 1 / (render.fps * solver.dt) steps.
 void simulate(RunContext& ctx, const std::vector<vec3>& scene_particles, const kernels::SceneSdf* sdf,
-              RunRenderer* renderer = nullptr);
+              RunRenderer* renderer = nullptr, const SdfGrid* grid = nullptr);
 
 }  // namespace seamless::app

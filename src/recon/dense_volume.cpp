@@ -60,6 +60,10 @@ SceneParticles DenseVolume::extract_scene_particles(const SceneParticleParams& p
   return seamless::extract_scene_particles(device_, device_view(), block_coords_, block_coords_.size(), p);
 }
 
+std::vector<float> DenseVolume::sample_sdf_grid(vec3 origin, int3 dims, float voxel) {
+  return seamless::sample_sdf_grid(device_, device_view(), origin, dims, voxel, params_.truncation);
+}
+
 VolumeStats DenseVolume::stats() {
   VolumeStats s;
   s.frames = frames_;

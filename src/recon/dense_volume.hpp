@@ -21,6 +21,7 @@ class DenseVolume final : public Volume {
   using Volume::raycast;
   Mesh extract_mesh() override;
   SceneParticles extract_scene_particles(const SceneParticleParams& p) override;
+  std::vector<float> sample_sdf_grid(vec3 origin, int3 dims, float voxel) override;
   VolumeStats stats() override;
   Device device() const override { return device_; }
   const VolumeParams& params() const override { return params_; }

@@ -57,4 +57,19 @@ template SceneParticles extract_scene_particles<kernels::DenseAccess>(Device, co
                                                                       const Buffer<int3>&, std::int64_t,
                                                                       const SceneParticleParams&);
 
+template <class Acc>
+std::vector<float> sample_sdf_grid(Device d, const Acc& a, vec3 origin, int3 dims, float voxel, float unknown) {
+  const std::int64_t n = std::int64_t{dims.x} * dims.y * dims.z;
+  if (dims.x <= 0 || dims.y <= 0 || dims.z <= 0 || !(voxel > 0.f))
+    throw Error("SDF grid: dimensions and voxel size must be positive");
+  Buffer<float> out(n, d);
+  with_exec(d, [&](const auto& ex) { kernels::sample_sdf_grid(ex, a, origin, dims, voxel, unknown, out.view()); });
+  return out.to_host();
+}
+
+template std::vector<float> sample_sdf_grid<kernels::HashAccess>(Device, const kernels::HashAccess&, vec3, int3, float,
+                                                                float);
+template std::vector<float> sample_sdf_grid<kernels::DenseAccess>(Device, const kernels::DenseAccess&, vec3, int3,
+                                                                 float, float);
+
 }  // namespace seamless

@@ -1,5 +1,6 @@
 // Static scene particles for the physics solver, taken from the fused TSDF (DESIGN "Physics").
 #pragma once
+#include <vector>
 #include <cstdint>
 
 #include "core/buffer.hpp"
@@ -32,5 +33,9 @@ struct SceneParticles {
 template <class Acc>
 SceneParticles extract_scene_particles(Device d, const Acc& a, const Buffer<int3>& blocks, std::int64_t block_count,
                                        const SceneParticleParams& p);
+
+// Samples accessor a's SDF on a grid (Volume::sample_sdf_grid); unknown points read `unknown`.
+template <class Acc>
+std::vector<float> sample_sdf_grid(Device d, const Acc& a, vec3 origin, int3 dims, float voxel, float unknown);
 
 }  // namespace seamless

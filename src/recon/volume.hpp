@@ -74,6 +74,9 @@ class Volume {
   virtual Mesh extract_mesh() = 0;
   // Static scene particles for the physics solver (positions and normals on the volume's device).
   virtual SceneParticles extract_scene_particles(const SceneParticleParams& p) = 0;
+  // The SDF on a regular grid (x fastest) at origin + voxel * (x, y, z); unknown points read as
+  // +truncation (free space). For the solver's scene_collision: sdf.
+  virtual std::vector<float> sample_sdf_grid(vec3 origin, int3 dims, float voxel) = 0;
   virtual VolumeStats stats() = 0;
   virtual Device device() const = 0;
   virtual const VolumeParams& params() const = 0;

@@ -311,6 +311,10 @@ SceneParticles VoxelHashVolume::extract_scene_particles(const SceneParticleParam
   return seamless::extract_scene_particles(device_, device_view(), coords, n, p);
 }
 
+std::vector<float> VoxelHashVolume::sample_sdf_grid(vec3 origin, int3 dims, float voxel) {
+  return seamless::sample_sdf_grid(device_, device_view(), origin, dims, voxel, params_.truncation);
+}
+
 VolumeStats VoxelHashVolume::stats() {
   HashCounters c = read_counters();
   VolumeStats s;

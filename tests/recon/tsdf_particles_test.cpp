@@ -19,19 +19,19 @@ Scene box_scene() {
   return s;
 }
 
-VoxelHashVolume fused(const Scene& s) {
+VoxelHashVolume fused(const Scene& s, Device d = Device::CPU) {
   VolumeParams p;
   p.voxel_size = 0.01f;
   p.truncation = 0.04f;
   p.hash_buckets = 1 << 14;
   p.capacity = 4096;
   p.min_depth = 0.2f;
-  VoxelHashVolume vol(p, Device::CPU);
+  VoxelHashVolume vol(p, d);
   Intrinsics K = test::camera(320, 240, 280.f);
   // Translations only: the projective distance to the fronto-parallel faces is then exact.
   for (SE3 T : {test::pose({0.f, 0.f, 0.f}), test::pose({0.05f, 0.f, 0.f}), test::pose({-0.05f, 0.03f, 0.f}),
                 test::pose({0.f, -0.04f, 0.05f})})
-    vol.integrate(Image<float>::from_host(s.render(K, T), K.width, K.height, Device::CPU), Image<uchar3>{}, K, T);
+    vol.integrate(Image<float>::from_host(s.render(K, T), K.width, K.height, d), Image<uchar3>{}, K, T);
   return vol;
 }
 
@@ -104,6 +104,44 @@ TEST(TsdfSampler, ValueAndGradientMatchTheWall) {
   EXPECT_GT(checked, 100);
   float v;
   EXPECT_FALSE(kernels::sample_sdf(view, vec3{0.f, 0.f, 0.5f}, &v, nullptr));  // free space: unknown
+}
+
+TEST(TsdfSampler, GridSamplesMatchTheWallAndFillUnknown) {
+  // The grid is sample_sdf at grid points: the same exactness as above near the wall, and the
+  // truncation distance (free space) where nothing was observed.
+  Scene s = box_scene();
+  VoxelHashVolume vol = fused(s);
+  const vec3 origin{-0.5f, 0.35f, 1.40f};
+  const int3 dims{21, 1, 31};
+  const float voxel = 0.01f;
+  std::vector<float> g = vol.sample_sdf_grid(origin, dims, voxel);
+  ASSERT_EQ(g.size(), 21u * 31u);
+  int near_wall = 0;
+  for (int z = 0; z < dims.z; ++z)
+    for (int x = 0; x < dims.x; ++x) {
+      vec3 p = origin + vec3{float(x), 0.f, float(z)} * voxel;
+      float v = g[z * dims.x + x];
+      EXPECT_LE(v, 0.04f + 1e-6f);  // never beyond the truncation
+      if (std::fabs(s.wall_z - p.z) < 0.03f) {
+        EXPECT_NEAR(v, s.wall_z - p.z, 1e-4f) << p.x << " " << p.z;
+        ++near_wall;
+      }
+    }
+  EXPECT_GT(near_wall, 100);
+  EXPECT_FLOAT_EQ(vol.sample_sdf_grid({0.f, 0.f, 0.5f}, {1, 1, 1}, 0.01f)[0], 0.04f);  // unobserved: free space
+}
+
+// The grid on both backends from volumes fused on each: the fused values agree to float rounding
+// (TsdfParity), and trilinear sampling adds a few ulps; 1e-5 m is far below a voxel.
+TEST(TsdfSamplerParity, GridOnCpuAndCudaAgree) {
+  if (!cuda_available()) GTEST_SKIP() << "no CUDA device";
+  Scene s = box_scene();
+  VoxelHashVolume a = fused(s, Device::CPU), b = fused(s, Device::CUDA);
+  const vec3 origin{-0.5f, -0.3f, 0.9f};
+  const int3 dims{50, 30, 40};
+  std::vector<float> ga = a.sample_sdf_grid(origin, dims, 0.02f), gb = b.sample_sdf_grid(origin, dims, 0.02f);
+  ASSERT_EQ(ga.size(), gb.size());
+  for (std::size_t i = 0; i < ga.size(); ++i) ASSERT_NEAR(ga[i], gb[i], 1e-5f) << i;
 }
 
 }  // namespace
