@@ -119,9 +119,7 @@ void add_config_command(CLI::App& app, std::function<int()>& action) {
         spdlog::error("seamless config: give an experiment file, or --list");
         return 2;
       }
-      std::vector<std::string> sets = o->sets;
-      if (!o->device.empty()) sets.push_back("device=" + o->device);
-      std::fputs(to_yaml(load_experiment(o->config, sets)).c_str(), stdout);
+      std::fputs(to_yaml(load_experiment(o->config, overrides(*o))).c_str(), stdout);
       return 0;
     };
   });

@@ -20,9 +20,7 @@ namespace seamless::app {
 namespace {
 
 int dry_run(const CommonOptions& o) {
-  std::vector<std::string> sets = o.sets;
-  if (!o.device.empty()) sets.push_back("device=" + o.device);
-  Experiment e = load_experiment(o.config, sets);
+  Experiment e = load_experiment(o.config, overrides(o));
   spdlog::info("{}: valid ({} spawn entries, input {}, device {})", o.config, e.spawn.size(), e.input.source,
                e.device);
   return 0;

@@ -138,7 +138,7 @@ void live(RunContext& ctx, RunRenderer* renderer) {
     }
     if (renderer) {
       renderer->set_kinect_frame(frame, rec.result.world_T_camera);
-      if (reextract) renderer->set_scene(volume->extract_mesh(), rec.result.world_T_camera);
+      if (reextract && e.render.view == "mesh") renderer->set_scene(volume->extract_mesh(), rec.result.world_T_camera);
       renderer->draw(solver);
     }
     ctx.timer().add(k, "track", rec.track_ms);

@@ -24,6 +24,12 @@ void add_common_options(CLI::App& cmd, CommonOptions& o, bool config_required) {
       ->check(CLI::IsMember({"cpu", "cuda", "auto"}));
 }
 
+std::vector<std::string> overrides(const CommonOptions& o) {
+  std::vector<std::string> sets = o.sets;
+  if (!o.device.empty()) sets.push_back("device=" + o.device);
+  return sets;
+}
+
 namespace {
 std::string timestamp() {
   std::time_t t = std::time(nullptr);
@@ -34,9 +40,7 @@ std::string timestamp() {
 }  // namespace
 
 RunContext::RunContext(const CommonOptions& o) {
-  std::vector<std::string> sets = o.sets;
-  if (!o.device.empty()) sets.push_back("device=" + o.device);
-  exp_ = load_experiment(o.config, sets);
+  exp_ = load_experiment(o.config, overrides(o));
   device_ = resolve_device(exp_.device);
 
   out_ = o.out.empty() ? exp_.output.dir + "/" + fs::path(o.config).stem().string() + "-" + timestamp() : o.out;

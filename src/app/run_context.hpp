@@ -22,6 +22,9 @@ struct CommonOptions {
   bool dry_run = false;
 };
 
+// The config overrides of the options, in order: every --set, then --device as device=...
+std::vector<std::string> overrides(const CommonOptions& o);
+
 // Adds config, --set, --out, --device (and --dry-run when asked) to a subcommand.
 void add_common_options(CLI::App& cmd, CommonOptions& o, bool config_required = true);
 

@@ -15,13 +15,8 @@ namespace seamless {
 namespace {
 
 VolumeParams params_with_tile(int tile) {
-  VolumeParams p;
-  p.voxel_size = 0.01f;
-  p.truncation = 0.03f;
-  p.hash_buckets = 1 << 14;
+  VolumeParams p = test::small_volume_params();
   p.capacity = 8192;
-  p.min_depth = 0.2f;
-  p.max_depth = 3.f;
   p.raycast_tile = tile;
   return p;
 }

@@ -23,13 +23,7 @@ namespace {
 Intrinsics small_camera() { return test::camera(80, 60, 70.f); }
 
 VolumeParams params(float stream_radius) {
-  VolumeParams p;
-  p.voxel_size = 0.01f;
-  p.truncation = 0.03f;
-  p.hash_buckets = 1 << 14;
-  p.capacity = 4096;
-  p.min_depth = 0.2f;
-  p.max_depth = 3.f;
+  VolumeParams p = test::small_volume_params();
   p.stream_radius = stream_radius;
   p.stream_step = 0.25f;
   return p;
