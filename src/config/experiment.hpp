@@ -9,6 +9,7 @@
 #include "io/input_params.hpp"
 #include "physics/solver_params.hpp"
 #include "recon/preprocess_params.hpp"
+#include "recon/refine/refine_params.hpp"
 #include "recon/tracker_params.hpp"
 #include "recon/volume_params.hpp"
 #include "render/render_params.hpp"
@@ -49,6 +50,7 @@ struct Experiment {
   PreprocessParams preprocess;
   VolumeParams volume;
   TrackerParams tracker;
+  RefineParams refine;
   SolverParams solver;
   std::vector<SpawnParams> spawn;
   RenderParams render;
@@ -70,6 +72,7 @@ struct Experiment {
     v("preprocess", preprocess, "depth filtering, pyramid, vertex and normal maps");
     v("volume", volume, "TSDF volume");
     v("tracker", tracker, "camera tracking");
+    v("refine", refine, "offline keyframe pose-graph refinement of the tracked trajectory (Ceres)");
     v("solver", solver, "particle solver");
     v("spawn", spawn, "what to drop into the scene and when (list)");
     v("render", render, "rendering");
