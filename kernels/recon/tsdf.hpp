@@ -199,21 +199,37 @@ void slot_block_coords(const Exec& ex, HashTableView t, View<const std::int32_t>
 
 namespace seamless::kernels {
 
-// Static scene particles (DESIGN "Physics": scene particles come from the hash blocks): the
-// points of the lattice spacing * Z^3 inside the listed blocks whose TSDF lies in
-// [-interior_depth, spacing/2] (the surface band, plus the solid interior to that depth as far as
-// the truncated TSDF knows it). Candidate i is lattice point i % m^3 of block i / m^3 with
-// m = lattice_per_block(...); flags[i] = 1 for a particle. Returns the count; flags become offsets.
+// Static scene particles (DESIGN "Physics": scene particles come from the hash blocks), in two
+// passes over the listed blocks and a thinning (tsdf_extract.inl says why): the candidates of a
+// block are owned by the points of the lattice spacing * Z^3 inside it. Lattice point L gives the
+// zero crossings of the TSDF on the segments L -> L + spacing e_axis (axis x, y, z) where the
+// surface faces along that axis (surface particles ON the fused surface, about one per spacing^2),
+// plus L itself when interior_depth > 0 and its TSDF is in [-interior_depth, -spacing/2] (the
+// solid fill, as far as the truncated TSDF knows it). Candidate slots of lattice point i % m^3 of
+// block i / m^3 with m = lattice_per_block(...): counts[i] = its candidates; returns the total
+// and turns counts into offsets.
 SEAMLESS_HD inline int lattice_per_block(float voxel_size, float spacing) {
   return static_cast<int>(ceilf(kBlockSide * voxel_size / spacing)) + 1;
 }
 template <class Exec, class Acc>
 std::int64_t scene_particle_count(const Exec& ex, Acc a, View<const int3> blocks, float spacing, float interior_depth,
-                                  View<std::int32_t> flags);
-// Writes position and unit normal (TSDF gradient) of each particle at offsets[i].
+                                  View<std::int32_t> counts);
+// Writes each candidate's position, unit normal (TSDF gradient) and thinning score at offsets[i].
 template <class Exec, class Acc>
 void scene_particle_emit(const Exec& ex, Acc a, View<const int3> blocks, float spacing, float interior_depth,
-                         View<const std::int32_t> offsets, View<vec3> positions, View<vec3> normals);
+                         View<const std::int32_t> offsets, View<vec3> positions, View<vec3> normals,
+                         View<float> scores);
+// keep[i] = 0 for a candidate within min_distance of one that outranks it (higher score first),
+// else 1; keys and order are scratch (one per candidate). Returns how many are kept and turns keep
+// into offsets for scene_particle_compact, which copies the kept ones to out (kept of them).
+template <class Exec>
+std::int64_t scene_particle_thin(const Exec& ex, View<const vec3> positions, View<const float> scores,
+                                 float min_distance, View<std::uint64_t> keys, View<std::int32_t> order,
+                                 View<std::int32_t> keep);
+template <class Exec>
+void scene_particle_compact(const Exec& ex, View<const std::int32_t> offsets, std::int64_t kept,
+                            View<const vec3> positions, View<const vec3> normals, View<vec3> out_positions,
+                            View<vec3> out_normals);
 
 // Samples the SDF (sample_sdf) on a regular grid, x fastest: out[(z * dims.y + y) * dims.x + x] at
 // origin + voxel * (x, y, z). Unknown points (unobserved or outside the band) get `unknown`.

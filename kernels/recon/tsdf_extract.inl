@@ -111,58 +111,254 @@ void mesh_emit(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t
   });
 }
 
-// Lattice point of candidate i, or false when it falls outside its block (blocks own the lattice
-// points p with floor((p - origin) / (8 s)) == b; the same float expression decides for both
-// neighbours, so no point is taken twice or lost at a seam).
+// ---- scene particles ---------------------------------------------------------------------------
+// Why not the lattice points themselves: a lattice point is at most half a spacing from a surface
+// only in the lucky case. A surface between two lattice planes (the demo's desk top, y = -0.62
+// between -0.60 and -0.64 at 4 cm) is s/2 from both, and the fused TSDF there is the projective
+// distance, which a camera looking at the desk top from 20 degrees above its plane stretches by
+// 1 / sin(20 deg) ~ 3 (KinectFusion's TSDF is the distance along the ray, Newcombe 2011 eq. 6), so
+// both lattice points read about 1.5 s and neither was taken: the top had holes, and fluid leaked.
+// So surface particles are put ON the fused surface instead: each lattice line (a row of lattice
+// points along one axis) is searched for the zero crossings of the TSDF, and a crossing becomes a
+// particle when the surface there faces along that axis (its normal's dominant component). The
+// crossings along the normal's axis sit one per lattice column, so a surface gets about one
+// particle per spacing^2 whatever its height, and they form a grid of at most s x s*sqrt(2) cells
+// (s * |n| / |n_axis| with |n_axis| >= |n| / sqrt(3)): every hole has a circumradius below one
+// spacing, so a particle of diameter s cannot pass. Near-duplicates (edges, where two axes meet)
+// are thinned afterwards (scene_particle_thin).
+
+// Integer lattice coordinates of candidate i, or false when it falls outside its block (blocks own
+// the lattice points p with floor((p - origin) / (8 s)) == b; the same float expression decides
+// for both neighbours, so no point is taken twice or lost at a seam).
 template <class Acc>
-SEAMLESS_HD inline bool lattice_point(const Acc& a, View<const int3> blocks, float spacing, std::int64_t i, vec3* p) {
+SEAMLESS_HD inline bool lattice_coords(const Acc& a, View<const int3> blocks, float spacing, std::int64_t i, int3* L) {
   const int m = lattice_per_block(a.geom.voxel_size, spacing);
   const std::int64_t m3 = static_cast<std::int64_t>(m) * m * m;
   int3 b = blocks[i / m3];
   int j = static_cast<int>(i % m3);
-  int l[3] = {j % m, (j / m) % m, j / (m * m)}, bb[3] = {b.x, b.y, b.z};
-  float o[3] = {a.geom.origin.x, a.geom.origin.y, a.geom.origin.z}, r[3];
+  int l[3] = {j % m, (j / m) % m, j / (m * m)}, bb[3] = {b.x, b.y, b.z}, r[3];
+  float o[3] = {a.geom.origin.x, a.geom.origin.y, a.geom.origin.z};
   const float block = kBlockSide * a.geom.voxel_size;
   for (int k = 0; k < 3; ++k) {
     float lo = o[k] + bb[k] * block, hi = lo + block;
     int first = static_cast<int>(ceilf(lo / spacing)), end = static_cast<int>(ceilf(hi / spacing));
     if (first + l[k] >= end) return false;
-    r[k] = (first + l[k]) * spacing;
+    r[k] = first + l[k];
   }
-  *p = {r[0], r[1], r[2]};
+  *L = {r[0], r[1], r[2]};
   return true;
 }
 
+// Steps per spacing when a lattice line is searched: samples at most one voxel apart, so that two
+// consecutive samples bracket a crossing within the band where the TSDF is not truncated.
+// (The 1e-4 keeps a spacing of exactly k voxels, give or take float rounding, at k steps.)
+SEAMLESS_HD inline int line_steps(float voxel_size, float spacing) {
+  int n = static_cast<int>(ceilf(spacing / voxel_size - 1e-4f));
+  return n > 1 ? n : 1;
+}
+
+// World position of sample j (0..n) on the line from lattice point L along `axis`. The coordinate is
+// (L n + j) * (s / n) on every axis, so sample n of L and sample 0 of its neighbour are the same
+// float: a crossing at a lattice point is found once, by the segment that ends there.
+SEAMLESS_HD inline vec3 line_sample(int3 L, int axis, int j, int n, float spacing) {
+  const float h = spacing / static_cast<float>(n);
+  int c[3] = {L.x * n, L.y * n, L.z * n};
+  c[axis] += j;
+  return {static_cast<float>(c[0]) * h, static_cast<float>(c[1]) * h, static_cast<float>(c[2]) * h};
+}
+
+// TSDF at world point p for the crossing search: false where unknown, and where truncated (a sign
+// change between +mu and -mu is the seam behind a surface, not a surface; as mc_cube).
 template <class Acc>
-SEAMLESS_HD inline bool is_scene_particle(const Acc& a, vec3 p, float spacing, float interior_depth, float* sdf) {
+SEAMLESS_HD inline bool band_sdf(const Acc& a, vec3 p, BlockCache& c, float* v) {
+  return sample_tsdf(a, a.geom.to_voxel(p), c, v) && fabsf(*v) < 0.999f * a.geom.truncation;
+}
+
+// Zero of the TSDF between p0 (value v0) and p1 (v1) of opposite signs: regula falsi. Along an axis
+// the trilinear field is linear inside a cell; a segment of at most one voxel crosses at most one
+// cell face, so two steps reach the zero of the piecewise-linear field to float rounding.
+template <class Acc>
+SEAMLESS_HD inline vec3 line_zero(const Acc& a, vec3 p0, float v0, vec3 p1, float v1, BlockCache& c) {
+  vec3 x = p0;
+  for (int it = 0; it < 3; ++it) {
+    x = p0 + (p1 - p0) * (v0 / (v0 - v1));
+    float vx;
+    if (it == 2 || !band_sdf(a, x, c, &vx) || vx == 0.f) break;
+    if ((vx < 0.f) == (v0 < 0.f)) p0 = x, v0 = vx;
+    else p1 = x, v1 = vx;
+  }
+  return x;
+}
+
+// A crossing on a line along `axis` becomes a particle when the surface faces along that axis: the
+// gradient's component there is at least kAxisShare of its largest one. 1 would be the dominant
+// axis alone; a little less keeps a surface at 45 degrees from being dropped by both axes when
+// float noise decides the tie (the thinning removes the pairs this creates).
+constexpr float kAxisShare = 0.8f;
+
+// Where candidates go (already offset to the first slot of this lattice point); null: count only.
+// score = |n_axis|, how squarely the searched line meets the surface: the thinning keeps the higher.
+struct CandidateOut {
+  vec3* position;
+  vec3* normal;
+  float* score;
+};
+
+// The surface particles owned by lattice point L: crossings on the three segments L -> L + e_axis.
+// Writes them to out (unless out.position is null); returns how many there are.
+template <class Acc>
+SEAMLESS_HD inline int surface_crossings(const Acc& a, int3 L, float spacing, CandidateOut out) {
+  const int n = line_steps(a.geom.voxel_size, spacing);
   BlockCache c;
-  if (!sample_tsdf(a, a.geom.to_voxel(p), c, sdf)) return false;
-  return *sdf <= 0.5f * spacing && *sdf >= -fmaxf(interior_depth, 0.5f * spacing);
+  int found = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    vec3 p0 = line_sample(L, axis, 0, n, spacing);
+    float v0 = 0.f;
+    bool ok0 = band_sdf(a, p0, c, &v0);
+    for (int j = 1; j <= n; ++j) {
+      vec3 p1 = line_sample(L, axis, j, n, spacing);
+      float v1 = 0.f;
+      bool ok1 = band_sdf(a, p1, c, &v1);
+      if (ok0 && ok1 && (v0 < 0.f) != (v1 < 0.f)) {
+        vec3 x = line_zero(a, p0, v0, p1, v1, c);
+        float vx = 0.f;
+        sample_tsdf(a, a.geom.to_voxel(x), c, &vx);
+        vec3 g = tsdf_gradient(a, a.geom.to_voxel(x), vx, c);
+        float ga[3] = {fabsf(g.x), fabsf(g.y), fabsf(g.z)}, gl = length(g);
+        float gmax = fmaxf(ga[0], fmaxf(ga[1], ga[2]));
+        if (gl > 0.f && ga[axis] >= kAxisShare * gmax) {
+          if (out.position)
+            out.position[found] = x, out.normal[found] = g / gl, out.score[found] = ga[axis] / gl;
+          ++found;
+        }
+      }
+      p0 = p1, v0 = v1, ok0 = ok1;
+    }
+  }
+  return found;
+}
+
+// The optional solid fill stays on the lattice: a lattice point at least s/2 below the fused surface
+// (so at least s/2 from the surface particles where the TSDF is the true distance, and farther where
+// it is a stretched projective one) down to interior_depth, as far as the truncated TSDF knows it.
+template <class Acc>
+SEAMLESS_HD inline bool interior_point(const Acc& a, int3 L, float spacing, float interior_depth, vec3* p,
+                                       vec3* normal) {
+  if (!(interior_depth > 0.f)) return false;
+  *p = line_sample(L, 0, 0, 1, spacing);
+  float v;
+  vec3 g{0.f, 0.f, 0.f};
+  if (!sample_sdf(a, *p, &v, &g) || v > -0.5f * spacing || v < -interior_depth) return false;
+  *normal = length(g) > 0.f ? normalize(g) : vec3{0.f, 0.f, 0.f};
+  return true;
 }
 
 template <class Exec, class Acc>
 std::int64_t scene_particle_count(const Exec& ex, Acc a, View<const int3> blocks, float spacing, float interior_depth,
-                                  View<std::int32_t> flags) {
-  const std::int64_t n = flags.size;
-  ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) {
-    vec3 p;
-    float s;
-    flags[i] = lattice_point(a, blocks, spacing, i, &p) && is_scene_particle(a, p, spacing, interior_depth, &s);
+                                  View<std::int32_t> counts) {
+  ex.for_each(counts.size, [=] SEAMLESS_HD(std::int64_t i) {
+    int3 L;
+    vec3 p, nrm;
+    int k = 0;
+    if (lattice_coords(a, blocks, spacing, i, &L))
+      k = surface_crossings(a, L, spacing, CandidateOut{nullptr, nullptr, nullptr}) + (interior_point(a, L, spacing, interior_depth, &p, &nrm) ? 1 : 0);
+    counts[i] = k;
   });
-  return ex.exclusive_scan(flags.data, flags.data, n);
+  return ex.exclusive_scan(counts.data, counts.data, counts.size);
 }
 
 template <class Exec, class Acc>
 void scene_particle_emit(const Exec& ex, Acc a, View<const int3> blocks, float spacing, float interior_depth,
-                         View<const std::int32_t> offsets, View<vec3> positions, View<vec3> normals) {
+                         View<const std::int32_t> offsets, View<vec3> positions, View<vec3> normals,
+                         View<float> scores) {
   ex.for_each(offsets.size, [=] SEAMLESS_HD(std::int64_t i) {
-    vec3 p;
-    float s;
-    if (!lattice_point(a, blocks, spacing, i, &p) || !is_scene_particle(a, p, spacing, interior_depth, &s)) return;
-    vec3 g{0.f, 0.f, 0.f};
-    sample_sdf(a, p, &s, &g);
-    positions[offsets[i]] = p;
-    normals[offsets[i]] = normalize(g);
+    int3 L;
+    if (!lattice_coords(a, blocks, spacing, i, &L)) return;
+    const std::int64_t first = offsets[i];
+    const std::int64_t k = surface_crossings(
+        a, L, spacing, CandidateOut{positions.data + first, normals.data + first, scores.data + first});
+    vec3 p, nrm;
+    if (interior_point(a, L, spacing, interior_depth, &p, &nrm))
+      positions[first + k] = p, normals[first + k] = nrm, scores[first + k] = 0.f;  // surface ones win thinning
+  });
+}
+
+// ---- thinning: no two scene particles closer than min_distance ----------------------------------
+// Where two lines meet one surface patch (box edges and corners, concave seams, the 45-degree ties
+// of kAxisShare) their crossings can nearly coincide. Each candidate looks at the candidates within
+// min_distance (cells of that side, the 27 around its own, found by binary search in the sorted
+// cell keys) and is dropped when one of them outranks it. Of every close pair the lower one goes,
+// so no close pair survives; a dropped candidate is within min_distance of one that outranks it,
+// which in turn is kept or within min_distance of a higher one, and so on up a chain that ends.
+
+// Cell of p on a grid of side r, packed 21 bits a coordinate (+-2^20 cells: +-1 km at 1 mm cells).
+SEAMLESS_HD inline std::uint64_t thin_cell_key(int3 c) {
+  const std::uint64_t m = (1ull << 21) - 1ull, bias = 1ull << 20;
+  return (((std::uint64_t(c.x) + bias) & m) << 42) | (((std::uint64_t(c.y) + bias) & m) << 21) |
+         ((std::uint64_t(c.z) + bias) & m);
+}
+
+// First index in the sorted keys[0, n) whose key is not less than k.
+SEAMLESS_HD inline std::int64_t lower_bound_key(const std::uint64_t* keys, std::int64_t n, std::uint64_t k) {
+  std::int64_t lo = 0, hi = n;
+  while (lo < hi) {
+    std::int64_t mid = lo + (hi - lo) / 2;
+    if (keys[mid] < k) lo = mid + 1;
+    else hi = mid;
+  }
+  return lo;
+}
+
+// Whether candidate j outranks candidate i: the higher score, then the lexicographically smaller
+// position, then the smaller index. A strict total order that does not depend on the candidates'
+// order (which follows the hash table's slots) except for exact duplicates.
+SEAMLESS_HD inline bool outranks(vec3 pj, float sj, std::int64_t j, vec3 pi, float si, std::int64_t i) {
+  if (sj != si) return sj > si;
+  if (pj.x != pi.x) return pj.x < pi.x;
+  if (pj.y != pi.y) return pj.y < pi.y;
+  if (pj.z != pi.z) return pj.z < pi.z;
+  return j < i;
+}
+
+template <class Exec>
+std::int64_t scene_particle_thin(const Exec& ex, View<const vec3> positions, View<const float> scores,
+                                 float min_distance, View<std::uint64_t> keys, View<std::int32_t> order,
+                                 View<std::int32_t> keep) {
+  const std::int64_t n = positions.size;
+  const float r = min_distance;
+  ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) {
+    keys[i] = thin_cell_key(floor_to_int(positions[i] / r));
+    order[i] = static_cast<std::int32_t>(i);
+  });
+  ex.sort_by_key(keys.data, order.data, n, 63);
+  ex.for_each(n, [=] SEAMLESS_HD(std::int64_t k) {
+    const std::int64_t i = order[k];
+    const vec3 p = positions[i];
+    const int3 c = floor_to_int(p / r);
+    bool drop = false;
+    for (int d = 0; d < 27 && !drop; ++d) {
+      const std::uint64_t key = thin_cell_key(c + int3{d % 3 - 1, (d / 3) % 3 - 1, d / 9 - 1});
+      for (std::int64_t m = lower_bound_key(keys.data, n, key); m < n && keys[m] == key && !drop; ++m) {
+        const std::int64_t j = order[m];
+        const vec3 q = positions[j];
+        drop = j != i && dot(q - p, q - p) < r * r && outranks(q, scores[j], j, p, scores[i], i);
+      }
+    }
+    keep[i] = drop ? 0 : 1;
+  });
+  return ex.exclusive_scan(keep.data, keep.data, n);
+}
+
+template <class Exec>
+void scene_particle_compact(const Exec& ex, View<const std::int32_t> offsets, std::int64_t kept,
+                            View<const vec3> positions, View<const vec3> normals, View<vec3> out_positions,
+                            View<vec3> out_normals) {
+  const std::int64_t n = offsets.size;
+  ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) {
+    const std::int64_t next = i + 1 < n ? offsets[i + 1] : kept;
+    if (next == offsets[i]) return;
+    out_positions[offsets[i]] = positions[i];
+    out_normals[offsets[i]] = normals[i];
   });
 }
 
@@ -194,7 +390,7 @@ void slot_block_coords(const Exec& ex, HashTableView t, View<const std::int32_t>
   template std::int64_t scene_particle_count<EXEC, ACC>(const EXEC&, ACC, View<const int3>, float, float,         \
                                                         View<std::int32_t>);                                      \
   template void scene_particle_emit<EXEC, ACC>(const EXEC&, ACC, View<const int3>, float, float,                  \
-                                               View<const std::int32_t>, View<vec3>, View<vec3>);                 \
+                                               View<const std::int32_t>, View<vec3>, View<vec3>, View<float>);    \
   template void sample_sdf_grid<EXEC, ACC>(const EXEC&, ACC, vec3, int3, float, float, View<float>);              \
   }
 #define SEAMLESS_INSTANTIATE_TSDF_EXTRACT(EXEC)                                                                   \
@@ -202,4 +398,8 @@ void slot_block_coords(const Exec& ex, HashTableView t, View<const std::int32_t>
   SEAMLESS_INSTANTIATE_TSDF_EXTRACT_ACC(EXEC, DenseAccess)                                                        \
   namespace seamless::kernels {                                                                                   \
   template void slot_block_coords<EXEC>(const EXEC&, HashTableView, View<const std::int32_t>, View<int3>);        \
+  template std::int64_t scene_particle_thin<EXEC>(const EXEC&, View<const vec3>, View<const float>, float,         \
+                                                  View<std::uint64_t>, View<std::int32_t>, View<std::int32_t>);    \
+  template void scene_particle_compact<EXEC>(const EXEC&, View<const std::int32_t>, std::int64_t,                 \
+                                             View<const vec3>, View<const vec3>, View<vec3>, View<vec3>);         \
   }

@@ -11,19 +11,37 @@
 
 namespace seamless {
 
+namespace {
+
+// Candidates before thinning: position, normal, score (kernels::scene_particle_emit).
+struct Candidates {
+  Buffer<vec3> positions, normals;
+  Buffer<float> scores;
+  std::int64_t count = 0;
+};
+
+// Concatenates per-chunk buffers into one of `total` elements on device d.
+template <class T>
+Buffer<T> concat(std::vector<Buffer<T>>& parts, std::int64_t total, Device d) {
+  Buffer<T> out(total, d);
+  std::int64_t at = 0;
+  for (auto& b : parts) {
+    memory::copy(out.data() + at, d, b.data(), d, b.bytes());
+    at += b.size();
+  }
+  return out;
+}
+
+// The candidates of all blocks, a chunk of blocks at a time (bounds the per-lattice-point scratch).
 template <class Acc>
-SceneParticles extract_scene_particles(Device d, const Acc& a, const Buffer<int3>& blocks, std::int64_t block_count,
-                                       const SceneParticleParams& p) {
-  if (!(p.spacing > 0.f)) throw Error("scene particles: spacing must be positive");
-  if (p.interior_depth > a.geom.truncation)
-    spdlog::warn("scene particles: interior_depth {} m is deeper than the TSDF truncation {} m; the fill stops at the "
-                 "truncation (raise volume.truncation to fill deeper)",
-                 p.interior_depth, a.geom.truncation);
+Candidates candidates(Device d, const Acc& a, const Buffer<int3>& blocks, std::int64_t block_count,
+                      const SceneParticleParams& p) {
   const int m = kernels::lattice_per_block(a.geom.voxel_size, p.spacing);
   const std::int64_t per_block = static_cast<std::int64_t>(m) * m * m;
-  const std::int64_t chunk = std::max<std::int64_t>(1, (std::int64_t(1) << 22) / per_block);  // bounds scratch
-  std::vector<std::pair<Buffer<vec3>, Buffer<vec3>>> parts;
-  SceneParticles out;
+  const std::int64_t chunk = std::max<std::int64_t>(1, (std::int64_t(1) << 22) / per_block);
+  std::vector<Buffer<vec3>> pos_parts, nrm_parts;
+  std::vector<Buffer<float>> score_parts;
+  Candidates c;
   for (std::int64_t first = 0; first < block_count; first += chunk) {
     std::int64_t nb = std::min(chunk, block_count - first);
     View<const int3> part{blocks.data() + first, nb};
@@ -33,21 +51,50 @@ SceneParticles extract_scene_particles(Device d, const Acc& a, const Buffer<int3
     });
     if (n == 0) continue;
     Buffer<vec3> pos(n, d), nrm(n, d);
+    Buffer<float> score(n, d);
     with_exec(d, [&](const auto& ex) {
-      kernels::scene_particle_emit(ex, a, part, p.spacing, p.interior_depth, offsets.cview(), pos.view(), nrm.view());
+      kernels::scene_particle_emit(ex, a, part, p.spacing, p.interior_depth, offsets.cview(), pos.view(), nrm.view(),
+                                   score.view());
     });
-    out.count += n;
-    parts.emplace_back(std::move(pos), std::move(nrm));
+    c.count += n;
+    pos_parts.push_back(std::move(pos)), nrm_parts.push_back(std::move(nrm)), score_parts.push_back(std::move(score));
   }
+  c.positions = concat(pos_parts, c.count, d);
+  c.normals = concat(nrm_parts, c.count, d);
+  c.scores = concat(score_parts, c.count, d);
+  return c;
+}
+
+// Drops every candidate closer than min_distance to one that outranks it (kernels::scene_particle_thin).
+SceneParticles thin(Device d, const Candidates& c, float min_distance) {
+  SceneParticles out;
+  if (c.count == 0) return out;
+  Buffer<std::uint64_t> keys(c.count, d);
+  Buffer<std::int32_t> order(c.count, d), keep(c.count, d);
+  with_exec(d, [&](const auto& ex) {
+    out.count = kernels::scene_particle_thin(ex, c.positions.cview(), c.scores.cview(), min_distance, keys.view(),
+                                             order.view(), keep.view());
+  });
   out.positions = Buffer<vec3>(out.count, d);
   out.normals = Buffer<vec3>(out.count, d);
-  std::int64_t at = 0;
-  for (auto& [pos, nrm] : parts) {
-    memory::copy(out.positions.data() + at, d, pos.data(), d, pos.bytes());
-    memory::copy(out.normals.data() + at, d, nrm.data(), d, nrm.bytes());
-    at += pos.size();
-  }
+  with_exec(d, [&](const auto& ex) {
+    kernels::scene_particle_compact(ex, keep.cview(), out.count, c.positions.cview(), c.normals.cview(),
+                                    out.positions.view(), out.normals.view());
+  });
   return out;
+}
+
+}  // namespace
+
+template <class Acc>
+SceneParticles extract_scene_particles(Device d, const Acc& a, const Buffer<int3>& blocks, std::int64_t block_count,
+                                       const SceneParticleParams& p) {
+  if (!(p.spacing > 0.f)) throw Error("scene particles: spacing must be positive");
+  if (p.interior_depth > a.geom.truncation)
+    spdlog::warn("scene particles: interior_depth {} m is deeper than the TSDF truncation {} m; the fill stops at the "
+                 "truncation (raise volume.truncation to fill deeper)",
+                 p.interior_depth, a.geom.truncation);
+  return thin(d, candidates(d, a, blocks, block_count, p), kSceneParticleMinDistance * p.spacing);
 }
 
 template SceneParticles extract_scene_particles<kernels::HashAccess>(Device, const kernels::HashAccess&,

@@ -19,9 +19,16 @@ struct SceneParticleParams {
   }
 };
 
-// Particles on the lattice spacing * Z^3 whose TSDF is in [-max(interior_depth, spacing/2),
-// spacing/2], so each lies within half a spacing of the fused surface; normals are the unit TSDF
-// gradient. Both buffers live on the volume's device.
+// Surface particles ON the fused surface (zeros of the TSDF on the lattice lines spacing * Z^2
+// along the axis the surface faces: about one per spacing^2 of surface, at any height between
+// lattice planes), plus, with interior_depth > 0, the lattice points of the solid from spacing/2
+// down to interior_depth below it. No two are closer than kSceneParticleMinDistance spacings.
+// Normals are the unit TSDF gradient. Both buffers live on the volume's device.
+// (kernels/recon/tsdf_extract.inl explains the choice; docs/RECONSTRUCTION.md.)
+// Below half a spacing a second particle adds nothing a solver particle (diameter = spacing)
+// could feel as a separate contact; the thinning drops the lower-ranked of such pairs.
+constexpr float kSceneParticleMinDistance = 0.5f;
+
 struct SceneParticles {
   Buffer<vec3> positions;
   Buffer<vec3> normals;

@@ -1,8 +1,14 @@
-// Scene particles and the SDF sampler against an analytic scene (a box in front of a wall).
+// Scene particles and the SDF sampler against analytic scenes: a box in front of a wall, and the
+// synthetic room fused from exact depth at ground-truth poses.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <vector>
 
+#include "io/synthetic_source.hpp"
+#include "kernels/io/synthetic_room.hpp"
 #include "kernels/recon/voxel_hash.hpp"
 #include "recon/voxel_hash_volume.hpp"
 #include "tsdf_scene.hpp"
@@ -46,22 +52,27 @@ TEST(TsdfParticles, LieOnTheSurfaceWithinHalfASpacing) {
   int front = 0;
   for (std::int64_t i = 0; i < sp.count; ++i) {
     vec3 p = pos[i];
-    // Selection is |TSDF| <= s/2. The TSDF equals the true distance in front of the box's and the
-    // wall's faces (fronto-parallel, seen head-on by translated cameras); beside the box's
-    // edges it is the projective distance, which is never smaller than the true one in front of a
-    // surface, so selection only gets stricter there. Float rounding: 1e-5.
+    // A particle is a zero of the trilinear TSDF. In front of the faces seen head-on (the box
+    // front, the wall) the TSDF is the true distance, linear across a cell, so its zero is the face
+    // itself (float rounding 1e-5). Elsewhere (beside the box's edges) a zero lies in a cell whose
+    // corners have both signs, and exact depth and poses give every fused voxel the sign of its
+    // side, so the surface crosses that cell too; those cells border the front face here, whose
+    // zero is exact, and the seam rule drops crossings next to truncated values (the sides).
     EXPECT_LE(std::fabs(s.sdf(p)), 0.5f * pp.spacing + 1e-5f) << p.x << " " << p.y << " " << p.z;
     EXPECT_NEAR(length(nrm[i]), 1.f, 1e-4f);
-    // Particles on the lattice spacing * Z^3.
-    EXPECT_NEAR(p.x / pp.spacing, std::round(p.x / pp.spacing), 1e-3f);
+    // Particles sit on lattice lines: two of their coordinates are multiples of the spacing.
+    float c[3] = {p.x, p.y, p.z};
+    int on_lattice = 0;
+    for (float v : c) on_lattice += std::fabs(v / pp.spacing - std::round(v / pp.spacing)) < 1e-3f ? 1 : 0;
+    EXPECT_GE(on_lattice, 2) << p.x << " " << p.y << " " << p.z;
     if (std::fabs(p.z - s.box_lo.z) < 0.011f && std::fabs(p.x) < 0.17f && std::fabs(p.y) < 0.07f) {
       ++front;
       EXPECT_GT(-nrm[i].z, 0.99f);  // the front face looks at the camera
+      EXPECT_NEAR(p.z, s.box_lo.z, 1e-4f);  // on the face: the head-on TSDF is exact (rounding)
     }
   }
-  // The box front (0.4 x 0.2 m) holds one lattice layer within s/2 of z = 1.0 (the lattice
-  // planes z = 0.98 and 1.02 are a full spacing away): the part of it counted above has
-  // x in {-0.16, ..., 0.16} and y in {-0.06, ..., 0.06}: 17 * 7 points, none missing.
+  // One particle per lattice column through the box front (0.4 x 0.2 m): the part counted above
+  // has x in {-0.16, ..., 0.16} and y in {-0.06, ..., 0.06}: 17 * 7 columns, none missing.
   EXPECT_EQ(front, 17 * 7);
 }
 
@@ -142,6 +153,218 @@ TEST(TsdfSamplerParity, GridOnCpuAndCudaAgree) {
   std::vector<float> ga = a.sample_sdf_grid(origin, dims, 0.02f), gb = b.sample_sdf_grid(origin, dims, 0.02f);
   ASSERT_EQ(ga.size(), gb.size());
   for (std::size_t i = 0; i < ga.size(); ++i) ASSERT_NEAR(ga[i], gb[i], 1e-5f) << i;
+}
+
+// ---- the synthetic room (issue #4 / #8: surfaces between lattice planes) -------------------------
+
+namespace R = kernels::room;
+
+constexpr float kRoomSpacing = 0.04f;  // the demo's particle diameter
+// The room's world shifted down 1 cm: the desk top (z = 0.75) comes to z = 0.74, halfway between
+// the lattice planes 0.72 and 0.76 at 4 cm, as in the demo's tracker world (y = -0.62 between
+// -0.60 and -0.64), where the lattice points missed it. The back wall (y = 2.5) is halfway between
+// 2.48 and 2.52 as it is.
+const vec3 kShift{0.f, 0.f, -0.01f};
+constexpr float kDeskTop = R::kDeskTopZ - 0.01f;
+constexpr float kBackWall = 2.5f;
+constexpr int kRoomFrames = 16;  // every 2nd frame of a noise-free second of orbit (15 degrees)
+
+SE3 shifted(SE3 T) { return {T.R, T.t + kShift}; }
+float room_sdf(vec3 p) { return R::room_sdf(p - kShift); }
+
+// The demo's volume (1 cm voxels, 4 cm truncation) fused from exact depth at ground-truth poses.
+VoxelHashVolume fuse_room(Device d, std::vector<SE3>* poses = nullptr) {
+  InputParams in;
+  in.source = "synthetic";
+  in.synthetic.noise = false;
+  in.synthetic.frames = 2 * kRoomFrames;
+  SyntheticSource src(in);
+  VolumeParams p = test::small_volume_params();
+  p.truncation = 0.04f;
+  p.max_depth = 4.f;
+  p.hash_buckets = 1 << 16;
+  p.capacity = 1 << 15;
+  VoxelHashVolume vol(p, d);
+  RgbdFrame f;
+  for (int k = 0; src.next(f); ++k) {
+    if (k % 2) continue;
+    SE3 T = shifted(*f.ground_truth);
+    if (poses) poses->push_back(T);
+    Image<float> depth = Image<float>::from_host(f.depth.to_host(), f.depth.width(), f.depth.height(), d);
+    vol.integrate(depth, Image<uchar3>{}, f.intrinsics, T);
+  }
+  return vol;
+}
+
+// One CPU scan shared by the room tests (fusing costs a few seconds).
+struct RoomScan {
+  std::vector<SE3> poses;
+  Intrinsics K;
+  VoxelHashVolume vol;
+  std::vector<vec3> particles, normals;
+  RoomScan() : K(SyntheticSource(InputParams{}).intrinsics()), vol(fuse_room(Device::CPU, &poses)) {
+    SceneParticleParams pp;
+    pp.spacing = kRoomSpacing;
+    SceneParticles sp = vol.extract_scene_particles(pp);
+    particles = sp.positions.to_host(), normals = sp.normals.to_host();
+  }
+};
+const RoomScan& room_scan() {
+  static RoomScan scan;
+  return scan;
+}
+
+// Whether every fused view saw world point q (shifted world): in front of the camera, inside the
+// image with a 2-pixel margin, and the first surface on the ray from the camera (the exact room).
+bool seen_by_all(const RoomScan& r, vec3 q) {
+  for (const SE3& T : r.poses) {
+    vec3 c = transpose(T.R) * (q - T.t);
+    if (c.z <= 0.f) return false;
+    vec2 uv = r.K.project(c);
+    if (uv.x < 2.f || uv.y < 2.f || uv.x > r.K.width - 3.f || uv.y > r.K.height - 3.f) return false;
+    vec3 o = T.t - kShift, d = normalize(q - T.t);
+    R::Hit h = R::room_raycast(o, d);
+    if (h.t < length(q - T.t) - 1e-3f) return false;
+  }
+  return true;
+}
+
+// Columns (lattice lines along `axis`) through a planar patch at `level` on that axis, whose
+// lattice coordinates on the other two axes are in [lo, hi]; a column counts when the patch point
+// is seen by every view and at least two spacings from any other surface (objects standing on it,
+// its edges), where the patch is the nearest surface. Each must have a particle within one
+// spacing of the column, across it, and within half a spacing of the patch along it.
+//   half a spacing: a particle is a zero of the trilinear TSDF, in a cell whose corners have both
+//     signs; exact depth and poses give each fused voxel the sign of its side, so the patch crosses
+//     that cell, and the particle is within a cell diagonal (sqrt(3) cm = 0.017 m) of it: < s/2.
+//   one spacing: the hole the issue is about is a column without any particle; a particle of
+//     diameter s passes a hole only when the hole's circumradius reaches s.
+// `side` (+1 or -1) is the direction of free space along the axis.
+int holes(const RoomScan& r, int axis, float side, float level, vec2 lo, vec2 hi, int* columns) {
+  const float s = kRoomSpacing;
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  int missing = 0;
+  *columns = 0;
+  for (int i = static_cast<int>(std::ceil(lo.x / s - 1e-4f)); i * s <= hi.x + 1e-4f; ++i)
+    for (int j = static_cast<int>(std::ceil(lo.y / s - 1e-4f)); j * s <= hi.y + 1e-4f; ++j) {
+      float q3[3];
+      q3[axis] = level, q3[u] = i * s, q3[v] = j * s;
+      vec3 q{q3[0], q3[1], q3[2]};
+      vec3 off{0.f, 0.f, 0.f};
+      (axis == 0 ? off.x : axis == 1 ? off.y : off.z) = 2.f * s * side;  // probe in front of the patch
+      bool clear = true;
+      for (float t : {0.5f, 1.f})  // the patch is the nearest surface up to 2 s in front of it
+        clear = clear && std::fabs(room_sdf(q + off * t) - 2.f * s * t) < 1e-4f;
+      for (int k = 0; k < 8 && clear; ++k) {  // and 2 s around it (no edge, nothing standing on it)
+        float a = 6.2831853f * k / 8.f;
+        float w3[3];
+        w3[axis] = level + 0.25f * s * side, w3[u] = q3[u] + 2.f * s * std::cos(a), w3[v] = q3[v] + 2.f * s * std::sin(a);
+        clear = std::fabs(room_sdf({w3[0], w3[1], w3[2]}) - 0.25f * s) < 1e-4f;
+      }
+      if (!clear || !seen_by_all(r, q)) continue;
+      ++*columns;
+      bool found = false;
+      for (vec3 p : r.particles) {
+        float p3[3] = {p.x, p.y, p.z};
+        float du = p3[u] - q3[u], dv = p3[v] - q3[v];
+        if (du * du + dv * dv <= s * s && std::fabs(p3[axis] - level) <= 0.5f * s) {
+          found = true;
+          break;
+        }
+      }
+      if (!found) {
+        ++missing;
+        ADD_FAILURE() << "hole at " << q.x << " " << q.y << " " << q.z;
+      }
+    }
+  return missing;
+}
+
+TEST(TsdfParticlesRoom, DeskTopBetweenLatticePlanesHasNoHole) {
+  const RoomScan& r = room_scan();
+  int columns = 0;
+  // The desk top spans x in [-0.7, 0.7], y in [0.25, 0.95]; columns 2 spacings inside its edges.
+  EXPECT_EQ(holes(r, 2, 1.f, kDeskTop, {-0.7f + 0.08f, 0.25f + 0.08f}, {0.7f - 0.08f, 0.95f - 0.08f}, &columns), 0);
+  // Not vacuous: at least a quarter of the 31 x 14 columns (the objects with their margins and the
+  // shadows behind them, never seen by all views, leave out the rest).
+  EXPECT_GE(columns, 31 * 14 / 4);
+  std::printf("desk top: %d columns checked\n", columns);
+}
+
+TEST(TsdfParticlesRoom, BackWallBetweenLatticePlanesHasNoHole) {
+  const RoomScan& r = room_scan();
+  int columns = 0;
+  // A 1.2 x 0.8 m patch of the back wall above the desk, axis y; lattice coordinates (z, x).
+  EXPECT_EQ(holes(r, 1, -1.f, kBackWall, {1.0f, -0.6f}, {1.8f, 0.6f}, &columns), 0);
+  EXPECT_GE(columns, 21 * 31 / 2);  // not vacuous: of 21 x 31 columns most are seen by every view
+  std::printf("back wall: %d columns checked\n", columns);
+}
+
+// Every particle whose nearest surface point every view saw lies within half a spacing of it: as
+// in holes(), within a cell diagonal (0.017 m). Elsewhere the fused TSDF itself strays: behind
+// silhouette corners (a desk leg's back face, seen by no view) nearest-pixel projection fuses small
+// negative values into free space, and the TSDF (its mesh too) has a ghost zero there. Those are
+// bounded all the same: a zero needs a negative corner within a cell diagonal, and a negative voxel
+// is at most mu behind the observed surface along a ray, 1.22 mu away at the 35-degree half
+// diagonal field of view: every particle is within 1.22 mu + sqrt(3) voxels of the room.
+TEST(TsdfParticlesRoom, ParticlesLieOnTheRoomWithinHalfASpacingWhereSeen) {
+  const RoomScan& r = room_scan();
+  ASSERT_GT(r.particles.size(), 1000u);
+  const float s = kRoomSpacing, loose = 1.22f * 0.04f + 1.7321f * 0.01f;
+  int far = 0, seen = 0;
+  for (std::size_t i = 0; i < r.particles.size(); ++i) {
+    const vec3 p = r.particles[i];
+    const float d = room_sdf(p);
+    EXPECT_LE(std::fabs(d), loose) << p.x << " " << p.y << " " << p.z;
+    EXPECT_NEAR(length(r.normals[i]), 1.f, 1e-4f);
+    if (!seen_by_all(r, p - R::room_sdf_grad(p - kShift) * d)) continue;
+    ++seen;
+    if (std::fabs(d) > 0.5f * s && ++far <= 10) ADD_FAILURE() << "particle " << p.x << " " << p.y << " " << p.z << " at " << d;
+  }
+  EXPECT_EQ(far, 0);
+  EXPECT_GT(seen, static_cast<int>(r.particles.size() / 4));  // not vacuous: much of the room was seen by all
+  std::printf("room: %zu particles, %d on surfaces seen by every view\n", r.particles.size(), seen);
+}
+
+// The thinning's promise: no two particles closer than kSceneParticleMinDistance spacings, so that
+// the count stays about one per spacing^2 of surface (sweep over x-sorted particles).
+TEST(TsdfParticlesRoom, NoTwoParticlesCloserThanHalfASpacing) {
+  std::vector<vec3> p = room_scan().particles;
+  std::sort(p.begin(), p.end(), [](vec3 a, vec3 b) { return a.x < b.x; });
+  const float r = kSceneParticleMinDistance * kRoomSpacing;
+  float closest = 1e9f;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    for (std::size_t j = i + 1; j < p.size() && p[j].x - p[i].x < r; ++j) closest = std::min(closest, length(p[j] - p[i]));
+  EXPECT_GE(closest, r * (1.f - 1e-5f));
+}
+
+// Both backends from volumes fused on each: fused values agree to float rounding (TsdfParity), so
+// crossings agree to ~1e-5 m (rounding / gradient ~1); a candidate or a thinning decision flips only
+// when a value sits within that rounding of a threshold (a sign, kAxisShare, the thinning
+// distance), which a few candidates in ten thousand may: up to 0.5% unmatched either way.
+TEST(TsdfParticlesParity, RoomParticlesOnCpuAndCudaAgree) {
+  if (!cuda_available()) GTEST_SKIP() << "no CUDA device";
+  const RoomScan& r = room_scan();
+  VoxelHashVolume b = fuse_room(Device::CUDA);
+  SceneParticleParams pp;
+  pp.spacing = kRoomSpacing;
+  SceneParticles sp = b.extract_scene_particles(pp);
+  std::vector<vec3> pb = sp.positions.to_host();
+  auto unmatched = [](const std::vector<vec3>& x, const std::vector<vec3>& y) {
+    std::vector<vec3> ys = y;
+    std::sort(ys.begin(), ys.end(), [](vec3 a, vec3 c) { return a.x < c.x; });
+    std::size_t n = 0;
+    for (vec3 p : x) {
+      auto it = std::lower_bound(ys.begin(), ys.end(), p.x - 1e-4f, [](vec3 a, float v) { return a.x < v; });
+      bool hit = false;
+      for (; it != ys.end() && it->x <= p.x + 1e-4f && !hit; ++it) hit = length(*it - p) < 1e-4f;
+      n += hit ? 0 : 1;
+    }
+    return n;
+  };
+  const std::size_t allowed = r.particles.size() / 200;
+  EXPECT_LE(unmatched(r.particles, pb), allowed);
+  EXPECT_LE(unmatched(pb, r.particles), allowed);
 }
 
 }  // namespace
