@@ -27,7 +27,9 @@ struct TrackerParams {
   vec3 fixed_gravity{0.f, 1.f, 0.f};      // camera frame (y down), used when gravity: fixed
 
   template <class V> void visit(V& v) {
-    v("kind", kind, "tracker", Choices{"icp", "rgbd", "ground_truth", "opencv_icp", "opencv_rgbd", "pcl_gicp"});
+    v("kind", kind, "tracker; opencv_* and pcl_gicp are external libraries, always frame to frame",
+      Choices{"icp", "rgbd", "ground_truth", "opencv_rgbd_odometry", "opencv_icp", "opencv_rgbd_icp", "opencv_fast_icp",
+              "pcl_gicp"});
     v("mode", mode, "align to the model raycast or to the previous frame",
       Choices{"frame_to_model", "frame_to_frame"});
     v("iterations", iterations, "ICP iterations per pyramid level, finest first", Range{0, 1000});

@@ -3,6 +3,8 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
+#include <optional>
 
 #include "core/error.hpp"
 #include "core/exec.hpp"
@@ -25,25 +27,44 @@ double ms_since(Clock::time_point t0, Device d) {
 
 // ---- registry -----------------------------------------------------------------------------------
 
+namespace {
+// An external tracker's entry: available when its factory was compiled in.
+TrackerInfo external_entry(std::string kind, std::string description, external::OdometryFactory make,
+                           std::string missing) {
+  bool on = static_cast<bool>(make);
+  return {std::move(kind), std::move(description), on, on ? "" : std::move(missing), std::move(make)};
+}
+const char* kOpenCvMissing = "OpenCV's rgbd contrib module is not in this build (apt-get install libopencv-contrib-dev, rebuild)";
+const char* kPclMissing = "PCL is not in this build (apt-get install libpcl-dev, rebuild)";
+}  // namespace
+
 const std::vector<TrackerInfo>& tracker_registry() {
+  using external::OpenCvMethod;
   static const std::vector<TrackerInfo> r = {
-      {"icp", "point-to-plane ICP, projective association, 3-level pyramid (KinectFusion)", true, ""},
-      {"rgbd", "ICP plus a photometric term in one Gauss-Newton solve", true, ""},
-      {"ground_truth", "the source's ground-truth poses (upper bound for fusion and physics)", true, ""},
-      {"opencv_icp", "OpenCV rgbd::ICPOdometry", false,
-       "OpenCV's rgbd contrib module (libopencv-contrib-dev) is not in this build"},
-      {"opencv_rgbd", "OpenCV rgbd::RgbdICPOdometry", false,
-       "OpenCV's rgbd contrib module (libopencv-contrib-dev) is not in this build"},
-      {"pcl_gicp", "PCL generalized ICP, frame to frame", false, "PCL (libpcl-dev) is not in this build"},
+      {"icp", "point-to-plane ICP, projective association, 3-level pyramid (KinectFusion)", true, "", {}},
+      {"rgbd", "ICP plus a photometric term in one Gauss-Newton solve", true, "", {}},
+      {"ground_truth", "the source's ground-truth poses (upper bound for fusion and physics)", true, "", {}},
+      external_entry("opencv_rgbd_odometry", "OpenCV contrib rgbd::RgbdOdometry (photometric), frame to frame",
+                     external::opencv_factory(OpenCvMethod::rgbd), kOpenCvMissing),
+      external_entry("opencv_icp", "OpenCV contrib rgbd::ICPOdometry, frame to frame",
+                     external::opencv_factory(OpenCvMethod::icp), kOpenCvMissing),
+      external_entry("opencv_rgbd_icp", "OpenCV contrib rgbd::RgbdICPOdometry, frame to frame",
+                     external::opencv_factory(OpenCvMethod::rgbd_icp), kOpenCvMissing),
+      external_entry("opencv_fast_icp", "OpenCV contrib rgbd::FastICPOdometry (kinfu's ICP), frame to frame",
+                     external::opencv_factory(OpenCvMethod::fast_icp), kOpenCvMissing),
+      external_entry("pcl_gicp", "PCL generalized ICP on a 2 cm voxel grid, frame to frame", external::pcl_gicp_factory(),
+                     kPclMissing),
   };
   return r;
 }
 
-void require_tracker(const std::string& kind) {
+void require_tracker(const std::string& kind) { (void)tracker_info(kind); }
+
+const TrackerInfo& tracker_info(const std::string& kind) {
   for (const TrackerInfo& t : tracker_registry()) {
     if (t.kind != kind) continue;
     if (!t.available) throw Error("tracker.kind '" + kind + "' is not available in this build: " + t.missing);
-    return;
+    return t;
   }
   std::string known;
   for (const TrackerInfo& t : tracker_registry()) known += (known.empty() ? "" : ", ") + t.kind;
@@ -52,12 +73,35 @@ void require_tracker(const std::string& kind) {
 
 // ---- TrackingSession ----------------------------------------------------------------------------
 
+namespace {
+// A frame the session keeps beyond the source's next() (which may reuse its images).
+RgbdFrame host_copy(const RgbdFrame& f) {
+  RgbdFrame c;
+  c.index = f.index;
+  c.timestamp = f.timestamp;
+  if (f.depth.width() > 0) c.depth = f.depth.clone(Device::CPU);
+  if (f.rgb.width() > 0) c.rgb = f.rgb.clone(Device::CPU);
+  c.intrinsics = f.intrinsics;
+  c.accelerometer = f.accelerometer;
+  c.ground_truth = f.ground_truth;
+  return c;
+}
+}  // namespace
+
 TrackingSession::TrackingSession(const TrackSequenceParams& params, Device device, const Intrinsics& K,
                                  Volume* volume)
     : p_(params), device_(device), K_(K), volume_(volume), pyr_(device, K, params.preprocess.levels) {
-  require_tracker(p_.tracker.kind);
-  if (p_.tracker.kind != "ground_truth") tracker_ = std::make_unique<Tracker>(p_.tracker, device);
-  if (!volume_ && p_.tracker.mode == "frame_to_model" && p_.tracker.kind != "ground_truth") {
+  const TrackerInfo& info = tracker_info(p_.tracker.kind);
+  if (info.make_external) {
+    odometry_ = info.make_external(K, p_.tracker);
+    if (p_.tracker.mode != "frame_to_frame")
+      spdlog::info("tracker.kind {} is frame to frame (tracker.mode {} does not apply)", p_.tracker.kind,
+                   p_.tracker.mode);
+  } else if (p_.tracker.kind != "ground_truth") {
+    tracker_ = std::make_unique<Tracker>(p_.tracker, device);
+  }
+  // Only our own trackers need a model of their own; a volume that is given is fused into by all.
+  if (!volume_ && p_.tracker.mode == "frame_to_model" && tracker_) {
     own_volume_ = make_volume(p_.volume, device);
     volume_ = own_volume_.get();
   }
@@ -98,13 +142,13 @@ void TrackingSession::update_reference(const SE3& pose) {
 }
 
 void TrackingSession::accept(const RgbdFrame& frame, const SE3& pose, FrameRecord& rec) {
-  (void)frame;
   auto t0 = Clock::now();
   if (volume_) {
     volume_->integrate(depth_, rgb_, K_, pose);
     rec.fused = true;
   }
   if (tracker_) update_reference(pose);
+  if (odometry_) last_good_frame_ = host_copy(frame);
   rec.fuse_ms = ms_since(t0, device_);
   prev_good_ = started_ ? last_good_ : pose;
   last_good_ = pose;
@@ -133,6 +177,7 @@ TrackResult TrackingSession::track_frame(const RgbdFrame& frame) {
     }
     return r;  // no ground truth for this frame: reported as no_reference
   }
+  if (odometry_) return track_external(frame);
   // KinectFusion starts from the last pose; a constant-velocity prediction helps fast motion.
   SE3 initial = p_.tracker.constant_velocity ? last_good_ * (prev_good_.inverse() * last_good_) : last_good_;
   r = tracker_->track(pyr_, ref_, initial);
@@ -149,12 +194,48 @@ TrackResult TrackingSession::track_frame(const RgbdFrame& frame) {
   return r;
 }
 
+// The relative pose of an external library, chained onto the last good pose. The prediction is
+// ours (the last motion when tracker.constant_velocity, else none), a failure retries without it
+// like our tracker does, and the same jump test applies; what the library does not report stays
+// NaN or 0 in the statistics.
+TrackResult TrackingSession::track_external(const RgbdFrame& frame) {
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  TrackResult r;
+  r.world_T_camera = last_good_;
+  r.residual_rms = r.inlier_ratio = r.condition = nan;
+  std::optional<SE3> guess;
+  if (p_.tracker.constant_velocity) guess = prev_good_.inverse() * last_good_;
+  std::optional<external::OdometryEstimate> e = odometry_->prev_T_cur(last_good_frame_, frame, guess);
+  if (!e && guess) {
+    guess.reset();
+    e = odometry_->prev_T_cur(last_good_frame_, frame, guess);
+  }
+  if (!e) {
+    r.status = TrackStatus::degenerate;  // the library found no solution (it does not say why)
+    return r;
+  }
+  r.world_T_camera = last_good_ * e->prev_T_cur;
+  r.residual_rms = e->residual_rms;
+  r.inlier_ratio = e->inlier_ratio;
+  r.inliers = e->inliers;
+  r.iterations = e->iterations;
+  SE3 jump = (last_good_ * guess.value_or(SE3::identity())).inverse() * r.world_T_camera;
+  r.translation_jump = length(jump.t);
+  r.rotation_jump_deg = rotation_angle_deg(jump.R);
+  bool implausible = r.translation_jump > p_.tracker.max_translation_jump ||
+                     r.rotation_jump_deg > p_.tracker.max_rotation_jump_deg;
+  r.status = implausible ? TrackStatus::implausible_jump : TrackStatus::ok;
+  return r;
+}
+
 FrameRecord TrackingSession::process(const RgbdFrame& frame) {
   FrameRecord rec;
   rec.frame = frame.index;
   rec.timestamp = frame.timestamp;
   auto t0 = Clock::now();
-  upload(frame);
+  // External trackers read the host frame; our pyramid is needed only for the floor-plane gravity
+  // of the first frame and for a volume to fuse into.
+  if (!odometry_ || !started_ || volume_) upload(frame);
   rec.preprocess_ms = ms_since(t0, device_);
   if (!started_) {
     first_frame(frame, rec);

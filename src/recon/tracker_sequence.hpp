@@ -12,6 +12,7 @@
 
 #include "io/frame_source.hpp"
 #include "io/trajectory.hpp"
+#include "recon/external/odometry.hpp"
 #include "recon/preprocess.hpp"
 #include "recon/tracker.hpp"
 #include "recon/tracker_gravity.hpp"
@@ -41,6 +42,9 @@ struct FrameRecord {
 // The per-frame state machine. World frame: the first camera, rotated so that gravity is world -y
 // when tracker.gravity finds it. A lost frame keeps the last good pose, is not fused, and the
 // reference stays the last good view, so the next frames try to recover against it.
+// External trackers (registry entries with make_external: OpenCV, PCL) are frame to frame whatever
+// tracker.mode says: their relative poses prev_T_cur are chained from the same world frame, against
+// the last good frame, and a frame the library fails on is lost like ours (docs/TRACKING.md).
 class TrackingSession {
  public:
   // volume: the model for frame-to-model tracking. nullptr: the session makes its own from
@@ -60,6 +64,7 @@ class TrackingSession {
   void upload(const RgbdFrame& frame);
   void first_frame(const RgbdFrame& frame, FrameRecord& rec);
   TrackResult track_frame(const RgbdFrame& frame);
+  TrackResult track_external(const RgbdFrame& frame);
   void accept(const RgbdFrame& frame, const SE3& pose, FrameRecord& rec);
   void update_reference(const SE3& pose);
 
@@ -69,6 +74,8 @@ class TrackingSession {
   std::unique_ptr<Volume> own_volume_;
   Volume* volume_ = nullptr;
   std::unique_ptr<Tracker> tracker_;
+  std::unique_ptr<external::Odometry> odometry_;  // external kinds only
+  RgbdFrame last_good_frame_;                     // external kinds: host copy of the last frame accepted
   FramePyramid pyr_;
   ReferenceMaps ref_;
   RaycastMaps maps_;
@@ -104,16 +111,20 @@ TrackSequenceResult track_sequence(FrameSource& source, const TrackSequenceParam
 void write_tracking_stats(const std::string& path, const std::vector<FrameRecord>& frames);
 
 // The trackers this build knows (tracker.kind values): every entry says whether it is available and,
-// if not, why. Adding a tracker (OpenCV's RGB-D odometry, PCL's GICP) is one entry here plus its
-// implementation behind make_pose_tracker-style dispatch in TrackingSession.
+// if not, what to install. Adding a tracker is one entry in tracker_registry() plus its
+// implementation: our own kinds are driven by Tracker, an external one by the Odometry its
+// make_external builds (src/recon/external/odometry.hpp).
 struct TrackerInfo {
   std::string kind;
   std::string description;
   bool available;
-  std::string missing;  // what to install when not available
+  std::string missing;                    // what to install when not available
+  external::OdometryFactory make_external;  // external frame-to-frame trackers only
 };
 const std::vector<TrackerInfo>& tracker_registry();
 // Throws seamless::Error naming the fix when `kind` is unknown or not built in.
 void require_tracker(const std::string& kind);
+// The registry entry of `kind` (require_tracker's checks first).
+const TrackerInfo& tracker_info(const std::string& kind);
 
 }  // namespace seamless

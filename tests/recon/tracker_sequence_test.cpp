@@ -122,7 +122,9 @@ TEST(TrackSequence, UnavailableTrackerSaysSo) {
   InputParams in = test::synthetic_input(2);
   auto src = make_source(in);
   TrackSequenceParams p;
-  p.tracker.kind = "opencv_rgbd";
+  for (const TrackerInfo& t : tracker_registry())
+    if (!t.available) p.tracker.kind = t.kind;
+  if (p.tracker.kind == "icp") GTEST_SKIP() << "every tracker of the registry is in this build";
   p.write_files = false;
   try {
     track_sequence(*src, p, Device::CPU, "");
