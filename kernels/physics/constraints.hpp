@@ -34,6 +34,19 @@ SEAMLESS_HD inline vec3 distance_delta(vec3 pi, vec3 pj, float wi, float wj, flo
   return d * (-k * (wi / ws) * (l - L) / l);
 }
 
+// Strain limit (Provot 1995, section 5): correction of p_i that brings |p_i - p_j| back into
+// [(1 - limit) L, (1 + limit) L] (the nearer bound), mass-weighted and over-relaxed by omega in
+// [1, 2) (the edge ends omega - 1 times its excess inside the band, which speeds up Gauss-Seidel
+// along chains of limited edges); zero inside the band.
+SEAMLESS_HD inline vec3 strain_limit_delta(vec3 pi, vec3 pj, float wi, float wj, float L, float limit, float omega) {
+  vec3 d = pi - pj;
+  float l = length(d), lo = (1.f - limit) * L, hi = (1.f + limit) * L;
+  float target = l > hi ? hi : l < lo ? lo : l;
+  float ws = wi + wj;
+  if (target == l || !(ws > 0.f) || l < 1e-12f) return {0.f, 0.f, 0.f};
+  return d * (-(wi / ws) * omega * (l - target) / l);
+}
+
 // Dihedral bending constraint (Mueller 2007, eq. 4.9 and appendix A): p[0], p[1] share the edge,
 // p[2], p[3] are the opposite vertices; phi0 is the rest angle. Writes the corrections of all
 // four vertices to out[0..3].

@@ -53,7 +53,8 @@ struct SimConstants {
   float drag = 0.f, lift = 0.f, air_density = 1.2f;
   vec3 wind{0.f, 0.f, 0.f};
   float sleep_threshold = 0.f;
-  float cloth_self_exclusion = 0.06f;  // same-cloth pairs closer than this at rest never collide
+  float cloth_self_exclusion = 0.06f;
+  float strain_omega = 1.5f;           // over-relaxation of cloth strain limiting (Provot 1995)  // same-cloth pairs closer than this at rest never collide
   int max_neighbors = 64, max_static_neighbors = 64;
   int rotation_iterations = 8;
 };
@@ -126,10 +127,12 @@ struct SimViews {
   SlipSum* chunk_slip = nullptr;
   vec3* scene_n = nullptr;  // sum of the scene contact normals at the last count (count_contacts)
 
-  // cloth, CSR by id: distance constraints (other id, rest length, stiffness already scaled by
-  // the averaging factor), bending constraints and triangles incident to each particle
-  const int *dist_off = nullptr, *dist_other = nullptr, *dist_colour = nullptr;
-  const float *dist_len = nullptr, *dist_k = nullptr;
+  // cloth stretch constraints (ids), grouped by colour: no particle has two edges of one colour
+  // (the host colours them), so one colour's edges are projected in place in one pass. Rest
+  // length, stiffness and the strain limit (0 = none; Provot 1995) per edge.
+  const int *edge_a = nullptr, *edge_b = nullptr;
+  const float *edge_len = nullptr, *edge_k = nullptr, *edge_limit = nullptr;
+  // cloth, CSR by id: bending constraints and triangles incident to each particle
   const int *bend_off = nullptr, *bend_list = nullptr;
   const Quad* bend_ids = nullptr;
   const float *bend_rest = nullptr, *bend_k = nullptr;

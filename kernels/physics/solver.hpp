@@ -5,7 +5,8 @@
 //   predict -> sort_by_key -> reorder -> cell_starts -> find_neighbors
 //   -> stabilize (section 4.4)
 //   -> iterations: prepare_constraints, solve_contacts_fluid (swap sp/tmp), shape_match,
-//                  cloth_stretch per colour, cloth_bend (each: swap sp/tmp)
+//                  cloth_stretch per colour (in place), cloth_bend (swap sp/tmp)
+//   -> cloth_strain_limit per colour (passes)
 //   -> update_velocity -> velocity_effects (swap sv/vtmp) -> write_back
 #pragma once
 #include <cstdint>
@@ -38,7 +39,10 @@ template <class Exec> void solve_contacts_fluid(const Exec& ex, const SimViews& 
 // Shape matching of every rigid body (Mueller 2005): per-body sums, rotation, goal positions.
 template <class Exec> void shape_match(const Exec& ex, const SimViews& S);
 // Cloth stretch and bending (Mueller 2007); writes tmp.
-template <class Exec> void cloth_stretch(const Exec& ex, const SimViews& S, int colour);
+// Stretch constraints of the edges [first, first + count) (one colour), in place.
+template <class Exec> void cloth_stretch(const Exec& ex, const SimViews& S, std::int64_t first, std::int64_t count);
+// Strain limiting of one colour's edges (Provot 1995), in place.
+template <class Exec> void cloth_strain_limit(const Exec& ex, const SimViews& S, std::int64_t first, std::int64_t count);
 template <class Exec> void cloth_bend(const Exec& ex, const SimViews& S);
 // v = v_pred + (p - p0) / dt (exactly symplectic Euler when nothing acted), restitution, sleeping.
 template <class Exec> void update_velocity(const Exec& ex, const SimViews& S);
@@ -65,7 +69,8 @@ template <class Exec> float max_speed2(const Exec& ex, const SimViews& S);
   template void prepare_constraints<E>(const E&, const SimViews&);                                          \
   template void solve_contacts_fluid<E>(const E&, const SimViews&);                                         \
   template void shape_match<E>(const E&, const SimViews&);                                                  \
-  template void cloth_stretch<E>(const E&, const SimViews&, int);                                           \
+  template void cloth_stretch<E>(const E&, const SimViews&, std::int64_t, std::int64_t);                    \
+  template void cloth_strain_limit<E>(const E&, const SimViews&, std::int64_t, std::int64_t);               \
   template void cloth_bend<E>(const E&, const SimViews&);                                                  \
   template void update_velocity<E>(const E&, const SimViews&);                                              \
   template void velocity_effects<E>(const E&, const SimViews&, bool);                                       \

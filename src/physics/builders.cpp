@@ -203,6 +203,7 @@ ParticleBatch make_cloth(const SpawnParams& s, const SolverParams& p) {
   }
   b.stretch_k = s.stiffness;
   b.bend_k = s.bend_stiffness;
+  b.max_strain = s.max_strain;
   return b;
 }
 

@@ -25,6 +25,7 @@ struct ParticleBatch {
   std::vector<float> bend_rest;
   std::vector<int3> tris;
   float stretch_k = 1.f, bend_k = 0.f;
+  float max_strain = 0.f;  // strain limit of every stretch edge (Provot 1995); 0 = none
   bool self_collide = false;
   // rigid body frame
   vec3 centre{0.f, 0.f, 0.f};

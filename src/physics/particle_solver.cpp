@@ -87,13 +87,14 @@ struct ParticleSolver::Impl {
   Buffer<K::SlipSum> chunk_slip;
   // cloth (global ids)
   std::vector<int> edge_a, edge_b;
-  std::vector<float> edge_len, edge_k0;
+  std::vector<float> edge_len, edge_k0, edge_limit0;
   std::vector<K::Quad> bends;
   std::vector<float> bend_rest, bend_k0;
   std::vector<int3> tris;
-  int stretch_colours = 0;
-  Buffer<int> dist_off, dist_other, dist_colour, bend_off, bend_list, tri_off, tri_list;
-  Buffer<float> dist_len, dist_k, d_bend_rest, d_bend_k;
+  std::vector<std::int64_t> colour_off;  // stretch edges of colour c: [colour_off[c], colour_off[c + 1])
+  bool strain_limited = false;
+  Buffer<int> d_edge_a, d_edge_b, bend_off, bend_list, tri_off, tri_list;
+  Buffer<float> d_edge_len, d_edge_k, d_edge_limit, d_bend_rest, d_bend_k;
   Buffer<K::Quad> d_bends;
   Buffer<vec3> bend_delta;
   Buffer<int3> d_tris;
@@ -164,6 +165,7 @@ struct ParticleSolver::Impl {
     c.drag = P.drag, c.lift = P.lift, c.air_density = P.air_density, c.wind = P.wind;
     c.sleep_threshold = P.sleep_threshold;
     c.cloth_self_exclusion = 1.5f * d;
+    c.strain_omega = P.cloth_strain_omega;
     c.max_neighbors = P.max_neighbours, c.max_static_neighbors = P.max_static_neighbours;
     c.rotation_iterations = P.rotation_iterations;
     S.n = n;
@@ -192,7 +194,8 @@ struct ParticleSolver::Impl {
     S.nchunks = static_cast<int>(chunk_start.size());
     S.chunk_start = d_chunk_start.data(), S.chunk_count = d_chunk_count.data(), S.chunk_body = d_chunk_body.data();
     S.chunk_sum = chunk_sum.data(), S.chunk_slip = chunk_slip.data();
-    S.dist_off = dist_off.data(), S.dist_other = dist_other.data(), S.dist_colour = dist_colour.data(), S.dist_len = dist_len.data(), S.dist_k = dist_k.data();
+    S.edge_a = d_edge_a.data(), S.edge_b = d_edge_b.data(), S.edge_len = d_edge_len.data();
+    S.edge_k = d_edge_k.data(), S.edge_limit = d_edge_limit.data();
     S.bend_off = bend_off.data(), S.bend_list = bend_list.data(), S.bend_ids = d_bends.data();
     S.bend_rest = d_bend_rest.data(), S.bend_k = d_bend_k.data();
     S.nbends = static_cast<std::int64_t>(bends.size()), S.bend_delta = bend_delta.data();
@@ -235,6 +238,7 @@ struct ParticleSolver::Impl {
         K::shape_match(ex, S);
         if (has_cloth) solve_cloth(ex, S);
       }
+      if (strain_limited) limit_strain(ex, S);
       K::update_velocity(ex, S);
       if (effects) {
         K::velocity_effects(ex, S, has_fluid);
@@ -246,14 +250,20 @@ struct ParticleSolver::Impl {
 
   template <class Ex>
   void solve_cloth(const Ex& ex, K::SimViews& S) {
-    for (int c = 0; c < stretch_colours; ++c) {
-      K::cloth_stretch(ex, S, c);
-      std::swap(S.sp, S.tmp);
-    }
+    for (std::size_t c = 0; c + 1 < colour_off.size(); ++c)
+      K::cloth_stretch(ex, S, colour_off[c], colour_off[c + 1] - colour_off[c]);
     if (!bends.empty()) {
       K::cloth_bend(ex, S);
       std::swap(S.sp, S.tmp);
     }
+  }
+
+  // Strain limiting after the iterations (Provot 1995): Gauss-Seidel over the edge colours.
+  template <class Ex>
+  void limit_strain(const Ex& ex, const K::SimViews& S) {
+    for (int pass = 0; pass < P.cloth_strain_passes; ++pass)
+      for (std::size_t c = 0; c + 1 < colour_off.size(); ++c)
+        K::cloth_strain_limit(ex, S, colour_off[c], colour_off[c + 1] - colour_off[c]);
   }
 
   void upload_bodies(const std::vector<vec3>& c, const std::vector<vec4>& q) {
@@ -299,7 +309,6 @@ struct ParticleSolver::Impl {
   std::vector<int> colour_edges(std::size_t N) {
     std::vector<std::uint64_t> used(N, 0);
     std::vector<int> col(edge_a.size());
-    stretch_colours = 0;
     for (std::size_t e = 0; e < edge_a.size(); ++e) {
       std::uint64_t busy = used[edge_a[e]] | used[edge_b[e]];
       int c = 0;
@@ -307,36 +316,37 @@ struct ParticleSolver::Impl {
       if (c == 64) throw Error("particle solver: a cloth particle has more than 63 stretch constraints");
       col[e] = c;
       used[edge_a[e]] |= std::uint64_t{1} << c, used[edge_b[e]] |= std::uint64_t{1} << c;
-      stretch_colours = std::max(stretch_colours, c + 1);
     }
     return col;
   }
 
-  // CSR by particle id of the cloth constraints. Stretch constraints are coloured and keep their
-  // stiffness; bending stiffness is divided by the larger degree of a constraint's particles over
-  // cloth_relaxation (Macklin 2014 eq. 11 averaging, made symmetric so that a pair's corrections
-  // stay equal and opposite).
+  // Stretch edges grouped by colour (uploaded), bending constraints and triangles as CSR by
+  // particle id. Stretch constraints are coloured and keep their stiffness; bending stiffness is
+  // divided by the larger degree of a constraint's particles over cloth_relaxation (Macklin 2014
+  // eq. 11 averaging, made symmetric so that a pair's corrections stay equal and opposite).
   void rebuild_cloth() {
     const std::size_t N = static_cast<std::size_t>(n);
-    std::vector<int> deg(N, 0), bdeg(N, 0);
-    for (std::size_t e = 0; e < edge_a.size(); ++e) ++deg[edge_a[e]], ++deg[edge_b[e]];
+    std::vector<int> bdeg(N, 0);
     for (const K::Quad& q : bends) ++bdeg[q.a], ++bdeg[q.b], ++bdeg[q.c], ++bdeg[q.d];
     auto scale = [&](int dmax) { return std::min(1.f, P.cloth_relaxation / static_cast<float>(std::max(dmax, 1))); };
     std::vector<int> col = colour_edges(N);
-    std::vector<int> off(N + 1, 0), other(2 * edge_a.size()), ecol(other.size());
-    std::vector<float> len(other.size()), k(other.size());
-    for (std::size_t i = 0; i < N; ++i) off[i + 1] = off[i] + deg[i];
-    std::vector<int> fill(off.begin(), off.end() - 1);
+    const int colours = col.empty() ? 0 : *std::max_element(col.begin(), col.end()) + 1;
+    colour_off.assign(static_cast<std::size_t>(colours) + 1, 0);
+    for (int c : col) ++colour_off[c + 1];
+    for (int c = 0; c < colours; ++c) colour_off[c + 1] += colour_off[c];
+    std::vector<std::int64_t> fill(colour_off.begin(), colour_off.end() - 1);
+    std::vector<int> ea(edge_a.size()), eb(edge_a.size());
+    std::vector<float> len(edge_a.size()), k(edge_a.size()), lim(edge_a.size());
+    strain_limited = false;
     for (std::size_t e = 0; e < edge_a.size(); ++e) {
-      int a = edge_a[e], b = edge_b[e];
-      float ke = edge_k0[e];
-      ecol[fill[a]] = col[e], other[fill[a]] = b, len[fill[a]] = edge_len[e], k[fill[a]++] = ke;
-      ecol[fill[b]] = col[e], other[fill[b]] = a, len[fill[b]] = edge_len[e], k[fill[b]++] = ke;
+      std::int64_t at = fill[col[e]]++;
+      ea[at] = edge_a[e], eb[at] = edge_b[e], len[at] = edge_len[e], k[at] = edge_k0[e], lim[at] = edge_limit0[e];
+      strain_limited = strain_limited || edge_limit0[e] > 0.f;
     }
-    if (other.empty()) other.push_back(0), ecol.push_back(-1), len.push_back(0.f), k.push_back(0.f);
-    dist_colour = Buffer<int>::from_host(ecol, dev);
-    dist_off = Buffer<int>::from_host(off, dev), dist_other = Buffer<int>::from_host(other, dev);
-    dist_len = Buffer<float>::from_host(len, dev), dist_k = Buffer<float>::from_host(k, dev);
+    if (ea.empty()) ea.push_back(0), eb.push_back(0), len.push_back(0.f), k.push_back(0.f), lim.push_back(0.f);
+    d_edge_a = Buffer<int>::from_host(ea, dev), d_edge_b = Buffer<int>::from_host(eb, dev);
+    d_edge_len = Buffer<float>::from_host(len, dev), d_edge_k = Buffer<float>::from_host(k, dev);
+    d_edge_limit = Buffer<float>::from_host(lim, dev);
     std::vector<float> bk(bends.size());
     std::vector<std::vector<int>> inc(N);
     for (std::size_t i = 0; i < bends.size(); ++i) {
@@ -391,7 +401,7 @@ struct ParticleSolver::Impl {
       const int o = static_cast<int>(first);
       for (std::size_t e = 0; e < b.edge_a.size(); ++e) {
         edge_a.push_back(b.edge_a[e] + o), edge_b.push_back(b.edge_b[e] + o);
-        edge_len.push_back(b.edge_len[e]), edge_k0.push_back(b.stretch_k);
+        edge_len.push_back(b.edge_len[e]), edge_k0.push_back(b.stretch_k), edge_limit0.push_back(b.max_strain);
       }
       for (std::size_t i = 0; i < b.bends.size(); ++i) {
         const K::Quad& q = b.bends[i];
@@ -568,6 +578,9 @@ std::vector<RigidFrame> ParticleSolver::rigid_frames() const {
   return out;
 }
 
+const std::vector<int3>& ParticleSolver::cloth_triangles() const { return impl_->tris; }
+const vec3* ParticleSolver::device_positions() const { return impl_->x.data(); }
+const std::uint32_t* ParticleSolver::device_phases() const { return impl_->phase.data(); }
 std::int64_t ParticleSolver::size() const { return impl_->n; }
 const SolverParams& ParticleSolver::params() const { return impl_->P; }
 Device ParticleSolver::device() const { return impl_->dev; }

@@ -80,6 +80,12 @@ class ParticleSolver {
   SolverStats stats() const;
   ParticleState download_state() const;
   std::vector<RigidFrame> rigid_frames() const;
+  // Triangles of every cloth sheet spawned so far, in particle ids (read-only; for rendering).
+  const std::vector<int3>& cloth_triangles() const;
+  // Positions and phases of the size() particles in id order on device(), read-only, valid until
+  // the next step or spawn (for CUDA-OpenGL interop: the renderer copies them device to device).
+  const vec3* device_positions() const;
+  const std::uint32_t* device_phases() const;
   std::int64_t size() const;
   const SolverParams& params() const;
   Device device() const;

@@ -47,6 +47,8 @@ struct SolverParams {
   float cloth_relaxation = 2.f;         // cloth constraint averaging: k / max(1, degree / this)
   int rotation_iterations = 8;          // Mueller 2016 rotation extraction steps per shape match
   int max_static_neighbours = 64;
+  int cloth_strain_passes = 4;          // strain-limiting passes over all edge colours per substep
+  float cloth_strain_omega = 1.5f;      // over-relaxation of strain limiting
 
   template <class V> void visit(V& v) {
     v("particle_diameter", particle_diameter, "particle diameter, metres", Range{0.001, 1.0});
@@ -85,6 +87,9 @@ struct SolverParams {
     v("cloth_relaxation", cloth_relaxation, "cloth constraint averaging divisor", Range{0.5, 16.0});
     v("rotation_iterations", rotation_iterations, "rotation extraction iterations", Range{1, 100});
     v("max_static_neighbours", max_static_neighbours, "scene particles kept per particle", Range{1, 1024});
+    v("cloth_strain_passes", cloth_strain_passes, "cloth strain-limiting passes per substep (Provot 1995)",
+      Range{0, 100});
+    v("cloth_strain_omega", cloth_strain_omega, "over-relaxation of cloth strain limiting", Range{1.0, 1.95});
   }
 };
 
@@ -103,6 +108,7 @@ struct SpawnParams {
   std::vector<int> pinned;            // cloth corners held fixed: 0..3 = (0,0) (nx-1,0) (0,ny-1) (nx-1,ny-1)
   float stiffness = 1.f;              // cloth stretch stiffness (PBD k); rigid: shape matching stiffness
   float bend_stiffness = 0.1f;        // cloth bending stiffness
+  float max_strain = 0.1f;            // cloth: largest relative edge length change (Provot 1995); 0 = no limit
   bool self_collide = false;          // cloth collides with itself
   std::string shape = "box";          // rigid
   std::string mesh;                   // rigid, shape: mesh (OBJ/PLY path)
@@ -124,6 +130,8 @@ struct SpawnParams {
     v("pinned", pinned, "cloth corners held fixed (0..3)", Range{0, 3});
     v("stiffness", stiffness, "cloth stretch stiffness", Range{0.0, 1.0});
     v("bend_stiffness", bend_stiffness, "cloth bending stiffness", Range{0.0, 1.0});
+    v("max_strain", max_strain, "cloth strain limit: largest relative edge stretch or compression; 0 = none",
+      Range{0.0, 1.0});
     v("self_collide", self_collide, "cloth collides with itself");
     v("shape", shape, "rigid body shape", Choices{"box", "sphere", "mesh"});
     v("rotation", rotation, "Euler angles about x, y, z, degrees (cloth, rigid)");

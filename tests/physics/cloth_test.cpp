@@ -77,7 +77,7 @@ DrapeRun drape() {
     if (std::fabs(x.x) < half && std::fabs(x.z) < half && x.y > 2 * half) ++r.on_top;
     if (x.y < 0.5f * d + 0.01f) ++r.on_floor;
   }
-  std::printf("cloth on box: max edge strain %.4f (at rest %.4f), closest centre to the box %.4g m (radius %.3g), "
+  std::printf("cloth on box: max edge strain %.6f (at rest %.6f), closest centre to the box %.4g m (radius %.3g), "
               "lowest %.4g m, %d particles over the top, %d on the floor\n",
               r.worst_strain, r.final_strain, r.deepest, 0.5f * d, r.lowest, r.on_top, r.on_floor);
   return r;
@@ -96,15 +96,16 @@ TEST(PhysicsCloth, DroppedOnBoxStaysOutside) {
   EXPECT_GT(r.on_floor, 0);
 }
 
-// The requirement: edge strain <= 10 % at every frame. NOT MET YET (disabled so that CI
-// stays green; run with --gtest_also_run_disabled_tests): with 2 iterations and coloured
-// Gauss-Seidel stretch constraints the peak is 26 % at impact and 12 % at rest, at the box's top
-// corners, where the contacts (projected before the cloth in each iteration) and the stretch
-// constraints fight; 4 iterations give 18 %. docs/PHYSICS.md, known limitations, lists what else
-// was tried (re-projected contacts, heavier contact particles, more passes, long-range limits).
-TEST(PhysicsCloth, DISABLED_DroppedOnBoxEdgeStrainAtMostTenPercent) {
+// The requirement: edge strain <= 10 % at every frame (structural and shear edges). The
+// cloth's default strain limit (SpawnParams::max_strain = 0.1, Provot 1995's value) is projected
+// after the solver iterations in cloth_strain_passes Gauss-Seidel passes; this checks that they
+// converge at the impact, where the overhang keeps falling while the top stops on the box (before
+// strain limiting: 26 % there). The tolerance 1e-5 is float rounding of an edge length at these
+// coordinates (positions ~0.5 m carry ~6e-8 m, relative to a 0.04 m edge ~3e-6), not slack.
+TEST(PhysicsCloth, DroppedOnBoxEdgeStrainAtMostTenPercent) {
   DrapeRun r = drape();
-  EXPECT_LE(r.worst_strain, 0.10);
+  EXPECT_LE(r.worst_strain, 0.10 + 1e-5);
+  EXPECT_LE(r.final_strain, 0.10 + 1e-5);
 }
 
 }  // namespace
