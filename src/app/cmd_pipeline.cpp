@@ -4,6 +4,7 @@
 #include "app/run_context.hpp"
 #include "core/error.hpp"
 #include "kernels/io/synthetic_room.hpp"
+#include "recon/refine/refine.hpp"
 
 namespace seamless::app {
 
@@ -37,7 +38,14 @@ void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
   t->callback([&action, trk] {
     action = [trk] {
       RunContext ctx(*trk);
-      scan(ctx, false);
+      const Experiment& e = ctx.experiment();
+      require_refine(e.refine);  // before tracking: a missing Ceres is not found out 150 frames later
+      ScanResult r = scan(ctx, false);
+      if (e.refine.enabled) {
+        std::vector<bool> tracked;
+        for (const FrameRecord& f : r.tracking.frames) tracked.push_back(f.result.ok());
+        refine_run(e.input, r.tracking.trajectory, tracked, e.refine, e.preprocess, ctx.device(), ctx.out_dir());
+      }
       return 0;
     };
   });

@@ -26,7 +26,7 @@ struct RefineParams {
   float max_pair_correction = 0.1f;        // ... and when it moves the odometry's relative pose less, metres
   float max_pair_correction_deg = 5.f;     // ... and degrees
   float information_samples = 1000.f;      // independent samples a dense alignment is worth (pixels correlate)
-  float odometry_weight = 1.f;             // odometry edges relative to a pairwise alignment of the same pair
+  float odometry_weight = 1.f;             // odometry edge vs an alignment of the same pair, / frames between
   std::string robust_loss = "huber";
   float robust_scale = 3.f;                // in whitened units (standard deviations)
   int max_iterations = 100;                // Ceres Levenberg-Marquardt iterations
@@ -61,7 +61,8 @@ struct RefineParams {
     v("information_samples", information_samples, "independent samples one dense alignment is worth: its 6x6 "
       "information is scaled to this many pixels (neighbouring pixels' errors correlate)", Range{1.0, 1e9});
     v("odometry_weight", odometry_weight, "weight of an odometry edge relative to a pairwise alignment of the "
-      "same keyframes", Range{0.0, 1e6});
+      "same keyframes, divided by the frames between them (the odometry is a chain of that many alignments)",
+      Range{0.0, 1e6});
     v("robust_loss", robust_loss, "robust loss on each edge's whitened residual",
       Choices{"none", "huber", "cauchy"});
     v("robust_scale", robust_scale, "scale of the robust loss, in standard deviations", Range{1e-6, 1e6});
