@@ -1,4 +1,4 @@
-// reconstruct, track, simulate, render: the pipeline's parts run on their own.
+// reconstruct, track, simulate: the pipeline's parts run on their own (render: cmd_render.cpp).
 #include "app/commands.hpp"
 #include "app/pipeline.hpp"
 #include "app/run_context.hpp"
@@ -8,19 +8,7 @@
 
 namespace seamless::app {
 
-namespace {
-struct Part {
-  const char* name;
-  const char* help;
-  const char* missing;
-};
-}  // namespace
-
 void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
-  static const Part parts[] = {
-      {"render", "render a run's outputs (mesh, particles, fluid) to images or a window",
-       "the renderer (issue 7) is not built yet"},
-  };
   auto rec = std::make_shared<CommonOptions>();
   auto* r = app.add_subcommand("reconstruct", "track and fuse the input into the TSDF volume; write mesh.ply, "
                                               "trajectory.txt and tracking_stats.csv");
@@ -66,12 +54,6 @@ void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
       return 0;
     };
   });
-  for (const Part& p : parts) {
-    auto o = std::make_shared<CommonOptions>();
-    auto* cmd = app.add_subcommand(p.name, p.help);
-    add_common_options(*cmd, *o);
-    cmd->callback([&action, p] { action = [p] { return not_built(p.name, p.missing); }; });
-  }
 }
 
 }  // namespace seamless::app

@@ -6,7 +6,8 @@
 
 namespace seamless::app {
 void add_run_command(CLI::App& app, std::function<int()>& action);
-void add_pipeline_commands(CLI::App& app, std::function<int()>& action);  // reconstruct, track, simulate, render
+void add_pipeline_commands(CLI::App& app, std::function<int()>& action);  // reconstruct, track, simulate
+void add_render_command(CLI::App& app, std::function<int()>& action);     // cmd_render.cpp
 void add_eval_command(CLI::App& app, std::function<int()>& action);
 void add_bench_command(CLI::App& app, std::function<int()>& action);
 void add_record_command(CLI::App& app, std::function<int()>& action);

@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   std::function<int()> action;
   app::add_run_command(app, action);
   app::add_pipeline_commands(app, action);
+  app::add_render_command(app, action);
   app::add_eval_command(app, action);
   app::add_bench_command(app, action);
   app::add_record_command(app, action);

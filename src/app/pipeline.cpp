@@ -93,6 +93,7 @@ void simulate(RunContext& ctx, const std::vector<vec3>& scene_particles, const k
   progress.finish();
   if (renderer) renderer->finish();
   write_particles_ply(ctx.out_path("particles.ply"), solver.download_state());
+  write_run_objects(ctx.out_path("objects.txt"), collect_run_objects(solver, e.spawn));  // for `seamless render`
   SolverStats st = solver.stats();
   spdlog::info("physics: {} particles ({} fluid, {} cloth, {} rigid in {} bodies), {} substeps/step, median {:.3f} ms "
                "per step; neighbour overflow {} / {}",
@@ -153,6 +154,7 @@ void live(RunContext& ctx, RunRenderer* renderer) {
   if (renderer) renderer->finish();
   if (e.output.write_stats) write_tracking_stats(ctx.out_path("tracking_stats.csv"), records);
   write_particles_ply(ctx.out_path("particles.ply"), solver.download_state());
+  write_run_objects(ctx.out_path("objects.txt"), collect_run_objects(solver, e.spawn));  // for `seamless render`
   spdlog::info("live: {} frames ({} lost), median track {:.3f} ms, physics {:.3f} ms, extraction {:.3f} ms",
                records.size(), session.lost_frames(), ctx.timer().median_ms("track"), ctx.timer().median_ms("physics"),
                ctx.timer().median_ms("extract"));

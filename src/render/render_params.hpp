@@ -36,7 +36,9 @@ struct RenderParams {
   // particles sit about one diameter apart, and on a cubic lattice seen face-on the gaps between
   // four touching spheres close only above sqrt(2) (the gap centre is sqrt(2) r from each).
   float fluid_radius_scale = 1.5f;
-  int filter_iterations = 2;          // separable bilateral passes (x then y) over the depth
+  std::string fluid_filter = "narrow_range";  // depth smoothing: narrow_range (Truong & Yuksel 2018) or bilateral
+  int filter_iterations = 1;          // separable filter passes (x then y) over the depth
+  int filter_max_taps = 12;           // taps per side at most: wider kernels sample every k-th pixel
   float filter_size = 3.f;            // filter half-width in particle radii (world), projected per pixel
   int filter_max_px = 24;             // ... but at most this many pixels
   float filter_depth_sigma = 1.f;     // range sigma of the bilateral filter, in particle radii
@@ -44,6 +46,11 @@ struct RenderParams {
   float refraction = 0.06f;           // screen-space refraction offset per metre of thickness
   float fresnel_f0 = 0.02f;           // reflectance at normal incidence (water: ((1-1.33)/(1+1.33))^2)
   int cube_size = 256;                // cube map face size for reflections in the mesh view
+  // Cost of the fluid passes (docs/RENDERING.md, section Speed).
+  int thickness_downsample = 2;       // thickness pass and its blur at 1/this resolution (1, 2 or 4), bilinear up
+  bool depth_prepass = true;          // hardware depth test of the sprites against the scene depth (early-Z)
+  float max_point_size = 64.f;        // sprite size limit, pixels: nearer spheres are cut to this square
+  bool cuda_interop = true;           // CUDA runs: copy particles device to device into GL (no host trip)
 
   template <class V> void visit(V& v) {
     v("mode", mode, "window, headless (PNGs) or no rendering", Choices{"window", "headless", "none"});
@@ -71,7 +78,9 @@ struct RenderParams {
     v("cloth_color", cloth_color, "colour of cloth, RGB 0..1");
     v("fluid_radius_scale", fluid_radius_scale, "fluid sphere size in the SSFR passes, particle radii",
       Range{0.5, 4.0});
-    v("filter_iterations", filter_iterations, "bilateral depth filter passes", Range{0, 16});
+    v("fluid_filter", fluid_filter, "fluid depth filter", Choices{"narrow_range", "bilateral"});
+    v("filter_iterations", filter_iterations, "depth filter passes (x then y)", Range{0, 16});
+    v("filter_max_taps", filter_max_taps, "depth filter taps per side at most (wider: strided)", Range{1, 128});
     v("filter_size", filter_size, "depth filter half-width, particle radii", Range{0.0, 50.0});
     v("filter_max_px", filter_max_px, "depth filter half-width limit, pixels", Range{1, 128});
     v("filter_depth_sigma", filter_depth_sigma, "bilateral range sigma, particle radii", Range{0.01, 100.0});
@@ -79,6 +88,10 @@ struct RenderParams {
     v("refraction", refraction, "refraction offset, screen fraction per metre of thickness", Range{0.0, 10.0});
     v("fresnel_f0", fresnel_f0, "fluid reflectance at normal incidence", Range{0.0, 1.0});
     v("cube_size", cube_size, "reflection cube map face size, pixels", Range{16, 4096});
+    v("thickness_downsample", thickness_downsample, "fluid thickness at 1/this resolution (1, 2 or 4)", Range{1, 4});
+    v("depth_prepass", depth_prepass, "early depth test of fluid sprites against the scene");
+    v("max_point_size", max_point_size, "largest particle sprite, pixels", Range{4.0, 2048.0});
+    v("cuda_interop", cuda_interop, "on CUDA, copy particles into OpenGL device to device");
   }
 };
 

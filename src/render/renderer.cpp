@@ -15,18 +15,6 @@ std::vector<float> mat3_cols(const mat3& R) {  // column-major for glUniformMatr
   return {R.m[0][0], R.m[1][0], R.m[2][0], R.m[0][1], R.m[1][1], R.m[2][1], R.m[0][2], R.m[1][2], R.m[2][2]};
 }
 
-// Area-weighted vertex normals of a triangle mesh (smooth shading, dissertation eq. 4.23 summed
-// over the triangles around each vertex).
-std::vector<vec3> vertex_normals(const std::vector<vec3>& p, const std::vector<int3>& tris) {
-  std::vector<vec3> n(p.size(), vec3{0.f, 0.f, 0.f});
-  for (const int3& t : tris) {
-    const vec3 c = cross(p[t.y] - p[t.x], p[t.z] - p[t.x]);  // |c| = twice the area
-    n[t.x] += c, n[t.y] += c, n[t.z] += c;
-  }
-  for (vec3& v : n) v = normalize(v);
-  return n;
-}
-
 }  // namespace
 
 void Renderer::Impl::build_programs() {
@@ -35,6 +23,7 @@ void Renderer::Impl::build_programs() {
   const std::vector<std::string> sphere_fs = {"camera.glsl", "sphere_hit.glsl"};
   auto with = [](std::vector<std::string> a, const char* f) { a.push_back(f); return a; };
   mesh_prog = Program("mesh", {vs({"mesh.vert"}), fs({"mesh.frag"})});
+  cloth_prog = Program("cloth", {vs({"cloth.vert"}), fs({"mesh.frag"})});
   particle_prog = Program("particles", {vs({"sphere.vert"}), fs(with(sphere_fs, "particle.frag"))});
   fluid_depth_prog = Program("fluid depth", {vs({"sphere.vert"}), fs(with(sphere_fs, "ssfr_depth.frag"))});
   fluid_thick_prog = Program("fluid thickness", {vs({"sphere.vert"}), fs(with(sphere_fs, "ssfr_thickness.frag"))});
@@ -52,12 +41,20 @@ void Renderer::Impl::make_targets() {
   reflect_color = make_texture_2d(GL_RGBA8, w, h);
   refract_color = make_texture_2d(GL_RGBA8, w, h);
   final_fbo = make_framebuffer({final_color, reflect_color, refract_color}, 0, "fluid composite");
+  const int ds = std::max(1, p.thickness_downsample);
+  tw = std::max(1, w / ds), th = std::max(1, h / ds);
   for (int i = 0; i < 2; ++i) {
     fluid_depth[i] = make_texture_2d(GL_R32F, w, h);
-    thick[i] = make_texture_2d(GL_R32F, w, h);
+    thick[i] = make_texture_2d(GL_R32F, tw, th, GL_LINEAR);  // upsampled bilinearly by the composite
     fluid_filter_fbo[i] = make_framebuffer({fluid_depth[i]}, 0, "fluid filter");
     thick_fbo[i] = make_framebuffer({thick[i]}, 0, "fluid thickness");
   }
+  // The thickness pass tests its sprites against the scene depth, scaled down into this.
+  thick_zbuf = Renderbuffer(new_name(glGenRenderbuffers));
+  glBindRenderbuffer(GL_RENDERBUFFER, thick_zbuf);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, tw, th);
+  glBindFramebuffer(GL_FRAMEBUFFER, thick_fbo[0]);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, thick_zbuf);
   normals = make_texture_2d(GL_RGBA16F, w, h);
   normal_fbo = make_framebuffer({normals}, 0, "fluid normals");
   fluid_zbuf = Renderbuffer(new_name(glGenRenderbuffers));
@@ -170,29 +167,106 @@ void Renderer::Impl::draw_spheres(const Program& prog, std::int64_t n, std::uint
   glUniform1f(prog.loc("u_radius"), radius);
   glUniform1f(prog.loc("u_fmax"), std::max(cam.K.fx, cam.K.fy));
   glUniform1ui(prog.loc("u_phase_mask"), mask);
+  glUniform1f(prog.loc("u_max_point_size"), p.max_point_size);
   glBindVertexArray(part_vao);
   glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(n));
   glBindVertexArray(0);
 }
 
+const GlMesh& Renderer::Impl::body_mesh(const std::shared_ptr<const BodyMesh>& m) {
+  for (auto it = body_meshes.begin(); it != body_meshes.end();)
+    it = it->second.first.expired() ? body_meshes.erase(it) : std::next(it);
+  auto it = body_meshes.find(m.get());
+  if (it != body_meshes.end()) return it->second.second;
+  if (m->normals.size() != m->positions.size())
+    throw Error("render: rigid body mesh has " + std::to_string(m->positions.size()) + " positions but " +
+                std::to_string(m->normals.size()) + " normals");
+  auto& e = body_meshes[m.get()];
+  e.first = m;
+  e.second.upload(m->positions, m->normals, {}, m->triangles, GL_STATIC_DRAW);
+  return e.second;
+}
+
+namespace {
+void buffer_texture(Texture& tex, GLuint buf, GLenum format) {
+  if (!tex) tex = Texture(new_name(glGenTextures));
+  glBindTexture(GL_TEXTURE_BUFFER, tex);
+  glTexBuffer(GL_TEXTURE_BUFFER, format, buf);
+}
+}  // namespace
+
+// Indices and per-vertex triangle rings of the sheets, re-made only when the topology changes
+// (a sheet is spawned); positions stay in the particle buffer.
+void Renderer::Impl::upload_cloth(const std::vector<int3>& tris, std::int64_t n) {
+  const bool same = tris.size() == cloth_tris.size() &&
+                    std::equal(tris.begin(), tris.end(), cloth_tris.begin(),
+                               [](int3 a, int3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; });
+  if (same) return;
+  int lo = tris[0].x, hi = lo;
+  for (const int3& t : tris) lo = std::min({lo, t.x, t.y, t.z}), hi = std::max({hi, t.x, t.y, t.z});
+  if (lo < 0 || hi >= n)
+    throw Error("render: cloth triangle index " + std::to_string(lo < 0 ? lo : hi) + " is outside the " +
+                std::to_string(n) + " particles drawn");
+  std::vector<int> off(static_cast<std::size_t>(hi - lo + 2), 0), ring;
+  for (const int3& t : tris) ++off[t.x - lo + 1], ++off[t.y - lo + 1], ++off[t.z - lo + 1];
+  for (std::size_t i = 1; i < off.size(); ++i) off[i] += off[i - 1];
+  ring.resize(2 * static_cast<std::size_t>(off.back()));
+  std::vector<int> fill(off.begin(), off.end() - 1);
+  auto put = [&](int i, int j, int k) {
+    const int at = fill[i - lo]++;
+    ring[2 * at] = j, ring[2 * at + 1] = k;
+  };
+  for (const int3& t : tris) put(t.x, t.y, t.z), put(t.y, t.z, t.x), put(t.z, t.x, t.y);  // winding kept
+  if (!cloth_vao) {
+    cloth_vao = VertexArray(new_name(glGenVertexArrays));
+    cloth_idx = GlBuffer(new_name(glGenBuffers)), cloth_ring_off = GlBuffer(new_name(glGenBuffers));
+    cloth_ring = GlBuffer(new_name(glGenBuffers));
+  }
+  glBindVertexArray(cloth_vao);
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, cloth_idx);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(tris.size() * sizeof(int3)), tris.data(), GL_STATIC_DRAW);
+  glBindVertexArray(0);
+  glBindBuffer(GL_TEXTURE_BUFFER, cloth_ring_off);
+  glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(off.size() * sizeof(int)), off.data(), GL_STATIC_DRAW);
+  glBindBuffer(GL_TEXTURE_BUFFER, cloth_ring);
+  glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(ring.size() * sizeof(int)), ring.data(), GL_STATIC_DRAW);
+  glBindBuffer(GL_TEXTURE_BUFFER, 0);
+  buffer_texture(ring_off_tbo, cloth_ring_off, GL_R32I);
+  buffer_texture(ring_tbo, cloth_ring, GL_RG32I);
+  cloth_tris = tris;
+  cloth_first = lo;
+}
+
+void Renderer::Impl::draw_cloth(const RenderCamera& cam) {
+  set_camera_uniforms(cloth_prog, cam);
+  buffer_texture(pos_tbo, part_pos, GL_RGB32F);  // the buffer may have been re-allocated
+  glActiveTexture(GL_TEXTURE0), glBindTexture(GL_TEXTURE_BUFFER, pos_tbo);
+  glActiveTexture(GL_TEXTURE1), glBindTexture(GL_TEXTURE_BUFFER, ring_off_tbo);
+  glActiveTexture(GL_TEXTURE2), glBindTexture(GL_TEXTURE_BUFFER, ring_tbo);
+  glUniform1i(cloth_prog.loc("u_pos"), 0);
+  glUniform1i(cloth_prog.loc("u_ring_off"), 1);
+  glUniform1i(cloth_prog.loc("u_ring"), 2);
+  glUniform1i(cloth_prog.loc("u_first"), cloth_first);
+  glUniform3f(cloth_prog.loc("u_tint"), p.cloth_color.x, p.cloth_color.y, p.cloth_color.z);
+  glUniform1i(cloth_prog.loc("u_lit"), 1);
+  glUniform1i(cloth_prog.loc("u_two_sided"), 1);
+  glBindVertexArray(cloth_vao);
+  glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * cloth_tris.size()), GL_UNSIGNED_INT, nullptr);
+  glBindVertexArray(0);
+  glActiveTexture(GL_TEXTURE0);
+}
+
 void Renderer::Impl::draw_objects(const DrawList& list, std::int64_t n, const RenderCamera& cam) {
   if (p.show_rigid)
-    for (const RigidDraw& r : list.rigids)
-      draw_mesh(box, cam, model_matrix(r.world_T_body, r.half_extents), false, p.rigid_color, true);
-  if (p.show_cloth && !list.positions.empty())
+    for (const RigidDraw& r : list.rigids) {
+      if (r.mesh) draw_mesh(body_mesh(r.mesh), cam, model_matrix(r.world_T_body), false, p.rigid_color, true);
+      else draw_mesh(box, cam, model_matrix(r.world_T_body, r.half_extents), false, p.rigid_color, true);
+    }
+  if (p.show_cloth && n > 0)
     for (const ClothDraw& c : list.cloths) {
       if (c.triangles.empty()) continue;
-      // The sheet's particles are one id range (spawn order): upload only that range.
-      int lo = c.triangles[0].x, hi = lo;
-      for (const int3& t : c.triangles) lo = std::min({lo, t.x, t.y, t.z}), hi = std::max({hi, t.x, t.y, t.z});
-      if (lo < 0 || hi >= static_cast<int>(list.positions.size()))
-        throw Error("render: cloth triangle index " + std::to_string(lo < 0 ? lo : hi) + " is outside the " +
-                    std::to_string(list.positions.size()) + " particles of the DrawList");
-      std::vector<vec3> pos(list.positions.begin() + lo, list.positions.begin() + hi + 1);
-      std::vector<int3> tris(c.triangles);
-      for (int3& t : tris) t = {t.x - lo, t.y - lo, t.z - lo};
-      cloth.upload(pos, vertex_normals(pos, tris), {}, tris, GL_STREAM_DRAW);
-      draw_mesh(cloth, cam, model_matrix(SE3::identity()), false, p.cloth_color, true, true);
+      upload_cloth(c.triangles, n);
+      draw_cloth(cam);
     }
   const bool fluid_as_particles = p.show_fluid && p.fluid == "particles";
   if (n > 0 && (p.show_particles || fluid_as_particles)) {

@@ -44,6 +44,18 @@ Image<uchar3> normals_to_rgb(const std::vector<float>& v, int w, int h) {
   return Image<uchar3>::from_host(flip_rows(out, w, h), w, h, Device::CPU);
 }
 
+// The thickness stage image at the frame's size, so that all stage images line up.
+Image<uchar3> upsample_nearest(Image<uchar3> im, int w, int h) {
+  if (im.width() == w && im.height() == h) return im;
+  const std::vector<uchar3> src = im.to_host();
+  std::vector<uchar3> out(static_cast<std::size_t>(w) * h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      out[static_cast<std::size_t>(y) * w + x] =
+          src[static_cast<std::size_t>(y * im.height() / h) * im.width() + x * im.width() / w];
+  return Image<uchar3>::from_host(out, w, h, Device::CPU);
+}
+
 }  // namespace
 
 Image<uchar3> float_to_grey(const std::vector<float>& v, int w, int h) {
@@ -99,56 +111,107 @@ void bind_tex(int unit, GLenum target, GLuint tex) {
 }
 }  // namespace
 
-// Returns false when no fluid particle is drawn.
-bool Renderer::Impl::draw_fluid(std::int64_t n, float radius, const RenderCamera& cam) {
-  if (fluid_count == 0) return false;
-  const std::uint32_t fluid = kernels::phase::kFluid;
-  const float s = p.fluid_radius_scale, sphere_r = radius * s;
-  // 1. Nearest sphere depth per pixel, in front of the scene.
+// Copies the scene's depth into the depth buffer of `dst` (w x h, scaled with nearest samples), so
+// that the hardware depth test rejects sprites behind the scene before their fragment shader.
+void Renderer::Impl::copy_scene_depth(GLuint dst, int dw, int dh) {
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, scene_fbo);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, dst);
+  glBlitFramebuffer(0, 0, w, h, 0, 0, dw, dh, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+  glBindFramebuffer(GL_FRAMEBUFFER, dst);
+}
+
+// SSFR 1: nearest sphere depth per pixel, in front of the scene.
+void Renderer::Impl::fluid_depth_pass(std::int64_t n, float sphere_r, const RenderCamera& cam) {
   glBindFramebuffer(GL_FRAMEBUFFER, fluid_depth_fbo);
   glClearColor(0.f, 0.f, 0.f, 0.f);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  if (p.depth_prepass) {
+    glClear(GL_COLOR_BUFFER_BIT);
+    copy_scene_depth(fluid_depth_fbo, w, h);
+  } else {
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  }
+  glEnable(GL_DEPTH_TEST);
+  glDepthMask(GL_TRUE);
   bind_tex(0, GL_TEXTURE_2D, scene_depth);
   fluid_depth_prog.use();
   glUniform1i(fluid_depth_prog.loc("u_scene_depth"), 0);
-  draw_spheres(fluid_depth_prog, n, fluid, sphere_r, cam);
-  timer.mark("fluid_depth");
-  if (p.stage_images) stages.push_back({"1_depth", float_to_grey(read_float(fluid_depth_fbo, 0, GL_RED, 1, w, h), w, h)});
-  // 2. Thickness: every sphere's chord, added up.
-  glDisable(GL_DEPTH_TEST);
+  glUniform1i(fluid_depth_prog.loc("u_test_scene"), !p.depth_prepass);
+  draw_spheres(fluid_depth_prog, n, kernels::phase::kFluid, sphere_r, cam);
+}
+
+// SSFR 2: every sphere's chord, added up, at 1 / thickness_downsample resolution; sprites wholly
+// behind the scene fail the depth test (no depth writes), the rest are cut at the scene.
+void Renderer::Impl::fluid_thickness_pass(std::int64_t n, float sphere_r, const RenderCamera& cam) {
+  RenderCamera low = cam;
+  low.K = scale_intrinsics(cam.K, tw, th);
+  glViewport(0, 0, tw, th);
   glBindFramebuffer(GL_FRAMEBUFFER, thick_fbo[0]);
   glClear(GL_COLOR_BUFFER_BIT);
+  if (p.depth_prepass) {
+    copy_scene_depth(thick_fbo[0], tw, th);
+    glEnable(GL_DEPTH_TEST);
+    glDepthMask(GL_FALSE);
+  } else {
+    glDisable(GL_DEPTH_TEST);
+  }
   glEnable(GL_BLEND);
   glBlendFunc(GL_ONE, GL_ONE);
+  bind_tex(0, GL_TEXTURE_2D, scene_depth);
   fluid_thick_prog.use();
   glUniform1i(fluid_thick_prog.loc("u_scene_depth"), 0);
+  const float s = p.fluid_radius_scale;
   glUniform1f(fluid_thick_prog.loc("u_thickness_scale"), 6.f / (kernels::kPi * s * s * s));
-  draw_spheres(fluid_thick_prog, n, fluid, sphere_r, cam);
+  draw_spheres(fluid_thick_prog, n, kernels::phase::kFluid, sphere_r, low);
   glDisable(GL_BLEND);
-  timer.mark("fluid_thickness");
-  // 3. Separable filters: depth (bilateral, world-sized), thickness (small Gaussian).
-  set_camera_uniforms(filter_prog, cam);
+  glDisable(GL_DEPTH_TEST);
+  glDepthMask(GL_TRUE);
+  // Small Gaussian over the thickness, at its resolution.
+  set_camera_uniforms(filter_prog, low);
   glBindVertexArray(empty_vao);
-  auto pass = [&](GLuint src, GLuint dst_fbo, int dx, int dy) {
-    glBindFramebuffer(GL_FRAMEBUFFER, dst_fbo);
-    bind_tex(0, GL_TEXTURE_2D, src);
-    glUniform1i(filter_prog.loc("u_src"), 0);
-    glUniform2i(filter_prog.loc("u_dir"), dx, dy);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-  };
-  glUniform1f(filter_prog.loc("u_world_radius"), p.filter_size * radius);
-  glUniform1i(filter_prog.loc("u_max_px"), p.filter_max_px);
-  glUniform1f(filter_prog.loc("u_range_sigma"), p.filter_depth_sigma * radius);
-  glUniform1i(filter_prog.loc("u_skip_empty"), 1);
-  for (int it = 0; it < p.filter_iterations; ++it) {
-    pass(fluid_depth[0], fluid_filter_fbo[1], 1, 0);
-    pass(fluid_depth[1], fluid_filter_fbo[0], 0, 1);
-  }
   glUniform1i(filter_prog.loc("u_max_px"), 3);
+  glUniform1i(filter_prog.loc("u_max_taps"), 3);
   glUniform1f(filter_prog.loc("u_range_sigma"), 0.f);
   glUniform1i(filter_prog.loc("u_skip_empty"), 0);
-  pass(thick[0], thick_fbo[1], 1, 0);
-  pass(thick[1], thick_fbo[0], 0, 1);
+  filter_pass(thick[0], thick_fbo[1], 1, 0);
+  filter_pass(thick[1], thick_fbo[0], 0, 1);
+  glViewport(0, 0, w, h);
+}
+
+void Renderer::Impl::filter_pass(GLuint src, GLuint dst_fbo, int dx, int dy) {
+  glBindFramebuffer(GL_FRAMEBUFFER, dst_fbo);
+  bind_tex(0, GL_TEXTURE_2D, src);
+  glUniform1i(filter_prog.loc("u_src"), 0);
+  glUniform2i(filter_prog.loc("u_dir"), dx, dy);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+// SSFR 3: the separable edge-preserving filter of the depth, world-sized.
+void Renderer::Impl::fluid_filter_passes(float radius, const RenderCamera& cam) {
+  glDisable(GL_DEPTH_TEST);
+  set_camera_uniforms(filter_prog, cam);
+  glBindVertexArray(empty_vao);
+  glUniform1f(filter_prog.loc("u_world_radius"), p.filter_size * radius);
+  glUniform1i(filter_prog.loc("u_max_px"), p.filter_max_px);
+  glUniform1i(filter_prog.loc("u_max_taps"), p.filter_max_taps);
+  glUniform1f(filter_prog.loc("u_range_sigma"), p.filter_depth_sigma * radius);
+  glUniform1i(filter_prog.loc("u_skip_empty"), 1);
+  glUniform1i(filter_prog.loc("u_narrow_range"), p.fluid_filter == "narrow_range");
+  for (int it = 0; it < p.filter_iterations; ++it) {
+    filter_pass(fluid_depth[0], fluid_filter_fbo[1], 1, 0);
+    filter_pass(fluid_depth[1], fluid_filter_fbo[0], 0, 1);
+  }
+}
+
+// Returns false when no fluid particle is drawn.
+bool Renderer::Impl::draw_fluid(std::int64_t n, float radius, const RenderCamera& cam) {
+  if (fluid_count == 0) return false;
+  const float sphere_r = radius * p.fluid_radius_scale;
+  fluid_depth_pass(n, sphere_r, cam);
+  timer.mark("fluid_depth");
+  if (p.stage_images) stages.push_back({"1_depth", float_to_grey(read_float(fluid_depth_fbo, 0, GL_RED, 1, w, h), w, h)});
+  fluid_thickness_pass(n, sphere_r, cam);
+  timer.mark("fluid_thickness");
+  fluid_filter_passes(radius, cam);
   timer.mark("fluid_filter");
   // 4. Normals from the filtered depth.
   glBindFramebuffer(GL_FRAMEBUFFER, normal_fbo);
@@ -186,7 +249,7 @@ bool Renderer::Impl::draw_fluid(std::int64_t n, float radius, const RenderCamera
 void Renderer::Impl::capture_stages() {
   stages.push_back({"2_depth_filtered", float_to_grey(read_float(fluid_filter_fbo[0], 0, GL_RED, 1, w, h), w, h)});
   stages.push_back({"3_normals", normals_to_rgb(read_float(normal_fbo, 0, GL_RGBA, 4, w, h), w, h)});
-  stages.push_back({"4_thickness", float_to_grey(read_float(thick_fbo[0], 0, GL_RED, 1, w, h), w, h)});
+  stages.push_back({"4_thickness", upsample_nearest(float_to_grey(read_float(thick_fbo[0], 0, GL_RED, 1, tw, th), tw, th), w, h)});
   stages.push_back({"5_reflection", read_rgb8(final_fbo, 1, w, h)});
   stages.push_back({"6_refraction", read_rgb8(final_fbo, 2, w, h)});
   stages.push_back({"7_composite", read_rgb8(final_fbo, 0, w, h)});

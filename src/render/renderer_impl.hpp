@@ -3,6 +3,7 @@
 #pragma once
 #include <epoxy/gl.h>
 
+#include <map>
 #include <memory>
 #include <string>
 #include <utility>
@@ -81,7 +82,7 @@ struct Renderer::Impl {
   std::unique_ptr<HeadlessContext> ctx;
   GlInfo info;
 
-  Program mesh_prog, particle_prog, kinect_prog;
+  Program mesh_prog, cloth_prog, particle_prog, kinect_prog;
   Program fluid_depth_prog, fluid_thick_prog, filter_prog, normal_prog, composite_prog;
   VertexArray empty_vao;
 
@@ -91,7 +92,8 @@ struct Renderer::Impl {
   Texture final_color, reflect_color, refract_color;
   Framebuffer final_fbo;
   Texture fluid_depth[2], thick[2], normals;
-  Renderbuffer fluid_zbuf;
+  Renderbuffer fluid_zbuf, thick_zbuf;
+  int tw = 0, th = 0;  // thickness targets: the framebuffer over render.thickness_downsample
   Framebuffer fluid_depth_fbo, fluid_filter_fbo[2], thick_fbo[2], normal_fbo;
   bool last_has_fluid = false;
   int last_fluid_read = 0;  // which fluid_depth[] holds the filtered depth
@@ -109,7 +111,15 @@ struct Renderer::Impl {
   bool has_kinect = false;
 
   // Objects.
-  GlMesh box, cloth;
+  GlMesh box;
+  // Cloth topology (particle ids) for cloth.vert: indices, and each vertex's ring of triangles.
+  std::vector<int3> cloth_tris;
+  int cloth_first = 0;
+  VertexArray cloth_vao;
+  GlBuffer cloth_idx, cloth_ring_off, cloth_ring;
+  Texture pos_tbo, ring_off_tbo, ring_tbo;
+  // Rigid body meshes, uploaded once each; an entry whose owner has gone is dropped.
+  std::map<const BodyMesh*, std::pair<std::weak_ptr<const BodyMesh>, GlMesh>> body_meshes;
   VertexArray part_vao;
   GlBuffer part_pos, part_phase;
   std::int64_t part_capacity = 0;
@@ -128,10 +138,18 @@ struct Renderer::Impl {
   void draw_objects(const DrawList& list, std::int64_t n, const RenderCamera& cam);
   void draw_mesh(const GlMesh& m, const RenderCamera& cam, const Mat4& model, bool vertex_color, vec3 tint, bool lit,
                  bool two_sided = false);
+  void upload_cloth(const std::vector<int3>& tris, std::int64_t n);
+  void draw_cloth(const RenderCamera& cam);
+  const GlMesh& body_mesh(const std::shared_ptr<const BodyMesh>& m);
   void draw_spheres(const Program& prog, std::int64_t n, std::uint32_t mask, float radius, const RenderCamera& cam);
   void render_cube_map();
   // renderer_fluid.cpp
   bool draw_fluid(std::int64_t n, float radius, const RenderCamera& cam);
+  void copy_scene_depth(GLuint dst, int dw, int dh);
+  void fluid_depth_pass(std::int64_t n, float sphere_r, const RenderCamera& cam);
+  void fluid_thickness_pass(std::int64_t n, float sphere_r, const RenderCamera& cam);
+  void fluid_filter_passes(float radius, const RenderCamera& cam);
+  void filter_pass(GLuint src, GLuint dst_fbo, int dx, int dy);
   void capture_stages();
   void set_camera_uniforms(const Program& prog, const RenderCamera& cam) const;
   vec3 light_eye(const RenderCamera& cam) const;

@@ -58,7 +58,9 @@ using Sources = std::vector<std::pair<std::string, std::string>>;  // file name,
 // section 3.4), so that a reported line says both the file and its own line. (The source-string
 // number of #line would be the natural carrier, but Mesa reports it as 0.)
 std::string assemble(const Sources& src) {
-  std::string s = "#version 410 core\n";
+  // Conservative depth (GL 4.2 core, an extension to 4.1) lets the sphere shaders keep the early
+  // depth test although they write gl_FragDepth; "enable" only warns where it is missing.
+  std::string s = "#version 410 core\n#extension GL_ARB_conservative_depth : enable\n";
   for (std::size_t i = 0; i < src.size(); ++i)
     s += "#line " + std::to_string((static_cast<long>(i) + 1) * kLinesPerFile + 1) + "\n" + src[i].second + "\n";
   return s;

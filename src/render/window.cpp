@@ -36,8 +36,7 @@ vec3 fly_forward(const Ui& u) {
   return o.eye(u.up);
 }
 
-void on_key(GLFWwindow* w, int key, int, int action, int) {
-  if (action != GLFW_PRESS) return;
+void press(GLFWwindow* w, int key) {
   Ui& u = ui_of(w);
   RenderParams& p = *u.params;
   switch (key) {
@@ -61,6 +60,10 @@ void on_key(GLFWwindow* w, int key, int, int action, int) {
       break;
     default: break;
   }
+}
+
+void on_key(GLFWwindow* w, int key, int, int action, int) {
+  if (action == GLFW_PRESS) press(w, key);
 }
 
 void on_mouse(GLFWwindow* w, double x, double y) {
@@ -172,6 +175,8 @@ void run_window(const RenderParams& params, const std::string& title, const Wind
       const double dt = std::chrono::duration<double>(now - last).count();
       last = now;
       glfwPollEvents();
+      if (cb.scripted_keys)
+        for (int key : cb.scripted_keys(frame)) press(w, key);
       if (ui.spawn && cb.spawn_next) cb.spawn_next();
       if ((!ui.paused || ui.step_once) && cb.step) cb.step();
       ui.spawn = ui.step_once = false;

@@ -8,6 +8,7 @@
 #pragma once
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "render/draw_list.hpp"
 #include "render/render_params.hpp"
@@ -22,6 +23,9 @@ struct WindowCallbacks {
   std::function<void()> spawn_next;                 // the next configured object (key G)
   std::function<void(Renderer&)> before_draw;       // e.g. set_kinect_view with the newest frame
   std::function<void(Renderer&)> on_start;          // e.g. set_scene_mesh
+  // Keys pressed before frame `frame` (GLFW key codes), handled as if typed: for scripted runs
+  // and tests (a display server delivers no events to an unattended window).
+  std::function<std::vector<int>(int frame)> scripted_keys;
 };
 
 struct WindowView {

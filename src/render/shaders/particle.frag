@@ -4,6 +4,9 @@ uniform vec3 u_light;
 uniform float u_ambient;
 
 layout(location = 0) out vec4 o_color;
+#ifdef GL_ARB_conservative_depth
+layout(depth_greater) out float gl_FragDepth;  // the sphere lies behind its sprite (sphere.vert)
+#endif
 
 vec3 phase_color(uint ph) {
   if ((ph & (1u << 24)) != 0u) return vec3(0.2, 0.45, 0.95);  // fluid

@@ -7,6 +7,7 @@ uniform mat4 u_view, u_proj;
 uniform float u_radius;
 uniform float u_fmax;        // max(fx, fy), pixels
 uniform uint u_phase_mask;   // draw particles with any of these phase flags; 0 = all
+uniform float u_max_point_size;  // pixels (render.max_point_size)
 
 flat out vec3 v_centre;      // eye space
 flat out uint v_phase;
@@ -21,6 +22,12 @@ void main() {
     gl_PointSize = 1.0;
     return;
   }
-  gl_Position = u_proj * pe;
-  gl_PointSize = 2.0 * u_radius * u_fmax / (pe.z - u_radius) + 2.0;
+  // The sprite sits at the sphere's nearest depth, pe.z - r, on the ray through the centre (same
+  // projected centre): every fragment's sphere depth is then behind the sprite's, which the
+  // fragment shaders declare (conservative depth), so the depth test can run before them.
+  gl_Position = u_proj * vec4(pe.xyz * ((pe.z - u_radius) / pe.z), 1.0);
+  // Half-width of the sphere's image, bounded by r f / (z - r) (the silhouette's extent at the
+  // front depth), plus a pixel; cut at u_max_point_size so that a sphere next to the camera
+  // cannot cover the screen with fragments.
+  gl_PointSize = min(2.0 * u_radius * u_fmax / (pe.z - u_radius) + 2.0, u_max_point_size);
 }

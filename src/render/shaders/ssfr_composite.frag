@@ -30,7 +30,9 @@ void main() {
   vec3 P = z * pixel_ray(frag_pixel());
   vec3 V = normalize(-P);
   vec3 N = texelFetch(u_normal, p, 0).xyz;
-  float T = texelFetch(u_thickness, p, 0).r;
+  // Thickness may be at reduced resolution: bilinear upsampling (it is smooth: a blurred sum of
+  // chords), and only read where the full-resolution depth has fluid.
+  float T = texture(u_thickness, gl_FragCoord.xy / u_size).r;
   vec2 uv = gl_FragCoord.xy / u_size;
   // Thicker fluid bends the background further; eye y runs down, texture v up.
   vec2 uv_t = clamp(uv + vec2(N.x, -N.y) * u_refraction * T, 0.0, 1.0);

@@ -10,7 +10,9 @@ layout(location = 0) out float o_thickness;  // metres
 void main() {
   float z_in, z_out;
   if (!hit_sphere(z_in, z_out)) discard;
-  float z_scene = eye_depth(texelFetch(u_scene_depth, ivec2(gl_FragCoord.xy), 0).r);
+  // The pass may run at reduced resolution (render.thickness_downsample): sample the full-size
+  // scene depth at this pixel's position.
+  float z_scene = eye_depth(texture(u_scene_depth, gl_FragCoord.xy / u_size).r);
   float len = (min(z_out, z_scene) - z_in) * length(pixel_ray(frag_pixel()));
   if (len <= 0.0) discard;
   o_thickness = len * u_thickness_scale;

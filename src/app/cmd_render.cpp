@@ -1,0 +1,189 @@
+// seamless render <run_dir>: draws a finished run again from what it saved: mesh.ply (mesh view)
+// or the input's frames at their tracked poses (Kinect view), particles_<step>.ply, objects.txt
+// (cloth triangles, rigid rest shapes) and the effective config.yaml (docs/RENDERING.md).
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <regex>
+
+#include "app/commands.hpp"
+#include "app/render_stage.hpp"
+#include "app/run_context.hpp"
+#include "config/config.hpp"
+#include "core/error.hpp"
+#include "io/trajectory.hpp"
+#include "recon/ply.hpp"
+#include "seamless/build_config.hpp"
+#if SEAMLESS_HAS_GL
+#include "render/headless_output.hpp"
+#include "render/renderer.hpp"
+#endif
+
+namespace seamless::app {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct RenderOptions {
+  std::string run_dir, out, view;
+  int width = 0, height = 0;
+  std::vector<std::string> sets;
+  bool stage_images = false, video = false, last_only = false;
+};
+
+// The saved particle states by step: particles_<step>.ply, or the final particles.ply alone.
+std::map<std::int64_t, std::string> snapshots(const std::string& dir, bool last_only) {
+  std::map<std::int64_t, std::string> out;
+  const std::regex name(R"(particles_(\d+)\.ply)");
+  for (const auto& f : fs::directory_iterator(dir)) {
+    std::smatch m;
+    const std::string n = f.path().filename().string();
+    if (std::regex_match(n, m, name)) out[std::stoll(m[1])] = f.path().string();
+  }
+  const std::string last = dir + "/particles.ply";
+  if ((out.empty() || last_only) && fs::exists(last)) return {{out.empty() ? 0 : out.rbegin()->first + 1, last}};
+  if (out.empty()) throw Error(dir + " holds no particles_<step>.ply nor particles.ply: is it a `seamless run` folder?");
+  return out;
+}
+
+Experiment load_run_config(const RenderOptions& o) {
+  const std::string cfg = o.run_dir + "/config.yaml";
+  if (!fs::exists(cfg))
+    throw Error(cfg + " is missing: `seamless render` needs the run's effective config (output.write_config: true)");
+  Experiment e = load_experiment(cfg, o.sets);
+  RenderParams& p = e.render;
+  if (!o.view.empty()) p.view = o.view;
+  if (o.width > 0) p.width = o.width;
+  if (o.height > 0) p.height = o.height;
+  p.stage_images = p.stage_images || o.stage_images;
+  p.video = o.video;
+  p.write_frames = true;
+  p.mode = "headless";
+  return e;
+}
+
+#if SEAMLESS_HAS_GL
+
+// The Kinect frame shown behind each snapshot: in live mode the frame of that step (one solver
+// step per frame), otherwise the scan's last frame; each at its pose in trajectory.txt.
+class KinectFrames {
+ public:
+  KinectFrames(const Experiment& e, const std::string& run_dir) : live_(e.mode == "live"), limit_(e.frames) {
+    traj_ = read_tum_trajectory(run_dir + "/trajectory.txt");
+    source_ = make_source(e.input, Device::CPU);
+  }
+
+  // Advances to the frame for `step` and sets it on the renderer; false if there is none.
+  bool set(Renderer& r, std::int64_t step) {
+    const std::int64_t want = live_ ? std::max<std::int64_t>(step - 1, 0) : -1;
+    RgbdFrame f;
+    while ((want < 0 || read_ < want + 1) && (limit_ <= 0 || read_ < limit_) && source_->next(f)) {
+      ++read_;
+      have_ = true;
+      frame_ = std::move(f);
+      f = RgbdFrame{};
+    }
+    if (!have_) return false;
+    for (const TumPose& p : traj_)
+      if (std::fabs(p.timestamp - frame_.timestamp) < 1e-6) {
+        r.set_kinect_view(frame_.rgb, frame_.depth, frame_.intrinsics, p.se3());
+        return true;
+      }
+    throw Error("trajectory.txt has no pose at the input's frame time " + std::to_string(frame_.timestamp) +
+                ": was the run made from this config's input?");
+  }
+
+ private:
+  bool live_;
+  std::int64_t limit_, read_ = 0;
+  Trajectory traj_;
+  std::unique_ptr<FrameSource> source_;
+  RgbdFrame frame_;
+  bool have_ = false;
+};
+
+RenderCamera mesh_camera(Renderer& r, const RenderOptions& o, const RenderParams& p) {
+  const std::string mesh_path = o.run_dir + "/mesh.ply", traj_path = o.run_dir + "/trajectory.txt";
+  Mesh mesh;
+  if (fs::exists(mesh_path)) mesh = read_ply(mesh_path);
+  else spdlog::warn("{} is missing: drawing the objects without the scene", mesh_path);
+  if (!mesh.triangles.empty()) r.set_scene_mesh(mesh);
+  SE3 first = SE3::identity();
+  if (fs::exists(traj_path)) {
+    Trajectory t = read_tum_trajectory(traj_path);
+    if (!t.empty()) first = t.front().se3();
+  }
+  SceneCamera c = mesh_view_camera(mesh, first);
+  return RenderCamera::look_at(c.eye, c.target, {0.f, 1.f, 0.f}, p.fov_y, p.width, p.height, p.znear, p.zfar);
+}
+
+int render_run(const RenderOptions& o) {
+  if (!fs::is_directory(o.run_dir)) throw Error("run folder '" + o.run_dir + "' does not exist");
+  Experiment e = load_run_config(o);
+  const RenderParams& p = e.render;
+  const std::string out_dir = o.out.empty() ? o.run_dir + "/render" : o.out;
+  fs::create_directories(out_dir);
+  const auto states = snapshots(o.run_dir, o.last_only);
+  RunObjects objects;
+  if (fs::exists(o.run_dir + "/objects.txt")) {
+    objects = read_run_objects(o.run_dir + "/objects.txt");
+  } else {
+    spdlog::warn("{}/objects.txt is missing (a run older than `seamless render`): cloth and rigid bodies are drawn "
+                 "as particles", o.run_dir);
+    e.render.show_particles = true;
+  }
+  const auto meshes = body_meshes(objects, e.spawn, e.solver);
+  Renderer r(p, p.width, p.height);
+  spdlog::info("re-rendering {} states of {} at {}x{}, {} view, with {}", states.size(), o.run_dir, p.width, p.height,
+               p.view, r.gl_info().renderer);
+  RenderCamera cam = p.view == "mesh" ? mesh_camera(r, o, p) : RenderCamera{};
+  std::unique_ptr<KinectFrames> kinect;
+  if (p.view == "kinect") kinect = std::make_unique<KinectFrames>(e, o.run_dir);
+  HeadlessOutput out(out_dir, p);
+  std::vector<vec4> warm;
+  for (const auto& [step, path] : states) {
+    if (kinect && !kinect->set(r, step)) throw Error("the run's input gives no frame for the Kinect view");
+    ParticleState s = read_particles_ply(path);
+    std::vector<RigidFrame> frames = match_rigid_frames(objects, s, warm);
+    r.draw(run_draw_list(s, frames, objects, meshes, 0.5f * e.solver.particle_diameter), cam);
+    out.add(r);
+  }
+  out.finish();
+  spdlog::info("wrote {} frames to {}/frames{}", out.frames(), out_dir, out.video_open() ? " and a video" : "");
+  return 0;
+}
+
+#else
+
+int render_run(const RenderOptions&) {
+  return not_built("render", "this build has no renderer (GL module off: apt-get install libegl-dev libgl-dev "
+                             "libepoxy-dev, then re-run cmake)");
+}
+
+#endif
+
+}  // namespace
+
+void add_render_command(CLI::App& app, std::function<int()>& action) {
+  auto o = std::make_shared<RenderOptions>();
+  auto* cmd = app.add_subcommand("render", "draw a finished run again from its saved states (PNG frames, video)");
+  cmd->add_option("run_dir", o->run_dir, "output folder of `seamless run`")->required();
+  cmd->add_option("--out", o->out, "where frames/ go (default: <run_dir>/render)");
+  cmd->add_option("--view", o->view, "mesh or kinect (default: the run's render.view)")
+      ->check(CLI::IsMember({"mesh", "kinect"}));
+  cmd->add_option("--width", o->width, "frame width, pixels (default: the run's render.width)")
+      ->check(CLI::Range(16, 16384));
+  cmd->add_option("--height", o->height, "frame height, pixels")->check(CLI::Range(16, 16384));
+  cmd->add_option("--set", o->sets, "override a key of the run's config, e.g. --set render.fluid=particles");
+  cmd->add_flag("--stage-images", o->stage_images, "also write the fluid stage images");
+  cmd->add_flag("--video", o->video, "encode video.mp4 (needs ffmpeg)");
+  cmd->add_flag("--last", o->last_only, "only the final state (particles.ply)");
+  cmd->callback([&action, o] { action = [o] { return render_run(*o); }; });
+}
+
+}  // namespace seamless::app
