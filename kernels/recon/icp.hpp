@@ -1,6 +1,8 @@
 // Point-to-plane ICP after KinectFusion (Newcombe et al. 2011, section 3.5): projective data
 // association, rejection by distance and normal angle, and the 6x6 normal equations of one
-// Gauss-Newton step summed over all pixels in a single device reduction. The host solves them.
+// Gauss-Newton step summed over all pixels in a single device reduction, then solved (6x6 Cholesky)
+// and applied to the estimate by a one-thread kernel, so that a frame's whole coarse-to-fine loop
+// runs on the device without a host round trip (the host reads the result once, at the end).
 //
 // Parametrisation (the "small-angle" linearisation of KinectFusion eq. 16-19): the current estimate
 // ref_T_cur is updated on the left, ref_T_cur <- exp(xi) ref_T_cur with xi = (omega, upsilon), so a
@@ -95,9 +97,92 @@ SEAMLESS_HD inline void add_point_to_plane(IcpSums& s, const Correspondence& c, 
   s.inliers += 1.0;
 }
 
-// Sums the point-to-plane normal equations over every pixel of the current level (one pass).
+// The estimate ref_T_cur of one Gauss-Newton loop, kept on the device in double: ~20 left
+// compositions of float rotations would drift from orthonormal.
+struct IcpPose {
+  double R[9];     // row-major
+  double t[3];
+  int stalled;     // the solve failed at this level: the level's later steps change nothing
+  int steps;       // Gauss-Newton steps taken; a stalled level counts its failing step
+};
+
+SEAMLESS_HD inline IcpPose to_icp_pose(const SE3& T) {
+  IcpPose p{};
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) p.R[3 * r + c] = T.R.m[r][c];
+  p.t[0] = T.t.x, p.t[1] = T.t.y, p.t[2] = T.t.z;
+  return p;
+}
+SEAMLESS_HD inline SE3 to_se3(const IcpPose& p) {
+  SE3 T;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) T.R.m[r][c] = static_cast<float>(p.R[3 * r + c]);
+  T.t = {static_cast<float>(p.t[0]), static_cast<float>(p.t[1]), static_cast<float>(p.t[2])};
+  return T;
+}
+
+// Solves J^T J x = -J^T r by Cholesky (the system is symmetric positive definite whenever it is
+// solvable at all). False when a pivot is not positive or the result is not finite.
+SEAMLESS_HD inline bool solve_normal_equations(const IcpSums& s, double x[6]) {
+  double A[6][6], L[6][6] = {}, y[6];
+  for (int i = 0, k = 0; i < 6; ++i)
+    for (int j = i; j < 6; ++j, ++k) A[i][j] = A[j][i] = s.jtj[k];
+  for (int j = 0; j < 6; ++j) {
+    double d = A[j][j];
+    for (int k = 0; k < j; ++k) d -= L[j][k] * L[j][k];
+    if (!(d > 0.0)) return false;
+    L[j][j] = sqrt(d);
+    for (int i = j + 1; i < 6; ++i) {
+      double v = A[i][j];
+      for (int k = 0; k < j; ++k) v -= L[i][k] * L[j][k];
+      L[i][j] = v / L[j][j];
+    }
+  }
+  for (int i = 0; i < 6; ++i) {  // L y = -J^T r
+    double v = -s.jtr[i];
+    for (int k = 0; k < i; ++k) v -= L[i][k] * y[k];
+    y[i] = v / L[i][i];
+  }
+  for (int i = 5; i >= 0; --i) {  // L^T x = y
+    double v = y[i];
+    for (int k = i + 1; k < 6; ++k) v -= L[k][i] * x[k];
+    x[i] = v / L[i][i];
+  }
+  for (int i = 0; i < 6; ++i)
+    if (!is_finite(x[i])) return false;
+  return true;
+}
+
+// p <- exp(xi) p with exp(xi) = (Rodrigues rotation of omega, translation upsilon): the left
+// update of the header comment, first order in xi like KinectFusion eq. 19, kept exactly rigid.
+SEAMLESS_HD inline void left_update(IcpPose& p, const double xi[6]) {
+  const double th = sqrt(xi[0] * xi[0] + xi[1] * xi[1] + xi[2] * xi[2]);
+  double D[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  if (th > 0.0) {
+    const double k[3] = {xi[0] / th, xi[1] / th, xi[2] / th}, s = sin(th), c = 1.0 - cos(th);
+    // R = I + sin(th) K + (1 - cos(th)) K^2, K the cross-product matrix of the unit axis k.
+    D[0] = 1 - c * (k[1] * k[1] + k[2] * k[2]), D[1] = -s * k[2] + c * k[0] * k[1], D[2] = s * k[1] + c * k[0] * k[2];
+    D[3] = s * k[2] + c * k[0] * k[1], D[4] = 1 - c * (k[0] * k[0] + k[2] * k[2]), D[5] = -s * k[0] + c * k[1] * k[2];
+    D[6] = -s * k[1] + c * k[0] * k[2], D[7] = s * k[0] + c * k[1] * k[2], D[8] = 1 - c * (k[0] * k[0] + k[1] * k[1]);
+  }
+  double R[9], t[3];
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) R[3 * r + c] = D[3 * r] * p.R[c] + D[3 * r + 1] * p.R[3 + c] + D[3 * r + 2] * p.R[6 + c];
+    t[r] = D[3 * r] * p.t[0] + D[3 * r + 1] * p.t[1] + D[3 * r + 2] * p.t[2] + xi[3 + r];
+  }
+  for (int i = 0; i < 9; ++i) p.R[i] = R[i];
+  for (int i = 0; i < 3; ++i) p.t[i] = t[i];
+}
+
+// Sums the point-to-plane normal equations over every pixel of the current level (one pass) at the
+// estimate *pose (level.ref_T_cur is ignored), into *out on the device.
 template <class Exec>
-IcpSums icp_reduce(const Exec& ex, IcpLevel level);
+void icp_reduce_into(const Exec& ex, IcpLevel level, const IcpPose* pose, IcpSums* out);
+
+// One Gauss-Newton step on the device: solves *sums and applies the update to *pose, unless the
+// level has stalled. first_of_level clears the stall of the previous level.
+template <class Exec>
+void icp_step(const Exec& ex, const IcpSums* sums, IcpPose* pose, bool first_of_level);
 
 // Moves vertex and normal maps into another frame (x -> T x, n -> R n); invalid pixels stay zero.
 // Used to express a world-space raycast in the coordinates of the camera it was rendered from.

@@ -45,8 +45,9 @@ SEAMLESS_HD inline void add_photometric(IcpSums& s, const RgbdLevel& L, const Co
 
 // Sums the combined geometric + photometric normal equations over the current level (one pass).
 // error holds the weighted sum of both terms; inliers counts geometric correspondences.
+// (at the estimate *pose, into *out on the device, like icp_reduce_into)
 template <class Exec>
-IcpSums rgbd_reduce(const Exec& ex, RgbdLevel level);
+void rgbd_reduce_into(const Exec& ex, RgbdLevel level, const IcpPose* pose, IcpSums* out);
 
 // Intensity in [0, 1] from 8-bit RGB (ITU-R BT.601 luma weights).
 template <class Exec>

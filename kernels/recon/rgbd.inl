@@ -6,9 +6,11 @@
 namespace seamless::kernels {
 
 template <class Exec>
-IcpSums rgbd_reduce(const Exec& ex, RgbdLevel L) {
-  const int w = L.geo.cur_vertex.width;
-  return ex.transform_reduce(L.geo.cur_vertex.count(), IcpSums{}, [=] SEAMLESS_HD(std::int64_t i) {
+void rgbd_reduce_into(const Exec& ex, RgbdLevel R, const IcpPose* pose, IcpSums* out) {
+  const int w = R.geo.cur_vertex.width;
+  ex.transform_reduce_into(R.geo.cur_vertex.count(), [=] SEAMLESS_HD(std::int64_t i) {
+    RgbdLevel L = R;
+    L.geo.ref_T_cur = to_se3(*pose);
     IcpSums s{};
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
     if (valid_point(L.geo.cur_vertex(x, y))) s.valid = 1.0;
@@ -18,7 +20,7 @@ IcpSums rgbd_reduce(const Exec& ex, RgbdLevel L) {
       add_photometric(s, L, c, x, y);
     }
     return s;
-  });
+  }, out);
 }
 
 template <class Exec>
@@ -35,6 +37,6 @@ void rgb_to_intensity(const Exec& ex, View2D<const uchar3> rgb, View2D<float> ou
 
 #define SEAMLESS_INSTANTIATE_RGBD(EXEC)                                                   \
   namespace seamless::kernels {                                                           \
-  template IcpSums rgbd_reduce<EXEC>(const EXEC&, RgbdLevel);                             \
+  template void rgbd_reduce_into<EXEC>(const EXEC&, RgbdLevel, const IcpPose*, IcpSums*); \
   template void rgb_to_intensity<EXEC>(const EXEC&, View2D<const uchar3>, View2D<float>); \
   }

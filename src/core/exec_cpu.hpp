@@ -79,4 +79,9 @@ T CpuExec::transform_reduce(std::int64_t n, T init, F fn) const {
   return sum;
 }
 
+template <class T, class F>
+void CpuExec::transform_reduce_into(std::int64_t n, F fn, T* out) const {
+  *out = transform_reduce(n, T{}, fn);
+}
+
 }  // namespace seamless

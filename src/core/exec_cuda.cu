@@ -5,6 +5,83 @@ namespace seamless {
 
 void CudaExec::synchronize() const { SEAMLESS_CUDA_CHECK(cudaDeviceSynchronize()); }
 
+CudaStream::CudaStream() {
+  cudaStream_t s = nullptr;
+  cudaEvent_t a = nullptr, b = nullptr;
+  SEAMLESS_CUDA_CHECK(cudaStreamCreateWithFlags(&s, cudaStreamNonBlocking));
+  SEAMLESS_CUDA_CHECK(cudaEventCreateWithFlags(&a, cudaEventDisableTiming));
+  SEAMLESS_CUDA_CHECK(cudaEventCreateWithFlags(&b, cudaEventDisableTiming));
+  stream_ = s, joined_ = a, done_ = b;
+}
+
+CudaStream::~CudaStream() {
+  cudaEventDestroy(static_cast<cudaEvent_t>(joined_));
+  cudaEventDestroy(static_cast<cudaEvent_t>(done_));
+  cudaStreamDestroy(static_cast<cudaStream_t>(stream_));
+}
+
+void CudaStream::after_default() {
+  auto e = static_cast<cudaEvent_t>(joined_);
+  SEAMLESS_CUDA_CHECK(cudaEventRecord(e, cudaStreamLegacy));
+  SEAMLESS_CUDA_CHECK(cudaStreamWaitEvent(static_cast<cudaStream_t>(stream_), e, 0));
+}
+
+void CudaStream::before_default() {
+  auto e = static_cast<cudaEvent_t>(done_);
+  SEAMLESS_CUDA_CHECK(cudaEventRecord(e, static_cast<cudaStream_t>(stream_)));
+  SEAMLESS_CUDA_CHECK(cudaStreamWaitEvent(cudaStreamLegacy, e, 0));
+}
+
+CudaGraph::~CudaGraph() {
+  abort_capture();
+  reset();
+}
+
+void CudaGraph::begin_capture(const CudaStream& s) {
+  if (capturing_) throw Error("CudaGraph::begin_capture: a capture is already open; end or abort it first");
+  SEAMLESS_CUDA_CHECK(cudaStreamBeginCapture(static_cast<cudaStream_t>(s.get()), cudaStreamCaptureModeThreadLocal));
+  capturing_ = s.get();
+}
+
+void CudaGraph::end_capture() {
+  if (!capturing_) throw Error("CudaGraph::end_capture: no capture is open (call begin_capture first)");
+  cudaGraph_t g = nullptr;
+  cudaError_t e = cudaStreamEndCapture(static_cast<cudaStream_t>(capturing_), &g);
+  capturing_ = nullptr;
+  if (e != cudaSuccess) {
+    if (g) cudaGraphDestroy(g);
+    detail::throw_cuda_error(e, "cudaStreamEndCapture", __FILE__, __LINE__);
+  }
+  reset();
+  cudaGraphExec_t x = nullptr;
+  e = cudaGraphInstantiate(&x, g, 0);
+  cudaGraphDestroy(g);
+  if (e != cudaSuccess) detail::throw_cuda_error(e, "cudaGraphInstantiate", __FILE__, __LINE__);
+  exec_ = x;
+}
+
+void CudaGraph::abort_capture() {
+  if (!capturing_) return;
+  cudaGraph_t g = nullptr;
+  cudaStreamEndCapture(static_cast<cudaStream_t>(capturing_), &g);  // invalidated captures end with an error
+  if (g) cudaGraphDestroy(g);
+  cudaGetLastError();  // clears the error that the failed capture left for the next check
+  capturing_ = nullptr;
+}
+
+void CudaGraph::launch(const CudaStream& s) const {
+  if (!exec_) throw Error("CudaGraph::launch: nothing captured (call begin_capture / end_capture first)");
+  SEAMLESS_CUDA_CHECK(cudaGraphLaunch(static_cast<cudaGraphExec_t>(exec_), static_cast<cudaStream_t>(s.get())));
+  launched_ = s.get();
+}
+
+void CudaGraph::reset() {
+  if (!exec_) return;
+  if (launched_) cudaStreamSynchronize(static_cast<cudaStream_t>(launched_));
+  cudaGraphExecDestroy(static_cast<cudaGraphExec_t>(exec_));
+  exec_ = nullptr, launched_ = nullptr;
+}
+
 namespace cuda_detail {
 
 void* scratch(std::size_t bytes) {
@@ -16,6 +93,27 @@ void* scratch(std::size_t bytes) {
     SEAMLESS_CUDA_CHECK(cudaMalloc(&ptr, size));
   }
   return ptr;
+}
+
+void* result_slot(std::size_t bytes) {
+  static void* ptr = nullptr;
+  static std::size_t size = 0;
+  if (bytes > size) {
+    if (ptr) SEAMLESS_CUDA_CHECK(cudaFree(ptr));
+    size = bytes;
+    SEAMLESS_CUDA_CHECK(cudaMalloc(&ptr, size));
+  }
+  return ptr;
+}
+
+unsigned* reduce_counter() {
+  static unsigned* counter = [] {
+    unsigned* c = nullptr;
+    SEAMLESS_CUDA_CHECK(cudaMalloc(&c, sizeof(unsigned)));
+    SEAMLESS_CUDA_CHECK(cudaMemset(c, 0, sizeof(unsigned)));
+    return c;
+  }();
+  return counter;
 }
 
 int multiprocessors() {

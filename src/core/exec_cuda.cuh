@@ -3,6 +3,7 @@
 #include <cub/cub.cuh>
 
 #include <cstdint>
+#include <string>
 
 #include "core/cuda_check.hpp"
 #include "core/exec.hpp"
@@ -12,6 +13,8 @@ namespace seamless {
 namespace cuda_detail {
 // One growing scratch allocation shared by the collectives (they run one at a time on stream 0).
 void* scratch(std::size_t bytes);
+// A device slot for a host-returned reduction's total, apart from scratch (which holds the partials).
+void* result_slot(std::size_t bytes);
 int multiprocessors();
 
 template <class F>
@@ -25,26 +28,39 @@ struct Plus {
   __device__ T operator()(const T& a, const T& b) const { return a + b; }
 };
 
+// Zeroed once; the last block of every reduction puts it back to zero (see below).
+unsigned* reduce_counter();
+
+// One launch for the whole sum (the "last block" pattern of the CUDA samples' threadFenceReduction):
+// every block writes its partial, and the block that finishes last, as counted by an atomic on a
+// counter that starts at zero, adds the partials and writes *out. No second launch, and *out
+// stays on the device for the next kernel in the stream.
 template <int kThreads, class T, class F>
-__global__ void transform_reduce_kernel(std::int64_t n, F fn, T* partial) {
+__global__ void transform_reduce_kernel(std::int64_t n, F fn, T* partial, unsigned* counter, T* out) {
   using BlockReduce = cub::BlockReduce<T, kThreads>;
   __shared__ typename BlockReduce::TempStorage tmp;
+  __shared__ bool last;
   T local{};
   for (std::int64_t i = static_cast<std::int64_t>(blockIdx.x) * kThreads + threadIdx.x; i < n;
        i += static_cast<std::int64_t>(gridDim.x) * kThreads)
     local = local + fn(i);
   T block = BlockReduce(tmp).Reduce(local, Plus{});
-  if (threadIdx.x == 0) partial[blockIdx.x] = block;
-}
-
-template <int kThreads, class T>
-__global__ void sum_partials_kernel(const T* partial, int m, T* out) {
-  using BlockReduce = cub::BlockReduce<T, kThreads>;
-  __shared__ typename BlockReduce::TempStorage tmp;
-  T local{};
-  for (int i = threadIdx.x; i < m; i += kThreads) local = local + partial[i];
-  T total = BlockReduce(tmp).Reduce(local, Plus{});
-  if (threadIdx.x == 0) *out = total;
+  if (threadIdx.x == 0) {
+    partial[blockIdx.x] = block;
+    __threadfence();  // the partial is visible device-wide before the counter says so
+    last = atomicAdd(counter, 1u) == gridDim.x - 1;
+  }
+  __syncthreads();
+  if (!last) return;
+  __threadfence();
+  T sum{};
+  for (unsigned i = threadIdx.x; i < gridDim.x; i += kThreads) sum = sum + partial[i];
+  __syncthreads();  // tmp is reused
+  T total = BlockReduce(tmp).Reduce(sum, Plus{});
+  if (threadIdx.x == 0) {
+    *out = total;
+    *counter = 0;
+  }
 }
 }  // namespace cuda_detail
 
@@ -53,7 +69,7 @@ void CudaExec::for_each(std::int64_t n, F fn) const {
   if (n <= 0) return;
   constexpr int kThreads = 256;
   auto blocks = static_cast<unsigned>((n + kThreads - 1) / kThreads);
-  cuda_detail::for_each_kernel<<<blocks, kThreads>>>(n, fn);
+  cuda_detail::for_each_kernel<<<blocks, kThreads, 0, static_cast<cudaStream_t>(stream)>>>(n, fn);
   SEAMLESS_CUDA_CHECK_LAUNCH("for_each");
 }
 
@@ -70,39 +86,66 @@ T CudaExec::exclusive_scan(const T* in, T* out, std::int64_t n) const {
   return last_out + last_in;
 }
 
+namespace cuda_detail {
+struct SortLayout {
+  std::size_t keys, values, cub;  // bytes: alternate keys, alternate values, CUB temp (256-aligned)
+  std::size_t total() const { return keys + values + cub; }
+};
+template <class K, class V>
+SortLayout sort_layout(std::int64_t n, int key_bits) {
+  auto align = [](std::size_t b) { return (b + 255) / 256 * 256; };
+  SortLayout L{align(sizeof(K) * n), align(sizeof(V) * n), 0};
+  cub::DoubleBuffer<K> dk(nullptr, nullptr);
+  cub::DoubleBuffer<V> dv(nullptr, nullptr);
+  SEAMLESS_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, L.cub, dk, dv, n, 0, key_bits));
+  return L;
+}
+}  // namespace cuda_detail
+
+template <class K, class V>
+std::size_t CudaExec::sort_by_key_temp_bytes(std::int64_t n, int key_bits) const {
+  return n <= 1 ? 0 : cuda_detail::sort_layout<K, V>(n, key_bits).total();
+}
+
 template <class K, class V>
 void CudaExec::sort_by_key(K* keys, V* values, std::int64_t n, int key_bits) const {
   if (n <= 1) return;
   // Scratch layout: [alternate keys | alternate values | CUB temp].
-  auto align = [](std::size_t b) { return (b + 255) / 256 * 256; };
-  std::size_t kb = align(sizeof(K) * n), vb = align(sizeof(V) * n);
-  std::size_t tmp = 0;
-  cub::DoubleBuffer<K> dk(keys, nullptr);
-  cub::DoubleBuffer<V> dv(values, nullptr);
-  SEAMLESS_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, tmp, dk, dv, n, 0, key_bits));
-  char* s = static_cast<char*>(cuda_detail::scratch(kb + vb + tmp));
-  dk = cub::DoubleBuffer<K>(keys, reinterpret_cast<K*>(s));
-  dv = cub::DoubleBuffer<V>(values, reinterpret_cast<V*>(s + kb));
-  SEAMLESS_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(s + kb + vb, tmp, dk, dv, n, 0, key_bits));
+  const cuda_detail::SortLayout L = cuda_detail::sort_layout<K, V>(n, key_bits);
+  if (temp && temp_bytes < L.total())
+    throw Error("CudaExec::sort_by_key: the caller's temp storage has " + std::to_string(temp_bytes) +
+                " bytes, the sort of " + std::to_string(n) + " pairs needs " + std::to_string(L.total()) +
+                "; size it with sort_by_key_temp_bytes");
+  char* s = static_cast<char*>(temp ? temp : cuda_detail::scratch(L.total()));
+  cudaStream_t st = static_cast<cudaStream_t>(stream);
+  std::size_t tmp = L.cub;
+  cub::DoubleBuffer<K> dk(keys, reinterpret_cast<K*>(s));
+  cub::DoubleBuffer<V> dv(values, reinterpret_cast<V*>(s + L.keys));
+  SEAMLESS_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(s + L.keys + L.values, tmp, dk, dv, n, 0, key_bits, st));
   if (dk.Current() != keys) {
-    SEAMLESS_CUDA_CHECK(cudaMemcpyAsync(keys, dk.Current(), sizeof(K) * n, cudaMemcpyDeviceToDevice));
-    SEAMLESS_CUDA_CHECK(cudaMemcpyAsync(values, dv.Current(), sizeof(V) * n, cudaMemcpyDeviceToDevice));
+    SEAMLESS_CUDA_CHECK(cudaMemcpyAsync(keys, dk.Current(), sizeof(K) * n, cudaMemcpyDeviceToDevice, st));
+    SEAMLESS_CUDA_CHECK(cudaMemcpyAsync(values, dv.Current(), sizeof(V) * n, cudaMemcpyDeviceToDevice, st));
   }
+}
+
+template <class T, class F>
+void CudaExec::transform_reduce_into(std::int64_t n, F fn, T* out) const {
+  constexpr int kThreads = 256;
+  std::int64_t wanted = std::max<std::int64_t>(1, (n + kThreads - 1) / kThreads);
+  int blocks = static_cast<int>(std::min<std::int64_t>(wanted, 4 * cuda_detail::multiprocessors()));
+  T* partial = static_cast<T*>(cuda_detail::scratch(sizeof(T) * blocks));
+  cuda_detail::transform_reduce_kernel<kThreads, T><<<blocks, kThreads>>>(n, fn, partial, cuda_detail::reduce_counter(),
+                                                                          out);
+  SEAMLESS_CUDA_CHECK_LAUNCH("transform_reduce");
 }
 
 template <class T, class F>
 T CudaExec::transform_reduce(std::int64_t n, T init, F fn) const {
   if (n <= 0) return init;
-  constexpr int kThreads = 256;
-  std::int64_t wanted = (n + kThreads - 1) / kThreads;
-  int blocks = static_cast<int>(std::min<std::int64_t>(wanted, 4 * cuda_detail::multiprocessors()));
-  T* partial = static_cast<T*>(cuda_detail::scratch(sizeof(T) * (blocks + 1)));
-  cuda_detail::transform_reduce_kernel<kThreads, T><<<blocks, kThreads>>>(n, fn, partial);
-  SEAMLESS_CUDA_CHECK_LAUNCH("transform_reduce");
-  cuda_detail::sum_partials_kernel<kThreads, T><<<1, kThreads>>>(partial, blocks, partial + blocks);
-  SEAMLESS_CUDA_CHECK_LAUNCH("transform_reduce partials");
+  T* total_dev = static_cast<T*>(cuda_detail::result_slot(sizeof(T)));
+  transform_reduce_into(n, fn, total_dev);
   T total{};
-  SEAMLESS_CUDA_CHECK(cudaMemcpy(&total, partial + blocks, sizeof(T), cudaMemcpyDeviceToHost));
+  SEAMLESS_CUDA_CHECK(cudaMemcpy(&total, total_dev, sizeof(T), cudaMemcpyDeviceToHost));
   return init + total;
 }
 

@@ -50,6 +50,13 @@ SEAMLESS_HD inline bool is_finite(float v) {
   return std::isfinite(v);
 #endif
 }
+SEAMLESS_HD inline bool is_finite(double v) {
+#ifdef __CUDA_ARCH__
+  return isfinite(v);
+#else
+  return std::isfinite(v);
+#endif
+}
 SEAMLESS_HD inline bool is_finite(vec3 a) { return is_finite(a.x) && is_finite(a.y) && is_finite(a.z); }
 
 // int3

@@ -1,8 +1,8 @@
 #include "recon/tracker.hpp"
 
-#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -92,35 +92,22 @@ void ReferenceMaps::set_from_raycast(const RaycastMaps& maps, const Intrinsics& 
 
 IcpStep solve_icp_step(const kernels::IcpSums& s) {
   Eigen::Matrix<double, 6, 6> A;
-  Eigen::Matrix<double, 6, 1> b;
-  int k = 0;
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0, k = 0; i < 6; ++i)
     for (int j = i; j < 6; ++j) A(i, j) = A(j, i) = s.jtj[k++];
-    b(i) = -s.jtr[i];
-  }
   IcpStep step;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(A, Eigen::EigenvaluesOnly);
   double lo = eig.eigenvalues()(0), hi = eig.eigenvalues()(5);
   step.condition = lo > 0 ? hi / lo : std::numeric_limits<double>::infinity();
   if (!(lo > 0) || !std::isfinite(step.condition)) return step;
-  Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(A);
-  if (ldlt.info() != Eigen::Success) return step;
-  Eigen::Matrix<double, 6, 1> x = ldlt.solve(b);
-  if (!x.allFinite()) return step;
-  for (int i = 0; i < 6; ++i) step.xi[i] = x(i);
-  step.solved = true;
+  step.solved = kernels::solve_normal_equations(s, step.xi);  // the solve the device loop runs
+  if (!step.solved) std::fill(step.xi, step.xi + 6, 0.0);
   return step;
 }
 
 SE3 se3_exp(const double xi[6]) {
-  Eigen::Vector3d w(xi[0], xi[1], xi[2]);
-  double angle = w.norm();
-  Eigen::Matrix3d R = angle > 0 ? Eigen::AngleAxisd(angle, w / angle).toRotationMatrix() : Eigen::Matrix3d::Identity();
-  SE3 T;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) T.R.m[r][c] = static_cast<float>(R(r, c));
-  T.t = {static_cast<float>(xi[3]), static_cast<float>(xi[4]), static_cast<float>(xi[5])};
-  return T;
+  kernels::IcpPose p = kernels::to_icp_pose(SE3::identity());
+  kernels::left_update(p, xi);
+  return kernels::to_se3(p);
 }
 
 double rotation_angle_deg(const mat3& R) {
@@ -151,46 +138,69 @@ bool Tracker::use_photometric(const FramePyramid& frame, const ReferenceMaps& re
          frame.level(0).intensity.width() > 0;
 }
 
-kernels::IcpSums Tracker::reduce(const FramePyramid& frame, const ReferenceMaps& ref, int level,
-                                 const SE3& ref_T_cur) const {
+void Tracker::set_pose(const SE3& ref_T_cur) const {
+  if (pose_.size() != 1 || pose_.device() != device_) pose_ = Buffer<kernels::IcpPose>(1, device_);
+  const kernels::IcpPose p = kernels::to_icp_pose(ref_T_cur);
+  pose_.copy_from_host(&p, 1);
+}
+
+kernels::IcpSums* Tracker::sums_slot(int level) const {
+  if (sums_.size() <= level || sums_.device() != device_) sums_ = Buffer<kernels::IcpSums>(level + 8, device_);
+  return sums_.data() + level;
+}
+
+void Tracker::reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, int level, const kernels::IcpPose* pose,
+                          kernels::IcpSums* out) const {
   const PyramidLevel& cur = frame.level(level);
   const ReferenceLevel& rl = ref.level(level);
   kernels::IcpLevel L{cur.vertices.cview(), cur.normals.cview(), rl.vertices.cview(), rl.normals.cview(), rl.K,
-                      ref_T_cur, params_.dist_threshold,
+                      SE3::identity(), params_.dist_threshold,
                       static_cast<float>(std::cos(params_.angle_threshold_deg * kPi / 180.0))};
-  return with_exec(device_, [&](const auto& ex) {
-    if (!use_photometric(frame, ref)) return kernels::icp_reduce(ex, L);
+  with_exec(device_, [&](const auto& ex) {
+    if (!use_photometric(frame, ref)) return kernels::icp_reduce_into(ex, L, pose, out);
     kernels::RgbdLevel R{L, cur.intensity.cview(), rl.intensity.cview(), 1.f, params_.photometric_weight,
                          params_.max_intensity_diff};
-    return kernels::rgbd_reduce(ex, R);
+    kernels::rgbd_reduce_into(ex, R, pose, out);
   });
 }
 
+kernels::IcpSums Tracker::reduce(const FramePyramid& frame, const ReferenceMaps& ref, int level,
+                                 const SE3& ref_T_cur) const {
+  set_pose(ref_T_cur);
+  reduce_into(frame, ref, level, pose_.data(), sums_slot(0));
+  kernels::IcpSums s;
+  memory::copy(&s, Device::CPU, sums_slot(0), device_, sizeof s);
+  return s;
+}
+
+// The whole coarse-to-fine loop is queued on the device (reduce, then solve and update, per
+// iteration); the host waits once, for the final estimate and the finest level's last system.
 TrackResult Tracker::track(const FramePyramid& frame, const ReferenceMaps& ref,
                            const SE3& initial_world_T_camera) const {
   TrackResult r;
   r.world_T_camera = initial_world_T_camera;
   if (ref.empty()) return r;
   const int levels = std::min({frame.levels(), ref.levels(), static_cast<int>(params_.iterations.size())});
-  SE3 ref_T_cur = ref.world_T_ref().inverse() * initial_world_T_camera;
-  bool degenerate = false;
-  for (int l = levels - 1; l >= 0; --l) {
+  set_pose(ref.world_T_ref().inverse() * initial_world_T_camera);
+  for (int l = levels - 1; l >= 0; --l)
     for (int it = 0; it < params_.iterations[l]; ++it) {
-      kernels::IcpSums s = reduce(frame, ref, l, ref_T_cur);
-      IcpStep step = solve_icp_step(s);
-      ++r.iterations;
-      if (l == 0) {
-        r.inliers = static_cast<std::int64_t>(s.inliers);
-        r.inlier_ratio = s.valid > 0 ? s.inliers / s.valid : 0.0;
-        r.residual_rms = s.inliers > 0 ? std::sqrt(s.error / s.inliers) : 0.0;
-        r.condition = step.condition;
-        degenerate = !step.solved;
-      }
-      if (!step.solved) break;  // nothing to add at this level; a finer one may still constrain it
-      ref_T_cur = orthonormalize(se3_exp(step.xi) * ref_T_cur);
+      reduce_into(frame, ref, l, pose_.data(), sums_slot(l));
+      with_exec(device_, [&](const auto& ex) { kernels::icp_step(ex, sums_slot(l), pose_.data(), it == 0); });
     }
+  kernels::IcpPose pose = pose_.to_host()[0];
+  r.iterations = pose.steps;
+  bool degenerate = false;
+  if (levels > 0 && params_.iterations[0] > 0) {  // statistics of the finest level's last system
+    kernels::IcpSums s;
+    memory::copy(&s, Device::CPU, sums_slot(0), device_, sizeof s);
+    IcpStep step = solve_icp_step(s);
+    r.inliers = static_cast<std::int64_t>(s.inliers);
+    r.inlier_ratio = s.valid > 0 ? s.inliers / s.valid : 0.0;
+    r.residual_rms = s.inliers > 0 ? std::sqrt(s.error / s.inliers) : 0.0;
+    r.condition = step.condition;
+    degenerate = !step.solved;
   }
-  r.world_T_camera = ref.world_T_ref() * ref_T_cur;
+  r.world_T_camera = ref.world_T_ref() * orthonormalize(kernels::to_se3(pose));
   r.status = degenerate ? TrackStatus::degenerate : TrackStatus::ok;
   check_loss(r, initial_world_T_camera);
   return r;

@@ -2,7 +2,8 @@
 // projective data association over a 3-level pyramid, coarse to fine, against a reference view
 // (the model raycast for frame-to-model, the previous frame for frame-to-frame); optionally with a
 // photometric term (RGB-D). Each Gauss-Newton iteration is one device reduction of the 6x6 normal
-// equations (kernels/recon/icp.hpp) and one 6x6 solve here on the host (Eigen LDLT).
+// equations and one 6x6 Cholesky solve and pose update on the device (kernels/recon/icp.hpp); the
+// host reads the result once per frame.
 // Tracking loss is detected, not hidden: see TrackStatus. docs/TRACKING.md has the details.
 #pragma once
 #include <cstdint>
@@ -88,13 +89,21 @@ class Tracker {
 
  private:
   bool use_photometric(const FramePyramid& frame, const ReferenceMaps& ref) const;
+  void reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, int level, const kernels::IcpPose* pose,
+                   kernels::IcpSums* out) const;
+  kernels::IcpSums* sums_slot(int level) const;
+  void set_pose(const SE3& ref_T_cur) const;
   void check_loss(TrackResult& r, const SE3& initial) const;
   TrackerParams params_;
   Device device_;
+  // Device state of the Gauss-Newton loop (reused from frame to frame): the estimate and one
+  // system per level.
+  mutable Buffer<kernels::IcpPose> pose_;
+  mutable Buffer<kernels::IcpSums> sums_;
 };
 
-// Host side of one Gauss-Newton step (exposed for tests): solves J^T J xi = -J^T r by LDLT and
-// reports the condition number of J^T J (largest / smallest eigenvalue; infinity when singular).
+// One Gauss-Newton step on the host (tests, statistics): solves J^T J xi = -J^T r with the device
+// loop's Cholesky (kernels::solve_normal_equations) and reports the condition number of J^T J (largest / smallest eigenvalue; infinity when singular).
 struct IcpStep {
   double xi[6] = {0, 0, 0, 0, 0, 0};  // omega (rad), upsilon (m)
   double condition = 0;

@@ -17,6 +17,8 @@ struct Moments {
 
 template <class Exec> void square(const Exec& ex, View<const float> in, View<float> out);
 template <class Exec> Moments moments(const Exec& ex, View<const float> in);
+// The same sum left on the device in *out (transform_reduce_into).
+template <class Exec> void moments_into(const Exec& ex, View<const float> in, Moments* out);
 template <class Exec> std::uint32_t scan(const Exec& ex, View<const std::uint32_t> in, View<std::uint32_t> out);
 template <class Exec> void sort(const Exec& ex, View<std::uint32_t> keys, View<std::int32_t> values, int bits);
 // Histogram with atomics: counts[v % bins]++ for every v.

@@ -17,6 +17,14 @@ Moments moments(const Exec& ex, View<const float> in) {
 }
 
 template <class Exec>
+void moments_into(const Exec& ex, View<const float> in, Moments* out) {
+  ex.transform_reduce_into(in.size, [=] SEAMLESS_HD(std::int64_t i) {
+    double v = in[i];
+    return Moments{v, v * v, 1};
+  }, out);
+}
+
+template <class Exec>
 std::uint32_t scan(const Exec& ex, View<const std::uint32_t> in, View<std::uint32_t> out) {
   return ex.exclusive_scan(in.data, out.data, in.size);
 }
@@ -43,6 +51,7 @@ void atomic_float_sum(const Exec& ex, View<const float> in, float* total) {
   namespace seamless::probe {                                                                                \
   template void square<EXEC>(const EXEC&, View<const float>, View<float>);                                   \
   template Moments moments<EXEC>(const EXEC&, View<const float>);                                            \
+  template void moments_into<EXEC>(const EXEC&, View<const float>, Moments*);                                \
   template std::uint32_t scan<EXEC>(const EXEC&, View<const std::uint32_t>, View<std::uint32_t>);           \
   template void sort<EXEC>(const EXEC&, View<std::uint32_t>, View<std::int32_t>, int);                       \
   template void histogram<EXEC>(const EXEC&, View<const std::uint32_t>, View<std::uint32_t>);               \

@@ -58,6 +58,22 @@ TEST_P(ExecTest, TransformReduceOfStruct) {
   EXPECT_EQ(m.sum_sq, sq);
 }
 
+// The device-resident variant, run several times into one buffer: the "last block" counter must
+// be back at zero after every reduction, and an empty range must write a zero sum.
+TEST_P(ExecTest, TransformReduceIntoLeavesTheSumOnTheDevice) {
+  for (std::int64_t n : {std::int64_t{250001}, std::int64_t{1}, std::int64_t{0}, std::int64_t{70000}}) {
+    std::vector<float> h(static_cast<std::size_t>(n));
+    double sum = 0;
+    for (std::int64_t i = 0; i < n; ++i) sum += h[i] = static_cast<float>(i % 13);
+    auto in = Buffer<float>::from_host(h, dev());
+    auto out = Buffer<probe::Moments>::from_host({probe::Moments{-1.0, -1.0, -1}}, dev());  // poisoned
+    with_exec(dev(), [&](const auto& ex) { probe::moments_into(ex, in.cview(), out.data()); });
+    probe::Moments m = out.to_host()[0];
+    EXPECT_EQ(m.count, n);
+    EXPECT_EQ(m.sum, sum);
+  }
+}
+
 TEST_P(ExecTest, ExclusiveScanAndTotal) {
   auto h = random_keys(77777, 9, 1);
   auto in = Buffer<std::uint32_t>::from_host(h, dev());
