@@ -9,6 +9,7 @@
 //   -> cloth_strain_limit per colour (passes)
 //   -> update_velocity -> velocity_effects (swap sv/vtmp) -> write_back
 #pragma once
+#include <cstddef>
 #include <cstdint>
 
 #include "kernels/physics/sim_views.hpp"
@@ -19,6 +20,8 @@ namespace seamless::kernels {
 template <class Exec> void predict(const Exec& ex, const SimViews& S);
 // Stable sort of (key, value) pairs by the low `bits` bits of key (the executor's radix sort).
 template <class Exec> void sort_cells(const Exec& ex, std::uint32_t* keys, int* values, std::int64_t n, int bits);
+// Bytes of the executor's temp storage that sort_cells needs (CudaExec::temp; 0 on the CPU).
+template <class Exec> std::size_t sort_cells_temp_bytes(const Exec& ex, std::int64_t n, int bits);
 // Gathers the sorted arrays after sort_by_key(key, order) and fills rank.
 template <class Exec> void reorder(const Exec& ex, const SimViews& S);
 // Cell offsets of sorted keys: start[k] = number of keys below k, k in [0, cells] (cells + 1
@@ -49,10 +52,8 @@ template <class Exec> void update_velocity(const Exec& ex, const SimViews& S);
 // XSPH viscosity, vorticity confinement, Akinci cohesion and surface tension, cloth
 // aerodynamics; writes vtmp.
 template <class Exec> void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid);
-// x, v back to id order.
+// x, v back to id order; counters[4] = bits of the largest |v|^2 (reset by predict).
 template <class Exec> void write_back(const Exec& ex, const SimViews& S);
-// max |v|^2 over the active particles.
-template <class Exec> float max_speed2(const Exec& ex, const SimViews& S);
 
 }  // namespace seamless::kernels
 
@@ -75,5 +76,5 @@ template <class Exec> float max_speed2(const Exec& ex, const SimViews& S);
   template void update_velocity<E>(const E&, const SimViews&);                                              \
   template void velocity_effects<E>(const E&, const SimViews&, bool);                                       \
   template void write_back<E>(const E&, const SimViews&);                                                   \
-  template float max_speed2<E>(const E&, const SimViews&);                                                  \
+  template std::size_t sort_cells_temp_bytes<E>(const E&, std::int64_t, int);                              \
   }

@@ -13,10 +13,6 @@ SEAMLESS_HD inline bool both_fluid(std::uint32_t a, std::uint32_t b) {
   return phase::is(a, phase::kFluid) && phase::is(b, phase::kFluid);
 }
 
-struct MaxF {
-  float v;
-};
-SEAMLESS_HD inline MaxF operator+(MaxF a, MaxF b) { return {fmaxf(a.v, b.v)}; }
 
 // Pairs that never interact are left out of the lists: particles of one rigid body, and
 // particles of one cloth unless it collides with itself (then only pairs that are not already
@@ -164,12 +160,18 @@ void predict(const Exec& ex, const SimViews& S) {
     S.pred[i] = p;
     S.key[i] = S.grid.key(S.grid.cell_of(p));
     S.order[i] = static_cast<int>(i);
+    if (i == 0) S.counters[4] = 0;  // largest |v|^2 of this substep, found by write_back
   });
 }
 
 template <class Exec>
 void sort_cells(const Exec& ex, std::uint32_t* keys, int* values, std::int64_t n, int bits) {
   ex.sort_by_key(keys, values, n, bits);
+}
+
+template <class Exec>
+std::size_t sort_cells_temp_bytes(const Exec& ex, std::int64_t n, int bits) {
+  return ex.template sort_by_key_temp_bytes<std::uint32_t, int>(n, bits);
 }
 
 template <class Exec>
@@ -295,12 +297,13 @@ void prepare_constraints(const Exec& ex, const SimViews& S) {
     const float h = S.c.h, inv_rho0 = 1.f / S.c.rest_density, sw = S.c.solid_density_scale;
     float rho = S.c.W.poly6(0.f), sum2 = 0.f;
     vec3 gi{0.f, 0.f, 0.f};
+    const bool mixed = S.nsolid[s] != 0;  // otherwise every neighbour is fluid: no phase loads
     for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
       int j = S.nbrs(s)[k * S.nbr_col];
       vec3 r = p - S.sp[j];
       float wgt = S.c.W.poly6(length2(r));
       vec3 g = S.c.W.spiky_grad(r) * inv_rho0;
-      if (phase::is(S.sphase[j], phase::kFluid)) {
+      if (!mixed || phase::is(S.sphase[j], phase::kFluid)) {
         rho += wgt;
         gi += g;
         sum2 += length2(g);
@@ -335,12 +338,13 @@ void solve_contacts_fluid(const Exec& ex, const SimViews& S) {
     if (phase::is(S.sphase[s], phase::kFluid)) {
       // PBF position update (eq. 12) with the artificial pressure s_corr (eq. 13, n = 4).
       const float li = S.lambda[s], sw = S.c.solid_density_scale;
+      const bool mixed = S.nsolid[s] != 0;  // otherwise every neighbour is fluid: no phase loads
       vec3 f{0.f, 0.f, 0.f};
       for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
         int j = S.nbrs(s)[k * S.nbr_col];
         vec3 r = p - S.sp[j];
         vec3 g = S.c.W.spiky_grad(r);
-        if (phase::is(S.sphase[j], phase::kFluid)) {
+        if (!mixed || phase::is(S.sphase[j], phase::kFluid)) {
           float sc = 0.f;
           if (S.c.scorr_k > 0.f) {
             float q = S.c.W.poly6(length2(r)) * S.c.scorr_inv_wdq;
@@ -551,16 +555,17 @@ namespace detail {
 
 // Akinci 2013: cohesion (eq. 1) and curvature (eq. 5) accelerations, with the symmetrising
 // factor K_ij = 2 rho_0 / (rho_i + rho_j) (eq. 6). Masses are volume fractions 1 / rho_0.
-SEAMLESS_HD inline vec3 fluid_forces(const SimViews& S, int s) {
+// dv_visc: the XSPH sum of s, from the vorticity pass.
+SEAMLESS_HD inline vec3 fluid_forces(const SimViews& S, int s, vec3 dv_visc) {
   const float inv_rho0 = 1.f / S.c.rest_density;
-  const vec3 p = S.sp[s], vi = S.sv[s], wi = S.vort[s], ni = S.cnormal[s];
-  vec3 dv_visc{0.f, 0.f, 0.f}, eta{0.f, 0.f, 0.f}, acc{0.f, 0.f, 0.f};
+  const vec3 p = S.sp[s], wi = S.vort[s], ni = S.cnormal[s];
+  const bool mixed = S.nsolid[s] != 0;  // otherwise every neighbour is fluid: no phase loads
+  vec3 eta{0.f, 0.f, 0.f}, acc{0.f, 0.f, 0.f};
   for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
     int j = S.nbrs(s)[k * S.nbr_col];
-    if (!phase::is(S.sphase[j], phase::kFluid)) continue;
+    if (mixed && !phase::is(S.sphase[j], phase::kFluid)) continue;
     vec3 r = p - S.sp[j];
-    float l2 = length2(r), l = sqrtf(l2);
-    dv_visc += (S.sv[j] - vi) * (S.c.W.poly6(l2) * inv_rho0);  // XSPH, PBF eq. 17
+    float l = sqrtf(length2(r));
     eta += S.c.W.spiky_grad(r) * (S.vort_len[j] * inv_rho0);
     float K = 2.f * S.c.rest_density / (S.density[s] + S.density[j]);
     vec3 coh = l > 1e-9f ? r * (-S.c.cohesion * inv_rho0 * S.c.W.akinci(l) / l) : vec3{0.f, 0.f, 0.f};
@@ -591,23 +596,30 @@ SEAMLESS_HD inline vec3 cloth_aero(const SimViews& S, int s) {
 template <class Exec>
 void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
   if (has_fluid) {
-    // Vorticity omega_i = sum_j v_ij x grad_j W_ij (PBF eq. 15) and Akinci's colour-field normal
-    // n_i = h sum_j (1 / rho_j) grad W_ij (Akinci 2013, eq. 4; dissertation eq. 4.21).
+    // Vorticity omega_i = sum_j v_ij x grad_j W_ij (PBF eq. 15), Akinci's colour-field normal
+    // n_i = h sum_j (1 / rho_j) grad W_ij (Akinci 2013, eq. 4; dissertation eq. 4.21), and the
+    // XSPH sum (PBF eq. 17), which needs only this pass's velocities (kept in vtmp for
+    // fluid_forces: one neighbour loop fewer that gathers velocities).
     ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t i) {
       const int s = static_cast<int>(i);
       if (!phase::is(S.sphase[s], phase::kFluid)) return;
       const float inv_rho0 = 1.f / S.c.rest_density;
-      vec3 w{0.f, 0.f, 0.f}, n{0.f, 0.f, 0.f};
+      const vec3 p = S.sp[s], vi = S.sv[s];
+      const bool mixed = S.nsolid[s] != 0;  // otherwise every neighbour is fluid: no phase loads
+      vec3 w{0.f, 0.f, 0.f}, n{0.f, 0.f, 0.f}, dv_visc{0.f, 0.f, 0.f};
       for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
         int j = S.nbrs(s)[k * S.nbr_col];
-        if (!phase::is(S.sphase[j], phase::kFluid)) continue;
-        vec3 g = S.c.W.spiky_grad(S.sp[s] - S.sp[j]);
-        w += cross(S.sv[j] - S.sv[s], -g) * inv_rho0;
+        if (mixed && !phase::is(S.sphase[j], phase::kFluid)) continue;
+        vec3 r = p - S.sp[j], vj = S.sv[j];
+        vec3 g = S.c.W.spiky_grad(r);
+        w += cross(vj - vi, -g) * inv_rho0;
         n += g * S.h_rho[j];
+        dv_visc += (vj - vi) * (S.c.W.poly6(length2(r)) * inv_rho0);
       }
       S.vort[s] = w;
       S.vort_len[s] = length(w);  // read by every neighbour in fluid_forces
       S.cnormal[s] = n;
+      S.vtmp[s] = dv_visc;
     });
   }
   const bool aero = S.has_cloth_constraints && (S.c.drag > 0.f || S.c.lift > 0.f);
@@ -615,7 +627,7 @@ void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
     const int s = static_cast<int>(i);
     std::uint32_t ph = S.sphase[s];
     vec3 v = S.sv[s];
-    if (has_fluid && phase::is(ph, phase::kFluid)) v += detail::fluid_forces(S, s);
+    if (has_fluid && phase::is(ph, phase::kFluid)) v += detail::fluid_forces(S, s, S.vtmp[s]);
     if (aero && phase::is(ph, phase::kCloth)) v += detail::cloth_aero(S, s);
     S.vtmp[s] = v;
   });
@@ -627,12 +639,12 @@ void write_back(const Exec& ex, const SimViews& S) {
     int id = S.order[s];
     S.x[id] = S.sp[s];
     S.v[id] = S.sv[s];
+    // Largest |v|^2 for stats() without a reduction: the bits of non-negative floats order like
+    // ints. Read first: the shared maximum rarely changes, so most particles only load it.
+    const int v2 = nonneg_float_order(length2(S.sv[s]));
+    if (v2 > atomic_load(&S.counters[4])) atomic_max(&S.counters[4], v2);
   });
 }
 
-template <class Exec>
-float max_speed2(const Exec& ex, const SimViews& S) {
-  return ex.transform_reduce(S.n, detail::MaxF{0.f}, [=] SEAMLESS_HD(std::int64_t i) { return detail::MaxF{length2(S.v[i])}; }).v;
-}
 
 }  // namespace seamless::kernels

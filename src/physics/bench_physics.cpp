@@ -8,8 +8,9 @@ namespace seamless {
 
 namespace {
 
-SolverParams bench_params(std::int64_t capacity) {
+SolverParams bench_params(std::int64_t capacity, bool graph) {
   SolverParams p;
+  p.cuda_graph = graph;
   p.max_speed = 2.f;  // one substep at dt = 0.01 s, d = 0.04 m
   p.max_particles = capacity;
   return p;
@@ -27,8 +28,8 @@ PhysicsBenchCase make_case(const std::string& name, const std::string& detail, s
   return {name, detail, [s] { s->step(); }, s};
 }
 
-PhysicsBenchCase fluid(Device dev, const std::string& name, int nx, int ny, int nz) {
-  auto s = std::make_shared<ParticleSolver>(bench_params(std::int64_t{nx} * ny * nz), dev);
+PhysicsBenchCase fluid(Device dev, bool graph, const std::string& name, int nx, int ny, int nz) {
+  auto s = std::make_shared<ParticleSolver>(bench_params(std::int64_t{nx} * ny * nz, graph), dev);
   const float d = s->params().particle_diameter;
   s->set_scene_sdf(floor_box(0.5f * nx * d + 0.2f));
   SpawnParams f;
@@ -37,8 +38,8 @@ PhysicsBenchCase fluid(Device dev, const std::string& name, int nx, int ny, int 
   return make_case(name, std::to_string(s->size()) + " fluid particles, 2 iterations", s);
 }
 
-PhysicsBenchCase cloth(Device dev, const std::string& name, int n) {
-  auto s = std::make_shared<ParticleSolver>(bench_params(std::int64_t{n} * n), dev);
+PhysicsBenchCase cloth(Device dev, bool graph, const std::string& name, int n) {
+  auto s = std::make_shared<ParticleSolver>(bench_params(std::int64_t{n} * n, graph), dev);
   s->set_scene_sdf(floor_box(0.05f * n + 1.f));
   SpawnParams c;
   c.kind = "cloth", c.nx = n, c.ny = n, c.position = {0.f, 1.f, 0.f}, c.pinned = {0, 1};
@@ -46,8 +47,8 @@ PhysicsBenchCase cloth(Device dev, const std::string& name, int n) {
   return make_case(name, std::to_string(n) + "x" + std::to_string(n) + " cloth, 2 iterations", s);
 }
 
-PhysicsBenchCase rigid(Device dev, const std::string& name, int bodies) {
-  auto s = std::make_shared<ParticleSolver>(bench_params(std::int64_t{bodies} * 64), dev);
+PhysicsBenchCase rigid(Device dev, bool graph, const std::string& name, int bodies) {
+  auto s = std::make_shared<ParticleSolver>(bench_params(std::int64_t{bodies} * 64, graph), dev);
   const float d = s->params().particle_diameter;
   int side = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(bodies))));
   s->set_scene_sdf(floor_box(0.5f * side * 6 * d + 0.5f));
@@ -64,15 +65,20 @@ PhysicsBenchCase rigid(Device dev, const std::string& name, int bodies) {
 
 std::vector<PhysicsBenchCase> physics_bench_cases(Device dev, const std::string& scale) {
   std::vector<PhysicsBenchCase> out;
-  if (scale == "paper" || scale == "all") {
-    out.push_back(fluid(dev, "fluid_10k", 25, 16, 25));  // 10,000
-    out.push_back(cloth(dev, "cloth_40x40", 40));
-    out.push_back(rigid(dev, "rigid_4", 4));
-  }
-  if (scale == "large" || scale == "all") {
-    out.push_back(fluid(dev, "fluid_1m", 100, 100, 100));
-    out.push_back(cloth(dev, "cloth_512x512", 512));
-    out.push_back(rigid(dev, "rigid_4096", 4096));
+  // On CUDA every scene also runs without graphs ("_nograph"), to compare (solver.cuda_graph).
+  for (bool graph : {true, false}) {
+    if (!graph && dev != Device::CUDA) break;
+    const std::string tag = graph ? "" : "_nograph";
+    if (scale == "paper" || scale == "all") {
+      out.push_back(fluid(dev, graph, "fluid_10k" + tag, 25, 16, 25));  // 10,000
+      out.push_back(cloth(dev, graph, "cloth_40x40" + tag, 40));
+      out.push_back(rigid(dev, graph, "rigid_4" + tag, 4));
+    }
+    if (scale == "large" || scale == "all") {
+      out.push_back(fluid(dev, graph, "fluid_1m" + tag, 100, 100, 100));
+      out.push_back(cloth(dev, graph, "cloth_512x512" + tag, 512));
+      out.push_back(rigid(dev, graph, "rigid_4096" + tag, 4096));
+    }
   }
   return out;
 }

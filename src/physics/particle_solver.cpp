@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <exception>
 #include <fstream>
 #include <utility>
 
@@ -106,8 +107,22 @@ struct ParticleSolver::Impl {
   double time = 0.0;
   std::int64_t steps = 0;
   float rho0 = 1.f, eps = 0.f;
+  // Anything a captured step points to or depends on (particle count, buffers, constraints, scene)
+  // bumps the generation; a CUDA graph is captured for a generation that one step has already
+  // run with, and replayed while the generation, dt and the substeps stay the same.
+  std::uint64_t generation = 0, stepped_generation = ~std::uint64_t{0};
+#if SEAMLESS_HAS_CUDA
+  std::unique_ptr<CudaStream> stream;
+  CudaGraph graph;
+  Buffer<unsigned char> sort_temp;  // the sort's own temp storage (the graph keeps pointing at it)
+  std::int64_t sort_temp_n = -1;    // particle count sort_temp was sized for
+  std::uint64_t graph_generation = ~std::uint64_t{0};
+  float graph_dt = 0.f;
+  int graph_substeps = 0;
+  bool graph_failed = false;
+#endif
 
-  Impl(const SolverParams& p, Device d) : P(p), dev(d), counters(4, d) {
+  Impl(const SolverParams& p, Device d) : P(p), dev(d), counters(5, d) {
     counters.zero();
     compute_fluid_constants();
   }
@@ -204,12 +219,88 @@ struct ParticleSolver::Impl {
     return S;
   }
 
+  // Grid size and the buffers it needs for n particles; a reallocation bumps the generation.
   void prepare_grid() {
     bits = grid_bits(n);
     std::int64_t cells = std::int64_t{1} << (3 * bits);
+    const void* before[3] = {cell_start.data(), snbr.data(), nullptr};
     cell_start.reserve_discard(cells + 1, dev);
     if (!static_host.empty()) snbr.reserve_discard(cap * (P.max_static_neighbours + 1), dev);
+#if SEAMLESS_HAS_CUDA
+    before[2] = sort_temp.data();
+    if (dev == Device::CUDA && sort_temp_n != n) {
+      std::size_t need = K::sort_cells_temp_bytes(CudaExec{}, n, 3 * bits);
+      if (static_cast<std::size_t>(sort_temp.size()) < need)
+        sort_temp.reserve_discard(static_cast<std::int64_t>(need + need / 4), dev);
+      sort_temp_n = n;
+    }
+    if (before[2] != sort_temp.data()) ++generation;
+#endif
+    if (before[0] != cell_start.data() || before[1] != snbr.data()) ++generation;
   }
+
+  // Calls fn(executor): on CUDA, one that launches on the solver's own stream and sorts in its
+  // own temp storage (so that a step can be captured as a graph).
+  template <class F>
+  void run(F&& fn) {
+#if SEAMLESS_HAS_CUDA
+    if (dev == Device::CUDA) {
+      if (!stream) stream = std::make_unique<CudaStream>();
+      CudaExec ex;
+      ex.stream = stream->get(), ex.temp = sort_temp.data(), ex.temp_bytes = static_cast<std::size_t>(sort_temp.size());
+      fn(ex);
+      return;
+    }
+#endif
+    with_exec(dev, fn);
+  }
+
+  // k substeps of dt / k. On CUDA they run on the solver's stream, ordered after what the default
+  // stream holds and before what it gets next (no host synchronisation), as one graph launch
+  // when solver.cuda_graph is set and the scene did not change since the last step.
+  void advance(float dt, int k) {
+    if (n == 0) return;
+    prepare_grid();
+#if SEAMLESS_HAS_CUDA
+    if (dev == Device::CUDA) {
+      if (!stream) stream = std::make_unique<CudaStream>();
+      stream->after_default();
+      if (!replay_graph(dt, k))
+        for (int i = 0; i < k; ++i) substep(dt / static_cast<float>(k));
+      stream->before_default();
+      stepped_generation = generation;
+      return;
+    }
+#endif
+    for (int i = 0; i < k; ++i) substep(dt / static_cast<float>(k));
+    stepped_generation = generation;
+  }
+
+#if SEAMLESS_HAS_CUDA
+  // Captures the step (if the graph held is not for this generation, dt and substeps) and
+  // launches it. A scene that changed since the last step is stepped directly: a capture pays
+  // only when it is replayed (an emitter adding particles every step never captures). If the
+  // capture fails, the step runs directly and graphs stay off (nothing recorded was run).
+  bool replay_graph(float dt, int k) {
+    if (!P.cuda_graph || graph_failed || generation != stepped_generation) return false;
+    if (!graph.ready() || graph_generation != generation || graph_dt != dt || graph_substeps != k) {
+      try {
+        graph.begin_capture(*stream);
+        for (int i = 0; i < k; ++i) substep(dt / static_cast<float>(k));
+        graph.end_capture();
+      } catch (const std::exception& e) {
+        graph.abort_capture();
+        graph.reset();
+        graph_failed = true;
+        spdlog::warn("particle solver: capturing the step as a CUDA graph failed ({}); stepping without graphs", e.what());
+        return false;
+      }
+      graph_generation = generation, graph_dt = dt, graph_substeps = k;
+    }
+    graph.launch(*stream);
+    return true;
+  }
+#endif
 
   // Sort, grid and neighbour lists of the predicted positions (S.pred must be filled).
   template <class Ex>
@@ -222,12 +313,10 @@ struct ParticleSolver::Impl {
 
   // One substep of Algorithm 1 (dissertation section 4.2.2) with Macklin 2014's additions.
   void substep(float dt) {
-    if (n == 0) return;
-    prepare_grid();
     K::SimViews S = views(dt);
     const bool has_fluid = n_fluid > 0, has_cloth = !edge_a.empty() || !bends.empty();
     const bool effects = has_fluid || (n_cloth > 0 && (P.drag > 0.f || P.lift > 0.f));
-    with_exec(dev, [&](const auto& ex) {
+    run([&](const auto& ex) {
       K::predict(ex, S);
       build_neighbours(ex, S);
       for (int i = 0; i < P.stabilization_iterations; ++i) K::stabilize(ex, S);
@@ -377,6 +466,7 @@ struct ParticleSolver::Impl {
   std::int64_t add_batch(const ParticleBatch& b) {
     const std::int64_t m = b.size(), first = n;
     if (m == 0) return first;
+    ++generation;
     ensure_capacity(n + m);
     std::uint32_t flags = 0;
     if (b.kind == ParticleBatch::kFluid) flags = K::phase::kFluid;
@@ -459,6 +549,7 @@ struct ParticleSolver::Impl {
   }
 
   void rebuild_static() {
+    ++generation;
     const std::int64_t ns = static_cast<std::int64_t>(static_host.size());
     int sb = grid_bits(ns);
     sgrid = K::GridSpec::for_radius(std::max(P.fluid_smoothing * P.particle_diameter, 1.5f * P.particle_diameter), sb);
@@ -488,7 +579,10 @@ void ParticleSolver::add_static_particles(const std::vector<vec3>& points) {
   impl_->rebuild_static();
 }
 
-void ParticleSolver::clear_static_particles() { impl_->static_host.clear(); }
+void ParticleSolver::clear_static_particles() {
+  impl_->static_host.clear();
+  ++impl_->generation;
+}
 
 void ParticleSolver::set_scene_sdf(const kernels::SceneSdf& sdf) {
   const float* g = impl_->sdf.grid;
@@ -496,6 +590,7 @@ void ParticleSolver::set_scene_sdf(const kernels::SceneSdf& sdf) {
   vec3 origin = impl_->sdf.origin;
   float voxel = impl_->sdf.voxel;
   impl_->sdf = sdf;
+  ++impl_->generation;
   impl_->sdf.grid = g, impl_->sdf.dims = dims, impl_->sdf.origin = origin, impl_->sdf.voxel = voxel;
 }
 
@@ -505,6 +600,7 @@ void ParticleSolver::set_scene_sdf_grid(const std::vector<float>& values, int3 d
                 std::to_string(dims.x) + "x" + std::to_string(dims.y) + "x" + std::to_string(dims.z) +
                 " grid with a positive voxel size");
   impl_->sdf_grid = Buffer<float>::from_host(values, impl_->dev);
+  ++impl_->generation;
   impl_->sdf.grid = impl_->sdf_grid.data(), impl_->sdf.dims = dims, impl_->sdf.origin = origin, impl_->sdf.voxel = voxel;
 }
 
@@ -528,8 +624,7 @@ void ParticleSolver::step(float dt) {
   if (dt < 0.f) dt = impl_->P.dt;
   impl_->spawn_due();
   impl_->run_emitters(dt);
-  const int k = substeps(dt);
-  for (int i = 0; i < k; ++i) impl_->substep(dt / static_cast<float>(k));
+  impl_->advance(dt, substeps(dt));
   impl_->time += dt;
   ++impl_->steps;
 }
@@ -542,14 +637,12 @@ SolverStats ParticleSolver::stats() const {
   s.static_particles = static_cast<std::int64_t>(I.static_host.size());
   s.substeps = substeps();
   s.time = I.time, s.steps = I.steps, s.emitter_dropped = I.emitter_dropped;
+  // One small read: the counters the kernels keep on the device (overflow, longest lists, the
+  // largest |v|^2 of the last step).
   std::vector<int> c = I.counters.to_host();
   s.neighbour_overflow = c[0], s.static_neighbour_overflow = c[1];
   s.max_neighbours_seen = c[2], s.max_static_neighbours_seen = c[3];
-  if (I.n > 0) {
-    K::SimViews S = I.views(I.P.dt);
-    float m2 = with_exec(I.dev, [&](const auto& ex) { return K::max_speed2(ex, S); });
-    s.max_speed = std::sqrt(m2);
-  }
+  if (I.n > 0) s.max_speed = std::sqrt(K::nonneg_float_from_order(c[4]));
   if (s.neighbour_overflow > 0 || s.static_neighbour_overflow > 0)
     spdlog::warn("particle solver: {} neighbour lists and {} scene lists exceeded the cap ({} / {}); raise "
               "solver.max_neighbours / solver.max_static_neighbours",

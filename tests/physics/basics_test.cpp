@@ -1,6 +1,7 @@
 // Free fall, momentum conservation, the substep rule and tunnelling (docs/PHYSICS.md).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "physics/particle_solver.hpp"
@@ -38,6 +39,8 @@ TEST(PhysicsFreeFall, EqualsSymplecticEuler) {
       EXPECT_FLOAT_EQ(st.v[i].y, v[i].y);
     }
   }
+  // stats() reads the largest speed from the counter write_back keeps on the device.
+  EXPECT_FLOAT_EQ(s.stats().max_speed, std::max(length(v[0]), length(v[1])));
 }
 
 // No gravity, no scene: rigid cubes and a fluid blob collide. Every pairwise correction is
