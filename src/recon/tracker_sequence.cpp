@@ -214,7 +214,7 @@ TrackResult TrackingSession::track_external(const RgbdFrame& frame) {
     r.status = TrackStatus::degenerate;  // the library found no solution (it does not say why)
     return r;
   }
-  r.world_T_camera = last_good_ * e->prev_T_cur;
+  r.world_T_camera = external::make_rigid(last_good_ * e->prev_T_cur);  // float products drift off SO(3)
   r.residual_rms = e->residual_rms;
   r.inlier_ratio = e->inlier_ratio;
   r.inliers = e->inliers;

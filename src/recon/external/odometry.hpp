@@ -45,6 +45,12 @@ class Odometry {
 // tracker section of the experiment (the settings the libraries share with ours, e.g. dist_threshold).
 using OdometryFactory = std::function<std::unique_ptr<Odometry>(const Intrinsics& K, const TrackerParams& p)>;
 
+// A library's 4x4 result (row-major, rows 0-2 used) as an exactly rigid transform: the nearest
+// rotation by SVD. A chain of poses must stay rigid: a slightly non-orthonormal pose, fed back as
+// the next initial guess, grows frame after frame (seen with OpenCV's initRt on freiburg1_rpy).
+SE3 rigid_from_matrix(const double m[4][4]);
+SE3 make_rigid(const SE3& T);
+
 // The factories this build has: an empty function when the library is missing.
 enum class OpenCvMethod { rgbd, icp, rgbd_icp, fast_icp };
 OdometryFactory opencv_factory(OpenCvMethod m);

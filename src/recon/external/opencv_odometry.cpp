@@ -71,12 +71,10 @@ cv::Mat to_cv(const SE3& T) {
 }
 
 SE3 from_cv(const cv::Mat& m) {
-  SE3 T = SE3::identity();
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) T.R.m[r][c] = static_cast<float>(m.at<double>(r, c));
-    (&T.t.x)[r] = static_cast<float>(m.at<double>(r, 3));
-  }
-  return T;
+  double a[4][4];
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) a[r][c] = m.at<double>(r, c);
+  return rigid_from_matrix(a);
 }
 
 class OpenCvOdometry : public Odometry {

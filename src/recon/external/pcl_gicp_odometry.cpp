@@ -59,12 +59,10 @@ Eigen::Matrix4f to_eigen(const SE3& T) {
 }
 
 SE3 from_eigen(const Eigen::Matrix4f& m) {
-  SE3 T = SE3::identity();
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) T.R.m[r][c] = m(r, c);
-    (&T.t.x)[r] = m(r, 3);
-  }
-  return T;
+  double a[4][4];
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) a[r][c] = m(r, c);
+  return rigid_from_matrix(a);
 }
 
 class PclGicpOdometry : public Odometry {
