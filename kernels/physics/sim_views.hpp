@@ -54,7 +54,8 @@ struct SimConstants {
   vec3 wind{0.f, 0.f, 0.f};
   float sleep_threshold = 0.f;
   float cloth_self_exclusion = 0.06f;
-  float strain_omega = 1.5f;           // over-relaxation of cloth strain limiting (Provot 1995)  // same-cloth pairs closer than this at rest never collide
+  float strain_omega = 1.5f;           // over-relaxation of cloth strain limiting (Provot 1995)
+  float strain_contact_weight = 0.3f;  // inverse-mass factor there of particles touching the scene  // same-cloth pairs closer than this at rest never collide
   int max_neighbors = 64, max_static_neighbors = 64;
   int rotation_iterations = 8;
 };

@@ -480,7 +480,11 @@ void cloth_stretch(const Exec& ex, const SimViews& S, std::int64_t first, std::i
 // Strain limiting (Provot 1995, section 5): after the solver iterations, every edge of the colour
 // stretched or compressed by more than its limit (a fraction of the rest length) is brought back
 // to the limit (over-relaxed by cloth_strain_omega), in place; edges within the limit are left
-// alone.
+// alone. This pass cannot see the contacts, so a particle that touched the scene in the last
+// iteration (scene_n != 0) counts as heavier (inverse mass times strain_contact_weight): the
+// scene holds it, and the free part of the cloth takes more of the correction instead of the
+// limiter pulling the particle into the scene (mass scaling in the spirit of Macklin 2014's
+// stacking heuristic).
 template <class Exec>
 void cloth_strain_limit(const Exec& ex, const SimViews& S, std::int64_t first, std::int64_t count) {
   ex.for_each(count, [=] SEAMLESS_HD(std::int64_t i) {
@@ -489,7 +493,9 @@ void cloth_strain_limit(const Exec& ex, const SimViews& S, std::int64_t first, s
     if (!(lim > 0.f)) return;
     const int a = S.rank[S.edge_a[e]], b = S.rank[S.edge_b[e]];
     const vec3 pa = S.sp[a], pb = S.sp[b];
-    const float wa = S.sw[a], wb = S.sw[b], L = S.edge_len[e];
+    const float L = S.edge_len[e], cw = S.c.strain_contact_weight;
+    const float wa = S.sw[a] * (length2(S.scene_n[a]) > 0.f ? cw : 1.f);
+    const float wb = S.sw[b] * (length2(S.scene_n[b]) > 0.f ? cw : 1.f);
     const float om = S.c.strain_omega;
     S.sp[a] = pa + strain_limit_delta(pa, pb, wa, wb, L, lim, om);
     S.sp[b] = pb + strain_limit_delta(pb, pa, wb, wa, L, lim, om);

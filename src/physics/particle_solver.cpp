@@ -180,7 +180,7 @@ struct ParticleSolver::Impl {
     c.drag = P.drag, c.lift = P.lift, c.air_density = P.air_density, c.wind = P.wind;
     c.sleep_threshold = P.sleep_threshold;
     c.cloth_self_exclusion = 1.5f * d;
-    c.strain_omega = P.cloth_strain_omega;
+    c.strain_omega = P.cloth_strain_omega, c.strain_contact_weight = P.cloth_strain_contact_weight;
     c.max_neighbors = P.max_neighbours, c.max_static_neighbors = P.max_static_neighbours;
     c.rotation_iterations = P.rotation_iterations;
     S.n = n;

@@ -31,7 +31,7 @@ struct SolverStats {
   std::int64_t neighbour_overflow = 0, static_neighbour_overflow = 0;
   int max_neighbours_seen = 0, max_static_neighbours_seen = 0;
   std::int64_t emitter_dropped = 0;  // particles an emitter could not create (capacity)
-  float max_speed = 0.f;             // m/s, now
+  float max_speed = 0.f;             // m/s, after the last step (0 before the first)
 };
 
 // Particle state in id order (ids are given in spawn order and never change).

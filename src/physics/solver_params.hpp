@@ -49,6 +49,7 @@ struct SolverParams {
   int max_static_neighbours = 64;
   int cloth_strain_passes = 4;          // strain-limiting passes over all edge colours per substep
   float cloth_strain_omega = 1.5f;      // over-relaxation of strain limiting
+  float cloth_strain_contact_weight = 0.3f;  // strain limiting: inverse-mass factor of particles on the scene
   bool cuda_graph = true;               // CUDA: replay a step as one captured graph (docs/PHYSICS.md)
 
   template <class V> void visit(V& v) {
@@ -91,6 +92,8 @@ struct SolverParams {
     v("cloth_strain_passes", cloth_strain_passes, "cloth strain-limiting passes per substep (Provot 1995)",
       Range{0, 100});
     v("cloth_strain_omega", cloth_strain_omega, "over-relaxation of cloth strain limiting", Range{1.0, 1.95});
+    v("cloth_strain_contact_weight", cloth_strain_contact_weight,
+      "strain limiting: inverse-mass factor of cloth particles touching the scene (1 = none)", Range{0.01, 1.0});
     v("cuda_graph", cuda_graph, "CUDA: capture a step as a graph and replay it while the scene is unchanged");
   }
 };

@@ -47,9 +47,10 @@ struct DrapeRun {
   int on_top = 0, on_floor = 0;
 };
 
-// A 24 x 24 cloth (0.92 m square, particle spacing = diameter) falls 0.2 m onto the cube (0.3 m
-// edge), drapes over it and settles on the floor around it, 2 s simulated, checked every frame.
-DrapeRun drape() {
+// A 24 x 24 cloth (0.92 m square, particle spacing = diameter) falls `height` (0.2 m) onto the
+// cube (0.3 m edge), drapes over it and settles on the floor around it, 2 s simulated, checked
+// every frame.
+DrapeRun drape(float height = 0.2f) {
   SolverParams p;
   const float d = p.particle_diameter, half = 0.15f;
   ParticleSolver s(p, Device::CPU);
@@ -57,7 +58,7 @@ DrapeRun drape() {
   s.set_scene_sdf(sdf);
   SpawnParams c;
   const int n = 24;
-  c.kind = "cloth", c.nx = n, c.ny = n, c.position = {0.01f, 2 * half + 0.2f, 0.02f};
+  c.kind = "cloth", c.nx = n, c.ny = n, c.position = {0.01f, 2 * half + height, 0.02f};
   s.spawn(c);
   kernels::SceneSdf only_box;
   only_box.count = 1, only_box.prims[0] = sdf.prims[1];
@@ -77,9 +78,9 @@ DrapeRun drape() {
     if (std::fabs(x.x) < half && std::fabs(x.z) < half && x.y > 2 * half) ++r.on_top;
     if (x.y < 0.5f * d + 0.01f) ++r.on_floor;
   }
-  std::printf("cloth on box: max edge strain %.6f (at rest %.6f), closest centre to the box %.4g m (radius %.3g), "
+  std::printf("cloth on box from %.2f m: max edge strain %.6f (at rest %.6f), closest centre to the box %.4g m (radius %.3g), "
               "lowest %.4g m, %d particles over the top, %d on the floor\n",
-              r.worst_strain, r.final_strain, r.deepest, 0.5f * d, r.lowest, r.on_top, r.on_floor);
+              height, r.worst_strain, r.final_strain, r.deepest, 0.5f * d, r.lowest, r.on_top, r.on_floor);
   return r;
 }
 
@@ -94,6 +95,15 @@ TEST(PhysicsCloth, DroppedOnBoxStaysOutside) {
   EXPECT_GE(r.lowest, 0.f);
   EXPECT_GE(r.on_top, 36);
   EXPECT_GT(r.on_floor, 0);
+}
+
+// Twice the drop (2.8 m/s at impact, 1.4 cm per substep): the strain limiter, which runs after the
+// contacts, must not pull particles into the box (particles touching the scene count as heavier
+// there). Strain is not asserted here: 4 passes leave 11 % at this impact (docs/PHYSICS.md).
+TEST(PhysicsCloth, DroppedFromFortyCentimetresStaysOutside) {
+  DrapeRun r = drape(0.4f);
+  EXPECT_GE(r.deepest, 0.f);
+  EXPECT_GE(r.lowest, 0.f);
 }
 
 // The requirement: edge strain <= 10 % at every frame (structural and shear edges). The
