@@ -1,6 +1,7 @@
 // Cloth is one two-sided mesh lit on whichever side is seen; rigid bodies are boxes in their
 // shape-matching frames.
 #include <cmath>
+#include <memory>
 
 #include "kernels/physics/particle_math.hpp"
 #include "physics/particle_solver.hpp"
@@ -95,6 +96,42 @@ TEST(RenderRigid, BoxCoversItsProjection) {
       if (u < u0 - 1 || u > u1 + 1 || v < v0 - 1 || v > v1 + 1)
         EXPECT_TRUE(same(img.at(u, v), uchar3{0, 0, 0})) << u << "," << v;
     }
+}
+
+// A body with its own mesh: a 0.4 x 0.2 m rectangle in the body frame (normal -z), turned 90
+// degrees about z and moved to (dx, 0, 2), covers x in [dx - 0.1, dx + 0.1], y in [-0.2, 0.2] at z = 2:
+// pixels [fx x / 2 + cx] x [fy y / 2 + cy] (1 px margin). Drawn twice with two poses: the mesh is
+// uploaded once and moved by the frame only.
+TEST(RenderRigid, BodyMeshMovesWithItsFrame) {
+  SEAMLESS_REQUIRE_EGL();
+  RenderParams p;
+  p.light_dir = {0.f, 0.f, 1.f};
+  p.rigid_color = {180 / 255.f, 60 / 255.f, 40 / 255.f};
+  p.background = {0.f, 0.f, 0.f};
+  const Intrinsics K = intrinsics(100.f, 79.5f, 59.5f, 160, 120);
+  Renderer r(p, K.width, K.height);
+  auto m = std::make_shared<BodyMesh>();
+  m->positions = {{-0.2f, -0.1f, 0.f}, {0.2f, -0.1f, 0.f}, {0.2f, 0.1f, 0.f}, {-0.2f, 0.1f, 0.f}};
+  m->normals.assign(4, vec3{0.f, 0.f, -1.f});
+  m->triangles = {{0, 1, 2}, {0, 2, 3}};
+  for (float dx : {0.1f, -0.3f}) {
+    DrawList l;
+    l.rigids.push_back(RigidDraw{SE3{rotation({0.f, 0.f, 1.f}, 1.5707963f), {dx, 0.f, 2.f}}, {1.f, 1.f, 1.f}, m});
+    Pixels img(r.render(l, camera(K)));
+    const float u0 = 100.f * (dx - 0.1f) / 2.f + 79.5f, u1 = 100.f * (dx + 0.1f) / 2.f + 79.5f;
+    const float v0 = 100.f * -0.2f / 2.f + 59.5f, v1 = 100.f * 0.2f / 2.f + 59.5f;
+    int inside = 0;
+    for (int v = 0; v < img.h; ++v)
+      for (int u = 0; u < img.w; ++u) {
+        if (u > u0 + 1 && u < u1 - 1 && v > v0 + 1 && v < v1 - 1) {
+          EXPECT_LE(max_diff(img.at(u, v), uchar3{180, 60, 40}), 2) << u << "," << v;
+          ++inside;
+        }
+        if (u < u0 - 1 || u > u1 + 1 || v < v0 - 1 || v > v1 + 1)
+          EXPECT_TRUE(same(img.at(u, v), uchar3{0, 0, 0})) << u << "," << v << " (a box drawn instead?)";
+      }
+    EXPECT_GT(inside, 100);  // 10 x 20 pixels less the margins
+  }
 }
 
 // make_draw_list: a body's box is its particles' extent in the body frame plus one radius.
