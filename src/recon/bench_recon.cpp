@@ -4,33 +4,59 @@
 
 namespace seamless {
 
-ReconBenchResult bench_recon(const std::vector<ReconFrame>& frames, const Intrinsics& K, const VolumeParams& params,
-                             Device d, int warmup) {
-  std::vector<ReconFrame> dev;
+ReconBench::ReconBench(const std::vector<ReconFrame>& frames, const Intrinsics& K, const VolumeParams& params,
+                       Device d)
+    : K_(K), device_(d), volume_(make_volume(params, d)), timer_(std::make_unique<StageTimer>(d)) {
   for (const ReconFrame& f : frames)
-    dev.push_back({f.depth.clone(d), f.rgb.width() ? f.rgb.clone(d) : Image<uchar3>{}, f.world_T_camera});
-  auto volume = make_volume(params, d);
-  RaycastMaps maps;
-  StageTimer warm(d), timer(d);
-  std::int64_t index = 0;
-  for (const ReconFrame& f : dev) {
-    StageTimer& t = index < warmup ? warm : timer;
-    t.begin("frame");
-    volume->integrate(f.depth, f.rgb, K, f.world_T_camera, &t);
-    volume->raycast(K, f.world_T_camera, maps, &t);
-    t.end("frame");
-    t.end_frame(index++);
-  }
+    frames_.push_back({f.depth.clone(d), f.rgb.width() ? f.rgb.clone(d) : Image<uchar3>{}, f.world_T_camera});
+}
+
+void ReconBench::step() {
+  const ReconFrame& f = frames_[static_cast<std::size_t>(next_ % static_cast<std::int64_t>(frames_.size()))];
+  timer_->begin("frame");
+  volume_->integrate(f.depth, f.rgb, K_, f.world_T_camera, timer_.get());
+  volume_->raycast(K_, f.world_T_camera, maps_, timer_.get());
+  timer_->end("frame");
+  timer_->end_frame(next_++);
+  ++timed_;
+}
+
+void ReconBench::reset_timing() {
+  timer_ = std::make_unique<StageTimer>(device_);
+  timed_ = 0;
+}
+
+ReconBenchResult ReconBench::result() {
   ReconBenchResult r;
-  r.frames = static_cast<int>(std::max<std::int64_t>(0, index - warmup));
-  r.rows = timer.rows();
+  r.frames = static_cast<int>(timed_);
+  r.rows = timer_->rows();
   std::vector<std::string> stages;
   std::set<std::string> seen;
   for (const auto& row : r.rows)
     if (seen.insert(row.stage).second) stages.push_back(row.stage);
-  for (const std::string& s : stages) r.median_ms.emplace_back(s, timer.median_ms(s));
-  r.stats = volume->stats();
+  for (const std::string& s : stages) r.median_ms.emplace_back(s, timer_->median_ms(s));
+  r.stats = volume_->stats();
   return r;
+}
+
+std::string ReconBench::report() {
+  VolumeStats s = volume_->stats();
+  std::string r = "stage medians (ms):";
+  for (const char* st : {"allocate", "visible", "fuse", "remove_empty", "raycast_splat", "raycast"})
+    if (double m = timer_->median_ms(st); m > 0) r += std::string(" ") + st + " " + std::to_string(m);
+  return r + "; blocks " + std::to_string(s.allocated_blocks) + ", " + std::to_string(s.bytes_per_block) +
+         " bytes/block";
+}
+
+ReconBenchResult bench_recon(const std::vector<ReconFrame>& frames, const Intrinsics& K, const VolumeParams& params,
+                             Device d, int warmup) {
+  ReconBench b(frames, K, params, d);
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    if (static_cast<int>(i) == warmup) b.reset_timing();
+    b.step();
+  }
+  if (static_cast<int>(frames.size()) <= warmup) b.reset_timing();  // all warm-up: nothing reported
+  return b.result();
 }
 
 }  // namespace seamless

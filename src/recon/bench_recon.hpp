@@ -1,8 +1,10 @@
-// The reconstruction benchmark (`seamless bench recon`, wired by the app): allocation, visible
-// list, fusion, empty-block removal and raycast per frame, timed per stage with StageTimer (CUDA
-// events on the GPU). Goal on H100/H200: allocate + visible + fuse + raycast <= 0.5 ms per
-// 640x480 frame at 5 mm voxels (median).
+// The reconstruction benchmark: allocation, visible list, fusion, empty-block removal and raycast
+// per frame, timed per stage with StageTimer (CUDA events on the GPU). Goal on H100/H200:
+// allocate + visible + fuse + raycast <= 0.5 ms per 640x480 frame at 5 mm voxels (median).
+// One code path: ReconBench steps one frame at a time; bench_recon() runs a sequence through it,
+// and `seamless bench recon` (src/app/bench_recon_cases.cpp) registers its step and report.
 #pragma once
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -28,8 +30,32 @@ struct ReconBenchResult {
   VolumeStats stats;                  // after the last frame
 };
 
-// Runs frames through a fresh volume of params.layout on device d (frames are copied to d first,
-// outside the timing). The first `warmup` frames are run but not reported.
+// A fresh volume of params.layout on device d and the frames (copied to d here, outside any
+// timing), stepped one frame at a time.
+class ReconBench {
+ public:
+  ReconBench(const std::vector<ReconFrame>& frames, const Intrinsics& K, const VolumeParams& params, Device d);
+  // Integrates and raycasts the next frame (cycling through them), timing its stages and "frame".
+  void step();
+  // Forgets the frames timed so far (after a warm-up); the volume keeps what they fused.
+  void reset_timing();
+  // Frames timed since the last reset, their stage medians and rows, the volume's stats.
+  ReconBenchResult result();
+  // One line for `seamless bench recon`: "stage medians (ms): allocate ... ; blocks N, B bytes/block".
+  std::string report();
+  std::size_t frame_count() const { return frames_.size(); }
+
+ private:
+  std::vector<ReconFrame> frames_;
+  Intrinsics K_;
+  Device device_;
+  std::unique_ptr<Volume> volume_;
+  RaycastMaps maps_;
+  std::unique_ptr<StageTimer> timer_;
+  std::int64_t next_ = 0, timed_ = 0;
+};
+
+// Runs frames once through a ReconBench; the first `warmup` frames are run but not reported.
 ReconBenchResult bench_recon(const std::vector<ReconFrame>& frames, const Intrinsics& K, const VolumeParams& params,
                              Device d, int warmup = 2);
 
