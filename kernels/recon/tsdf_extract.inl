@@ -116,18 +116,17 @@ void mesh_emit(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t
 // only in the lucky case. A surface between two lattice planes (the demo's desk top, y = -0.62
 // between -0.60 and -0.64 at 4 cm) is s/2 from both, and the fused TSDF there is the projective
 // distance, which a camera looking at the desk top from 20 degrees above its plane stretches by
-// 1 / sin(20 deg) ~ 3 (the TSDF is the depth difference along the camera's z, Newcombe et al. 2011
-// section 3.3; tsdf_fusion.inl), so
-// both lattice points read about 1.5 s and neither was taken: the top had holes, and fluid leaked.
+// 1 / sin(20 deg) ~ 3 (the TSDF is the depth difference along the camera's z, Newcombe et al.
+// 2011 section 3.3; tsdf_fusion.inl), so both lattice points read about 1.5 s and neither was
+// taken: the top had holes, and fluid leaked.
 // So surface particles are put ON the fused surface instead: each lattice line (a row of lattice
 // points along one axis) is searched for the zero crossings of the TSDF, and a crossing becomes a
-// particle when the surface there faces along that axis (kAxisShare: its normal's largest
-// component, or nearly). The
-// crossings along the normal's axis sit one per lattice column, so a surface gets about one
-// particle per spacing^2 whatever its height, and they form a grid of at most s x s*sqrt(2) cells
-// (s * |n| / |n_axis| with |n_axis| >= |n| / sqrt(3)): every hole has a circumradius below one
-// spacing, so a particle of diameter s cannot pass. Near-duplicates (edges, where two axes meet)
-// are thinned afterwards (scene_particle_thin).
+// particle when the surface there faces along that axis (kAxisShare: the normal's largest
+// component, or nearly). The crossings along the normal's axis sit one per lattice column, so a
+// surface gets about one particle per spacing^2 whatever its height, and they form a grid of at
+// most s x s*sqrt(2) cells (s * |n| / |n_axis| with |n_axis| >= |n| / sqrt(3)): every hole has a
+// circumradius below one spacing, so a particle of diameter s cannot pass. Near-duplicates (edges,
+// where two axes meet) are thinned afterwards (scene_particle_thin).
 
 // Integer lattice coordinates of candidate i, or false when it falls outside its block (blocks own
 // the lattice points p with floor((p - origin) / (8 s)) == b; the same float expression decides
