@@ -92,12 +92,12 @@ struct SortLayout {
   std::size_t total() const { return keys + values + cub; }
 };
 template <class K, class V>
-SortLayout sort_layout(std::int64_t n, int key_bits) {
+SortLayout sort_layout(std::int64_t n, int key_bits, cudaStream_t stream = nullptr) {
   auto align = [](std::size_t b) { return (b + 255) / 256 * 256; };
   SortLayout L{align(sizeof(K) * n), align(sizeof(V) * n), 0};
   cub::DoubleBuffer<K> dk(nullptr, nullptr);
   cub::DoubleBuffer<V> dv(nullptr, nullptr);
-  SEAMLESS_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, L.cub, dk, dv, n, 0, key_bits));
+  SEAMLESS_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, L.cub, dk, dv, n, 0, key_bits, stream));
   return L;
 }
 }  // namespace cuda_detail
@@ -111,13 +111,13 @@ template <class K, class V>
 void CudaExec::sort_by_key(K* keys, V* values, std::int64_t n, int key_bits) const {
   if (n <= 1) return;
   // Scratch layout: [alternate keys | alternate values | CUB temp].
-  const cuda_detail::SortLayout L = cuda_detail::sort_layout<K, V>(n, key_bits);
+  cudaStream_t st = static_cast<cudaStream_t>(stream);
+  const cuda_detail::SortLayout L = cuda_detail::sort_layout<K, V>(n, key_bits, st);
   if (temp && temp_bytes < L.total())
     throw Error("CudaExec::sort_by_key: the caller's temp storage has " + std::to_string(temp_bytes) +
                 " bytes, the sort of " + std::to_string(n) + " pairs needs " + std::to_string(L.total()) +
                 "; size it with sort_by_key_temp_bytes");
   char* s = static_cast<char*>(temp ? temp : cuda_detail::scratch(L.total()));
-  cudaStream_t st = static_cast<cudaStream_t>(stream);
   std::size_t tmp = L.cub;
   cub::DoubleBuffer<K> dk(keys, reinterpret_cast<K*>(s));
   cub::DoubleBuffer<V> dv(values, reinterpret_cast<V*>(s + L.keys));
