@@ -13,8 +13,8 @@ struct RefineParams {
   bool enabled = false;
   std::string keyframes = "every";         // every keyframe_every frames, or by motion
   int keyframe_every = 10;                 // frames
-  float keyframe_translation = 0.05f;      // motion mode: metres since the last keyframe
-  float keyframe_rotation_deg = 5.f;       // motion mode: degrees since the last keyframe
+  float keyframe_translation = 0.1f;       // motion mode: metres since the last keyframe
+  float keyframe_rotation_deg = 15.f;      // motion mode: degrees since the last keyframe (1/4 of the view)
   float max_pair_translation = 0.5f;       // candidate pairs: odometry poses at most this far apart, metres
   float max_pair_rotation_deg = 30.f;      // ... and at most this much rotated, degrees
   float min_overlap = 0.3f;                // candidate pairs: share of keyframe j's pixels that land on i's surface
