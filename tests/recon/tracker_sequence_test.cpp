@@ -10,6 +10,7 @@
 
 #include "io/synthetic_source.hpp"
 #include "core/error.hpp"
+#include "recon/refine/refine.hpp"
 #include "tracker_test_util.hpp"
 
 using namespace seamless;
@@ -158,15 +159,32 @@ TEST(TrackSequence, TumFreiburg1RpyBestTrackerTracksEveryFrame) {
   RecordProperty("ate_rmse_m", std::to_string(ate.trans.rmse));
 }
 
-// Issue 5 asks ATE RMSE <= 3 cm here. NOT MET YET: the best tracker measures 3.2 cm (frame-to-frame
-// RGB-D 4.0 cm, geometric ICP much worse: on these frames the Kinect depth shows about 25 % less
-// rotation between frames than the ground truth and the colour do, see docs/TRACKING.md). Kept,
-// disabled, so that the target stays visible; run with --gtest_also_run_disabled_tests.
-TEST(TrackSequence, DISABLED_TumFreiburg1RpyBestTrackerWithinThreeCentimetres) {
+// Issue 5 asks ATE RMSE <= 3 cm here. The tracker alone measures 3.2 cm (frame-to-frame RGB-D 4.0
+// cm, geometric ICP much worse: on these frames the Kinect depth shows about 25 % less rotation
+// between frames than the ground truth and the colour do, see docs/TRACKING.md). Our best tracker
+// is therefore the tracker followed by the Ceres refinement (the refine section of
+// configs/tum_fr1.yaml: a keyframe every 5 frames, so that consecutive keyframes of this fast
+// rotation stay within the 30 degrees a pair may differ; docs/TRACKING.md, "Ceres refinement", has
+// the sensitivity to the keyframe spacing). Needs Ceres (libceres-dev).
+TEST(TrackSequence, TumFreiburg1RpyBestTrackerWithinThreeCentimetres) {
   const std::string dir = test::tum_rpy_dir();
   if (!std::filesystem::exists(dir)) GTEST_SKIP() << dir << " is absent (shared test data)";
+  if (!refine_available()) GTEST_SKIP() << "this build has no Ceres (libceres-dev): the refinement is not built";
   auto src = make_source(test::tum_input(dir));
-  auto t = test::track_with_gt(*src, best_tum_params(), Device::CPU, "");
-  AteResult ate = compute_ate(t.result.trajectory, read_tum_trajectory(dir + "/groundtruth.txt"));
-  EXPECT_LE(ate.trans.rmse, 0.03);
+  TrackSequenceParams p = best_tum_params();
+  auto t = test::track_with_gt(*src, p, Device::CPU, "");
+  EXPECT_EQ(t.result.lost_frames, 0);
+  ASSERT_EQ(t.result.trajectory.size(), 150u);
+  std::vector<bool> tracked;
+  for (const FrameRecord& f : t.result.frames) tracked.push_back(f.result.ok());
+  RefineParams refine;
+  refine.enabled = true;
+  refine.keyframe_every = 5;
+  auto again = make_source(test::tum_input(dir));
+  RefineResult r = refine_trajectory(*again, t.result.trajectory, refine, p.preprocess, Device::CPU, tracked);
+  const Trajectory gt = read_tum_trajectory(dir + "/groundtruth.txt");
+  AteResult odometry = compute_ate(t.result.trajectory, gt), refined = compute_ate(r.trajectory, gt);
+  EXPECT_LE(refined.trans.rmse, 0.03) << "odometry alone " << odometry.trans.rmse;
+  RecordProperty("ate_odometry_m", std::to_string(odometry.trans.rmse));
+  RecordProperty("ate_refined_m", std::to_string(refined.trans.rmse));
 }
