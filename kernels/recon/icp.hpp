@@ -19,19 +19,29 @@
 namespace seamless::kernels {
 
 // One Gauss-Newton system: upper triangle of J^T W J (row-major, 21 entries), J^T W r (6), the sum of
-// weighted squared residuals, and counts. Doubles: 300k pixels of float products summed in float
-// lose digits the 6x6 solve needs. Default-constructed to zero (value-initialised by the reduce).
-struct IcpSums {
-  double jtj[21];
-  double jtr[6];
-  double error;    // sum w r^2
-  double inliers;  // geometric correspondences accepted
-  double valid;    // current pixels with a vertex (the denominator of the inlier ratio)
+// weighted squared residuals, and counts. Default-constructed to zero (value-initialised by the
+// reduce). A pixel's terms are floats (IcpTerms: half the GPU registers, so twice the threads in
+// flight); the sums over a level are doubles (IcpSums): 300k pixels of float products summed in
+// float lose digits the 6x6 solve needs. The reductions add terms into sums (operator+ below).
+template <class S>
+struct IcpSumsOf {
+  S jtj[21];
+  S jtr[6];
+  S error;    // sum w r^2
+  S inliers;  // geometric correspondences accepted
+  S valid;    // current pixels with a vertex (the denominator of the inlier ratio)
 };
+using IcpSums = IcpSumsOf<double>;
+using IcpTerms = IcpSumsOf<float>;
 
-SEAMLESS_HD inline IcpSums operator+(const IcpSums& a, const IcpSums& b) {
-  IcpSums s;
+template <class A, class B>
+SEAMLESS_HD inline IcpSumsOf<A> operator+(const IcpSumsOf<A>& a, const IcpSumsOf<B>& b) {
+  // Fully unrolled here and in add_row: constant indices keep the sums in registers (a run-time
+  // index would put them in local memory, several times slower on the GPU).
+  IcpSumsOf<A> s;
+#pragma unroll
   for (int k = 0; k < 21; ++k) s.jtj[k] = a.jtj[k] + b.jtj[k];
+#pragma unroll
   for (int k = 0; k < 6; ++k) s.jtr[k] = a.jtr[k] + b.jtr[k];
   s.error = a.error + b.error;
   s.inliers = a.inliers + b.inliers;
@@ -40,15 +50,17 @@ SEAMLESS_HD inline IcpSums operator+(const IcpSums& a, const IcpSums& b) {
 }
 
 // Adds one residual row r with Jacobian J = [a^T, b^T] (6 entries) and weight w.
-SEAMLESS_HD inline void add_row(IcpSums& s, vec3 a, vec3 b, float r, float w) {
+template <class S>
+SEAMLESS_HD inline void add_row(IcpSumsOf<S>& s, vec3 a, vec3 b, float r, float w) {
   const float J[6] = {a.x, a.y, a.z, b.x, b.y, b.z};
-  int k = 0;
+#pragma unroll
   for (int i = 0; i < 6; ++i) {
-    const double wi = static_cast<double>(w) * J[i];
-    for (int j = i; j < 6; ++j) s.jtj[k++] += wi * J[j];
+    const S wi = static_cast<S>(w) * J[i];
+#pragma unroll
+    for (int j = i; j < 6; ++j) s.jtj[i * 6 - i * (i - 1) / 2 + (j - i)] += wi * J[j];  // row i of the upper triangle
     s.jtr[i] += wi * r;
   }
-  s.error += static_cast<double>(w) * r * r;
+  s.error += static_cast<S>(w) * r * r;
 }
 
 SEAMLESS_HD inline bool valid_point(vec3 v) { return v.z > 0.f; }
@@ -92,9 +104,9 @@ SEAMLESS_HD inline bool find_correspondence(const IcpLevel& L, int x, int y, Cor
 }
 
 // The point-to-plane row of a correspondence (see the header comment).
-SEAMLESS_HD inline void add_point_to_plane(IcpSums& s, const Correspondence& c, float w) {
+SEAMLESS_HD inline void add_point_to_plane(IcpTerms& s, const Correspondence& c, float w) {
   add_row(s, cross(c.q, c.n), c.n, dot(c.n, c.q - c.v), w);
-  s.inliers += 1.0;
+  s.inliers += 1.f;
 }
 
 // The estimate ref_T_cur of one Gauss-Newton loop, kept on the device in double: ~20 left
@@ -122,9 +134,11 @@ SEAMLESS_HD inline SE3 to_se3(const IcpPose& p) {
 }
 
 // Solves J^T J x = -J^T r by Cholesky (the system is symmetric positive definite whenever it is
-// solvable at all). False when a pivot is not positive or the result is not finite.
+// solvable at all). False when a pivot is not positive or the result is not finite. It runs in one
+// GPU thread per Gauss-Newton step, on the critical path: one reciprocal per pivot, then only
+// multiplications (double division is a long instruction sequence on the GPU).
 SEAMLESS_HD inline bool solve_normal_equations(const IcpSums& s, double x[6]) {
-  double A[6][6], L[6][6] = {}, y[6];
+  double A[6][6], L[6][6] = {}, inv[6], y[6];
   for (int i = 0, k = 0; i < 6; ++i)
     for (int j = i; j < 6; ++j, ++k) A[i][j] = A[j][i] = s.jtj[k];
   for (int j = 0; j < 6; ++j) {
@@ -132,21 +146,22 @@ SEAMLESS_HD inline bool solve_normal_equations(const IcpSums& s, double x[6]) {
     for (int k = 0; k < j; ++k) d -= L[j][k] * L[j][k];
     if (!(d > 0.0)) return false;
     L[j][j] = sqrt(d);
+    inv[j] = 1.0 / L[j][j];
     for (int i = j + 1; i < 6; ++i) {
       double v = A[i][j];
       for (int k = 0; k < j; ++k) v -= L[i][k] * L[j][k];
-      L[i][j] = v / L[j][j];
+      L[i][j] = v * inv[j];
     }
   }
   for (int i = 0; i < 6; ++i) {  // L y = -J^T r
     double v = -s.jtr[i];
     for (int k = 0; k < i; ++k) v -= L[i][k] * y[k];
-    y[i] = v / L[i][i];
+    y[i] = v * inv[i];
   }
   for (int i = 5; i >= 0; --i) {  // L^T x = y
     double v = y[i];
     for (int k = i + 1; k < 6; ++k) v -= L[k][i] * x[k];
-    x[i] = v / L[i][i];
+    x[i] = v * inv[i];
   }
   for (int i = 0; i < 6; ++i)
     if (!is_finite(x[i])) return false;
@@ -159,7 +174,8 @@ SEAMLESS_HD inline void left_update(IcpPose& p, const double xi[6]) {
   const double th = sqrt(xi[0] * xi[0] + xi[1] * xi[1] + xi[2] * xi[2]);
   double D[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   if (th > 0.0) {
-    const double k[3] = {xi[0] / th, xi[1] / th, xi[2] / th}, s = sin(th), c = 1.0 - cos(th);
+    const double r = 1.0 / th, k[3] = {xi[0] * r, xi[1] * r, xi[2] * r};
+    const double s = sin(th), c = 1.0 - cos(th);  // nvcc merges the two into one sincos
     // R = I + sin(th) K + (1 - cos(th)) K^2, K the cross-product matrix of the unit axis k.
     D[0] = 1 - c * (k[1] * k[1] + k[2] * k[2]), D[1] = -s * k[2] + c * k[0] * k[1], D[2] = s * k[1] + c * k[0] * k[2];
     D[3] = s * k[2] + c * k[0] * k[1], D[4] = 1 - c * (k[0] * k[0] + k[2] * k[2]), D[5] = -s * k[0] + c * k[1] * k[2];
@@ -174,15 +190,29 @@ SEAMLESS_HD inline void left_update(IcpPose& p, const double xi[6]) {
   for (int i = 0; i < 3; ++i) p.t[i] = t[i];
 }
 
-// Sums the point-to-plane normal equations over every pixel of the current level (one pass) at the
-// estimate *pose (level.ref_T_cur is ignored), into *out on the device.
-template <class Exec>
-void icp_reduce_into(const Exec& ex, IcpLevel level, const IcpPose* pose, IcpSums* out);
+// What a reduction does with its system once summed: nothing, or one Gauss-Newton step on *pose.
+enum class IcpUpdate { none, step, first_step };
 
-// One Gauss-Newton step on the device: solves *sums and applies the update to *pose, unless the
-// level has stalled. first_of_level clears the stall of the previous level.
+// One Gauss-Newton step: solves the system s and applies the update to p, unless the level has
+// stalled; first_step (a level's first) clears the stall of the previous level.
+SEAMLESS_HD inline void gauss_newton_update(const IcpSums& s, IcpPose& p, IcpUpdate u) {
+  if (u == IcpUpdate::none) return;
+  if (u == IcpUpdate::first_step) p.stalled = 0;
+  if (p.stalled) return;  // the same estimate would give the same failing system again
+  ++p.steps;
+  double xi[6];
+  if (!solve_normal_equations(s, xi)) {
+    p.stalled = 1;
+    return;
+  }
+  left_update(p, xi);
+}
+
+// Sums the point-to-plane normal equations over every pixel of the current level (one pass) at the
+// estimate *pose (level.ref_T_cur is ignored) into *out on the device, then applies `update` to
+// *pose in the same launch (after every pixel has read it).
 template <class Exec>
-void icp_step(const Exec& ex, const IcpSums* sums, IcpPose* pose, bool first_of_level);
+void icp_reduce_into(const Exec& ex, IcpLevel level, IcpPose* pose, IcpSums* out, IcpUpdate update);
 
 // Moves vertex and normal maps into another frame (x -> T x, n -> R n); invalid pixels stay zero.
 // Used to express a world-space raycast in the coordinates of the camera it was rendered from.

@@ -6,34 +6,21 @@
 namespace seamless::kernels {
 
 template <class Exec>
-void icp_reduce_into(const Exec& ex, IcpLevel L, const IcpPose* pose, IcpSums* out) {
+void icp_reduce_into(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSums* out, IcpUpdate update) {
   const int w = L.cur_vertex.width;
-  ex.transform_reduce_into(L.cur_vertex.count(), [=] SEAMLESS_HD(std::int64_t i) {
-    IcpLevel l = L;
-    l.ref_T_cur = to_se3(*pose);
-    IcpSums s{};
-    int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
-    if (valid_point(l.cur_vertex(x, y))) s.valid = 1.0;
-    Correspondence c;
-    if (find_correspondence(l, x, y, c)) add_point_to_plane(s, c, 1.f);
-    return s;
-  }, out);
-}
-
-template <class Exec>
-void icp_step(const Exec& ex, const IcpSums* sums, IcpPose* pose, bool first_of_level) {
-  ex.for_each(1, [=] SEAMLESS_HD(std::int64_t) {
-    IcpPose& p = *pose;
-    if (first_of_level) p.stalled = 0;
-    if (p.stalled) return;  // the same estimate would give the same failing system again
-    ++p.steps;
-    double xi[6];
-    if (!solve_normal_equations(*sums, xi)) {
-      p.stalled = 1;
-      return;
-    }
-    left_update(p, xi);
-  });
+  ex.transform_reduce_into(
+      L.cur_vertex.count(),
+      [=] SEAMLESS_HD(std::int64_t i) {
+        IcpLevel l = L;
+        l.ref_T_cur = to_se3(*pose);
+        IcpTerms s{};
+        int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
+        if (valid_point(l.cur_vertex(x, y))) s.valid = 1.f;
+        Correspondence c;
+        if (find_correspondence(l, x, y, c)) add_point_to_plane(s, c, 1.f);
+        return s;
+      },
+      out, [=] SEAMLESS_HD { gauss_newton_update(*out, *pose, update); });
 }
 
 template <class Exec>
@@ -84,8 +71,7 @@ void pyr_down_maps(const Exec& ex, View2D<const vec3> vin, View2D<const vec3> ni
 
 #define SEAMLESS_INSTANTIATE_ICP(EXEC)                                                                             \
   namespace seamless::kernels {                                                                                    \
-  template void icp_reduce_into<EXEC>(const EXEC&, IcpLevel, const IcpPose*, IcpSums*);                            \
-  template void icp_step<EXEC>(const EXEC&, const IcpSums*, IcpPose*, bool);                                       \
+  template void icp_reduce_into<EXEC>(const EXEC&, IcpLevel, IcpPose*, IcpSums*, IcpUpdate);                      \
   template void transform_maps<EXEC>(const EXEC&, View2D<const vec3>, View2D<const vec3>, SE3, View2D<vec3>,      \
                                      View2D<vec3>);                                                                \
   template void pyr_down_maps<EXEC>(const EXEC&, View2D<const vec3>, View2D<const vec3>, View2D<vec3>,             \

@@ -30,7 +30,7 @@ SEAMLESS_HD inline float bilinear(View2D<const float> im, float x, float y) {
 // Adds the photometric row of a geometric correspondence c of current pixel (x, y). Only pixels
 // that passed the geometric tests get one: that is the occlusion check (the reference pixel shows
 // the same surface), and it keeps the term away from depth edges where intensity means nothing.
-SEAMLESS_HD inline void add_photometric(IcpSums& s, const RgbdLevel& L, const Correspondence& c, int x, int y) {
+SEAMLESS_HD inline void add_photometric(IcpTerms& s, const RgbdLevel& L, const Correspondence& c, int x, int y) {
   const Intrinsics& K = L.geo.K;
   float u = c.uv.x, v = c.uv.y;
   if (u < 1.f || v < 1.f || u >= L.ref_intensity.width - 2.f || v >= L.ref_intensity.height - 2.f) return;
@@ -45,9 +45,9 @@ SEAMLESS_HD inline void add_photometric(IcpSums& s, const RgbdLevel& L, const Co
 
 // Sums the combined geometric + photometric normal equations over the current level (one pass).
 // error holds the weighted sum of both terms; inliers counts geometric correspondences.
-// (at the estimate *pose, into *out on the device, like icp_reduce_into)
+// (at the estimate *pose, into *out on the device, then `update`, like icp_reduce_into)
 template <class Exec>
-void rgbd_reduce_into(const Exec& ex, RgbdLevel level, const IcpPose* pose, IcpSums* out);
+void rgbd_reduce_into(const Exec& ex, RgbdLevel level, IcpPose* pose, IcpSums* out, IcpUpdate update);
 
 // Intensity in [0, 1] from 8-bit RGB (ITU-R BT.601 luma weights).
 template <class Exec>

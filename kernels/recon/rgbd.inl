@@ -6,21 +6,21 @@
 namespace seamless::kernels {
 
 template <class Exec>
-void rgbd_reduce_into(const Exec& ex, RgbdLevel R, const IcpPose* pose, IcpSums* out) {
+void rgbd_reduce_into(const Exec& ex, RgbdLevel R, IcpPose* pose, IcpSums* out, IcpUpdate update) {
   const int w = R.geo.cur_vertex.width;
   ex.transform_reduce_into(R.geo.cur_vertex.count(), [=] SEAMLESS_HD(std::int64_t i) {
     RgbdLevel L = R;
     L.geo.ref_T_cur = to_se3(*pose);
-    IcpSums s{};
+    IcpTerms s{};
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
-    if (valid_point(L.geo.cur_vertex(x, y))) s.valid = 1.0;
+    if (valid_point(L.geo.cur_vertex(x, y))) s.valid = 1.f;
     Correspondence c;
     if (find_correspondence(L.geo, x, y, c)) {
       add_point_to_plane(s, c, L.geometric_weight);
       add_photometric(s, L, c, x, y);
     }
     return s;
-  }, out);
+  }, out, [=] SEAMLESS_HD { gauss_newton_update(*out, *pose, update); });
 }
 
 template <class Exec>
@@ -37,6 +37,6 @@ void rgb_to_intensity(const Exec& ex, View2D<const uchar3> rgb, View2D<float> ou
 
 #define SEAMLESS_INSTANTIATE_RGBD(EXEC)                                                   \
   namespace seamless::kernels {                                                           \
-  template void rgbd_reduce_into<EXEC>(const EXEC&, RgbdLevel, const IcpPose*, IcpSums*); \
+  template void rgbd_reduce_into<EXEC>(const EXEC&, RgbdLevel, IcpPose*, IcpSums*, IcpUpdate); \
   template void rgb_to_intensity<EXEC>(const EXEC&, View2D<const uchar3>, View2D<float>); \
   }

@@ -161,8 +161,8 @@ void splat_ray_intervals(const Exec& ex, HashTableView t, VoxelGeometry geom, In
 
 // One ray per pixel from min_depth to max_depth, or only over its tile's interval when iv.bits is
 // set: skips unallocated blocks whole, steps by the TSDF inside allocated ones, refines the +/-
-// zero crossing by regula falsi on the trilinear field and takes the normal from its gradient
-// (KinectFusion section 3.5; Niessner section 4.3). A ray starting before its tile's near depth is
+// zero crossing by regula falsi on the trilinear field (KinectFusion section 3.5; Niessner section
+// 4.3); a second pass takes each hit's normal from its neighbours' vertices (vertex_map_normal). A ray starting before its tile's near depth is
 // in unallocated blocks up to there, where the full march skips block by block, so both take the
 // same samples from the first block on and hit the same surfaces.
 template <class Exec, class Acc>

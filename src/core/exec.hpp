@@ -4,9 +4,14 @@
 //   ex.for_each(n, fn)                   fn(i) for i in [0, n), in parallel
 //   ex.exclusive_scan(in, out, n)        out[i] = sum of in[0..i); returns the total (to the host)
 //   ex.sort_by_key(keys, values, n, b)   stable sort of (key, value) pairs by the low b bits of key
-//   ex.transform_reduce(n, init, fn)     init + sum of fn(i); T needs operator+ (returned to host)
-//   ex.transform_reduce_into(n, fn, out) *out = sum of fn(i), out on ex.device: no host round trip, so
-//                                        a loop of kernels (ICP's Gauss-Newton steps) never waits
+//   ex.transform_reduce(n, init, fn)     init + sum of fn(i); T needs operator+ (returned to host);
+//                                        fn may return a narrower type U with T + U and U + U
+//                                        (per-thread partial sums in U, the total in T)
+//   ex.transform_reduce_into(n, fn, out[, then])
+//                                        *out = sum of fn(i), out on ex.device: no host round trip, so
+//                                        a loop of kernels (ICP's Gauss-Newton steps) never waits;
+//                                        then(), if given, runs once on the device after *out is
+//                                        written (in the same launch on CUDA)
 //   ex.synchronize()
 // plus the SEAMLESS_HD atomics in core/atomics.hpp. Pointers passed in live on ex.device.
 //
@@ -19,9 +24,15 @@
 
 #include "core/device.hpp"
 #include "core/error.hpp"
+#include "core/hd.hpp"
 #include "seamless/build_config.hpp"
 
 namespace seamless {
+
+// The default `then` of transform_reduce_into: nothing.
+struct NoThen {
+  SEAMLESS_HD void operator()() const {}
+};
 
 struct CpuExec {
   static constexpr Device device = Device::CPU;
@@ -31,7 +42,7 @@ struct CpuExec {
   template <class T> T exclusive_scan(const T* in, T* out, std::int64_t n) const;
   template <class K, class V> void sort_by_key(K* keys, V* values, std::int64_t n, int key_bits = 8 * sizeof(K)) const;
   template <class T, class F> T transform_reduce(std::int64_t n, T init, F fn) const;
-  template <class T, class F> void transform_reduce_into(std::int64_t n, F fn, T* out) const;
+  template <class T, class F, class G = NoThen> void transform_reduce_into(std::int64_t n, F fn, T* out, G then = {}) const;
   void synchronize() const {}
 };
 
@@ -51,7 +62,7 @@ struct CudaExec {
   template <class T> T exclusive_scan(const T* in, T* out, std::int64_t n) const;
   template <class K, class V> void sort_by_key(K* keys, V* values, std::int64_t n, int key_bits = 8 * sizeof(K)) const;
   template <class T, class F> T transform_reduce(std::int64_t n, T init, F fn) const;
-  template <class T, class F> void transform_reduce_into(std::int64_t n, F fn, T* out) const;
+  template <class T, class F, class G = NoThen> void transform_reduce_into(std::int64_t n, F fn, T* out, G then = {}) const;
   void synchronize() const;
 };
 

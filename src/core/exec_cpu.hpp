@@ -79,9 +79,10 @@ T CpuExec::transform_reduce(std::int64_t n, T init, F fn) const {
   return sum;
 }
 
-template <class T, class F>
-void CpuExec::transform_reduce_into(std::int64_t n, F fn, T* out) const {
+template <class T, class F, class G>
+void CpuExec::transform_reduce_into(std::int64_t n, F fn, T* out, G then) const {
   *out = transform_reduce(n, T{}, fn);
+  then();
 }
 
 }  // namespace seamless

@@ -35,16 +35,23 @@ unsigned* reduce_counter();
 // every block writes its partial, and the block that finishes last, as counted by an atomic on a
 // counter that starts at zero, adds the partials and writes *out. No second launch, and *out
 // stays on the device for the next kernel in the stream.
-template <int kThreads, class T, class F>
-__global__ void transform_reduce_kernel(std::int64_t n, F fn, T* partial, unsigned* counter, T* out) {
-  using BlockReduce = cub::BlockReduce<T, kThreads>;
+// The sum runs in the type fn returns, Local, and is widened once into T at the end (T{} + total):
+// a narrower Local (float terms of a double sum) halves the registers, so twice the threads are in
+// flight. Its rounding stays small because the sum is a tree: a thread adds its few elements
+// (n / threads in flight), then the block and the partials are summed pairwise (CUB), so the
+// relative error grows with log2(n), not with n as in one long float sum.
+template <int kThreads, class T, class F, class G>
+__global__ void transform_reduce_kernel(std::int64_t n, F fn, decltype(fn(std::int64_t{}))* partial,
+                                        unsigned* counter, T* out, G then) {
+  using Local = decltype(fn(std::int64_t{}));
+  using BlockReduce = cub::BlockReduce<Local, kThreads>;
   __shared__ typename BlockReduce::TempStorage tmp;
   __shared__ bool last;
-  T local{};
+  Local local{};
   for (std::int64_t i = static_cast<std::int64_t>(blockIdx.x) * kThreads + threadIdx.x; i < n;
        i += static_cast<std::int64_t>(gridDim.x) * kThreads)
     local = local + fn(i);
-  T block = BlockReduce(tmp).Reduce(local, Plus{});
+  Local block = BlockReduce(tmp).Reduce(local, Plus{});
   if (threadIdx.x == 0) {
     partial[blockIdx.x] = block;
     __threadfence();  // the partial is visible device-wide before the counter says so
@@ -53,13 +60,14 @@ __global__ void transform_reduce_kernel(std::int64_t n, F fn, T* partial, unsign
   __syncthreads();
   if (!last) return;
   __threadfence();
-  T sum{};
+  Local sum{};
   for (unsigned i = threadIdx.x; i < gridDim.x; i += kThreads) sum = sum + partial[i];
   __syncthreads();  // tmp is reused
-  T total = BlockReduce(tmp).Reduce(sum, Plus{});
+  Local total = BlockReduce(tmp).Reduce(sum, Plus{});
   if (threadIdx.x == 0) {
-    *out = total;
+    *out = T{} + total;
     *counter = 0;
+    then();
   }
 }
 }  // namespace cuda_detail
@@ -128,14 +136,25 @@ void CudaExec::sort_by_key(K* keys, V* values, std::int64_t n, int key_bits) con
   }
 }
 
-template <class T, class F>
-void CudaExec::transform_reduce_into(std::int64_t n, F fn, T* out) const {
-  constexpr int kThreads = 256;
+template <class T, class F, class G>
+void CudaExec::transform_reduce_into(std::int64_t n, F fn, T* out, G then) const {
+  // One wave of as many blocks as fit on the device at once (registers decide): each thread then
+  // strides over several elements instead of blocks queueing behind each other.
+  constexpr int kThreads = 128;
+  static const int resident = [] {
+    int per_sm = 0;
+    SEAMLESS_CUDA_CHECK(cudaOccupancyMaxActiveBlocksPerMultiprocessor(
+        &per_sm, cuda_detail::transform_reduce_kernel<kThreads, T, F, G>, kThreads, 0));
+    return std::max(1, per_sm) * cuda_detail::multiprocessors();
+  }();
   std::int64_t wanted = std::max<std::int64_t>(1, (n + kThreads - 1) / kThreads);
-  int blocks = static_cast<int>(std::min<std::int64_t>(wanted, 4 * cuda_detail::multiprocessors()));
-  T* partial = static_cast<T*>(cuda_detail::scratch(sizeof(T) * blocks));
-  cuda_detail::transform_reduce_kernel<kThreads, T><<<blocks, kThreads>>>(n, fn, partial, cuda_detail::reduce_counter(),
-                                                                          out);
+  int blocks = static_cast<int>(std::min<std::int64_t>(wanted, resident));
+  using Local = decltype(fn(std::int64_t{}));
+  Local* partial = static_cast<Local*>(cuda_detail::scratch(sizeof(Local) * blocks));
+  // The partials (shared scratch) and the counter are one per process: reductions must not run
+  // concurrently on two streams.
+  cuda_detail::transform_reduce_kernel<kThreads, T><<<blocks, kThreads, 0, static_cast<cudaStream_t>(stream)>>>(
+      n, fn, partial, cuda_detail::reduce_counter(), out, then);
   SEAMLESS_CUDA_CHECK_LAUNCH("transform_reduce");
 }
 
@@ -143,7 +162,7 @@ template <class T, class F>
 T CudaExec::transform_reduce(std::int64_t n, T init, F fn) const {
   if (n <= 0) return init;
   T* total_dev = static_cast<T*>(cuda_detail::result_slot(sizeof(T)));
-  transform_reduce_into(n, fn, total_dev);
+  CudaExec{}.transform_reduce_into(n, fn, total_dev);  // on the legacy default stream, like the copy
   T total{};
   SEAMLESS_CUDA_CHECK(cudaMemcpy(&total, total_dev, sizeof(T), cudaMemcpyDeviceToHost));
   return init + total;

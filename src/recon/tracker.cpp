@@ -149,32 +149,33 @@ kernels::IcpSums* Tracker::sums_slot(int level) const {
   return sums_.data() + level;
 }
 
-void Tracker::reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, int level, const kernels::IcpPose* pose,
-                          kernels::IcpSums* out) const {
+void Tracker::reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, int level, kernels::IcpPose* pose,
+                          kernels::IcpSums* out, kernels::IcpUpdate update) const {
   const PyramidLevel& cur = frame.level(level);
   const ReferenceLevel& rl = ref.level(level);
   kernels::IcpLevel L{cur.vertices.cview(), cur.normals.cview(), rl.vertices.cview(), rl.normals.cview(), rl.K,
                       SE3::identity(), params_.dist_threshold,
                       static_cast<float>(std::cos(params_.angle_threshold_deg * kPi / 180.0))};
   with_exec(device_, [&](const auto& ex) {
-    if (!use_photometric(frame, ref)) return kernels::icp_reduce_into(ex, L, pose, out);
+    if (!use_photometric(frame, ref)) return kernels::icp_reduce_into(ex, L, pose, out, update);
     kernels::RgbdLevel R{L, cur.intensity.cview(), rl.intensity.cview(), 1.f, params_.photometric_weight,
                          params_.max_intensity_diff};
-    kernels::rgbd_reduce_into(ex, R, pose, out);
+    kernels::rgbd_reduce_into(ex, R, pose, out, update);
   });
 }
 
 kernels::IcpSums Tracker::reduce(const FramePyramid& frame, const ReferenceMaps& ref, int level,
                                  const SE3& ref_T_cur) const {
   set_pose(ref_T_cur);
-  reduce_into(frame, ref, level, pose_.data(), sums_slot(0));
+  reduce_into(frame, ref, level, pose_.data(), sums_slot(0), kernels::IcpUpdate::none);
   kernels::IcpSums s;
   memory::copy(&s, Device::CPU, sums_slot(0), device_, sizeof s);
   return s;
 }
 
-// The whole coarse-to-fine loop is queued on the device (reduce, then solve and update, per
-// iteration); the host waits once, for the final estimate and the finest level's last system.
+// The whole coarse-to-fine loop is queued on the device, one launch per iteration (reduce, then
+// solve and update in the same kernel); the host waits once, for the final estimate and the
+// finest level's last system.
 TrackResult Tracker::track(const FramePyramid& frame, const ReferenceMaps& ref,
                            const SE3& initial_world_T_camera) const {
   TrackResult r;
@@ -183,10 +184,9 @@ TrackResult Tracker::track(const FramePyramid& frame, const ReferenceMaps& ref,
   const int levels = std::min({frame.levels(), ref.levels(), static_cast<int>(params_.iterations.size())});
   set_pose(ref.world_T_ref().inverse() * initial_world_T_camera);
   for (int l = levels - 1; l >= 0; --l)
-    for (int it = 0; it < params_.iterations[l]; ++it) {
-      reduce_into(frame, ref, l, pose_.data(), sums_slot(l));
-      with_exec(device_, [&](const auto& ex) { kernels::icp_step(ex, sums_slot(l), pose_.data(), it == 0); });
-    }
+    for (int it = 0; it < params_.iterations[l]; ++it)
+      reduce_into(frame, ref, l, pose_.data(), sums_slot(l),
+                  it == 0 ? kernels::IcpUpdate::first_step : kernels::IcpUpdate::step);
   kernels::IcpPose pose = pose_.to_host()[0];
   r.iterations = pose.steps;
   bool degenerate = false;

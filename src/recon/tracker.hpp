@@ -89,8 +89,8 @@ class Tracker {
 
  private:
   bool use_photometric(const FramePyramid& frame, const ReferenceMaps& ref) const;
-  void reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, int level, const kernels::IcpPose* pose,
-                   kernels::IcpSums* out) const;
+  void reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, int level, kernels::IcpPose* pose,
+                   kernels::IcpSums* out, kernels::IcpUpdate update) const;
   kernels::IcpSums* sums_slot(int level) const;
   void set_pose(const SE3& ref_T_cur) const;
   void check_loss(TrackResult& r, const SE3& initial) const;
