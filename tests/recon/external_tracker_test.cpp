@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <ostream>
 #include <string>
 
 #include "core/error.hpp"
@@ -31,6 +32,8 @@ struct ExternalCase {
   std::string module;  // named in the skip message
   double per_frame_error_m;
 };
+
+void PrintTo(const ExternalCase& c, std::ostream* os) { *os << c.kind; }  // readable ctest names
 
 class ExternalTracker : public ::testing::TestWithParam<ExternalCase> {};
 
