@@ -196,25 +196,4 @@ SEAMLESS_HD inline vec4 extract_rotation(const mat3& A, vec4 q, int max_iter) {
   return q;
 }
 
-// Bits of a non-negative float as an int: they order like the floats, so an integer atomic max
-// finds the largest float (write_back's |v|^2).
-SEAMLESS_HD inline int nonneg_float_order(float f) {
-#ifdef __CUDA_ARCH__
-  return __float_as_int(f);
-#else
-  int i;
-  std::memcpy(&i, &f, sizeof i);
-  return i;
-#endif
-}
-SEAMLESS_HD inline float nonneg_float_from_order(int i) {
-#ifdef __CUDA_ARCH__
-  return __int_as_float(i);
-#else
-  float f;
-  std::memcpy(&f, &i, sizeof f);
-  return f;
-#endif
-}
-
 }  // namespace seamless::kernels

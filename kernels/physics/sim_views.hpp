@@ -104,7 +104,7 @@ struct SimViews {
   SEAMLESS_HD const int* nbrs(int s) const { return nbr + s * nbr_row; }
   SEAMLESS_HD const int* snbrs(int s) const { return snbr + s * snbr_row; }
   // [0] lists over the cap, [1] static lists over the cap, [2] max len, [3] max static len,
-  // [4] bits of the largest |v|^2 at the last write_back (kernels::nonneg_float_order)
+  // [4] bits of the largest |v|^2 at the last write_back (float_bits, core/math.hpp)
   int* counters = nullptr;
 
   // static scene particles, sorted by their own grid at upload

@@ -647,7 +647,7 @@ void write_back(const Exec& ex, const SimViews& S) {
     S.v[id] = S.sv[s];
     // Largest |v|^2 for stats() without a reduction: the bits of non-negative floats order like
     // ints. Read first: the shared maximum rarely changes, so most particles only load it.
-    const int v2 = nonneg_float_order(length2(S.sv[s]));
+    const int v2 = float_bits(length2(S.sv[s]));
     if (v2 > atomic_load(&S.counters[4])) atomic_max(&S.counters[4], v2);
   });
 }

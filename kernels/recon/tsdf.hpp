@@ -131,24 +131,6 @@ struct RayIntervals {
 };
 constexpr std::int32_t kEmptyNear = 0x7f800000;  // +infinity
 constexpr std::int32_t kEmptyFar = 0;            // +0: no block splatted
-SEAMLESS_HD inline std::int32_t float_bits(float f) {
-#ifdef __CUDA_ARCH__
-  return __float_as_int(f);
-#else
-  std::int32_t i;
-  std::memcpy(&i, &f, sizeof i);
-  return i;
-#endif
-}
-SEAMLESS_HD inline float bits_float(std::int32_t i) {
-#ifdef __CUDA_ARCH__
-  return __int_as_float(i);
-#else
-  float f;
-  std::memcpy(&f, &i, sizeof f);
-  return f;
-#endif
-}
 // Empties every tile (near = +inf, far = 0).
 template <class Exec>
 void clear_ray_intervals(const Exec& ex, RayIntervals iv);

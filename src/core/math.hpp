@@ -2,6 +2,7 @@
 // core/eigen_conv.hpp for the conversions at the boundary.
 #pragma once
 #include <cmath>
+#include <cstring>
 #include <cstdint>
 
 #include "core/hd.hpp"
@@ -43,6 +44,27 @@ SEAMLESS_HD inline vec3 normalize(vec3 a) {
 }
 SEAMLESS_HD inline vec3 vmin(vec3 a, vec3 b) { return {fminf(a.x, b.x), fminf(a.y, b.y), fminf(a.z, b.z)}; }
 SEAMLESS_HD inline vec3 vmax(vec3 a, vec3 b) { return {fmaxf(a.x, b.x), fmaxf(a.y, b.y), fmaxf(a.z, b.z)}; }
+// The bits of a float as an int and back. For non-negative floats they order like the floats,
+// so integer atomic min / max can find the smallest or largest float on both backends.
+SEAMLESS_HD inline std::int32_t float_bits(float f) {
+#ifdef __CUDA_ARCH__
+  return __float_as_int(f);
+#else
+  std::int32_t i;
+  std::memcpy(&i, &f, sizeof i);
+  return i;
+#endif
+}
+SEAMLESS_HD inline float bits_float(std::int32_t i) {
+#ifdef __CUDA_ARCH__
+  return __int_as_float(i);
+#else
+  float f;
+  std::memcpy(&f, &i, sizeof f);
+  return f;
+#endif
+}
+
 SEAMLESS_HD inline bool is_finite(float v) {
 #ifdef __CUDA_ARCH__
   return isfinite(v);

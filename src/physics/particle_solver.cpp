@@ -642,7 +642,7 @@ SolverStats ParticleSolver::stats() const {
   std::vector<int> c = I.counters.to_host();
   s.neighbour_overflow = c[0], s.static_neighbour_overflow = c[1];
   s.max_neighbours_seen = c[2], s.max_static_neighbours_seen = c[3];
-  if (I.n > 0) s.max_speed = std::sqrt(K::nonneg_float_from_order(c[4]));
+  if (I.n > 0) s.max_speed = std::sqrt(bits_float(c[4]));
   if (s.neighbour_overflow > 0 || s.static_neighbour_overflow > 0)
     spdlog::warn("particle solver: {} neighbour lists and {} scene lists exceeded the cap ({} / {}); raise "
               "solver.max_neighbours / solver.max_static_neighbours",
