@@ -118,6 +118,14 @@ struct IcpPose {
   int steps;       // Gauss-Newton steps taken; a stalled level counts its failing step
 };
 
+// What a frame's Gauss-Newton loop keeps on the device, in one allocation so that the host reads
+// the result with one copy: the estimate and the last system of each pyramid level.
+constexpr int kIcpMaxLevels = 8;
+struct IcpState {
+  IcpPose pose;
+  IcpSums sums[kIcpMaxLevels];
+};
+
 SEAMLESS_HD inline IcpPose to_icp_pose(const SE3& T) {
   IcpPose p{};
   for (int r = 0; r < 3; ++r)

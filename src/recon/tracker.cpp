@@ -138,15 +138,21 @@ bool Tracker::use_photometric(const FramePyramid& frame, const ReferenceMaps& re
          frame.level(0).intensity.width() > 0;
 }
 
+kernels::IcpState* Tracker::state() const {
+  if (state_.size() != 1 || state_.device() != device_) state_ = Buffer<kernels::IcpState>(1, device_);
+  return state_.data();
+}
+
 void Tracker::set_pose(const SE3& ref_T_cur) const {
-  if (pose_.size() != 1 || pose_.device() != device_) pose_ = Buffer<kernels::IcpPose>(1, device_);
   const kernels::IcpPose p = kernels::to_icp_pose(ref_T_cur);
-  pose_.copy_from_host(&p, 1);
+  memory::copy(&state()->pose, device_, &p, Device::CPU, sizeof p);
 }
 
 kernels::IcpSums* Tracker::sums_slot(int level) const {
-  if (sums_.size() <= level || sums_.device() != device_) sums_ = Buffer<kernels::IcpSums>(level + 8, device_);
-  return sums_.data() + level;
+  if (level >= kernels::kIcpMaxLevels)
+    throw Error("the tracker handles at most " + std::to_string(kernels::kIcpMaxLevels) + " pyramid levels, not " +
+                std::to_string(level + 1) + " (preprocess.levels)");
+  return &state()->sums[level];
 }
 
 void Tracker::reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, int level, kernels::IcpPose* pose,
@@ -167,7 +173,7 @@ void Tracker::reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, i
 kernels::IcpSums Tracker::reduce(const FramePyramid& frame, const ReferenceMaps& ref, int level,
                                  const SE3& ref_T_cur) const {
   set_pose(ref_T_cur);
-  reduce_into(frame, ref, level, pose_.data(), sums_slot(0), kernels::IcpUpdate::none);
+  reduce_into(frame, ref, level, &state()->pose, sums_slot(0), kernels::IcpUpdate::none);
   kernels::IcpSums s;
   memory::copy(&s, Device::CPU, sums_slot(0), device_, sizeof s);
   return s;
@@ -185,14 +191,15 @@ TrackResult Tracker::track(const FramePyramid& frame, const ReferenceMaps& ref,
   set_pose(ref.world_T_ref().inverse() * initial_world_T_camera);
   for (int l = levels - 1; l >= 0; --l)
     for (int it = 0; it < params_.iterations[l]; ++it)
-      reduce_into(frame, ref, l, pose_.data(), sums_slot(l),
+      reduce_into(frame, ref, l, &state()->pose, sums_slot(l),
                   it == 0 ? kernels::IcpUpdate::first_step : kernels::IcpUpdate::step);
-  kernels::IcpPose pose = pose_.to_host()[0];
+  kernels::IcpState st;  // one copy back, which waits for the loop
+  memory::copy(&st, Device::CPU, state(), device_, sizeof st);
+  const kernels::IcpPose& pose = st.pose;
   r.iterations = pose.steps;
   bool degenerate = false;
   if (levels > 0 && params_.iterations[0] > 0) {  // statistics of the finest level's last system
-    kernels::IcpSums s;
-    memory::copy(&s, Device::CPU, sums_slot(0), device_, sizeof s);
+    const kernels::IcpSums& s = st.sums[0];
     IcpStep step = solve_icp_step(s);
     r.inliers = static_cast<std::int64_t>(s.inliers);
     r.inlier_ratio = s.valid > 0 ? s.inliers / s.valid : 0.0;

@@ -91,6 +91,7 @@ class Tracker {
   bool use_photometric(const FramePyramid& frame, const ReferenceMaps& ref) const;
   void reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, int level, kernels::IcpPose* pose,
                    kernels::IcpSums* out, kernels::IcpUpdate update) const;
+  kernels::IcpState* state() const;
   kernels::IcpSums* sums_slot(int level) const;
   void set_pose(const SE3& ref_T_cur) const;
   void check_loss(TrackResult& r, const SE3& initial) const;
@@ -98,8 +99,7 @@ class Tracker {
   Device device_;
   // Device state of the Gauss-Newton loop (reused from frame to frame): the estimate and one
   // system per level.
-  mutable Buffer<kernels::IcpPose> pose_;
-  mutable Buffer<kernels::IcpSums> sums_;
+  mutable Buffer<kernels::IcpState> state_;
 };
 
 // One Gauss-Newton step on the host (tests, statistics): solves J^T J xi = -J^T r with the device
