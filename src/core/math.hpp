@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <cstdint>
+#include <type_traits>
 
 #include "core/hd.hpp"
 
@@ -65,14 +66,8 @@ SEAMLESS_HD inline float bits_float(std::int32_t i) {
 #endif
 }
 
-SEAMLESS_HD inline bool is_finite(float v) {
-#ifdef __CUDA_ARCH__
-  return isfinite(v);
-#else
-  return std::isfinite(v);
-#endif
-}
-SEAMLESS_HD inline bool is_finite(double v) {
+template <class T, class = std::enable_if_t<std::is_floating_point_v<T>>>
+SEAMLESS_HD inline bool is_finite(T v) {
 #ifdef __CUDA_ARCH__
   return isfinite(v);
 #else

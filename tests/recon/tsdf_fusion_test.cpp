@@ -249,16 +249,7 @@ TEST(TsdfParity, SameBlocksAndValues) {
   VoxelHashVolume cpu(test::small_volume_params(), Device::CPU), gpu(test::small_volume_params(), Device::CUDA);
   fuse(cpu, s, K, poses, true);
   fuse(gpu, s, K, poses, true);
-  auto a = cpu.download_blocks(), b = gpu.download_blocks();
-  ASSERT_EQ(a.size(), b.size());
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    ASSERT_TRUE(a[i].coord == b[i].coord);
-    for (int k = 0; k < kernels::kBlockVoxels; ++k) {
-      ASSERT_EQ(a[i].voxels[k].weight, b[i].voxels[k].weight);
-      ASSERT_NEAR(a[i].voxels[k].sdf, b[i].voxels[k].sdf, 1e-5f);
-      ASSERT_NEAR(a[i].voxels[k].color.x, b[i].voxels[k].color.x, 1);
-    }
-  }
+  ASSERT_NO_FATAL_FAILURE(test::expect_same_blocks(cpu.download_blocks(), gpu.download_blocks(), true));
   SE3 view = test::pose({0.01f, 0.01f, 0.02f}, 0.02f, -0.01f);
   auto da = cpu.raycast(K, view).depth.to_host(), db = gpu.raycast(K, view).depth.to_host();
   int differ = 0;

@@ -26,12 +26,9 @@ Scene box_scene() {
 }
 
 VoxelHashVolume fused(const Scene& s, Device d = Device::CPU) {
-  VolumeParams p;
-  p.voxel_size = 0.01f;
+  VolumeParams p = test::small_volume_params();
   p.truncation = 0.04f;
-  p.hash_buckets = 1 << 14;
-  p.capacity = 4096;
-  p.min_depth = 0.2f;
+  p.max_depth = VolumeParams{}.max_depth;
   VoxelHashVolume vol(p, d);
   Intrinsics K = test::camera(320, 240, 280.f);
   // Translations only: the projective distance to the fronto-parallel faces is then exact.

@@ -1,6 +1,8 @@
 // Analytic test scenes for the TSDF tests: depth maps ray-traced exactly from planes and spheres,
 // and the scene's signed distance, so that results can be checked against truth.
 #pragma once
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <vector>
 
@@ -8,6 +10,7 @@
 #include "core/camera.hpp"
 #include "core/math.hpp"
 #include "recon/volume_params.hpp"
+#include "recon/voxel_hash_volume.hpp"
 
 namespace seamless::test {
 
@@ -121,6 +124,22 @@ inline VolumeParams small_volume_params() {
   p.min_depth = 0.2f;
   p.max_depth = 3.f;
   return p;
+}
+
+// Two volumes' downloaded blocks (download_blocks(), sorted) hold the same blocks with the same
+// weights and TSDF values (1e-5 m: float reassociation between backends), and, with colour, the
+// same colour within one level. Call through ASSERT_NO_FATAL_FAILURE.
+inline void expect_same_blocks(const std::vector<VoxelHashVolume::HostBlock>& a,
+                               const std::vector<VoxelHashVolume::HostBlock>& b, bool colour) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ASSERT_TRUE(a[i].coord == b[i].coord);
+    for (int k = 0; k < kernels::kBlockVoxels; ++k) {
+      ASSERT_EQ(a[i].voxels[k].weight, b[i].voxels[k].weight);
+      ASSERT_NEAR(a[i].voxels[k].sdf, b[i].voxels[k].sdf, 1e-5f);
+      if (colour) ASSERT_NEAR(a[i].voxels[k].color.x, b[i].voxels[k].color.x, 1);
+    }
+  }
 }
 
 }  // namespace seamless::test

@@ -164,15 +164,7 @@ TEST(VolumeStreamParity, SameVolumeAfterAPath) {
   EXPECT_EQ(cpu.stats().host_blocks, gpu.stats().host_blocks);
   cpu.stream_in_all();
   gpu.stream_in_all();
-  auto a = cpu.download_blocks(), b = gpu.download_blocks();
-  ASSERT_EQ(a.size(), b.size());
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    ASSERT_TRUE(a[i].coord == b[i].coord);
-    for (int k = 0; k < kernels::kBlockVoxels; ++k) {
-      ASSERT_EQ(a[i].voxels[k].weight, b[i].voxels[k].weight);
-      ASSERT_NEAR(a[i].voxels[k].sdf, b[i].voxels[k].sdf, 1e-5f);
-    }
-  }
+  ASSERT_NO_FATAL_FAILURE(test::expect_same_blocks(cpu.download_blocks(), gpu.download_blocks(), false));
 }
 
 }  // namespace

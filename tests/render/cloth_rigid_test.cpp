@@ -72,18 +72,23 @@ TEST(RenderCloth, LightFromBehindGivesAmbientOnBothFaces) {
   }
 }
 
+// The rigid-body scenes: light from the camera, the rigid colour (180, 60, 40), black background.
+RenderParams rigid_params() {
+  RenderParams p;
+  p.light_dir = {0.f, 0.f, 1.f};
+  p.rigid_color = {180 / 255.f, 60 / 255.f, 40 / 255.f};
+  p.background = {0.f, 0.f, 0.f};
+  return p;
+}
+
 // A box 0.4 x 0.2 x 0.2 m (half extents 0.2, 0.1, 0.1) at (0, 0, 2), facing the camera: its
 // front face z = 1.9 covers [fx x / 1.9 + cx] x [fy y / 1.9 + cy]; a one-pixel margin as for
 // the mesh view. The front face's normal points at the camera and the light comes from it, so
 // the face has the full rigid colour.
 TEST(RenderRigid, BoxCoversItsProjection) {
   SEAMLESS_REQUIRE_EGL();
-  RenderParams p;
-  p.light_dir = {0.f, 0.f, 1.f};
-  p.rigid_color = {180 / 255.f, 60 / 255.f, 40 / 255.f};
-  p.background = {0.f, 0.f, 0.f};
   const Intrinsics K = intrinsics(100.f, 79.5f, 59.5f, 160, 120);
-  Renderer r(p, K.width, K.height);
+  Renderer r(rigid_params(), K.width, K.height);
   DrawList l;
   l.rigids.push_back(RigidDraw{SE3{mat3::identity(), {0.f, 0.f, 2.f}}, {0.2f, 0.1f, 0.1f}});
   Pixels img(r.render(l, camera(K)));
@@ -104,12 +109,8 @@ TEST(RenderRigid, BoxCoversItsProjection) {
 // uploaded once and moved by the frame only.
 TEST(RenderRigid, BodyMeshMovesWithItsFrame) {
   SEAMLESS_REQUIRE_EGL();
-  RenderParams p;
-  p.light_dir = {0.f, 0.f, 1.f};
-  p.rigid_color = {180 / 255.f, 60 / 255.f, 40 / 255.f};
-  p.background = {0.f, 0.f, 0.f};
   const Intrinsics K = intrinsics(100.f, 79.5f, 59.5f, 160, 120);
-  Renderer r(p, K.width, K.height);
+  Renderer r(rigid_params(), K.width, K.height);
   auto m = std::make_shared<BodyMesh>();
   m->positions = {{-0.2f, -0.1f, 0.f}, {0.2f, -0.1f, 0.f}, {0.2f, 0.1f, 0.f}, {-0.2f, 0.1f, 0.f}};
   m->normals.assign(4, vec3{0.f, 0.f, -1.f});
