@@ -19,6 +19,7 @@ struct RenderBenchResult {
   double median_draw_ms = 0.0;    // draw + glFinish with the particles already in GL buffers
                                   // (the CUDA-OpenGL interop path: no host upload)
   double median_readback_ms = 0.0;
+  double median_gpu_ms = 0.0;     // GPU time of the draw-only frame: first to last timestamp query
   double median_interop_ms = -1.0;  // CUDA device copy into GL + draw + glFinish; -1: not measured
                                     // (no CUDA, or the GL context is not on the CUDA device)
   std::vector<RenderTiming> passes;  // GPU time per pass, median over the frames
@@ -29,8 +30,8 @@ struct RenderBenchResult {
 // width and height are replaced by the arguments.
 RenderBenchResult bench_render(int width = 1920, int height = 1080, std::int64_t particles = 1'000'000,
                                int frames = 20, const RenderParams& settings = {});
-// The settings before the speed remedies (full-resolution thickness, no depth prepass, two
-// bilateral passes with every tap, unclamped sprites), for comparison.
+// The settings before the speed remedies (raster sprites, full-resolution thickness, no depth
+// prepass, two bilateral passes with every tap, unclamped sprites), for comparison.
 RenderParams unoptimised_render_settings();
 
 }  // namespace seamless

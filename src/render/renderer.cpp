@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "core/log.hpp"
 #include "kernels/physics/particle_math.hpp"
 #include "recon/volume.hpp"
 #include "render/renderer_impl.hpp"
@@ -63,6 +64,7 @@ void Renderer::Impl::make_targets() {
   fluid_depth_fbo = make_framebuffer({fluid_depth[0]}, 0, "fluid depth");
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, fluid_zbuf);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  make_splat_targets();
 }
 
 // Unit box [-1, 1]^3 with a normal per face (24 vertices), scaled to the body's half extents.
@@ -310,6 +312,12 @@ void init(Renderer::Impl& m, const RenderParams& params, int width, int height) 
   m.p = params;
   m.w = width, m.h = height;
   m.build_programs();
+  // Compute shaders and image atomics are core in GL 4.3.
+  m.has_compute = epoxy_gl_version() >= 43;
+  if (m.has_compute) m.build_compute_programs();
+  else if (params.fluid_splat == "compute")
+    spdlog::info("render: OpenGL {} has no compute shaders (4.3); fluid spheres are drawn as raster sprites",
+                 epoxy_gl_version() / 10.0);
   m.empty_vao = VertexArray(new_name(glGenVertexArrays));
   m.make_targets();
   m.make_box();
@@ -350,6 +358,17 @@ RenderParams& Renderer::params() { return impl_->p; }
 const GlInfo& Renderer::gl_info() const { return impl_->info; }
 const std::vector<StageImage>& Renderer::stage_images() const { return impl_->stages; }
 const std::vector<RenderTiming>& Renderer::timings() const { return impl_->timings; }
+bool Renderer::uses_compute_splat() const { return impl_->use_compute_splat(); }
+
+Renderer::FluidImages Renderer::read_fluid_images() const {
+  const Impl& m = *impl_;
+  FluidImages f;
+  f.w = m.w, f.h = m.h, f.tw = m.tw, f.th = m.th;
+  f.depth = read_float(m.fluid_filter_fbo[0], 0, GL_RED, 1, m.w, m.h);
+  f.thickness = read_float(m.thick_fbo[0], 0, GL_RED, 1, m.tw, m.th);
+  return f;
+}
+
 unsigned Renderer::particle_position_buffer() const { return impl_->part_pos; }
 unsigned Renderer::particle_phase_buffer() const { return impl_->part_phase; }
 

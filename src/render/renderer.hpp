@@ -75,6 +75,16 @@ class Renderer {
   const std::vector<StageImage>& stage_images() const;
   // GPU time of each pass of the last draw.
   const std::vector<RenderTiming>& timings() const;
+  // The fluid's float images of the last draw (rows bottom to top): eye depth after the filter
+  // (0 = no fluid; with render.filter_iterations 0 the spheres' own depth) at the framebuffer
+  // size, and the thickness in metres after its blur at 1/thickness_downsample. For tests.
+  struct FluidImages {
+    std::vector<float> depth, thickness;
+    int w = 0, h = 0, tw = 0, th = 0;
+  };
+  FluidImages read_fluid_images() const;
+  // Whether the fluid sphere passes run as compute splats (render.fluid_splat: compute and GL 4.3).
+  bool uses_compute_splat() const;
   // Copies the last frame to the bound draw framebuffer (0 = the window), scaled to w x h.
   void blit_to(unsigned framebuffer, int w, int h);
   // The particle position/phase buffers for CUDA-OpenGL interop (render/cuda_interop.hpp).

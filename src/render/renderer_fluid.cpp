@@ -122,6 +122,7 @@ void Renderer::Impl::copy_scene_depth(GLuint dst, int dw, int dh) {
 
 // SSFR 1: nearest sphere depth per pixel, in front of the scene.
 void Renderer::Impl::fluid_depth_pass(std::int64_t n, float sphere_r, const RenderCamera& cam) {
+  if (use_compute_splat()) return fluid_depth_splat(n, sphere_r, cam);
   glBindFramebuffer(GL_FRAMEBUFFER, fluid_depth_fbo);
   glClearColor(0.f, 0.f, 0.f, 0.f);
   if (p.depth_prepass) {
@@ -145,6 +146,10 @@ void Renderer::Impl::fluid_thickness_pass(std::int64_t n, float sphere_r, const 
   RenderCamera low = cam;
   low.K = scale_intrinsics(cam.K, tw, th);
   glViewport(0, 0, tw, th);
+  if (use_compute_splat()) {
+    fluid_thickness_splat(n, sphere_r, low);
+    return thickness_blur(low);
+  }
   glBindFramebuffer(GL_FRAMEBUFFER, thick_fbo[0]);
   glClear(GL_COLOR_BUFFER_BIT);
   if (p.depth_prepass) {
@@ -165,7 +170,12 @@ void Renderer::Impl::fluid_thickness_pass(std::int64_t n, float sphere_r, const 
   glDisable(GL_BLEND);
   glDisable(GL_DEPTH_TEST);
   glDepthMask(GL_TRUE);
-  // Small Gaussian over the thickness, at its resolution.
+  thickness_blur(low);
+}
+
+// Small Gaussian over the thickness, at its resolution (the viewport is tw x th on entry).
+void Renderer::Impl::thickness_blur(const RenderCamera& low) {
+  glDisable(GL_DEPTH_TEST);  // thick_fbo[0] has the raster path's depth buffer attached
   set_camera_uniforms(filter_prog, low);
   glBindVertexArray(empty_vao);
   glUniform1i(filter_prog.loc("u_max_px"), 3);

@@ -84,6 +84,9 @@ struct Renderer::Impl {
 
   Program mesh_prog, cloth_prog, particle_prog, kinect_prog;
   Program fluid_depth_prog, fluid_thick_prog, filter_prog, normal_prog, composite_prog;
+  // Compute splats (render.fluid_splat: compute), built only with GL >= 4.3 (has_compute).
+  bool has_compute = false;
+  Program depth_splat_prog, thick_splat_prog, resolve_prog;
   VertexArray empty_vao;
 
   // Framebuffer-sized targets (re-made by resize).
@@ -93,6 +96,9 @@ struct Renderer::Impl {
   Framebuffer final_fbo;
   Texture fluid_depth[2], thick[2], normals;
   Renderbuffer fluid_zbuf, thick_zbuf;
+  // Integer images the compute splats accumulate into (depth bits at w x h, fixed-point
+  // thickness at tw x th); the resolve pass clears them again after reading.
+  Texture depth_bits, thick_fixed;
   int tw = 0, th = 0;  // thickness targets: the framebuffer over render.thickness_downsample
   Framebuffer fluid_depth_fbo, fluid_filter_fbo[2], thick_fbo[2], normal_fbo;
   bool last_has_fluid = false;
@@ -150,6 +156,15 @@ struct Renderer::Impl {
   void fluid_thickness_pass(std::int64_t n, float sphere_r, const RenderCamera& cam);
   void fluid_filter_passes(float radius, const RenderCamera& cam);
   void filter_pass(GLuint src, GLuint dst_fbo, int dx, int dy);
+  void thickness_blur(const RenderCamera& low);
+  // renderer_splat.cpp: the compute path of SSFR 1 and 2.
+  bool use_compute_splat() const { return has_compute && p.fluid_splat == "compute"; }
+  void build_compute_programs();
+  void make_splat_targets();
+  void splat_uniforms(const Program& prog, std::int64_t n, float sphere_r, const RenderCamera& cam);
+  void resolve_splat(GLuint acc, GLuint out, int iw, int ih, bool depth_bits);
+  void fluid_depth_splat(std::int64_t n, float sphere_r, const RenderCamera& cam);
+  void fluid_thickness_splat(std::int64_t n, float sphere_r, const RenderCamera& low);
   void capture_stages();
   void set_camera_uniforms(const Program& prog, const RenderCamera& cam) const;
   vec3 light_eye(const RenderCamera& cam) const;

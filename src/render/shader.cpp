@@ -57,10 +57,13 @@ using Sources = std::vector<std::pair<std::string, std::string>>;  // file name,
 // "#version" first, then file i behind "#line (i + 1) * kLinesPerFile + 1" (GLSL 4.10 spec,
 // section 3.4), so that a reported line says both the file and its own line. (The source-string
 // number of #line would be the natural carrier, but Mesa reports it as 0.)
-std::string assemble(const Sources& src) {
+// Compute shaders need GLSL 4.30 (GL 4.3); they define SEAMLESS_COMPUTE so that shared files
+// leave out what only a fragment has (gl_FragCoord, flat inputs).
+std::string assemble(GLenum type, const Sources& src) {
   // Conservative depth (GL 4.2 core, an extension to 4.1) lets the sphere shaders keep the early
   // depth test although they write gl_FragDepth; "enable" only warns where it is missing.
-  std::string s = "#version 410 core\n#extension GL_ARB_conservative_depth : enable\n";
+  std::string s = type == GL_COMPUTE_SHADER ? "#version 430 core\n#define SEAMLESS_COMPUTE 1\n"
+                                            : "#version 410 core\n#extension GL_ARB_conservative_depth : enable\n";
   for (std::size_t i = 0; i < src.size(); ++i)
     s += "#line " + std::to_string((static_cast<long>(i) + 1) * kLinesPerFile + 1) + "\n" + src[i].second + "\n";
   return s;
@@ -75,7 +78,7 @@ std::string info_log(GLuint obj, bool program) {
 }
 
 GLuint compile(const std::string& program, GLenum type, const Sources& src) {
-  const std::string text = assemble(src);
+  const std::string text = assemble(type, src);
   const char* p = text.c_str();
   GLuint sh = glCreateShader(type);
   glShaderSource(sh, 1, &p, nullptr);

@@ -4,8 +4,10 @@ uniform vec4 u_K;         // fx, fy, cx, cy in framebuffer pixels
 uniform vec2 u_size;      // framebuffer width, height
 uniform vec2 u_near_far;  // znear, zfar
 
-// Image pixel (u right, v down) of this fragment.
+#ifndef SEAMLESS_COMPUTE
+// Image pixel (u right, v down) of this fragment (compute shaders have no fragment).
 vec2 frag_pixel() { return vec2(gl_FragCoord.x - 0.5, u_size.y - gl_FragCoord.y - 0.5); }
+#endif
 
 // Ray through a pixel with z = 1, so that a point at depth z is z * pixel_ray(p).
 vec3 pixel_ray(vec2 p) { return vec3((p.x - u_K.z) / u_K.x, (p.y - u_K.w) / u_K.y, 1.0); }

@@ -1,15 +1,22 @@
-// Exact ray-sphere intersection for a point sprite's fragment (needs camera.glsl).
+// Exact ray-sphere intersection (needs camera.glsl), shared by the sprite fragment shaders and the
+// compute splats (ssfr_*_splat.comp), so that both paths compute the same depths bit for bit.
 uniform float u_radius;
-flat in vec3 v_centre;
 
-// Eye depths where this pixel's ray enters and leaves the sphere; false if it misses.
-bool hit_sphere(out float z_in, out float z_out) {
-  vec3 d = pixel_ray(frag_pixel());
-  float a = dot(d, d), b = dot(d, v_centre), c = dot(v_centre, v_centre) - u_radius * u_radius;
-  float disc = b * b - a * c;
+// Eye depths where the ray z * d (d from pixel_ray, d.z = 1) enters and leaves the sphere of
+// radius u_radius about eye-space centre c; false if it misses or enters before the near plane.
+bool ray_sphere(vec3 d, vec3 c, out float z_in, out float z_out) {
+  float a = dot(d, d), b = dot(d, c), cc = dot(c, c) - u_radius * u_radius;
+  float disc = b * b - a * cc;
   if (disc < 0.0) return false;
   float s = sqrt(disc);
   z_in = (b - s) / a;  // d.z = 1, so the ray parameter is the eye depth
   z_out = (b + s) / a;
   return z_in > u_near_far.x;
 }
+
+#ifndef SEAMLESS_COMPUTE
+flat in vec3 v_centre;
+
+// The same for this fragment's pixel and the sprite's sphere.
+bool hit_sphere(out float z_in, out float z_out) { return ray_sphere(pixel_ray(frag_pixel()), v_centre, z_in, z_out); }
+#endif

@@ -1,0 +1,116 @@
+// The compute path of the fluid's sphere passes (render.fluid_splat: compute): sphere depth and
+// thickness splatted by compute shaders into integer images with atomics, instead of point
+// sprites through the rasteriser (docs/RENDERING.md, section Speed: GH100 has raster units on
+// only a few of its SMs, compute runs on all of them). Same images as the raster path.
+#include <algorithm>
+#include <vector>
+
+#include "core/error.hpp"
+#include "kernels/physics/particle_math.hpp"
+#include "render/renderer_impl.hpp"
+
+namespace seamless {
+namespace {
+
+constexpr GLuint kSplatGroup = 64;         // local_size_x of splat.glsl
+constexpr GLuint kResolveGroup = 8;        // local_size_x/y of ssfr_resolve.comp
+constexpr GLuint kEmptyDepth = 0xffffffffu;  // "no fluid" in the depth-bits image: above every depth
+
+// Fixed-point thickness: units per metre of path in fluid. Each chord is rounded to the nearest
+// unit, so a pixel's sum is off by at most 0.5 unit per sphere on its ray (2^-21 m = 0.5 um each;
+// 10^3 spheres on one ray: 0.5 mm, against a path of metres). uint32 then holds 2^32 / 2^20 =
+// 4096 m of path: a ray's path in fluid is at most its length inside the view volume (zfar, 30 m
+// by default, times the ray's length factor, below 2 for any usual field of view), so a room
+// scene is two orders of magnitude below the wrap-around.
+constexpr float kFixedPerMetre = 1048576.f;  // 2^20
+
+}  // namespace
+
+void Renderer::Impl::build_compute_programs() {
+  auto cs = [](const char* main) {
+    return ShaderStage{GL_COMPUTE_SHADER, {"camera.glsl", "sphere_hit.glsl", "splat.glsl", main}};
+  };
+  depth_splat_prog = Program("fluid depth splat", {cs("ssfr_depth_splat.comp")});
+  thick_splat_prog = Program("fluid thickness splat", {cs("ssfr_thickness_splat.comp")});
+  resolve_prog = Program("fluid splat resolve", {ShaderStage{GL_COMPUTE_SHADER, {"ssfr_resolve.comp"}}});
+}
+
+namespace {
+// An R32UI texture filled with `value` (the resolve pass keeps it so after every frame).
+Texture make_uint_image(int w, int h, GLuint value) {
+  Texture t = make_texture_2d(GL_R32UI, w, h);
+  const std::vector<GLuint> fill(static_cast<std::size_t>(w) * h, value);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RED_INTEGER, GL_UNSIGNED_INT, fill.data());
+  return t;
+}
+}  // namespace
+
+void Renderer::Impl::make_splat_targets() {
+  if (!has_compute) return;
+  depth_bits = make_uint_image(w, h, kEmptyDepth);
+  thick_fixed = make_uint_image(tw, th, 0u);
+}
+
+// Camera, sphere and particle-buffer bindings of a splat program; the same values sphere.vert gets.
+void Renderer::Impl::splat_uniforms(const Program& prog, std::int64_t n, float sphere_r, const RenderCamera& cam) {
+  set_camera_uniforms(prog, cam);
+  glUniform1f(prog.loc("u_radius"), sphere_r);
+  glUniform1f(prog.loc("u_fmax"), std::max(cam.K.fx, cam.K.fy));
+  glUniform1ui(prog.loc("u_phase_mask"), kernels::phase::kFluid);
+  glUniform1f(prog.loc("u_max_point_size"), p.max_point_size);
+  glUniform1ui(prog.loc("u_count"), static_cast<GLuint>(n));
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, scene_depth);
+  glUniform1i(prog.loc("u_scene_depth"), 0);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, part_pos);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, part_phase);
+}
+
+namespace {
+// One invocation per particle; the groups on a 2D grid (at most 65535 along each axis).
+void dispatch_particles(std::int64_t n) {
+  const std::int64_t groups = (n + kSplatGroup - 1) / kSplatGroup;
+  const auto gx = static_cast<GLuint>(std::min<std::int64_t>(groups, 65535));
+  const auto gy = static_cast<GLuint>((groups + gx - 1) / gx);
+  if (gy > 65535) throw Error("render: " + std::to_string(n) + " particles are more than one compute splat can take");
+  glDispatchCompute(gx, gy, 1);
+}
+}  // namespace
+
+// Integer splat image -> R32F image `out` (iw x ih), and the integer image cleared again.
+void Renderer::Impl::resolve_splat(GLuint acc, GLuint out, int iw, int ih, bool depth) {
+  glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);  // the splat's atomics before these loads
+  resolve_prog.use();
+  glBindImageTexture(0, acc, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+  glBindImageTexture(1, out, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+  glUniform1i(resolve_prog.loc("u_depth_bits"), depth);
+  glUniform1f(resolve_prog.loc("u_metres_per_unit"), 1.f / kFixedPerMetre);
+  glDispatchCompute((static_cast<GLuint>(iw) + kResolveGroup - 1) / kResolveGroup,
+                    (static_cast<GLuint>(ih) + kResolveGroup - 1) / kResolveGroup, 1);
+  // Later passes sample `out`, render into it (filter) or read it back (stage images); the next
+  // frame's splat does atomics on `acc`.
+  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
+                  GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+}
+
+// SSFR 1, compute: nearest sphere depth per pixel into fluid_depth[0] (0 = no fluid).
+void Renderer::Impl::fluid_depth_splat(std::int64_t n, float sphere_r, const RenderCamera& cam) {
+  splat_uniforms(depth_splat_prog, n, sphere_r, cam);
+  glBindImageTexture(0, depth_bits, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+  dispatch_particles(n);
+  resolve_splat(depth_bits, fluid_depth[0], w, h, true);
+}
+
+// SSFR 2, compute: summed chords at the thickness resolution (camera `low`) into thick[0].
+void Renderer::Impl::fluid_thickness_splat(std::int64_t n, float sphere_r, const RenderCamera& low) {
+  splat_uniforms(thick_splat_prog, n, sphere_r, low);
+  const float s = p.fluid_radius_scale;
+  glUniform1f(thick_splat_prog.loc("u_thickness_scale"), 6.f / (kernels::kPi * s * s * s));
+  glUniform1f(thick_splat_prog.loc("u_fixed_per_metre"), kFixedPerMetre);
+  glBindImageTexture(0, thick_fixed, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+  dispatch_particles(n);
+  resolve_splat(thick_fixed, thick[0], tw, th, false);
+}
+
+}  // namespace seamless

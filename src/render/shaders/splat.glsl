@@ -1,0 +1,51 @@
+// Particle splatting in compute shaders (GL 4.3): one invocation per particle, read from the same
+// buffers the sprite pass draws (renderer particle buffers bound as SSBOs), covering the same
+// pixels as sphere.vert's point sprite. Needs camera.glsl and sphere_hit.glsl before it.
+// Why compute at all: docs/RENDERING.md, section Speed (GH100 has almost no raster units).
+layout(local_size_x = 64) in;
+
+layout(std430, binding = 0) readonly buffer Positions { float b_pos[]; };  // x y z, tightly packed
+layout(std430, binding = 1) readonly buffer Phases { uint b_phase[]; };
+
+uniform mat4 u_view, u_proj;
+uniform uint u_count;            // particles in the buffers
+uniform uint u_phase_mask;       // splat particles with any of these phase flags; 0 = all
+uniform float u_fmax;            // max(fx, fy), pixels
+uniform float u_max_point_size;  // pixels (render.max_point_size)
+uniform sampler2D u_scene_depth; // window depth of the scene, full resolution
+
+// This invocation's particle: groups form a 2D grid because one dimension holds at most 65535.
+uint particle_index() {
+  return (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
+}
+
+// Eye-space centre of particle i, with sphere.vert's rules: only masked phases, and the sphere's
+// front (z - r) between the near and far planes (where the sprite vertex would be clipped).
+bool splat_centre(uint i, out vec3 c) {
+  if (i >= u_count) return false;
+  uint ph = b_phase[i];
+  if (u_phase_mask != 0u && (ph & u_phase_mask) == 0u) return false;
+  c = (u_view * vec4(b_pos[3u * i], b_pos[3u * i + 1u], b_pos[3u * i + 2u], 1.0)).xyz;
+  return c.z > u_radius && c.z - u_radius > u_near_far.x && c.z - u_radius < u_near_far.y;
+}
+
+// Image pixels (u right, v down) of sphere.vert's sprite, [lo, hi] inclusive, cut to the image:
+// the sprite's window position comes from u_proj as the rasteriser gets it, its size from the
+// same formula, and a point covers the pixels whose centres lie inside its square (GL 4.5 spec,
+// section 14.4). Unlike a point, a splat whose centre is off screen still draws its visible part.
+bool splat_rect(vec3 c, out ivec2 lo, out ivec2 hi) {
+  vec4 clip = u_proj * vec4(c * ((c.z - u_radius) / c.z), 1.0);
+  vec2 win = (clip.xy / clip.w * 0.5 + 0.5) * u_size;
+  float half_size = 0.5 * min(2.0 * u_radius * u_fmax / (c.z - u_radius) + 2.0, u_max_point_size);
+  ivec2 w_lo = ivec2(ceil(win - half_size - 0.5)), w_hi = ivec2(ceil(win + half_size - 0.5)) - 1;
+  ivec2 size = ivec2(u_size);
+  w_lo = max(w_lo, ivec2(0));
+  w_hi = min(w_hi, size - 1);
+  // Window rows run up, image rows down.
+  lo = ivec2(w_lo.x, size.y - 1 - w_hi.y);
+  hi = ivec2(w_hi.x, size.y - 1 - w_lo.y);
+  return all(lessThanEqual(lo, hi));
+}
+
+// Window (framebuffer) texel of image pixel p.
+ivec2 window_texel(ivec2 p) { return ivec2(p.x, int(u_size.y) - 1 - p.y); }

@@ -1,0 +1,184 @@
+// The compute splats (render.fluid_splat: compute) against the raster sprites: the same sphere
+// depth image and the same thickness, on the same renderer and particles.
+#include <cmath>
+#include <random>
+
+#include "kernels/physics/particle_math.hpp"
+#include "render_test_util.hpp"
+
+namespace seamless::test {
+namespace {
+
+constexpr float kNear = 0.05f, kWallZ = 2.f;
+
+// A jittered 6 x 6 x 6 block about z = 2 m (spheres overlap at many depths: inner silhouettes),
+// cut by a camera-facing wall at z = 2 m (some spheres partly behind the scene). Every centre
+// projects inside the image: a point sprite whose centre leaves the view is clipped whole, a
+// splat is not (docs/RENDERING.md), and that difference is not what this compares.
+struct Block {
+  std::vector<vec3> x;
+  std::vector<std::uint32_t> ph;
+  float r = 0.02f;
+  Block() {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> j(-0.4f * r, 0.4f * r);
+    for (int k = 0; k < 6; ++k)
+      for (int jj = 0; jj < 6; ++jj)
+        for (int i = 0; i < 6; ++i)
+          x.push_back(vec3{(i - 2.5f) * 2 * r + j(rng), (jj - 2.5f) * 2 * r + j(rng), kWallZ + (k - 2.5f) * 2 * r + j(rng)});
+    ph.assign(x.size(), kernels::phase::kFluid);
+  }
+  DrawList list() const {
+    DrawList d;
+    d.positions = x, d.phases = ph, d.particle_radius = r;
+    return d;
+  }
+};
+
+RenderParams splat_params(int thickness_downsample) {
+  RenderParams p;
+  p.znear = kNear;
+  p.filter_iterations = 0;  // the depth image is then the spheres' own
+  p.thickness_downsample = thickness_downsample;
+  return p;
+}
+
+Renderer::FluidImages draw_with(Renderer& r, const Block& b, const Intrinsics& K, const char* splat) {
+  r.params().fluid_splat = splat;
+  r.draw(b.list(), camera(K));
+  return r.read_fluid_images();
+}
+
+// Per window pixel of a w x h image with intrinsics K (rows bottom to top): how many spheres'
+// sprite squares cover it, a bound on how many chords the pixel sums.
+std::vector<int> chord_counts(const Block& b, const Intrinsics& K) {
+  const float rs = b.r * RenderParams{}.fluid_radius_scale;
+  std::vector<int> n(static_cast<std::size_t>(K.width) * K.height, 0);
+  for (vec3 c : b.x) {
+    const vec2 q = K.project(c);
+    const float half = K.fx * rs / (c.z - rs) + 1.f;
+    for (int y = 0; y < K.height; ++y)
+      for (int x = 0; x < K.width; ++x)
+        if (std::abs(q.x - x) <= half && std::abs(q.y - (K.height - 1 - y)) <= half) ++n[static_cast<std::size_t>(y) * K.width + x];
+  }
+  return n;
+}
+
+// The most of `n` within `reach` pixels of (x, y) (the thickness blur's square).
+int most_within(const std::vector<int>& n, int w, int h, int x, int y, int reach) {
+  int m = 0;
+  for (int v = std::max(0, y - reach); v <= std::min(h - 1, y + reach); ++v)
+    for (int u = std::max(0, x - reach); u <= std::min(w - 1, x + reach); ++u) m = std::max(m, n[static_cast<std::size_t>(v) * w + u]);
+  return m;
+}
+
+bool on_outer_silhouette(const std::vector<float>& d, int w, int h, int x, int y) {
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int u = x + dx, v = y + dy;
+      if (u < 0 || v < 0 || u >= w || v >= h || d[static_cast<std::size_t>(v) * w + u] <= 0.f) return true;
+    }
+  return false;
+}
+
+// Depth tolerance. Both paths evaluate the same ray_sphere (sphere_hit.glsl) on the same eye-space
+// centre and pixel ray, so a sphere's depth at a pixel is the same float. They can differ in which
+// sphere wins: the raster path keeps the least *window* depth d = window_depth(z) in a 32F depth
+// buffer, the splat the least eye depth z. d in [0.5, 1) has an ulp of 2^-24; allowing 4 ulp for
+// window_depth's own rounding, spheres closer than 2^-22 / (dd/dz) tie, and dd/dz =
+// f n / ((f - n) z^2) >= n / z^2. So |dz| <= 2^-22 z^2 / n (z = 2.2 m: 2.3e-5 m).
+float depth_tol(float z) { return std::ldexp(1.f, -22) * z * z / kNear; }
+
+TEST(RenderSplat, ComputeDepthMatchesRaster) {
+  SEAMLESS_REQUIRE_EGL();
+  const Intrinsics K = intrinsics(400.f, 79.5f, 59.5f, 160, 120);
+  const Block b;
+  Renderer r(splat_params(1), K.width, K.height);
+  if (!r.uses_compute_splat()) GTEST_SKIP() << "no GL 4.3 compute here";
+  r.set_scene_mesh(rectangle(-2.f, 2.f, -2.f, 2.f, kWallZ, uchar3{90, 120, 60}));
+  const auto ras = draw_with(r, b, K, "raster");
+  const auto cmp = draw_with(r, b, K, "compute");
+  ASSERT_EQ(ras.depth.size(), cmp.depth.size());
+  int both = 0, silhouette = 0;
+  for (int y = 0; y < ras.h; ++y)
+    for (int x = 0; x < ras.w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * ras.w + x;
+      const float a = ras.depth[i], c = cmp.depth[i];
+      if ((a > 0.f) != (c > 0.f)) {
+        // Only where a sphere's rim meets empty space (the discriminant's sign at a tangent ray)
+        // or where it passes through the wall (a tie with the scene depth, tolerance as above).
+        const float z = std::max(a, c);
+        const bool at_wall = std::abs(z - kWallZ) <= depth_tol(z);
+        EXPECT_TRUE(at_wall || on_outer_silhouette(a > 0.f ? ras.depth : cmp.depth, ras.w, ras.h, x, y))
+            << "pixel set differs inside the fluid at " << x << "," << y << ": raster " << a << ", compute " << c;
+        ++silhouette;
+        continue;
+      }
+      if (a <= 0.f) continue;
+      ++both;
+      EXPECT_NEAR(c, a, depth_tol(a)) << "at " << x << "," << y;
+      EXPECT_LT(a, kWallZ) << "fluid behind the wall at " << x << "," << y;
+    }
+  EXPECT_GT(both, 2000);                // the block covers about 60 x 60 pixels, partly cut by the wall
+  EXPECT_LT(silhouette, both / 50);     // differences are rare rim pixels, not a shifted image
+}
+
+// Thickness tolerance per pixel: the splat rounds each chord to 2^-20 m (0.5 * 2^-20 each); the
+// raster path sums floats (each addition off by half an ulp of the sum, <= T 2^-24); a sphere
+// whose front ties with the wall (window-depth resolution as in depth_tol, along a ray up to 1.2
+// times z, times the thickness scale 6 / (pi 1.5^3) < 0.6) may be rejected by the raster path's
+// early depth test but keep a chord of that length in the splat. The Gaussian after both has
+// weights summing to 1, so a bound on every pixel holds after it.
+float thickness_tol(int chords, float t) {
+  const float per_chord = std::ldexp(1.f, -21) + 1.2f * 0.6f * depth_tol(kWallZ + 0.1f);
+  return static_cast<float>(chords) * (per_chord + t * std::ldexp(1.f, -24)) + 1e-6f;
+}
+
+void expect_same_thickness(int downsample) {
+  const Intrinsics K = intrinsics(400.f, 79.5f, 59.5f, 160, 120);
+  const Block b;
+  Renderer r(splat_params(downsample), K.width, K.height);
+  if (!r.uses_compute_splat()) GTEST_SKIP() << "no GL 4.3 compute here";
+  r.set_scene_mesh(rectangle(-2.f, 2.f, -2.f, 2.f, kWallZ, uchar3{90, 120, 60}));
+  const auto ras = draw_with(r, b, K, "raster");
+  const auto cmp = draw_with(r, b, K, "compute");
+  const Intrinsics Kt = scale_intrinsics(K, ras.tw, ras.th);
+  // The blur (x then y) reaches 3 pixels: the most chords within that square bounds its error.
+  const std::vector<int> counts = chord_counts(b, Kt);
+  int covered = 0;
+  float most = 0.f;
+  for (int y = 0; y < ras.th; ++y)
+    for (int x = 0; x < ras.tw; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * ras.tw + x;
+      const float a = ras.thickness[i], c = cmp.thickness[i];
+      if (a <= 0.f && c <= 0.f) continue;
+      const int chords = most_within(counts, ras.tw, ras.th, x, y, 3);
+      ASSERT_NEAR(c, a, thickness_tol(chords, a)) << "at " << x << "," << y << " (" << chords << " chords)";
+      ++covered, most = std::max(most, a);
+    }
+  EXPECT_GT(covered, 2000 / (downsample * downsample));
+  EXPECT_GT(most, 0.05f);  // several spheres deep: a real sum was compared, not just one chord
+}
+
+TEST(RenderSplat, ComputeThicknessMatchesRasterFullResolution) {
+  SEAMLESS_REQUIRE_EGL();
+  expect_same_thickness(1);
+}
+
+TEST(RenderSplat, ComputeThicknessMatchesRasterHalfResolution) {
+  SEAMLESS_REQUIRE_EGL();
+  expect_same_thickness(2);
+}
+
+// The default is the compute path where GL 4.3 is there (Mesa: 4.5), and the setting switches it.
+TEST(RenderSplat, DefaultIsComputeAndRasterIsSelectable) {
+  SEAMLESS_REQUIRE_EGL();
+  Renderer r(RenderParams{}, 32, 24);
+  EXPECT_EQ(RenderParams{}.fluid_splat, "compute");
+  if (!r.uses_compute_splat()) GTEST_SKIP() << "no GL 4.3 compute here";
+  r.params().fluid_splat = "raster";
+  EXPECT_FALSE(r.uses_compute_splat());
+}
+
+}  // namespace
+}  // namespace seamless::test
