@@ -29,9 +29,12 @@ void Renderer::Impl::build_programs() {
   fluid_depth_prog = Program("fluid depth", {vs({"sphere.vert"}), fs(with(sphere_fs, "ssfr_depth.frag"))});
   fluid_thick_prog = Program("fluid thickness", {vs({"sphere.vert"}), fs(with(sphere_fs, "ssfr_thickness.frag"))});
   kinect_prog = Program("kinect view", {vs({"fullscreen.vert"}), fs({"camera.glsl", "kinect_bg.frag"})});
-  filter_prog = Program("fluid filter", {vs({"fullscreen.vert"}), fs({"camera.glsl", "ssfr_filter.frag"})});
-  normal_prog = Program("fluid normals", {vs({"fullscreen.vert"}), fs({"camera.glsl", "ssfr_normal.frag"})});
-  composite_prog = Program("fluid composite", {vs({"fullscreen.vert"}), fs({"camera.glsl", "ssfr_composite.frag"})});
+  auto screen = [&](const char* name, const char* body, const char* main) {
+    return Program(name, {vs({"fullscreen.vert"}), fs({"camera.glsl", body, main})});
+  };
+  filter_prog = screen("fluid filter", "ssfr_filter.glsl", "ssfr_filter.frag");
+  normal_prog = screen("fluid normals", "ssfr_normal.glsl", "ssfr_normal.frag");
+  composite_prog = screen("fluid composite", "ssfr_composite.glsl", "ssfr_composite.frag");
 }
 
 void Renderer::Impl::make_targets() {

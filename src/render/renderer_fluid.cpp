@@ -176,40 +176,94 @@ void Renderer::Impl::fluid_thickness_pass(std::int64_t n, float sphere_r, const 
 // Small Gaussian over the thickness, at its resolution (the viewport is tw x th on entry).
 void Renderer::Impl::thickness_blur(const RenderCamera& low) {
   glDisable(GL_DEPTH_TEST);  // thick_fbo[0] has the raster path's depth buffer attached
-  set_camera_uniforms(filter_prog, low);
+  const Program& fp = filter_program();
+  set_camera_uniforms(fp, low);
   glBindVertexArray(empty_vao);
-  glUniform1i(filter_prog.loc("u_max_px"), 3);
-  glUniform1i(filter_prog.loc("u_max_taps"), 3);
-  glUniform1f(filter_prog.loc("u_range_sigma"), 0.f);
-  glUniform1i(filter_prog.loc("u_skip_empty"), 0);
-  filter_pass(thick[0], thick_fbo[1], 1, 0);
-  filter_pass(thick[1], thick_fbo[0], 0, 1);
+  glUniform1i(fp.loc("u_max_px"), 3);
+  glUniform1i(fp.loc("u_max_taps"), 3);
+  glUniform1f(fp.loc("u_range_sigma"), 0.f);
+  glUniform1i(fp.loc("u_skip_empty"), 0);
+  filter_pass(thick[0], thick[1], thick_fbo[1], 1, 0, tw, th);
+  filter_pass(thick[1], thick[0], thick_fbo[0], 0, 1, tw, th);
   glViewport(0, 0, w, h);
 }
 
-void Renderer::Impl::filter_pass(GLuint src, GLuint dst_fbo, int dx, int dy) {
-  glBindFramebuffer(GL_FRAMEBUFFER, dst_fbo);
+// The bound filter program (filter_program()) over one axis; compute writes `dst` as an image,
+// the fragment version renders into dst_fbo.
+void Renderer::Impl::filter_pass(GLuint src, GLuint dst, GLuint dst_fbo, int dx, int dy, int iw, int ih) {
+  const Program& fp = filter_program();
   bind_tex(0, GL_TEXTURE_2D, src);
-  glUniform1i(filter_prog.loc("u_src"), 0);
-  glUniform2i(filter_prog.loc("u_dir"), dx, dy);
+  glUniform1i(fp.loc("u_src"), 0);
+  glUniform2i(fp.loc("u_dir"), dx, dy);
+  if (use_compute_splat()) {
+    glBindImageTexture(0, dst, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+    return dispatch_screen(iw, ih);
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, dst_fbo);
   glDrawArrays(GL_TRIANGLES, 0, 3);
 }
 
 // SSFR 3: the separable edge-preserving filter of the depth, world-sized.
 void Renderer::Impl::fluid_filter_passes(float radius, const RenderCamera& cam) {
   glDisable(GL_DEPTH_TEST);
-  set_camera_uniforms(filter_prog, cam);
+  const Program& fp = filter_program();
+  set_camera_uniforms(fp, cam);
   glBindVertexArray(empty_vao);
-  glUniform1f(filter_prog.loc("u_world_radius"), p.filter_size * radius);
-  glUniform1i(filter_prog.loc("u_max_px"), p.filter_max_px);
-  glUniform1i(filter_prog.loc("u_max_taps"), p.filter_max_taps);
-  glUniform1f(filter_prog.loc("u_range_sigma"), p.filter_depth_sigma * radius);
-  glUniform1i(filter_prog.loc("u_skip_empty"), 1);
-  glUniform1i(filter_prog.loc("u_narrow_range"), p.fluid_filter == "narrow_range");
+  glUniform1f(fp.loc("u_world_radius"), p.filter_size * radius);
+  glUniform1i(fp.loc("u_max_px"), p.filter_max_px);
+  glUniform1i(fp.loc("u_max_taps"), p.filter_max_taps);
+  glUniform1f(fp.loc("u_range_sigma"), p.filter_depth_sigma * radius);
+  glUniform1i(fp.loc("u_skip_empty"), 1);
+  glUniform1i(fp.loc("u_narrow_range"), p.fluid_filter == "narrow_range");
   for (int it = 0; it < p.filter_iterations; ++it) {
-    filter_pass(fluid_depth[0], fluid_filter_fbo[1], 1, 0);
-    filter_pass(fluid_depth[1], fluid_filter_fbo[0], 0, 1);
+    filter_pass(fluid_depth[0], fluid_depth[1], fluid_filter_fbo[1], 1, 0, w, h);
+    filter_pass(fluid_depth[1], fluid_depth[0], fluid_filter_fbo[0], 0, 1, w, h);
   }
+}
+
+// SSFR 4: normals from the filtered depth.
+void Renderer::Impl::normals_pass(const RenderCamera& cam) {
+  const bool compute = use_compute_splat();
+  const Program& np = compute ? normal_cprog : normal_prog;
+  set_camera_uniforms(np, cam);
+  bind_tex(0, GL_TEXTURE_2D, fluid_depth[0]);
+  glUniform1i(np.loc("u_depth"), 0);
+  if (compute) {
+    glBindImageTexture(0, normals, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+    return dispatch_screen(w, h);
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, normal_fbo);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+// SSFR 5: shading over the scene, into final_fbo's colour, reflection and refraction targets.
+void Renderer::Impl::composite_pass(const RenderCamera& cam) {
+  const bool compute = use_compute_splat();
+  const Program& cp = compute ? composite_cprog : composite_prog;
+  set_camera_uniforms(cp, cam);
+  bind_tex(0, GL_TEXTURE_2D, scene_color);
+  bind_tex(1, GL_TEXTURE_2D, fluid_depth[0]);
+  bind_tex(2, GL_TEXTURE_2D, normals);
+  bind_tex(3, GL_TEXTURE_2D, thick[0]);
+  bind_tex(4, GL_TEXTURE_CUBE_MAP, cube);
+  const char* samplers[] = {"u_scene_color", "u_fluid_depth", "u_normal", "u_thickness", "u_cube"};
+  for (int i = 0; i < 5; ++i) glUniform1i(cp.loc(samplers[i]), i);
+  const bool use_cube = has_cube && p.view == "mesh";
+  glUniform1i(cp.loc("u_use_cube"), use_cube);
+  const std::vector<float> R = {cam.world_T_camera.R.m[0][0], cam.world_T_camera.R.m[1][0], cam.world_T_camera.R.m[2][0],
+                                cam.world_T_camera.R.m[0][1], cam.world_T_camera.R.m[1][1], cam.world_T_camera.R.m[2][1],
+                                cam.world_T_camera.R.m[0][2], cam.world_T_camera.R.m[1][2], cam.world_T_camera.R.m[2][2]};
+  glUniformMatrix3fv(cp.loc("u_world_R_eye"), 1, GL_FALSE, R.data());
+  glUniform3f(cp.loc("u_absorption"), p.absorption.x, p.absorption.y, p.absorption.z);
+  glUniform1f(cp.loc("u_refraction"), p.refraction);
+  glUniform1f(cp.loc("u_f0"), p.fresnel_f0);
+  if (compute) {
+    const GLuint out[] = {final_color, reflect_color, refract_color};
+    for (GLuint i = 0; i < 3; ++i) glBindImageTexture(i, out[i], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
+    return dispatch_screen(w, h);
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, final_fbo);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
 }
 
 // Returns false when no fluid particle is drawn.
@@ -223,33 +277,9 @@ bool Renderer::Impl::draw_fluid(std::int64_t n, float radius, const RenderCamera
   timer.mark("fluid_thickness");
   fluid_filter_passes(radius, cam);
   timer.mark("fluid_filter");
-  // 4. Normals from the filtered depth.
-  glBindFramebuffer(GL_FRAMEBUFFER, normal_fbo);
-  set_camera_uniforms(normal_prog, cam);
-  bind_tex(0, GL_TEXTURE_2D, fluid_depth[0]);
-  glUniform1i(normal_prog.loc("u_depth"), 0);
-  glDrawArrays(GL_TRIANGLES, 0, 3);
+  normals_pass(cam);
   timer.mark("fluid_normals");
-  // 5. Shading over the scene.
-  glBindFramebuffer(GL_FRAMEBUFFER, final_fbo);
-  set_camera_uniforms(composite_prog, cam);
-  bind_tex(0, GL_TEXTURE_2D, scene_color);
-  bind_tex(1, GL_TEXTURE_2D, fluid_depth[0]);
-  bind_tex(2, GL_TEXTURE_2D, normals);
-  bind_tex(3, GL_TEXTURE_2D, thick[0]);
-  bind_tex(4, GL_TEXTURE_CUBE_MAP, cube);
-  const char* samplers[] = {"u_scene_color", "u_fluid_depth", "u_normal", "u_thickness", "u_cube"};
-  for (int i = 0; i < 5; ++i) glUniform1i(composite_prog.loc(samplers[i]), i);
-  const bool use_cube = has_cube && p.view == "mesh";
-  glUniform1i(composite_prog.loc("u_use_cube"), use_cube);
-  const std::vector<float> R = {cam.world_T_camera.R.m[0][0], cam.world_T_camera.R.m[1][0], cam.world_T_camera.R.m[2][0],
-                                cam.world_T_camera.R.m[0][1], cam.world_T_camera.R.m[1][1], cam.world_T_camera.R.m[2][1],
-                                cam.world_T_camera.R.m[0][2], cam.world_T_camera.R.m[1][2], cam.world_T_camera.R.m[2][2]};
-  glUniformMatrix3fv(composite_prog.loc("u_world_R_eye"), 1, GL_FALSE, R.data());
-  glUniform3f(composite_prog.loc("u_absorption"), p.absorption.x, p.absorption.y, p.absorption.z);
-  glUniform1f(composite_prog.loc("u_refraction"), p.refraction);
-  glUniform1f(composite_prog.loc("u_f0"), p.fresnel_f0);
-  glDrawArrays(GL_TRIANGLES, 0, 3);
+  composite_pass(cam);
   glBindVertexArray(0);
   glEnable(GL_DEPTH_TEST);
   timer.mark("fluid_composite");

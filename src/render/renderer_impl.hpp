@@ -87,6 +87,7 @@ struct Renderer::Impl {
   // Compute splats (render.fluid_splat: compute), built only with GL >= 4.3 (has_compute).
   bool has_compute = false;
   Program depth_splat_prog, thick_splat_prog, resolve_prog;
+  Program filter_cprog, normal_cprog, composite_cprog;  // the full-screen passes as compute
   VertexArray empty_vao;
 
   // Framebuffer-sized targets (re-made by resize).
@@ -155,7 +156,11 @@ struct Renderer::Impl {
   void fluid_depth_pass(std::int64_t n, float sphere_r, const RenderCamera& cam);
   void fluid_thickness_pass(std::int64_t n, float sphere_r, const RenderCamera& cam);
   void fluid_filter_passes(float radius, const RenderCamera& cam);
-  void filter_pass(GLuint src, GLuint dst_fbo, int dx, int dy);
+  // One axis of the filter from texture src into texture dst (iw x ih; dst_fbo renders to it).
+  void filter_pass(GLuint src, GLuint dst, GLuint dst_fbo, int dx, int dy, int iw, int ih);
+  const Program& filter_program() const { return use_compute_splat() ? filter_cprog : filter_prog; }
+  void normals_pass(const RenderCamera& cam);
+  void composite_pass(const RenderCamera& cam);
   void thickness_blur(const RenderCamera& low);
   // renderer_splat.cpp: the compute path of SSFR 1 and 2.
   bool use_compute_splat() const { return has_compute && p.fluid_splat == "compute"; }
@@ -163,6 +168,7 @@ struct Renderer::Impl {
   void make_splat_targets();
   void splat_uniforms(const Program& prog, std::int64_t n, float sphere_r, const RenderCamera& cam);
   void resolve_splat(GLuint acc, GLuint out, int iw, int ih, bool depth_bits);
+  void dispatch_screen(int iw, int ih);  // 8 x 8 tiles over iw x ih, then the barriers
   void fluid_depth_splat(std::int64_t n, float sphere_r, const RenderCamera& cam);
   void fluid_thickness_splat(std::int64_t n, float sphere_r, const RenderCamera& low);
   void capture_stages();

@@ -13,7 +13,7 @@ namespace seamless {
 namespace {
 
 constexpr GLuint kSplatGroup = 64;         // local_size_x of splat.glsl
-constexpr GLuint kResolveGroup = 8;        // local_size_x/y of ssfr_resolve.comp
+constexpr GLuint kResolveGroup = 8;        // local_size_x/y of ssfr_resolve.comp and screen.glsl
 constexpr GLuint kEmptyDepth = 0xffffffffu;  // "no fluid" in the depth-bits image: above every depth
 
 // Fixed-point thickness: units per metre of path in fluid. Each chord is rounded to the nearest
@@ -33,6 +33,27 @@ void Renderer::Impl::build_compute_programs() {
   depth_splat_prog = Program("fluid depth splat", {cs("ssfr_depth_splat.comp")});
   thick_splat_prog = Program("fluid thickness splat", {cs("ssfr_thickness_splat.comp")});
   resolve_prog = Program("fluid splat resolve", {ShaderStage{GL_COMPUTE_SHADER, {"ssfr_resolve.comp"}}});
+  auto screen = [](const char* name, const char* body, const char* main) {
+    return Program(name, {ShaderStage{GL_COMPUTE_SHADER, {"camera.glsl", "screen.glsl", body, main}}});
+  };
+  filter_cprog = screen("fluid filter (compute)", "ssfr_filter.glsl", "ssfr_filter.comp");
+  normal_cprog = screen("fluid normals (compute)", "ssfr_normal.glsl", "ssfr_normal.comp");
+  composite_cprog = screen("fluid composite (compute)", "ssfr_composite.glsl", "ssfr_composite.comp");
+}
+
+namespace {
+// After a compute pass wrote images: later passes sample them, render into or blit from them,
+// read them back (stage images, frames), or do image loads/atomics on them.
+void after_image_writes() {
+  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
+                  GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+}
+}  // namespace
+
+void Renderer::Impl::dispatch_screen(int iw, int ih) {
+  glDispatchCompute((static_cast<GLuint>(iw) + kResolveGroup - 1) / kResolveGroup,
+                    (static_cast<GLuint>(ih) + kResolveGroup - 1) / kResolveGroup, 1);
+  after_image_writes();
 }
 
 namespace {
@@ -86,12 +107,7 @@ void Renderer::Impl::resolve_splat(GLuint acc, GLuint out, int iw, int ih, bool 
   glBindImageTexture(1, out, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
   glUniform1i(resolve_prog.loc("u_depth_bits"), depth);
   glUniform1f(resolve_prog.loc("u_metres_per_unit"), 1.f / kFixedPerMetre);
-  glDispatchCompute((static_cast<GLuint>(iw) + kResolveGroup - 1) / kResolveGroup,
-                    (static_cast<GLuint>(ih) + kResolveGroup - 1) / kResolveGroup, 1);
-  // Later passes sample `out`, render into it (filter) or read it back (stage images); the next
-  // frame's splat does atomics on `acc`.
-  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
-                  GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  dispatch_screen(iw, ih);  // its barriers also order the next frame's atomics on `acc`
 }
 
 // SSFR 1, compute: nearest sphere depth per pixel into fluid_depth[0] (0 = no fluid).

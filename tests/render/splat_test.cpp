@@ -43,10 +43,18 @@ RenderParams splat_params(int thickness_downsample) {
   return p;
 }
 
-Renderer::FluidImages draw_with(Renderer& r, const Block& b, const Intrinsics& K, const char* splat) {
-  r.params().fluid_splat = splat;
+// Each path on its own renderer, so that no image of one can be left over for the other.
+struct Drawn {
+  Renderer::FluidImages fluid;
+  bool compute = false;
+  Image<uchar3> frame;
+};
+Drawn draw_with(RenderParams p, const Block& b, const Intrinsics& K, float wall_z, const char* splat) {
+  p.fluid_splat = splat;
+  Renderer r(p, K.width, K.height);
+  r.set_scene_mesh(rectangle(-2.f, 2.f, -2.f, 2.f, wall_z, uchar3{90, 120, 60}));
   r.draw(b.list(), camera(K));
-  return r.read_fluid_images();
+  return {r.read_fluid_images(), r.uses_compute_splat(), r.read_frame()};
 }
 
 // Per window pixel of a w x h image with intrinsics K (rows bottom to top): how many spheres'
@@ -93,11 +101,10 @@ TEST(RenderSplat, ComputeDepthMatchesRaster) {
   SEAMLESS_REQUIRE_EGL();
   const Intrinsics K = intrinsics(400.f, 79.5f, 59.5f, 160, 120);
   const Block b;
-  Renderer r(splat_params(1), K.width, K.height);
-  if (!r.uses_compute_splat()) GTEST_SKIP() << "no GL 4.3 compute here";
-  r.set_scene_mesh(rectangle(-2.f, 2.f, -2.f, 2.f, kWallZ, uchar3{90, 120, 60}));
-  const auto ras = draw_with(r, b, K, "raster");
-  const auto cmp = draw_with(r, b, K, "compute");
+  const auto ras = draw_with(splat_params(1), b, K, kWallZ, "raster").fluid;
+  const Drawn c = draw_with(splat_params(1), b, K, kWallZ, "compute");
+  if (!c.compute) GTEST_SKIP() << "no GL 4.3 compute here";
+  const auto& cmp = c.fluid;
   ASSERT_EQ(ras.depth.size(), cmp.depth.size());
   int both = 0, silhouette = 0;
   for (int y = 0; y < ras.h; ++y)
@@ -137,11 +144,10 @@ float thickness_tol(int chords, float t) {
 void expect_same_thickness(int downsample) {
   const Intrinsics K = intrinsics(400.f, 79.5f, 59.5f, 160, 120);
   const Block b;
-  Renderer r(splat_params(downsample), K.width, K.height);
-  if (!r.uses_compute_splat()) GTEST_SKIP() << "no GL 4.3 compute here";
-  r.set_scene_mesh(rectangle(-2.f, 2.f, -2.f, 2.f, kWallZ, uchar3{90, 120, 60}));
-  const auto ras = draw_with(r, b, K, "raster");
-  const auto cmp = draw_with(r, b, K, "compute");
+  const auto ras = draw_with(splat_params(downsample), b, K, kWallZ, "raster").fluid;
+  const Drawn c = draw_with(splat_params(downsample), b, K, kWallZ, "compute");
+  if (!c.compute) GTEST_SKIP() << "no GL 4.3 compute here";
+  const auto& cmp = c.fluid;
   const Intrinsics Kt = scale_intrinsics(K, ras.tw, ras.th);
   // The blur (x then y) reaches 3 pixels: the most chords within that square bounds its error.
   const std::vector<int> counts = chord_counts(b, Kt);
@@ -178,6 +184,48 @@ TEST(RenderSplat, DefaultIsComputeAndRasterIsSelectable) {
   if (!r.uses_compute_splat()) GTEST_SKIP() << "no GL 4.3 compute here";
   r.params().fluid_splat = "raster";
   EXPECT_FALSE(r.uses_compute_splat());
+}
+
+}  // namespace
+}  // namespace seamless::test
+
+namespace seamless::test {
+namespace {
+
+// The full-screen passes (filter, normals, composite) run as compute shaders with the splats: the
+// same per-texel functions (ssfr_*.glsl) as the fragment versions, so the same frame. Where the
+// filtered depth agrees bit for bit over the 5 x 5 texels a pixel's normal and shading read, the
+// colours can differ only through the thickness (fixed point, within 1e-4 m: see thickness_tol):
+// Beer-Lambert exp(-6/m T) changes by < 6e-4 relative (0.15 of a level), the refraction offset
+// 0.06 T of the screen by < 0.01 pixel (0.25 of a level across the sharpest edge, 255 per pixel).
+// Below half a level before rounding: at most 1 level apart after it.
+TEST(RenderSplat, ComputeScreenPassesGiveTheRasterFrame) {
+  SEAMLESS_REQUIRE_EGL();
+  const Intrinsics K = intrinsics(400.f, 79.5f, 59.5f, 160, 120);
+  const Block b;
+  RenderParams p;
+  p.znear = kNear;
+  const Drawn a = draw_with(p, b, K, 2.5f, "raster"), c = draw_with(p, b, K, 2.5f, "compute");  // wall behind
+  if (!c.compute) GTEST_SKIP() << "no GL 4.3 compute here";
+  const Pixels ras(a.frame), cmp(c.frame);
+  const auto &ras_d = a.fluid.depth, &cmp_d = c.fluid.depth;
+  auto same_depth_near = [&](int x, int y) {  // (x, y): window texel
+    for (int v = std::max(0, y - 2); v <= std::min(K.height - 1, y + 2); ++v)
+      for (int u = std::max(0, x - 2); u <= std::min(K.width - 1, x + 2); ++u)
+        if (ras_d[static_cast<std::size_t>(v) * K.width + u] != cmp_d[static_cast<std::size_t>(v) * K.width + u]) return false;
+    return true;
+  };
+  int fluid = 0, compared = 0;
+  for (int v = 0; v < K.height; ++v)
+    for (int u = 0; u < K.width; ++u) {
+      const int y = K.height - 1 - v;
+      fluid += ras_d[static_cast<std::size_t>(y) * K.width + u] > 0.f ? 1 : 0;
+      if (!same_depth_near(u, y)) continue;
+      ++compared;
+      EXPECT_LE(max_diff(ras.at(u, v), cmp.at(u, v)), 1) << "at " << u << "," << v;
+    }
+  EXPECT_GT(fluid, 2000);
+  EXPECT_GT(compared, K.width * K.height * 95 / 100);  // depth ties are rare: nearly all compared
 }
 
 }  // namespace

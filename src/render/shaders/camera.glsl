@@ -4,6 +4,10 @@ uniform vec4 u_K;         // fx, fy, cx, cy in framebuffer pixels
 uniform vec2 u_size;      // framebuffer width, height
 uniform vec2 u_near_far;  // znear, zfar
 
+// Image pixel (u right, v down) of window texel t: the same numbers as frag_pixel() gives for the
+// fragment at t, so that the compute and fragment versions of a screen pass agree.
+vec2 texel_pixel(ivec2 t) { return vec2(float(t.x), u_size.y - 1.0 - float(t.y)); }
+
 #ifndef SEAMLESS_COMPUTE
 // Image pixel (u right, v down) of this fragment (compute shaders have no fragment).
 vec2 frag_pixel() { return vec2(gl_FragCoord.x - 0.5, u_size.y - gl_FragCoord.y - 0.5); }
