@@ -47,9 +47,10 @@ struct RenderParams {
   float fresnel_f0 = 0.02f;           // reflectance at normal incidence (water: ((1-1.33)/(1+1.33))^2)
   int cube_size = 256;                // cube map face size for reflections in the mesh view
   // Cost of the fluid passes (docs/RENDERING.md, section Speed).
-  // Sphere depth and thickness as compute splats (GL 4.3; atomics into integer images) or as
-  // point sprites through the rasteriser. Compute is the default because GH100 (H100/H200) keeps
-  // raster units on only a few of its SMs; a context below GL 4.3 falls back to raster.
+  // compute: sphere depth and thickness as compute splats (GL 4.3; atomics into integer images)
+  // and the full-screen passes as compute shaders; raster: point sprites and full-screen
+  // triangles. Compute is the default because GH100 (H100/H200) keeps raster units on only a few
+  // of its SMs; a context below GL 4.3 falls back to raster.
   std::string fluid_splat = "compute";
   int thickness_downsample = 2;       // thickness pass and its blur at 1/this resolution (1, 2 or 4), bilinear up
   bool depth_prepass = true;          // hardware depth test of the sprites against the scene depth (early-Z)
@@ -92,7 +93,7 @@ struct RenderParams {
     v("refraction", refraction, "refraction offset, screen fraction per metre of thickness", Range{0.0, 10.0});
     v("fresnel_f0", fresnel_f0, "fluid reflectance at normal incidence", Range{0.0, 1.0});
     v("cube_size", cube_size, "reflection cube map face size, pixels", Range{16, 4096});
-    v("fluid_splat", fluid_splat, "fluid sphere depth/thickness passes: compute splats (GL 4.3) or raster sprites",
+    v("fluid_splat", fluid_splat, "fluid passes: compute shaders (GL 4.3: splats, screen passes) or raster sprites",
       Choices{"compute", "raster"});
     v("thickness_downsample", thickness_downsample, "fluid thickness at 1/this resolution (1, 2 or 4)", Range{1, 4});
     v("depth_prepass", depth_prepass, "early depth test of fluid sprites against the scene");
