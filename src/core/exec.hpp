@@ -12,6 +12,16 @@
 //                                        a loop of kernels (ICP's Gauss-Newton steps) never waits;
 //                                        then(), if given, runs once on the device after *out is
 //                                        written (in the same launch on CUDA)
+//   ex.for_each_grouped(n, max_lanes, fn)
+//                                        fn(i, lanes) for i in [0, n), each i by a group of
+//                                        lanes.size lanes (a power of two <= max_lanes, chosen
+//                                        by the executor; 1 on the CPU) that split i's work and
+//                                        combine it with lanes.sum / lanes.rank (Lanes below)
+//   ex.lanes(n, max_lanes)               the group size for_each_grouped(n, max_lanes, ...) uses
+//   ex.for_each_phases(phases, begin, end, fn)
+//                                        fn(p, i) for i in [begin[p], end[p]), phase after phase:
+//                                        phase p + 1 sees every write of phase p (a colour-
+//                                        sequenced Gauss-Seidel sweep); begin, end on the host
 //   ex.synchronize()
 // plus the SEAMLESS_HD atomics in core/atomics.hpp. Pointers passed in live on ex.device.
 //
@@ -21,6 +31,7 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 #include "core/device.hpp"
 #include "core/error.hpp"
@@ -34,6 +45,51 @@ struct NoThen {
   SEAMLESS_HD void operator()() const {}
 };
 
+// The lanes that work on one element of for_each_grouped: `size` (a power of two <= 32)
+// consecutive threads of a warp on CUDA, one thread on the CPU. A kernel splits the element's
+// loops over them (k = lane, lane + size, ...) and combines the partial results with sum and
+// rank. Every lane of a group must call these together, with the same loop bounds (the group's
+// control flow must be uniform there); on the CPU they are the identity.
+struct Lanes {
+  int lane = 0, size = 1;
+  unsigned mask = 1u;  // the group's lanes within the warp (CUDA)
+  int first = 0;       // the group's first lane within the warp (CUDA)
+
+  // The sum over the group's lanes of v (T trivially copyable, a multiple of 4 bytes, with
+  // operator+), in every lane, bit-identical in all of them: a butterfly of shuffles word by
+  // word, adding neighbours, then pairs, ... (a tree: the same order for a given size).
+  template <class T>
+  SEAMLESS_HD T sum(T v) const {
+#if defined(__CUDA_ARCH__)
+    static_assert(sizeof(T) % 4 == 0, "Lanes::sum shuffles 4-byte words");
+    constexpr int kWords = static_cast<int>(sizeof(T) / 4);
+    for (int o = 1; o < size; o <<= 1) {
+      unsigned w[kWords];
+      memcpy(w, &v, sizeof(T));
+      for (int k = 0; k < kWords; ++k) w[k] = __shfl_xor_sync(mask, w[k], o);
+      T u;
+      memcpy(&u, w, sizeof(T));
+      v = v + u;  // a + b == b + a bit for bit, so every lane ends with the same bits
+    }
+#endif
+    return v;
+  }
+
+  // Stream compaction within the group: the number of lanes below this one whose p is true;
+  // *total = the number of lanes whose p is true. Appending in lane order keeps the order of a
+  // one-lane loop that visits the same items.
+  SEAMLESS_HD int rank(bool p, int* total) const {
+#if defined(__CUDA_ARCH__)
+    const unsigned b = (__ballot_sync(mask, p) & mask) >> first;
+    *total = __popc(b);
+    return __popc(b & ((1u << lane) - 1u));
+#else
+    *total = p ? 1 : 0;
+    return 0;
+#endif
+  }
+};
+
 struct CpuExec {
   static constexpr Device device = Device::CPU;
   // sort_by_key allocates its own buffers on the CPU (see CudaExec::temp).
@@ -43,6 +99,11 @@ struct CpuExec {
   template <class K, class V> void sort_by_key(K* keys, V* values, std::int64_t n, int key_bits = 8 * sizeof(K)) const;
   template <class T, class F> T transform_reduce(std::int64_t n, T init, F fn) const;
   template <class T, class F, class G = NoThen> void transform_reduce_into(std::int64_t n, F fn, T* out, G then = {}) const;
+  // One thread per element on the CPU: the groups are single lanes.
+  int lanes(std::int64_t, int) const { return 1; }
+  template <class F> void for_each_grouped(std::int64_t n, int max_lanes, F fn) const;
+  template <class F>
+  void for_each_phases(int phases, const std::int64_t* begin, const std::int64_t* end, F fn) const;
   void synchronize() const {}
 };
 
@@ -63,6 +124,13 @@ struct CudaExec {
   template <class K, class V> void sort_by_key(K* keys, V* values, std::int64_t n, int key_bits = 8 * sizeof(K)) const;
   template <class T, class F> T transform_reduce(std::int64_t n, T init, F fn) const;
   template <class T, class F, class G = NoThen> void transform_reduce_into(std::int64_t n, F fn, T* out, G then = {}) const;
+  // Lanes per element: the smallest power of two that puts n x lanes threads on the device at
+  // once (so that a small n still fills every multiprocessor), at most max_lanes (how far the
+  // caller's per-element work splits usefully), at least 1. Defined in core/exec_cuda.cu.
+  int lanes(std::int64_t n, int max_lanes) const;
+  template <class F> void for_each_grouped(std::int64_t n, int max_lanes, F fn) const;
+  template <class F>
+  void for_each_phases(int phases, const std::int64_t* begin, const std::int64_t* end, F fn) const;
   void synchronize() const;
 };
 

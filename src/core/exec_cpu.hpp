@@ -22,6 +22,22 @@ void CpuExec::for_each(std::int64_t n, F fn) const {
   for (std::int64_t i = 0; i < n; ++i) fn(i);
 }
 
+template <class F>
+void CpuExec::for_each_grouped(std::int64_t n, int, F fn) const {
+  // A thread already walks several elements; the neighbour loops inside stay whole (Lanes{}:
+  // lane 0 of 1, so sum and rank are the identity and the order of every sum is the loop's).
+  for_each(n, [&](std::int64_t i) { fn(i, Lanes{}); });
+}
+
+// Phase after phase, each a parallel loop (the end of the loop is the barrier).
+template <class F>
+void CpuExec::for_each_phases(int phases, const std::int64_t* begin, const std::int64_t* end, F fn) const {
+  for (int p = 0; p < phases; ++p) {
+    const std::int64_t b = begin[p];
+    for_each(end[p] - b, [&](std::int64_t i) { fn(p, b + i); });
+  }
+}
+
 template <class T>
 T CpuExec::exclusive_scan(const T* in, T* out, std::int64_t n) const {
   T sum{};

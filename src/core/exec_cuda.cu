@@ -5,6 +5,20 @@ namespace seamless {
 
 void CudaExec::synchronize() const { SEAMLESS_CUDA_CHECK(cudaDeviceSynchronize()); }
 
+int CudaExec::lanes(std::int64_t n, int max_lanes) const {
+  // Threads the device holds at once (2048 per multiprocessor on Hopper): fewer elements than
+  // that leave multiprocessors idle unless each gets several lanes.
+  static const std::int64_t resident = [] {
+    int dev = 0, per_sm = 0;
+    SEAMLESS_CUDA_CHECK(cudaGetDevice(&dev));
+    SEAMLESS_CUDA_CHECK(cudaDeviceGetAttribute(&per_sm, cudaDevAttrMaxThreadsPerMultiProcessor, dev));
+    return std::int64_t{per_sm} * cuda_detail::multiprocessors();
+  }();
+  int g = 1;
+  while (2 * g <= max_lanes && g < 32 && n * g < resident) g <<= 1;
+  return g;
+}
+
 CudaStream::CudaStream() {
   cudaStream_t s = nullptr;
   cudaEvent_t a = nullptr, b = nullptr;

@@ -2,6 +2,7 @@
 #pragma once
 #include <cub/cub.cuh>
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 
@@ -79,6 +80,82 @@ void CudaExec::for_each(std::int64_t n, F fn) const {
   auto blocks = static_cast<unsigned>((n + kThreads - 1) / kThreads);
   cuda_detail::for_each_kernel<<<blocks, kThreads, 0, static_cast<cudaStream_t>(stream)>>>(n, fn);
   SEAMLESS_CUDA_CHECK_LAUNCH("for_each");
+}
+
+namespace cuda_detail {
+// Groups of 2^log2_lanes consecutive threads, one per element; blocks of 256 threads hold whole
+// groups, and groups never straddle a warp, so a group's shuffles stay within its warp.
+template <class F>
+__global__ void for_each_grouped_kernel(std::int64_t n, int log2_lanes, F fn) {
+  const std::int64_t t = static_cast<std::int64_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+  const std::int64_t i = t >> log2_lanes;
+  if (i >= n) return;  // the whole group leaves: its lanes share i
+  Lanes g;
+  g.size = 1 << log2_lanes;
+  g.lane = static_cast<int>(t) & (g.size - 1);
+  g.first = static_cast<int>(threadIdx.x & 31u) & ~(g.size - 1);
+  g.mask = g.size == 32 ? 0xFFFFFFFFu : ((1u << g.size) - 1u) << g.first;
+  fn(i, g);
+}
+
+// Up to kMax phases of for_each_phases in one block: __syncthreads() between phases makes each
+// phase's global writes visible to the whole block (CUDA programming guide, synchronization
+// functions), which is all a sweep needs when one block holds it. One block of 1024 threads,
+// instead of one launch per phase: a small cloth's colour has fewer edges than a launch costs.
+struct PhaseChunk {
+  static constexpr int kMax = 32;
+  int count = 0;
+  std::int64_t begin[kMax], end[kMax];
+};
+
+template <class F>
+__global__ void __launch_bounds__(1024) for_each_phases_kernel(PhaseChunk c, int first_phase, F fn) {
+  for (int p = 0; p < c.count; ++p) {
+    for (std::int64_t i = c.begin[p] + threadIdx.x; i < c.end[p]; i += blockDim.x) fn(first_phase + p, i);
+    __syncthreads();
+  }
+}
+
+// fn(p, begin + i): one phase as a plain for_each (phases too large for one block).
+template <class F>
+struct PhaseAt {
+  F fn;
+  int p;
+  std::int64_t begin;
+  __device__ void operator()(std::int64_t i) const { fn(p, begin + i); }
+};
+}  // namespace cuda_detail
+
+template <class F>
+void CudaExec::for_each_grouped(std::int64_t n, int max_lanes, F fn) const {
+  if (n <= 0) return;
+  int log2_lanes = 0;
+  while ((1 << log2_lanes) < lanes(n, max_lanes)) ++log2_lanes;
+  constexpr int kThreads = 256;
+  auto blocks = static_cast<unsigned>(((n << log2_lanes) + kThreads - 1) / kThreads);
+  cuda_detail::for_each_grouped_kernel<<<blocks, kThreads, 0, static_cast<cudaStream_t>(stream)>>>(n, log2_lanes, fn);
+  SEAMLESS_CUDA_CHECK_LAUNCH("for_each_grouped");
+}
+
+template <class F>
+void CudaExec::for_each_phases(int phases, const std::int64_t* begin, const std::int64_t* end, F fn) const {
+  // One block runs a phase of up to 2 x 1024 elements in about the time of one launch (two
+  // dependent rounds of loads); larger phases get the whole device, a launch each.
+  constexpr int kThreads = 1024;
+  constexpr std::int64_t kOneBlock = 2 * kThreads;
+  std::int64_t largest = 0;
+  for (int p = 0; p < phases; ++p) largest = std::max(largest, end[p] - begin[p]);
+  if (largest > kOneBlock) {
+    for (int p = 0; p < phases; ++p) for_each(end[p] - begin[p], cuda_detail::PhaseAt<F>{fn, p, begin[p]});
+    return;
+  }
+  for (int first = 0; first < phases; first += cuda_detail::PhaseChunk::kMax) {
+    cuda_detail::PhaseChunk c;
+    c.count = std::min(phases - first, cuda_detail::PhaseChunk::kMax);
+    for (int p = 0; p < c.count; ++p) c.begin[p] = begin[first + p], c.end[p] = end[first + p];
+    cuda_detail::for_each_phases_kernel<<<1, kThreads, 0, static_cast<cudaStream_t>(stream)>>>(c, first, fn);
+    SEAMLESS_CUDA_CHECK_LAUNCH("for_each_phases");
+  }
 }
 
 template <class T>
