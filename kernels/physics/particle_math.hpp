@@ -113,14 +113,15 @@ SEAMLESS_HD inline float slab_gap(float v, int i, float cs, float pad) {
   return g > 0.f ? g : 0.f;
 }
 
-// Calls fn(j) for every grid entry j in the cells that can hold a point within R of p. For each
-// row of cells along x (fixed y, z within reach) only the x range that the sphere of radius R
-// crosses at the row's nearest y-z distance is visited. Keys run along x within a row, so that
-// range is one run of the sorted entries, [start[first cell], start[last cell + 1]) (start[k] =
-// number of entries with key < k, k in [0, cells]), or two where it wraps around the grid.
-// Candidates still need the distance test.
+// Calls fn(a, e) for every run [a, e) of grid entries in the cells that can hold a point within
+// R of p. For each row of cells along x (fixed y, z within reach) only the x range that the
+// sphere of radius R crosses at the row's nearest y-z distance is visited. Keys run along x within
+// a row, so that range is one run of the sorted entries, [start[first cell], start[last cell + 1])
+// (start[k] = number of entries with key < k, k in [0, cells]), or two where it wraps around the
+// grid. The runs depend only on p and the grid: lanes that share p get the same runs (a group of
+// for_each_grouped may split each run). Candidates still need the distance test.
 template <class F>
-SEAMLESS_HD inline void for_each_in_radius(const GridSpec& g, const int* start, vec3 p, float R, F&& fn) {
+SEAMLESS_HD inline void for_each_run_in_radius(const GridSpec& g, const int* start, vec3 p, float R, F&& fn) {
   const int3 c = g.cell_of(p);
   const float R2 = R * R, pad = 1e-3f * g.cell;
   const std::uint32_t m = (1u << g.bits) - 1u;
@@ -139,13 +140,21 @@ SEAMLESS_HD inline void for_each_in_radius(const GridSpec& g, const int* start, 
       const std::uint32_t x0 = static_cast<std::uint32_t>(lo > c.x - g.reach ? lo : c.x - g.reach) & m;
       const std::uint32_t x1 = static_cast<std::uint32_t>(hi < c.x + g.reach ? hi : c.x + g.reach) & m;
       if (x0 <= x1) {
-        for (int j = start[row | x0], e = start[(row | x1) + 1]; j < e; ++j) fn(j);
+        fn(start[row | x0], start[(row | x1) + 1]);
       } else {  // the x range wraps: [x0, m] and [0, x1]
-        for (int j = start[row | x0], e = start[(row | m) + 1]; j < e; ++j) fn(j);
-        for (int j = start[row], e = start[(row | x1) + 1]; j < e; ++j) fn(j);
+        fn(start[row | x0], start[(row | m) + 1]);
+        fn(start[row], start[(row | x1) + 1]);
       }
     }
   }
+}
+
+// Calls fn(j) for every grid entry j of the runs above.
+template <class F>
+SEAMLESS_HD inline void for_each_in_radius(const GridSpec& g, const int* start, vec3 p, float R, F&& fn) {
+  for_each_run_in_radius(g, start, p, R, [&](int a, int e) {
+    for (int j = a; j < e; ++j) fn(j);
+  });
 }
 
 // start[k] for the sorted keys: the number of keys below k (lower bound), k in [0, cells].

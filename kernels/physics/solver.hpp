@@ -16,6 +16,17 @@
 
 namespace seamless::kernels {
 
+// Most lanes per particle of the neighbour loops (Exec::for_each_grouped; the executor takes
+// fewer where n particles alone fill the device, and 1 on the CPU). A particle's list holds about
+// 30-60 entries at the fluid's rest density, so 16 lanes still have 2-4 entries each, while the
+// lanes' sums cost log2(16) = 4 shuffles a word. find_neighbors splits each row's run of
+// candidates (about 5 at rest density, reach 2): more than 8 lanes would mostly idle.
+constexpr int kPairLanes = 16;
+constexpr int kSearchLanes = 8;
+// The lists are stored particle by particle (row-major) when at least this many lanes read one
+// list: 8 lanes x 4 bytes fill one 32-byte sector (sim_views.hpp).
+constexpr int kRowMajorLanes = 8;
+
 // External forces, speed limit, prediction p = x + v dt; cell keys of p; order = identity.
 template <class Exec> void predict(const Exec& ex, const SimViews& S);
 // Stable sort of (key, value) pairs by the low `bits` bits of key (the executor's radix sort).

@@ -1,5 +1,6 @@
 // Kernel bodies for physics/solver.hpp, compiled once per backend.
 #include "core/atomics.hpp"
+#include "core/exec.hpp"
 #include "kernels/physics/constraints.hpp"
 #include "kernels/physics/solver.hpp"
 
@@ -60,33 +61,49 @@ SEAMLESS_HD inline PairGeom pair_geometry(const SimViews& S, int s, int j, const
   return g;
 }
 
-// Number of active contacts of particle s at positions P (at least 1: it divides). A rigid
-// particle touching the scene also counts itself in its body's body_contacts.
-SEAMLESS_HD inline int count_contacts(const SimViews& S, int s, const vec3* P) {
+// Entries of s's particle list that can be contacts: none for a fluid particle whose list holds
+// only fluid (fluids meet through the density constraint), so its loops are skipped.
+SEAMLESS_HD inline int contact_list_len(const SimViews& S, int s) {
+  return phase::is(S.sphase[s], phase::kFluid) && S.nsolid[s] == 0 ? 0 : S.nnbr[s];
+}
+
+// Particle and scene-particle contacts of one lane's share of s's lists, and the sum of the scene
+// contact normals there (summed over the lanes with Lanes::sum).
+struct ContactCount {
+  int count, scene;
+  vec3 sn;
+};
+SEAMLESS_HD inline ContactCount operator+(const ContactCount& a, const ContactCount& b) {
+  return {a.count + b.count, a.scene + b.scene, a.sn + b.sn};
+}
+
+// Number of active contacts of particle s at positions P (at least 1: it divides), in lane 0 (the
+// lanes of g split s's lists). A rigid particle touching the scene also counts itself in its
+// body's body_contacts.
+SEAMLESS_HD inline int count_contacts(const SimViews& S, int s, const vec3* P, Lanes g) {
   const float D2 = S.c.diameter * S.c.diameter;
-  // A fluid particle whose list holds only fluid has no particle contacts (fluids meet through
-  // the density constraint), so the loop is skipped.
-  const bool fl = phase::is(S.sphase[s], phase::kFluid);
-  const int m = fl && S.nsolid[s] == 0 ? 0 : S.nnbr[s];
+  const int m = contact_list_len(S, s), ms = S.nsnbr[s];
   const vec3 p = P[s];
-  int count = 0;
-  for (int k = 0; k < m; ++k) {
+  ContactCount c{0, 0, {0.f, 0.f, 0.f}};
+  for (int k = g.lane; k < m; k += g.size) {
     int j = S.nbrs(s)[k * S.nbr_col];
     if (both_fluid(S.sphase[s], S.sphase[j])) continue;
-    if (length2(p - P[j]) < D2) ++count;
+    if (length2(p - P[j]) < D2) ++c.count;
   }
-  int scene = 0;
-  vec3 sn{0.f, 0.f, 0.f};  // sum of the scene contact normals
-  for (int k = 0, ms = S.nsnbr[s]; k < ms; ++k) {
+  for (int k = g.lane; k < ms; k += g.size) {
     vec3 r = p - S.stat[S.snbrs(s)[k * S.snbr_col]];
     float l2 = length2(r);
     if (l2 < D2) {
-      ++scene;
-      if (l2 > 1e-18f) sn += r / sqrtf(l2);
+      ++c.scene;
+      if (l2 > 1e-18f) c.sn += r / sqrtf(l2);
     }
   }
+  if (m > 0 || ms > 0) c = g.sum(c);  // m, ms are s's: the same in every lane
+  if (g.lane != 0) return 1;
+  int count = c.count, scene = c.scene;
+  vec3 sn = c.sn;  // sum of the scene contact normals
   if (S.sdf.active()) {
-    // Kept for contact_sum, which runs next at the same positions (the SDF costs more than the
+    // Kept for add_sdf_contact, which runs next at the same positions (the SDF costs more than the
     // rest of a fluid particle's contact work).
     SdfSample3 q = scene_sdf(S.sdf, p);
     S.sdf_at[s] = vec4{q.grad.x, q.grad.y, q.grad.z, q.d};
@@ -98,40 +115,48 @@ SEAMLESS_HD inline int count_contacts(const SimViews& S, int s, const vec3* P) {
   return count > 0 ? count : 1;
 }
 
-// Sum of the contact corrections of s at positions P (start positions X for friction); runs after
-// count_contacts at the same positions (it reuses the SDF sample stored there). Each
-// pair's correction is scaled by omega / max(n_s, n_j): averaging as in Macklin 2014 (eq. 11)
-// that keeps every pair's two corrections equal and opposite, so momentum is conserved.
-SEAMLESS_HD inline vec3 contact_sum(const SimViews& S, int s, const vec3* P, const vec3* X, bool friction) {
-  const float D = S.c.diameter, wi = S.sw[s];
+// Weight of s's scene contacts: omega / n_s, and for a rigid particle times (body particles / body
+// particles touching the scene): shape matching spreads a particle's correction over the whole
+// body, and without this a flat face resting on the scene would resolve only a fraction of its
+// contact (and of its static friction) per iteration, so that resting bodies creep.
+SEAMLESS_HD inline float scene_contact_weight(const SimViews& S, int s) {
   const std::uint32_t ph = S.sphase[s];
-  const bool fl = phase::is(ph, phase::kFluid);
-  const vec3 p = P[s], dx = p - X[s];
-  const float ni = static_cast<float>(S.ncontacts[s]);
-  const float mus = friction ? S.c.static_friction : 0.f, muk = friction ? S.c.kinetic_friction : 0.f;
-  vec3 acc{0.f, 0.f, 0.f};
-  for (int k = 0, m = fl && S.nsolid[s] == 0 ? 0 : S.nnbr[s]; k < m; ++k) {
-    int j = S.nbrs(s)[k * S.nbr_col];
-    std::uint32_t phj = S.sphase[j];
-    if (fl && phase::is(phj, phase::kFluid)) continue;
-    PairGeom g = pair_geometry(S, s, j, P);
-    if (!g.hit) continue;
-    bool any_fluid = fl || phase::is(phj, phase::kFluid);  // fluids slip
-    vec3 rel = dx - (P[j] - X[j]);
-    float scale = S.c.omega / fmaxf(ni, static_cast<float>(S.ncontacts[j]));
-    acc += contact_delta(g.n, g.depth, rel, wi, S.sw[j], any_fluid ? 0.f : mus, any_fluid ? 0.f : muk) * scale;
-  }
-  // Scene contacts of a rigid particle are scaled by (body particles / body particles touching
-  // the scene): shape matching spreads a particle's correction over the whole body, and without
-  // this a flat face resting on the scene would resolve only a fraction of its contact (and of
-  // its static friction) per iteration, so that resting bodies creep.
-  float self = S.c.omega / ni;
+  float self = S.c.omega / static_cast<float>(S.ncontacts[s]);
   if (phase::is(ph, phase::kRigid)) {
     int b = static_cast<int>(phase::group(ph));
     self *= static_cast<float>(S.body_count[b]) / static_cast<float>(max(S.body_contacts[b], 1));
   }
+  return self;
+}
+
+// One lane's share of the contact corrections of s at positions P (start positions X for
+// friction) with particles and scene particles; the contact sum is the lanes' sum plus add_sdf_contact. Runs
+// after count_contacts at the same positions. Each pair's correction is scaled by
+// omega / max(n_s, n_j): averaging as in Macklin 2014 (eq. 11) that keeps every pair's two
+// corrections equal and opposite, so momentum is conserved.
+SEAMLESS_HD inline vec3 contact_part(const SimViews& S, int s, const vec3* P, const vec3* X, bool friction, Lanes g) {
+  const float D = S.c.diameter, wi = S.sw[s];
+  const bool fl = phase::is(S.sphase[s], phase::kFluid);
+  const vec3 p = P[s], dx = p - X[s];
+  const float ni = static_cast<float>(S.ncontacts[s]);
+  const float mus = friction ? S.c.static_friction : 0.f, muk = friction ? S.c.kinetic_friction : 0.f;
+  vec3 acc{0.f, 0.f, 0.f};
+  for (int k = g.lane, m = contact_list_len(S, s); k < m; k += g.size) {
+    int j = S.nbrs(s)[k * S.nbr_col];
+    std::uint32_t phj = S.sphase[j];
+    if (fl && phase::is(phj, phase::kFluid)) continue;
+    PairGeom pg = pair_geometry(S, s, j, P);
+    if (!pg.hit) continue;
+    bool any_fluid = fl || phase::is(phj, phase::kFluid);  // fluids slip
+    vec3 rel = dx - (P[j] - X[j]);
+    float scale = S.c.omega / fmaxf(ni, static_cast<float>(S.ncontacts[j]));
+    acc += contact_delta(pg.n, pg.depth, rel, wi, S.sw[j], any_fluid ? 0.f : mus, any_fluid ? 0.f : muk) * scale;
+  }
+  const int ms = S.nsnbr[s];
+  if (ms == 0) return acc;
+  const float self = scene_contact_weight(S, s);
   const float smu_s = fl ? 0.f : mus, smu_k = fl ? 0.f : muk;
-  for (int k = 0, m = S.nsnbr[s]; k < m; ++k) {
+  for (int k = g.lane; k < ms; k += g.size) {
     vec3 r = p - S.stat[S.snbrs(s)[k * S.snbr_col]];
     float l2 = length2(r);
     if (l2 >= D * D) continue;
@@ -139,11 +164,23 @@ SEAMLESS_HD inline vec3 contact_sum(const SimViews& S, int s, const vec3* P, con
     vec3 n = l > 1e-9f ? r / l : vec3{0.f, 1.f, 0.f};
     acc += contact_delta(n, D - l, dx, wi, 0.f, smu_s, smu_k) * self;
   }
-  if (S.sdf.active()) {
-    const vec4 q = S.sdf_at[s];  // scene_sdf(S.sdf, p), stored by count_contacts
-    if (q.w < S.c.radius) acc += contact_delta(xyz(q), S.c.radius - q.w, dx, wi, 0.f, smu_s, smu_k) * self;
-  }
   return acc;
+}
+
+// Adds the scene SDF's contact correction of s (sampled by count_contacts at the same positions)
+// to acc, where the SDF touches s.
+SEAMLESS_HD inline void add_sdf_contact(const SimViews& S, int s, const vec3* P, const vec3* X, bool friction, vec3& acc) {
+  if (!S.sdf.active()) return;
+  const vec4 q = S.sdf_at[s];  // scene_sdf(S.sdf, p), stored by count_contacts
+  if (!(q.w < S.c.radius)) return;
+  const bool fl = phase::is(S.sphase[s], phase::kFluid);
+  const float mu_s = friction && !fl ? S.c.static_friction : 0.f, mu_k = friction && !fl ? S.c.kinetic_friction : 0.f;
+  acc += contact_delta(xyz(q), S.c.radius - q.w, P[s] - X[s], S.sw[s], 0.f, mu_s, mu_k) * scene_contact_weight(S, s);
+}
+
+// Whether s has list entries that contact_part visits (otherwise its lanes need no sum).
+SEAMLESS_HD inline bool has_contact_lists(const SimViews& S, int s) {
+  return contact_list_len(S, s) > 0 || S.nsnbr[s] > 0;
 }
 
 }  // namespace detail
@@ -218,40 +255,61 @@ void gather_vec3(const Exec& ex, const vec3* src, const int* idx, std::int64_t n
   ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) { dst[i] = src[idx[i]]; });
 }
 
+namespace detail {
+// Appends the candidates [a, e) of s that pass keep(j) to list (stride col, cap entries and a
+// spare slot at cap), the lanes of g taking every g.size-th candidate and Lanes::rank placing
+// them, so the list keeps the candidates' order whatever the lane count. Branch-free: about half
+// the candidates fail the distance test at random, which a branch mispredicts; a rejected one is
+// written to the spare slot, which nothing reads. cnt counts every accepted candidate (also past
+// the cap); kept(j) is called for those stored.
+template <class Keep, class Kept>
+SEAMLESS_HD inline void append_run(int a, int e, Lanes g, int* list, std::int64_t col, int cap, int& cnt,
+                                   Keep&& keep, Kept&& kept) {
+  for (int b = a; b < e; b += g.size) {  // the same trip count in every lane of the group
+    const bool in = b + g.lane < e;
+    const int j = in ? b + g.lane : a;  // lanes past the run look at a valid entry, and reject it
+    const bool ok = in & keep(j);
+    int found = 0;
+    const int slot = cnt + g.rank(ok, &found);
+    const bool store = ok & (slot < cap);
+    list[(store ? slot : cap) * col] = j;
+    kept(j, store);
+    cnt += found;
+  }
+}
+}  // namespace detail
+
 template <class Exec>
 void find_neighbors(const Exec& ex, const SimViews& S) {
-  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t i) {
+  ex.for_each_grouped(S.n, kSearchLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
     const int s = static_cast<int>(i);
     const vec3 p = S.sp[s];
     const float R = S.c.search_radius, R2 = R * R;
     const std::uint32_t ph = S.sphase[s];
-    int* list = S.nbr + s * S.nbr_row;
-    const int cap = S.c.max_neighbors;
     int cnt = 0, solid = 0;
-    // Branch-free acceptance: about half the candidates fail the distance test at random, which a
-    // branch mispredicts. Every candidate is written to slot min(cnt, cap) (slot cap is a spare
-    // that nothing reads) and kept by advancing cnt.
-    for_each_in_radius(S.grid, S.cell_start, p, R, [&](int j) {
-      const std::uint32_t phj = S.sphase[j];
-      const bool ok = (j != s) & (length2(p - S.sp[j]) < R2) & detail::may_interact(S, ph, phj, s, j);
-      const bool kept = ok & (cnt < cap);
-      list[(cnt < cap ? cnt : cap) * S.nbr_col] = j;
-      solid += kept & !detail::both_fluid(ph, phj);
-      cnt += ok;
+    for_each_run_in_radius(S.grid, S.cell_start, p, R, [&](int a, int e) {
+      detail::append_run(
+          a, e, g, S.nbr + s * S.nbr_row, S.nbr_col, S.c.max_neighbors, cnt,
+          [&](int j) { return (j != s) & (length2(p - S.sp[j]) < R2) & detail::may_interact(S, ph, S.sphase[j], s, j); },
+          [&](int j, bool stored) { solid += stored & !detail::both_fluid(ph, S.sphase[j]); });
     });
+    int scnt = 0;
+    if (S.ns > 0) {
+      for_each_run_in_radius(S.sgrid, S.scell_start, p, R, [&](int a, int e) {
+        detail::append_run(
+            a, e, g, S.snbr + s * S.snbr_row, S.snbr_col, S.c.max_static_neighbors, scnt,
+            [&](int j) { return length2(p - S.stat[j]) < R2; },
+            [](int, bool) {});
+      });
+    }
+    solid = g.sum(solid);
+    if (g.lane != 0) return;
     if (cnt > S.c.max_neighbors) atomic_add(&S.counters[0], 1);
     // Read first: the shared maximum rarely changes, so most particles only load it.
     if (cnt > atomic_load(&S.counters[2])) atomic_max(&S.counters[2], cnt);
     S.nnbr[s] = cnt < S.c.max_neighbors ? cnt : S.c.max_neighbors;
     S.nsolid[s] = solid;
-    int scnt = 0;
     if (S.ns > 0) {
-      int* slist = S.snbr + s * S.snbr_row;
-      const int scap = S.c.max_static_neighbors;
-      for_each_in_radius(S.sgrid, S.scell_start, p, R, [&](int j) {
-        slist[(scnt < scap ? scnt : scap) * S.snbr_col] = j;
-        scnt += length2(p - S.stat[j]) < R2;
-      });
       if (scnt > S.c.max_static_neighbors) atomic_add(&S.counters[1], 1);
       if (scnt > atomic_load(&S.counters[3])) atomic_max(&S.counters[3], scnt);
     }
@@ -264,9 +322,22 @@ void find_neighbors(const Exec& ex, const SimViews& S) {
 template <class Exec>
 void stabilize(const Exec& ex, const SimViews& S) {
   ex.for_each(S.nbodies, [=] SEAMLESS_HD(std::int64_t b) { S.body_contacts[b] = 0; });
-  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) { S.ncontacts[s] = detail::count_contacts(S, static_cast<int>(s), S.sx); });
-  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
-    S.tmp[s] = S.sw[s] > 0.f ? detail::contact_sum(S, static_cast<int>(s), S.sx, S.sx, false) : vec3{0.f, 0.f, 0.f};
+  ex.for_each_grouped(S.n, kPairLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
+    const int s = static_cast<int>(i);
+    const int nc = detail::count_contacts(S, s, S.sx, g);
+    if (g.lane == 0) S.ncontacts[s] = nc;
+  });
+  ex.for_each_grouped(S.n, kPairLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
+    const int s = static_cast<int>(i);
+    if (!(S.sw[s] > 0.f)) {
+      if (g.lane == 0) S.tmp[s] = {0.f, 0.f, 0.f};
+      return;
+    }
+    vec3 acc = detail::contact_part(S, s, S.sx, S.sx, false, g);
+    if (detail::has_contact_lists(S, s)) acc = g.sum(acc);
+    if (g.lane != 0) return;
+    detail::add_sdf_contact(S, s, S.sx, S.sx, false, acc);
+    S.tmp[s] = acc;
   });
   ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
     vec3 d = S.tmp[s];
@@ -280,95 +351,137 @@ void stabilize(const Exec& ex, const SimViews& S) {
 // solid_density_scale, Macklin 2014 section 7.1), constraint C_i = rho_i / rho_0 - 1 (eq. 1,
 // clamped to C_i >= 0 when unilateral) and lambda_i = -C_i / (sum_k |grad_k C_i|^2 + eps)
 // (eqs. 8-11). Only fluid particles are moved by the density constraint.
+namespace detail {
+// One lane's share of the density sums of fluid particle s (prepare_constraints).
+struct DensitySum {
+  float rho, sum2;
+  vec3 gi;
+};
+SEAMLESS_HD inline DensitySum operator+(const DensitySum& a, const DensitySum& b) {
+  return {a.rho + b.rho, a.sum2 + b.sum2, a.gi + b.gi};
+}
+
+// Lane g's share of rho_i (starting from W(0) in lane 0), sum_j |grad_j C_i|^2 and grad_i C_i.
+SEAMLESS_HD inline DensitySum density_part(const SimViews& S, int s, Lanes g) {
+  const vec3 p = S.sp[s];
+  const float inv_rho0 = 1.f / S.c.rest_density, sw = S.c.solid_density_scale;
+  DensitySum d{g.lane == 0 ? S.c.W.poly6(0.f) : 0.f, 0.f, {0.f, 0.f, 0.f}};
+  const bool mixed = S.nsolid[s] != 0;  // otherwise every neighbour is fluid: no phase loads
+  for (int k = g.lane, m = S.nnbr[s]; k < m; k += g.size) {
+    int j = S.nbrs(s)[k * S.nbr_col];
+    vec3 r = p - S.sp[j];
+    float wgt = S.c.W.poly6(length2(r));
+    vec3 grad = S.c.W.spiky_grad(r) * inv_rho0;
+    if (!mixed || phase::is(S.sphase[j], phase::kFluid)) {
+      d.rho += wgt;
+      d.gi += grad;
+      d.sum2 += length2(grad);
+    } else {
+      d.rho += sw * wgt;
+      d.gi += grad * sw;
+    }
+  }
+  for (int k = g.lane, m = S.nsnbr[s]; k < m; k += g.size) {
+    vec3 r = p - S.stat[S.snbrs(s)[k * S.snbr_col]];
+    d.rho += sw * S.c.W.poly6(length2(r));
+    d.gi += S.c.W.spiky_grad(r) * (sw * inv_rho0);
+  }
+  return d;
+}
+}  // namespace detail
+
 template <class Exec>
 void prepare_constraints(const Exec& ex, const SimViews& S) {
   ex.for_each(S.nbodies, [=] SEAMLESS_HD(std::int64_t b) { S.body_contacts[b] = 0; });
-  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t i) {
+  ex.for_each_grouped(S.n, kPairLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
     const int s = static_cast<int>(i);
-    S.ncontacts[s] = detail::count_contacts(S, s, S.sp);
-    const std::uint32_t ph = S.sphase[s];
-    if (!phase::is(ph, phase::kFluid)) {
+    const int nc = detail::count_contacts(S, s, S.sp, g);
+    if (!phase::is(S.sphase[s], phase::kFluid)) {
+      if (g.lane != 0) return;
+      S.ncontacts[s] = nc;
       S.lambda[s] = 0.f;
       S.density[s] = S.c.rest_density;
       S.h_rho[s] = S.c.h / S.c.rest_density;
       return;
     }
-    const vec3 p = S.sp[s];
-    const float h = S.c.h, inv_rho0 = 1.f / S.c.rest_density, sw = S.c.solid_density_scale;
-    float rho = S.c.W.poly6(0.f), sum2 = 0.f;
-    vec3 gi{0.f, 0.f, 0.f};
-    const bool mixed = S.nsolid[s] != 0;  // otherwise every neighbour is fluid: no phase loads
-    for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
-      int j = S.nbrs(s)[k * S.nbr_col];
-      vec3 r = p - S.sp[j];
-      float wgt = S.c.W.poly6(length2(r));
-      vec3 g = S.c.W.spiky_grad(r) * inv_rho0;
-      if (!mixed || phase::is(S.sphase[j], phase::kFluid)) {
-        rho += wgt;
-        gi += g;
-        sum2 += length2(g);
-      } else {
-        rho += sw * wgt;
-        gi += g * sw;
-      }
-    }
-    for (int k = 0, m = S.nsnbr[s]; k < m; ++k) {
-      vec3 r = p - S.stat[S.snbrs(s)[k * S.snbr_col]];
-      rho += sw * S.c.W.poly6(length2(r));
-      gi += S.c.W.spiky_grad(r) * (sw * inv_rho0);
-    }
-    float C = rho * inv_rho0 - 1.f;
+    const detail::DensitySum d = g.sum(detail::density_part(S, s, g));
+    if (g.lane != 0) return;
+    S.ncontacts[s] = nc;
+    float C = d.rho * (1.f / S.c.rest_density) - 1.f;
     if (S.c.unilateral && C < 0.f) C = 0.f;
-    S.lambda[s] = -C / (sum2 + length2(gi) + S.c.relaxation);
-    S.density[s] = rho;
-    S.h_rho[s] = h / rho;  // once here instead of once per neighbour pair in velocity_effects
+    S.lambda[s] = -C / (d.sum2 + length2(d.gi) + S.c.relaxation);
+    S.density[s] = d.rho;
+    S.h_rho[s] = S.c.h / d.rho;  // once here instead of once per neighbour pair in velocity_effects
   });
 }
 
+namespace detail {
+// Lane g's share of the contact corrections (acc) and of the PBF sum (f) of s.
+struct SolveSum {
+  vec3 acc, f;
+};
+SEAMLESS_HD inline SolveSum operator+(const SolveSum& a, const SolveSum& b) { return {a.acc + b.acc, a.f + b.f}; }
+
+// The PBF position update of fluid particle s (eq. 12) with the artificial pressure s_corr
+// (eq. 13, n = 4), before the division by rho_0: lane g's share.
+SEAMLESS_HD inline vec3 pbf_part(const SimViews& S, int s, Lanes g) {
+  const vec3 p = S.sp[s];
+  const float li = S.lambda[s], sw = S.c.solid_density_scale;
+  const bool mixed = S.nsolid[s] != 0;  // otherwise every neighbour is fluid: no phase loads
+  vec3 f{0.f, 0.f, 0.f};
+  for (int k = g.lane, m = S.nnbr[s]; k < m; k += g.size) {
+    int j = S.nbrs(s)[k * S.nbr_col];
+    vec3 r = p - S.sp[j];
+    vec3 grad = S.c.W.spiky_grad(r);
+    if (!mixed || phase::is(S.sphase[j], phase::kFluid)) {
+      float sc = 0.f;
+      if (S.c.scorr_k > 0.f) {
+        float q = S.c.W.poly6(length2(r)) * S.c.scorr_inv_wdq;
+        sc = -S.c.scorr_k * q * q * q * q;
+      }
+      f += grad * (li + S.lambda[j] + sc);
+    } else {
+      f += grad * (li * sw);
+    }
+  }
+  for (int k = g.lane, m = S.nsnbr[s]; k < m; k += g.size) f += S.c.W.spiky_grad(p - S.stat[S.snbrs(s)[k * S.snbr_col]]) * (li * sw);
+  return f;
+}
+
+// Two-way coupling of solid particle s: the reaction of the density correction a fluid neighbour
+// j received from it (equal and opposite momentum: scaled by w_s / w_j), lane g's share.
+SEAMLESS_HD inline vec3 coupling_part(const SimViews& S, int s, Lanes g) {
+  const vec3 p = S.sp[s];
+  const float ws = S.sw[s];
+  vec3 f{0.f, 0.f, 0.f};
+  for (int k = g.lane, m = S.nnbr[s]; k < m; k += g.size) {
+    int j = S.nbrs(s)[k * S.nbr_col];
+    if (!phase::is(S.sphase[j], phase::kFluid)) continue;
+    f += S.c.W.spiky_grad(p - S.sp[j]) * (S.lambda[j] * ws / S.sw[j]);
+  }
+  return f;
+}
+}  // namespace detail
+
 template <class Exec>
 void solve_contacts_fluid(const Exec& ex, const SimViews& S) {
-  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t i) {
+  ex.for_each_grouped(S.n, kPairLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
     const int s = static_cast<int>(i);
     const vec3 p = S.sp[s];
     if (!(S.sw[s] > 0.f)) {
-      S.tmp[s] = p;
+      if (g.lane == 0) S.tmp[s] = p;
       return;
     }
-    vec3 acc = detail::contact_sum(S, s, S.sp, S.sx, true);
-    if (phase::is(S.sphase[s], phase::kFluid)) {
-      // PBF position update (eq. 12) with the artificial pressure s_corr (eq. 13, n = 4).
-      const float li = S.lambda[s], sw = S.c.solid_density_scale;
-      const bool mixed = S.nsolid[s] != 0;  // otherwise every neighbour is fluid: no phase loads
-      vec3 f{0.f, 0.f, 0.f};
-      for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
-        int j = S.nbrs(s)[k * S.nbr_col];
-        vec3 r = p - S.sp[j];
-        vec3 g = S.c.W.spiky_grad(r);
-        if (!mixed || phase::is(S.sphase[j], phase::kFluid)) {
-          float sc = 0.f;
-          if (S.c.scorr_k > 0.f) {
-            float q = S.c.W.poly6(length2(r)) * S.c.scorr_inv_wdq;
-            sc = -S.c.scorr_k * q * q * q * q;
-          }
-          f += g * (li + S.lambda[j] + sc);
-        } else {
-          f += g * (li * sw);
-        }
-      }
-      for (int k = 0, m = S.nsnbr[s]; k < m; ++k) f += S.c.W.spiky_grad(p - S.stat[S.snbrs(s)[k * S.snbr_col]]) * (li * sw);
-      acc += f * (1.f / S.c.rest_density);
-    } else if (S.c.solid_density_scale > 0.f) {
-      // Two-way coupling: the reaction of the density correction a fluid neighbour j received
-      // from this solid particle (equal and opposite momentum: scaled by w_s / w_j).
-      const float ws = S.sw[s];
-      vec3 f{0.f, 0.f, 0.f};
-      for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
-        int j = S.nbrs(s)[k * S.nbr_col];
-        if (!phase::is(S.sphase[j], phase::kFluid)) continue;
-        f += S.c.W.spiky_grad(p - S.sp[j]) * (S.lambda[j] * ws / S.sw[j]);
-      }
-      acc += f * (S.c.solid_density_scale / S.c.rest_density);
-    }
+    const bool fluid = phase::is(S.sphase[s], phase::kFluid), coupled = !fluid && S.c.solid_density_scale > 0.f;
+    detail::SolveSum part{detail::contact_part(S, s, S.sp, S.sx, true, g), {0.f, 0.f, 0.f}};
+    if (fluid) part.f = detail::pbf_part(S, s, g);
+    if (coupled) part.f = detail::coupling_part(S, s, g);
+    part = g.sum(part);
+    if (g.lane != 0) return;
+    vec3 acc = part.acc;
+    detail::add_sdf_contact(S, s, S.sp, S.sx, true, acc);
+    if (fluid) acc += part.f * (1.f / S.c.rest_density);
+    if (coupled) acc += part.f * (S.c.solid_density_scale / S.c.rest_density);
     S.tmp[s] = p + acc;
   });
 }
@@ -560,28 +673,34 @@ void update_velocity(const Exec& ex, const SimViews& S) {
 namespace detail {
 
 // Akinci 2013: cohesion (eq. 1) and curvature (eq. 5) accelerations, with the symmetrising
-// factor K_ij = 2 rho_0 / (rho_i + rho_j) (eq. 6). Masses are volume fractions 1 / rho_0.
-// dv_visc: the XSPH sum of s, from the vorticity pass.
-SEAMLESS_HD inline vec3 fluid_forces(const SimViews& S, int s, vec3 dv_visc) {
+// factor K_ij = 2 rho_0 / (rho_i + rho_j) (eq. 6), and vorticity confinement (PBF eqs. 15-16),
+// summed over the lanes of g (in every lane). Masses are volume fractions 1 / rho_0.
+struct ForceSum {
+  vec3 eta, acc;
+};
+SEAMLESS_HD inline ForceSum operator+(const ForceSum& a, const ForceSum& b) { return {a.eta + b.eta, a.acc + b.acc}; }
+
+SEAMLESS_HD inline vec3 fluid_forces(const SimViews& S, int s, Lanes g) {
   const float inv_rho0 = 1.f / S.c.rest_density;
-  const vec3 p = S.sp[s], wi = S.vort[s], ni = S.cnormal[s];
+  const vec3 p = S.sp[s], ni = S.cnormal[s];
   const bool mixed = S.nsolid[s] != 0;  // otherwise every neighbour is fluid: no phase loads
-  vec3 eta{0.f, 0.f, 0.f}, acc{0.f, 0.f, 0.f};
-  for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
+  ForceSum t{{0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}};
+  for (int k = g.lane, m = S.nnbr[s]; k < m; k += g.size) {
     int j = S.nbrs(s)[k * S.nbr_col];
     if (mixed && !phase::is(S.sphase[j], phase::kFluid)) continue;
     vec3 r = p - S.sp[j];
     float l = sqrtf(length2(r));
-    eta += S.c.W.spiky_grad(r) * (S.vort_len[j] * inv_rho0);
+    t.eta += S.c.W.spiky_grad(r) * (S.vort_len[j] * inv_rho0);
     float K = 2.f * S.c.rest_density / (S.density[s] + S.density[j]);
     vec3 coh = l > 1e-9f ? r * (-S.c.cohesion * inv_rho0 * S.c.W.akinci(l) / l) : vec3{0.f, 0.f, 0.f};
     vec3 curv = (ni - S.cnormal[j]) * (-S.c.surface_tension);
-    acc += (coh + curv) * K;
+    t.acc += (coh + curv) * K;
   }
+  t = g.sum(t);
   // Vorticity confinement (PBF eqs. 15-16): f = eps (N x omega), N = eta / |eta|.
-  float el = length(eta);
-  if (el > 1e-9f && S.c.vorticity > 0.f) acc += cross(eta / el, wi) * S.c.vorticity;
-  return dv_visc * S.c.viscosity + acc * S.c.dt;
+  float el = length(t.eta);
+  if (el > 1e-9f && S.c.vorticity > 0.f) t.acc += cross(t.eta / el, S.vort[s]) * S.c.vorticity;
+  return t.acc;
 }
 
 // Keckeisen 2004 drag and lift of the triangles around cloth particle s, a third each.
@@ -599,6 +718,33 @@ SEAMLESS_HD inline vec3 cloth_aero(const SimViews& S, int s) {
 
 }  // namespace detail
 
+namespace detail {
+// Lane g's share of the vorticity omega_i, the colour-field normal n_i and the XSPH sum of s.
+struct VortSum {
+  vec3 w, n, dv_visc;
+};
+SEAMLESS_HD inline VortSum operator+(const VortSum& a, const VortSum& b) {
+  return {a.w + b.w, a.n + b.n, a.dv_visc + b.dv_visc};
+}
+
+SEAMLESS_HD inline VortSum vorticity_part(const SimViews& S, int s, Lanes g) {
+  const float inv_rho0 = 1.f / S.c.rest_density;
+  const vec3 p = S.sp[s], vi = S.sv[s];
+  const bool mixed = S.nsolid[s] != 0;  // otherwise every neighbour is fluid: no phase loads
+  VortSum t{{0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}};
+  for (int k = g.lane, m = S.nnbr[s]; k < m; k += g.size) {
+    int j = S.nbrs(s)[k * S.nbr_col];
+    if (mixed && !phase::is(S.sphase[j], phase::kFluid)) continue;
+    vec3 r = p - S.sp[j], vj = S.sv[j];
+    vec3 grad = S.c.W.spiky_grad(r);
+    t.w += cross(vj - vi, -grad) * inv_rho0;
+    t.n += grad * S.h_rho[j];
+    t.dv_visc += (vj - vi) * (S.c.W.poly6(length2(r)) * inv_rho0);
+  }
+  return t;
+}
+}  // namespace detail
+
 template <class Exec>
 void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
   if (has_fluid) {
@@ -606,34 +752,27 @@ void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
     // n_i = h sum_j (1 / rho_j) grad W_ij (Akinci 2013, eq. 4; dissertation eq. 4.21), and the
     // XSPH sum (PBF eq. 17), which needs only this pass's velocities (kept in vtmp for
     // fluid_forces: one neighbour loop fewer that gathers velocities).
-    ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t i) {
+    ex.for_each_grouped(S.n, kPairLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
       const int s = static_cast<int>(i);
       if (!phase::is(S.sphase[s], phase::kFluid)) return;
-      const float inv_rho0 = 1.f / S.c.rest_density;
-      const vec3 p = S.sp[s], vi = S.sv[s];
-      const bool mixed = S.nsolid[s] != 0;  // otherwise every neighbour is fluid: no phase loads
-      vec3 w{0.f, 0.f, 0.f}, n{0.f, 0.f, 0.f}, dv_visc{0.f, 0.f, 0.f};
-      for (int k = 0, m = S.nnbr[s]; k < m; ++k) {
-        int j = S.nbrs(s)[k * S.nbr_col];
-        if (mixed && !phase::is(S.sphase[j], phase::kFluid)) continue;
-        vec3 r = p - S.sp[j], vj = S.sv[j];
-        vec3 g = S.c.W.spiky_grad(r);
-        w += cross(vj - vi, -g) * inv_rho0;
-        n += g * S.h_rho[j];
-        dv_visc += (vj - vi) * (S.c.W.poly6(length2(r)) * inv_rho0);
-      }
-      S.vort[s] = w;
-      S.vort_len[s] = length(w);  // read by every neighbour in fluid_forces
-      S.cnormal[s] = n;
-      S.vtmp[s] = dv_visc;
+      const detail::VortSum t = g.sum(detail::vorticity_part(S, s, g));
+      if (g.lane != 0) return;
+      S.vort[s] = t.w;
+      S.vort_len[s] = length(t.w);  // read by every neighbour in fluid_forces
+      S.cnormal[s] = t.n;
+      S.vtmp[s] = t.dv_visc;
     });
   }
   const bool aero = S.has_cloth_constraints && (S.c.drag > 0.f || S.c.lift > 0.f);
-  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t i) {
+  ex.for_each_grouped(S.n, kPairLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
     const int s = static_cast<int>(i);
-    std::uint32_t ph = S.sphase[s];
+    const std::uint32_t ph = S.sphase[s];
+    const bool fluid = has_fluid && phase::is(ph, phase::kFluid);
+    vec3 forces{0.f, 0.f, 0.f};
+    if (fluid) forces = detail::fluid_forces(S, s, g);
+    if (g.lane != 0) return;  // vtmp[s] is read and written by lane 0 only
     vec3 v = S.sv[s];
-    if (has_fluid && phase::is(ph, phase::kFluid)) v += detail::fluid_forces(S, s, S.vtmp[s]);
+    if (fluid) v += S.vtmp[s] * S.c.viscosity + forces * S.c.dt;
     if (aero && phase::is(ph, phase::kCloth)) v += detail::cloth_aero(S, s);
     S.vtmp[s] = v;
   });

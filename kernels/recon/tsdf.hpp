@@ -141,6 +141,11 @@ template <class Exec>
 void splat_ray_intervals(const Exec& ex, HashTableView t, VoxelGeometry geom, Intrinsics K, SE3 world_T_camera,
                          float min_depth, float max_depth, RayIntervals iv);
 
+// Fills window w from the hash table: -1 everywhere, then the pool index of every live block
+// inside it. Run after the last change to the table and before the kernels that read through it.
+template <class Exec>
+void fill_block_window(const Exec& ex, HashTableView t, BlockWindow w);
+
 // One ray per pixel from min_depth to max_depth, or only over its tile's interval when iv.bits is
 // set: skips unallocated blocks whole, steps by the TSDF inside allocated ones, refines the +/-
 // zero crossing by regula falsi on the trilinear field (KinectFusion section 3.5; Niessner section

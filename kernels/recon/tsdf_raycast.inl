@@ -103,6 +103,17 @@ void splat_ray_intervals(const Exec& ex, HashTableView t, VoxelGeometry geom, In
   });
 }
 
+template <class Exec>
+void fill_block_window(const Exec& ex, HashTableView t, BlockWindow w) {
+  ex.for_each(w.count(), [=] SEAMLESS_HD(std::int64_t i) { w.index[i] = -1; });
+  ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
+    const HashKey k = t.keys[i];
+    if (!is_live_key(k) || t.values[i] < 0) return;
+    const std::int64_t e = w.entry(unpack_block(k));
+    if (e >= 0) w.index[e] = t.values[i];  // keys are unique: one writer per entry
+  });
+}
+
 // Marches the ray o + d z (voxel units, z = camera depth) from z to z_end; on a +/- zero crossing
 // returns true with its refined depth in *hit and the block cache left near it.
 template <class Acc>
@@ -241,6 +252,9 @@ void raycast(const Exec& ex, Acc a, Intrinsics K, SE3 world_T_camera, float min_
                                           RayIntervals);                                                         \
   template void raycast<EXEC, DenseAccess>(const EXEC&, DenseAccess, Intrinsics, SE3, float, float,              \
                                            RaycastOutput, RayIntervals);                                         \
+  template void raycast<EXEC, WindowedHashAccess>(const EXEC&, WindowedHashAccess, Intrinsics, SE3, float, float, \
+                                                  RaycastOutput, RayIntervals);                                  \
+  template void fill_block_window<EXEC>(const EXEC&, HashTableView, BlockWindow);                                \
   template void clear_ray_intervals<EXEC>(const EXEC&, RayIntervals);                                            \
   template void splat_ray_intervals<EXEC>(const EXEC&, HashTableView, VoxelGeometry, Intrinsics, SE3, float,     \
                                           float, RayIntervals);                                                  \

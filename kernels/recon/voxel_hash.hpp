@@ -167,6 +167,38 @@ struct HashAccess {
   }
 };
 
+// A dense window of block indices (side^3 entries, x fastest, -1 = no block) over part of the
+// block grid, filled from the hash table before a raycast (fill_block_window): inside it a block is
+// found with one load instead of a chain of hash probes, and an empty block, which open addressing
+// can only confirm by probing up to an empty slot, costs no more than a full one. Rays cross 10-20
+// blocks each (most of them empty space skipped block by block), so that chain was most of the
+// raycast's latency. The window is a cache: outside it the table answers, so results are equal.
+struct BlockWindow {
+  std::int32_t* index = nullptr;  // nullptr: no window
+  int3 origin{0, 0, 0};           // block coordinate of entry 0
+  int side = 0;
+  SEAMLESS_HD std::int64_t count() const { return static_cast<std::int64_t>(side) * side * side; }
+  // Entry of block b, or -1 when b is outside (unsigned compares catch negatives too).
+  SEAMLESS_HD std::int64_t entry(int3 b) const {
+    const unsigned x = static_cast<unsigned>(b.x - origin.x), y = static_cast<unsigned>(b.y - origin.y),
+                   z = static_cast<unsigned>(b.z - origin.z), n = static_cast<unsigned>(side);
+    if (x >= n || y >= n || z >= n) return -1;
+    return x + static_cast<std::int64_t>(n) * (y + static_cast<std::int64_t>(n) * z);
+  }
+};
+
+// HashAccess with a BlockWindow in front of the table (same answers, fewer probes).
+struct WindowedHashAccess {
+  HashAccess hash;
+  BlockWindow window;
+  Voxel* voxels = nullptr;  // = hash.voxels; named like the other accessors' members
+  VoxelGeometry geom;       // = hash.geom
+  SEAMLESS_HD std::int32_t find_block(int3 b) const {
+    const std::int64_t e = window.index ? window.entry(b) : -1;
+    return e >= 0 ? window.index[e] : hash.find_block(b);
+  }
+};
+
 // Dense grid access: blocks_per_side^3 blocks starting at block (0,0,0); the dense KinectFusion
 // volume stored brick-major so that every kernel below serves both layouts.
 struct DenseAccess {

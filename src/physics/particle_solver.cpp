@@ -193,9 +193,11 @@ struct ParticleSolver::Impl {
     S.grid = K::GridSpec::for_radius(c.search_radius, bits);
     S.cell_start = cell_start.data();
     S.nbr = nbr.data(), S.nnbr = nnbr.data(), S.snbr = snbr.data(), S.nsnbr = nsnbr.data(), S.nsolid = nsolid.data();
-    // List layout per backend (kernels/physics/sim_views.hpp): a particle's list contiguous on
-    // the CPU (one thread walks it), entry k of consecutive particles contiguous on the GPU.
-    if (dev == Device::CUDA) S.nbr_row = 1, S.nbr_col = n, S.snbr_row = 1, S.snbr_col = n;
+    // List layout (kernels/physics/sim_views.hpp): a particle's list contiguous where one thread
+    // (CPU) or a group of lanes (a GPU with few particles, kernels::kPairLanes) walks it, entry k
+    // of consecutive particles contiguous where one GPU thread per particle does.
+    const int lanes = with_exec(dev, [&](const auto& ex) { return ex.lanes(n, K::kPairLanes); });
+    if (dev == Device::CUDA && lanes < K::kRowMajorLanes) S.nbr_row = 1, S.nbr_col = n, S.snbr_row = 1, S.snbr_col = n;
     else S.nbr_row = P.max_neighbours + 1, S.nbr_col = 1, S.snbr_row = P.max_static_neighbours + 1, S.snbr_col = 1;
     S.counters = counters.data();
     S.ns = static_cast<std::int64_t>(static_host.size());

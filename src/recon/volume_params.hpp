@@ -24,6 +24,7 @@ struct VolumeParams {
   bool remove_empty_blocks = true;
   bool grow_when_full = true;        // double the hash table / block pool instead of dropping blocks
   int raycast_tile = 8;              // pixels per side of a ray-interval tile (Niessner 4.3); 0: none
+  int raycast_window = 128;          // blocks per side of the raycast's block-index window; 0: none
   float stream_radius = 0.f;         // blocks beyond this distance from the camera go to host memory; 0: off
   float stream_step = 0.25f;         // camera travel (metres) between two streaming passes
 
@@ -46,6 +47,11 @@ struct VolumeParams {
       "hash layout: rays march only over the depth range of the blocks projecting onto their tile of this many "
       "pixels per side (Niessner 2013, section 4.3); 0 marches every ray from min_depth",
       Range{0, 256});
+    v("raycast_window", raycast_window,
+      "hash layout: before a raycast, the blocks in a cube of this many blocks per side in front of the camera "
+      "are indexed densely, so rays find them with one load instead of hash probes (4 bytes per entry: 128 "
+      "gives 8 MiB); blocks outside it are still found through the table; 0: off",
+      Range{0, 512});
     v("stream_radius", stream_radius,
       "hash layout: blocks whose centre is farther than this from the camera are moved to host memory and brought "
       "back when the camera returns (Niessner 2013, section 5), metres; 0 keeps everything on the device. Must "

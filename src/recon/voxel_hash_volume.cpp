@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <tuple>
 
@@ -265,6 +266,25 @@ std::vector<VoxelHashVolume::HostBlock> VoxelHashVolume::download_blocks() const
   return out;
 }
 
+// The camera's block sits at the middle of the window's back face (along the view direction's
+// dominant axis), so the window covers the frustum up to `side` blocks deep and side / 2 blocks
+// either way across; the table answers for blocks outside it.
+kernels::BlockWindow VoxelHashVolume::raycast_window(const SE3& world_T_camera) {
+  const int side = params_.raycast_window;
+  if (side <= 0) return {};
+  window_.reserve_discard(static_cast<std::int64_t>(side) * side * side, device_);
+  const vec3 cam = geom_.to_voxel(world_T_camera.t) / 8.f;  // block units
+  const vec3 fwd = world_T_camera.rotate(vec3{0.f, 0.f, 1.f});
+  const float f[3] = {fwd.x, fwd.y, fwd.z}, c[3] = {cam.x, cam.y, cam.z};
+  int axis = 0;
+  for (int k = 1; k < 3; ++k)
+    if (std::fabs(f[k]) > std::fabs(f[axis])) axis = k;
+  int o[3];
+  for (int k = 0; k < 3; ++k) o[k] = static_cast<int>(std::floor(c[k])) - side / 2;  // centred on the camera
+  o[axis] = static_cast<int>(std::floor(c[axis])) - (f[axis] > 0.f ? 1 : side - 2);  // one block behind it
+  return {window_.data(), int3{o[0], o[1], o[2]}, side};
+}
+
 void VoxelHashVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, RaycastMaps& maps, StageTimer* timer) {
   detail::resize_maps(maps, K, device_);
   kernels::RaycastOutput out{maps.depth.view(), maps.vertex.view(), maps.normal.view(), maps.color.view()};
@@ -284,7 +304,15 @@ void VoxelHashVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, Ra
           kernels::splat_ray_intervals(ex, table(), geom_, K, world_T_camera, params_.min_depth, params_.max_depth,
                                        iv);
         });
-      kernels::raycast(ex, device_view(), K, world_T_camera, params_.min_depth, params_.max_depth, out, iv);
+      const kernels::BlockWindow w = raycast_window(world_T_camera);
+      if (!w.index) {
+        kernels::raycast(ex, device_view(), K, world_T_camera, params_.min_depth, params_.max_depth, out, iv);
+        return;
+      }
+      staged(timer, "raycast_window", [&] { kernels::fill_block_window(ex, table(), w); });  // part of "raycast"
+      const kernels::HashAccess h = device_view();
+      kernels::raycast(ex, kernels::WindowedHashAccess{h, w, h.voxels, h.geom}, K, world_T_camera, params_.min_depth,
+                       params_.max_depth, out, iv);
     });
   });
 }

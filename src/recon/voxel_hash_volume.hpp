@@ -63,6 +63,8 @@ class VoxelHashVolume final : public Volume {
 
  private:
   kernels::HashTableView table() const;
+  // The block-index window for a raycast from world_T_camera (index nullptr when off).
+  kernels::BlockWindow raycast_window(const SE3& world_T_camera);
   // Blocks with no observed voxel closer to a surface than this (metres) are freed as empty.
   float keep_below() const { return 0.999f * geom_.truncation; }
   kernels::HashCounters read_counters() const;
@@ -97,6 +99,7 @@ class VoxelHashVolume final : public Volume {
   Buffer<std::int32_t> visible_;
   Buffer<std::int32_t> keep_;             // per visible block: 1 = has a voxel near a surface
   Buffer<std::int32_t> intervals_;        // ray-interval tiles (kernels::RayIntervals)
+  Buffer<std::int32_t> window_;           // the raycast's block-index window (kernels::BlockWindow)
   mutable Buffer<std::int32_t> scratch_;  // one int per slot for scans
   kernels::HashCounters last_{};          // counters as read at the end of the last frame
   std::int64_t frames_ = 0, retries_ = 0, failed_ = 0;

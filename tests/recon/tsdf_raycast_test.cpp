@@ -104,6 +104,38 @@ TEST(TsdfRaycastIntervals, HitTheSameSurfacesAsThePlainMarch) {
   }
 }
 
+// The block-index window is a cache in front of the hash table: it returns the same pool indices,
+// so the march takes the same samples and the maps are bit-identical, whether the window covers
+// every block (128), cuts through the model (2: most lookups fall back to the table) or is off.
+TEST(TsdfRaycastWindow, SameMapsWithAndWithoutTheWindow) {
+  Intrinsics K = test::camera(200, 150, 170.f);
+  test::Scene s = scene();
+  VolumeParams off = params_with_tile(8);
+  off.raycast_window = 0;
+  VoxelHashVolume plain(off, Device::CPU);
+  fuse(plain, s, K);
+  const SE3 views[] = {test::pose({0.02f, 0.01f, 0.03f}, 0.03f, -0.02f), test::pose({0.f, 0.f, 0.f}, 0.6f, 0.1f),
+                       test::pose({0.f, 0.f, 2.0f}, 3.14159265f, 0.f), test::pose({0.f, 0.f, 0.f}, 1.2f, 0.f)};
+  for (int side : {2, 128}) {
+    VolumeParams p = off;
+    p.raycast_window = side;
+    VoxelHashVolume windowed(p, Device::CPU);
+    fuse(windowed, s, K);
+    for (int v = 0; v < 4; ++v) {
+      RaycastMaps a = plain.raycast(K, views[v]), b = windowed.raycast(K, views[v]);
+      auto da = a.depth.to_host(), db = b.depth.to_host();
+      auto va = a.vertex.to_host(), vb = b.vertex.to_host();
+      int hits = 0;
+      for (std::size_t i = 0; i < da.size(); ++i) {
+        ASSERT_EQ(da[i], db[i]) << "window " << side << " pixel " << i;
+        ASSERT_TRUE(va[i].x == vb[i].x && va[i].y == vb[i].y && va[i].z == vb[i].z) << "window " << side << " pixel " << i;
+        hits += da[i] > 0.f;
+      }
+      if (v == 0) EXPECT_GT(hits, static_cast<int>(da.size()) / 4) << "the first view must see the model";
+    }
+  }
+}
+
 // The rays the intervals leave out (tiles with no block) are misses in the plain march too, and
 // an empty volume casts no ray at all.
 TEST(TsdfRaycastIntervals, EmptyVolumeHitsNothing) {
