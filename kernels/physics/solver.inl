@@ -1,4 +1,6 @@
 // Kernel bodies for physics/solver.hpp, compiled once per backend.
+#include <vector>
+
 #include "core/atomics.hpp"
 #include "core/exec.hpp"
 #include "kernels/physics/constraints.hpp"
@@ -227,10 +229,15 @@ void reorder(const Exec& ex, const SimViews& S) {
 
 template <class Exec>
 void cell_starts(const Exec& ex, const std::uint32_t* keys, std::int64_t n, int* start, std::int64_t cells) {
-  // Each task fills a block of 32 cells: one binary search for the first, then a merge walk along
-  // the sorted keys (work per task: 32 cells plus the entries in them). Parallel on both backends,
-  // no atomics, no host sync, and no task fills a long run of empty cells alone.
-  constexpr std::int64_t kBlock = 32;
+  // Each task fills a block of cells: one binary search for the first, then a merge walk along
+  // the sorted keys (work per task: the block's cells plus the entries in them). Parallel on both
+  // backends, no atomics, no host sync, and no task fills a long run of empty cells alone. Blocks
+  // of 32 cells on the CPU, where a thread's binary search is shared by many cells; of 4 on CUDA,
+  // where the walk is a chain of dependent loads and stores: with 32, 10k particles' 2^18 cells
+  // made 33 blocks of threads that each waited on 32 of them (19 us on an H200, 40 of 132
+  // multiprocessors busy), with 4 it is 256 blocks of 4 (the binary searches' upper levels are
+  // shared in cache).
+  constexpr std::int64_t kBlock = Exec::device == Device::CUDA ? 4 : 32;
   const std::int64_t total = cells + 1;
   ex.for_each((total + kBlock - 1) / kBlock, [=] SEAMLESS_HD(std::int64_t b) {
     const std::int64_t k0 = b * kBlock, k1 = k0 + kBlock < total ? k0 + kBlock : total;
@@ -572,16 +579,16 @@ void shape_match(const Exec& ex, const SimViews& S) {
   if (S.c.static_friction > 0.f) body_static_friction(ex, S);
 }
 
-// Stretch constraints of one colour (Mueller 2007, eq. 4.7/4.8), edges [first, first + count).
-// The host colours the edges so that no particle has two edges of one colour: each colour is then
-// projected fully and in place (Gauss-Seidel over colours, the usual graph colouring of parallel
-// PBD) instead of averaged (Jacobi), which with 8 edges per particle and 2 iterations left hanging
-// cloth stretched by 20 %. One task per edge writes both of its particles, which no other task
-// of the colour touches.
+// Stretch constraints (Mueller 2007, eq. 4.7/4.8), colour after colour: edges
+// [colour_off[c], colour_off[c + 1]). The host colours the edges so that no particle has two edges
+// of one colour: each colour is then projected fully and in place (Gauss-Seidel over colours, the
+// usual graph colouring of parallel PBD) instead of averaged (Jacobi), which with 8 edges per
+// particle and 2 iterations left hanging cloth stretched by 20 %. One task per edge writes both
+// of its particles, which no other task of the colour touches. The colours are the phases of one
+// for_each_phases sweep (one launch for a small cloth on CUDA, the same order as a launch each).
 template <class Exec>
-void cloth_stretch(const Exec& ex, const SimViews& S, std::int64_t first, std::int64_t count) {
-  ex.for_each(count, [=] SEAMLESS_HD(std::int64_t i) {
-    const std::int64_t e = first + i;
+void cloth_stretch(const Exec& ex, const SimViews& S, const std::int64_t* colour_off, int colours) {
+  ex.for_each_phases(colours, colour_off, colour_off + 1, [=] SEAMLESS_HD(int, std::int64_t e) {
     const int a = S.rank[S.edge_a[e]], b = S.rank[S.edge_b[e]];
     const vec3 pa = S.sp[a], pb = S.sp[b];
     const float wa = S.sw[a], wb = S.sw[b], L = S.edge_len[e], k = S.edge_k[e];
@@ -590,7 +597,8 @@ void cloth_stretch(const Exec& ex, const SimViews& S, std::int64_t first, std::i
   });
 }
 
-// Strain limiting (Provot 1995, section 5): after the solver iterations, every edge of the colour
+// Strain limiting (Provot 1995, section 5): after the solver iterations, `passes` Gauss-Seidel
+// sweeps over the edge colours (as in cloth_stretch, all in one for_each_phases sweep); every edge
 // stretched or compressed by more than its limit (a fraction of the rest length) is brought back
 // to the limit (over-relaxed by cloth_strain_omega), in place; edges within the limit are left
 // alone. This pass cannot see the contacts, so a particle that touched the scene in the last
@@ -599,9 +607,11 @@ void cloth_stretch(const Exec& ex, const SimViews& S, std::int64_t first, std::i
 // limiter pulling the particle into the scene (mass scaling in the spirit of Macklin 2014's
 // stacking heuristic).
 template <class Exec>
-void cloth_strain_limit(const Exec& ex, const SimViews& S, std::int64_t first, std::int64_t count) {
-  ex.for_each(count, [=] SEAMLESS_HD(std::int64_t i) {
-    const std::int64_t e = first + i;
+void cloth_strain_limit(const Exec& ex, const SimViews& S, const std::int64_t* colour_off, int colours, int passes) {
+  std::vector<std::int64_t> begin, end;
+  for (int pass = 0; pass < passes; ++pass)
+    for (int c = 0; c < colours; ++c) begin.push_back(colour_off[c]), end.push_back(colour_off[c + 1]);
+  ex.for_each_phases(static_cast<int>(begin.size()), begin.data(), end.data(), [=] SEAMLESS_HD(int, std::int64_t e) {
     const float lim = S.edge_limit[e];
     if (!(lim > 0.f)) return;
     const int a = S.rank[S.edge_a[e]], b = S.rank[S.edge_b[e]];
