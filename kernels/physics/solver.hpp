@@ -5,8 +5,8 @@
 //   predict -> sort_by_key -> reorder -> cell_starts -> find_neighbors
 //   -> stabilize (section 4.4)
 //   -> iterations: prepare_constraints, solve_contacts_fluid (swap sp/tmp), shape_match,
-//                  cloth_stretch per colour (in place), cloth_bend (swap sp/tmp)
-//   -> cloth_strain_limit per colour (passes)
+//                  cloth_stretch (all colours, in place), cloth_bend (swap sp/tmp)
+//   -> cloth_strain_limit (all passes over the colours, in place)
 //   -> update_velocity -> velocity_effects (swap sv/vtmp) -> write_back
 #pragma once
 #include <cstddef>
@@ -53,10 +53,12 @@ template <class Exec> void solve_contacts_fluid(const Exec& ex, const SimViews& 
 // Shape matching of every rigid body (Mueller 2005): per-body sums, rotation, goal positions.
 template <class Exec> void shape_match(const Exec& ex, const SimViews& S);
 // Cloth stretch and bending (Mueller 2007); writes tmp.
-// Stretch constraints of the edges [first, first + count) (one colour), in place.
-template <class Exec> void cloth_stretch(const Exec& ex, const SimViews& S, std::int64_t first, std::int64_t count);
-// Strain limiting of one colour's edges (Provot 1995), in place.
-template <class Exec> void cloth_strain_limit(const Exec& ex, const SimViews& S, std::int64_t first, std::int64_t count);
+// Stretch constraints, colour after colour (edges [colour_off[c], colour_off[c + 1]), colour_off
+// on the host), in place.
+template <class Exec> void cloth_stretch(const Exec& ex, const SimViews& S, const std::int64_t* colour_off, int colours);
+// Strain limiting (Provot 1995): `passes` sweeps over the colours, in place.
+template <class Exec>
+void cloth_strain_limit(const Exec& ex, const SimViews& S, const std::int64_t* colour_off, int colours, int passes);
 template <class Exec> void cloth_bend(const Exec& ex, const SimViews& S);
 // v = v_pred + (p - p0) / dt (exactly symplectic Euler when nothing acted), restitution, sleeping.
 template <class Exec> void update_velocity(const Exec& ex, const SimViews& S);
@@ -81,8 +83,8 @@ template <class Exec> void write_back(const Exec& ex, const SimViews& S);
   template void prepare_constraints<E>(const E&, const SimViews&);                                          \
   template void solve_contacts_fluid<E>(const E&, const SimViews&);                                         \
   template void shape_match<E>(const E&, const SimViews&);                                                  \
-  template void cloth_stretch<E>(const E&, const SimViews&, std::int64_t, std::int64_t);                    \
-  template void cloth_strain_limit<E>(const E&, const SimViews&, std::int64_t, std::int64_t);               \
+  template void cloth_stretch<E>(const E&, const SimViews&, const std::int64_t*, int);                      \
+  template void cloth_strain_limit<E>(const E&, const SimViews&, const std::int64_t*, int, int);             \
   template void cloth_bend<E>(const E&, const SimViews&);                                                  \
   template void update_velocity<E>(const E&, const SimViews&);                                              \
   template void velocity_effects<E>(const E&, const SimViews&, bool);                                       \

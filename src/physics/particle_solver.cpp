@@ -341,20 +341,19 @@ struct ParticleSolver::Impl {
 
   template <class Ex>
   void solve_cloth(const Ex& ex, K::SimViews& S) {
-    for (std::size_t c = 0; c + 1 < colour_off.size(); ++c)
-      K::cloth_stretch(ex, S, colour_off[c], colour_off[c + 1] - colour_off[c]);
+    if (colour_off.size() > 1) K::cloth_stretch(ex, S, colour_off.data(), colours());
     if (!bends.empty()) {
       K::cloth_bend(ex, S);
       std::swap(S.sp, S.tmp);
     }
   }
 
+  int colours() const { return static_cast<int>(colour_off.size()) - 1; }
+
   // Strain limiting after the iterations (Provot 1995): Gauss-Seidel over the edge colours.
   template <class Ex>
   void limit_strain(const Ex& ex, const K::SimViews& S) {
-    for (int pass = 0; pass < P.cloth_strain_passes; ++pass)
-      for (std::size_t c = 0; c + 1 < colour_off.size(); ++c)
-        K::cloth_strain_limit(ex, S, colour_off[c], colour_off[c + 1] - colour_off[c]);
+    if (colour_off.size() > 1) K::cloth_strain_limit(ex, S, colour_off.data(), colours(), P.cloth_strain_passes);
   }
 
   void upload_bodies(const std::vector<vec3>& c, const std::vector<vec4>& q) {
