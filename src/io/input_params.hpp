@@ -104,6 +104,9 @@ struct InputParams {
   bool skip_bad_frames = false;
   bool undistort = true;            // remove lens distortion of presets that have it (freiburg1/2)
   double max_gt_gap = 0.1;          // seconds: no ground truth across larger motion-capture gaps
+  std::string association = "auto";  // TUM: pair rgb.txt/depth.txt by time (auto) or trust the folder's file
+  double association_max_dt = 0.02;  // TUM's associate.py --max_difference, seconds
+  double association_offset = 0.0;   // TUM's associate.py --offset: added to depth timestamps, seconds
   SyntheticParams synthetic;
   KinectParams kinect;
 
@@ -118,6 +121,15 @@ struct InputParams {
     v("undistort", undistort, "undistort images whose intrinsics have lens distortion");
     v("max_gt_gap", max_gt_gap, "interpolate ground truth only between samples closer than this, seconds",
       Range{0.0, 10.0});
+    // auto follows TUM's convention (rgb.txt and depth.txt are the data; an association file is a
+    // derived product and some published ones are partial: fr1_desk's 9-frame sample lists 2 pairs).
+    v("association", association,
+      "TUM rgb/depth pairing: auto pairs rgb.txt and depth.txt by time like TUM's associate.py (an "
+      "associations.txt/associate.txt that disagrees is reported and ignored); file uses that file as written",
+      Choices{"auto", "file"});
+    v("association_max_dt", association_max_dt, "auto association: largest rgb/depth timestamp difference, seconds",
+      Range{0.0, 1.0});
+    v("association_offset", association_offset, "auto association: seconds added to depth timestamps", Range{-10.0, 10.0});
     v("synthetic", synthetic, "synthetic room settings (source: synthetic)");
     v("kinect", kinect, "live Kinect v1 settings (source: kinect)");
   }

@@ -104,17 +104,20 @@ std::vector<TumListEntry> read_tum_list(const std::string& path) {
 }
 
 std::vector<TumPair> associate(const std::vector<TumListEntry>& rgb, const std::vector<TumListEntry>& depth,
-                               double max_difference) {
+                               double max_difference, double offset) {
   struct Candidate {
     double diff;
     std::size_t r, d;
   };
   std::vector<Candidate> cand;
   for (std::size_t r = 0; r < rgb.size(); ++r) {  // both lists are sorted: a window per rgb entry
-    auto lo = std::lower_bound(depth.begin(), depth.end(), rgb[r].timestamp - max_difference,
-                               [](const TumListEntry& e, double t) { return e.timestamp < t; });
-    for (auto it = lo; it != depth.end() && it->timestamp < rgb[r].timestamp + max_difference; ++it)
-      cand.push_back({std::fabs(it->timestamp - rgb[r].timestamp), r, static_cast<std::size_t>(it - depth.begin())});
+    const double t = rgb[r].timestamp - offset;      // the depth stamp that would match exactly
+    auto lo = std::lower_bound(depth.begin(), depth.end(), t - max_difference,
+                               [](const TumListEntry& e, double v) { return e.timestamp < v; });
+    for (auto it = lo; it != depth.end() && it->timestamp <= t + max_difference; ++it) {
+      const double diff = std::fabs(rgb[r].timestamp - (it->timestamp + offset));
+      if (diff < max_difference) cand.push_back({diff, r, static_cast<std::size_t>(it - depth.begin())});
+    }
   }
   std::stable_sort(cand.begin(), cand.end(), [](const Candidate& a, const Candidate& b) { return a.diff < b.diff; });
   std::vector<char> used_r(rgb.size(), 0), used_d(depth.size(), 0);
@@ -128,21 +131,59 @@ std::vector<TumPair> associate(const std::vector<TumListEntry>& rgb, const std::
   return out;
 }
 
+namespace {
+
+// associations.txt (written by `seamless record` and TUM's tools) or associate.txt; "" if neither.
+std::string association_file(const fs::path& dir) {
+  for (const char* name : {"associations.txt", "associate.txt"})
+    if (fs::exists(dir / name)) return (dir / name).string();
+  return "";
+}
+
+bool same_pairs(const std::vector<TumPair>& a, const std::vector<TumPair>& b) {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const TumPair& x, const TumPair& y) {
+    return x.rgb.file == y.rgb.file && x.depth.file == y.depth.file;
+  });
+}
+
+}  // namespace
+
+std::vector<TumPair> tum_folder_pairs(const std::string& folder, const InputParams& params) {
+  const fs::path dir(folder);
+  const std::string file = association_file(dir);
+  if (params.association == "file") {
+    if (file.empty())
+      throw Error("input.association is 'file' but '" + folder + "' has neither associations.txt nor associate.txt: " +
+                  "set input.association: auto to pair rgb.txt and depth.txt by time");
+    return read_associations(file);
+  }
+  const bool lists = fs::exists(dir / "rgb.txt") && fs::exists(dir / "depth.txt");
+  if (!lists && !file.empty()) return read_associations(file);  // nothing to pair by time
+  std::vector<TumPair> pairs = associate(read_tum_list((dir / "rgb.txt").string()),
+                                         read_tum_list((dir / "depth.txt").string()), params.association_max_dt,
+                                         params.association_offset);
+  if (!file.empty()) {
+    std::vector<TumPair> listed = read_associations(file);
+    if (!same_pairs(listed, pairs))
+      spdlog::warn("'{}' lists {} rgb/depth pairs, pairing rgb.txt and depth.txt by time (within {} s) finds {}: "
+                   "using the pairs by time, TUM's convention (input.association: auto); set input.association: file "
+                   "to use the file instead",
+                   file, listed.size(), params.association_max_dt, pairs.size());
+  }
+  return pairs;
+}
+
 TumSource::TumSource(const InputParams& params) : params_(params), folder_(params.path) {
   if (folder_.empty()) throw Error("input.path is empty: set it to a TUM RGB-D folder (source: tum)");
   if (!fs::is_directory(folder_))
     throw Error("input.path '" + folder_ + "' is not a folder: download one with datasets/download_tum.sh");
   K_ = resolve_intrinsics(params.intrinsics, folder_);
   fs::path dir(folder_);
-  for (const char* assoc : {"associations.txt", "associate.txt"})
-    if (fs::exists(dir / assoc)) {
-      pairs_ = read_associations((dir / assoc).string());
-      break;
-    }
-  if (pairs_.empty() && !fs::exists(dir / "associations.txt") && !fs::exists(dir / "associate.txt"))
-    pairs_ = associate(read_tum_list((dir / "rgb.txt").string()), read_tum_list((dir / "depth.txt").string()));
+  pairs_ = tum_folder_pairs(folder_, params);
   if (pairs_.empty())
-    throw Error("TUM folder '" + folder_ + "' has no rgb/depth pairs (no timestamps within 0.02 s, or empty lists)");
+    throw Error("TUM folder '" + folder_ + "' has no rgb/depth pairs (input.association " + params.association +
+                ": no rgb/depth timestamps within input.association_max_dt " + std::to_string(params.association_max_dt) +
+                " s, or empty lists); check rgb.txt and depth.txt, or input.association_offset");
   std::size_t first = static_cast<std::size_t>(std::min<std::int64_t>(params.first_frame, pairs_.size()));
   pairs_.erase(pairs_.begin(), pairs_.begin() + first);
   if (params.max_frames > 0 && pairs_.size() > static_cast<std::size_t>(params.max_frames)) pairs_.resize(params.max_frames);

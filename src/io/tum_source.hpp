@@ -22,10 +22,14 @@ std::vector<TumListEntry> read_tum_list(const std::string& path);
 struct TumPair {
   TumListEntry rgb, depth;
 };
-// Pairs rgb and depth like TUM's associate.py: all candidate pairs closer than max_difference
-// seconds, taken greedily by increasing time difference, each image used once, sorted by rgb time.
+// Pairs rgb and depth like TUM's associate.py: all candidate pairs with |t_rgb - (t_depth + offset)|
+// below max_difference seconds, taken greedily by increasing difference, each image used once,
+// sorted by rgb time.
 std::vector<TumPair> associate(const std::vector<TumListEntry>& rgb, const std::vector<TumListEntry>& depth,
-                               double max_difference = 0.02);
+                               double max_difference = 0.02, double offset = 0.0);
+// The pairs a TUM folder's frames are made of, per input.association (auto or file; see
+// docs/INPUT.md). Logs one warning when an association file disagrees with pairing by time.
+std::vector<TumPair> tum_folder_pairs(const std::string& folder, const InputParams& params);
 
 class TumSource : public FrameSource {
  public:

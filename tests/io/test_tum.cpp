@@ -70,7 +70,9 @@ TEST(TumReader, AssociationReproducesAssociateDotPy) {
   REQUIRE_DATA(dir);
   // associations.txt in this folder was made by TUM's associate.py: our pairing must match it.
   auto pairs = associate(read_tum_list(dir + "/rgb.txt"), read_tum_list(dir + "/depth.txt"));
-  TumSource src(tum_params(dir));
+  InputParams p = tum_params(dir);
+  p.association = "file";
+  TumSource src(p);
   const auto& want = src.pairs();
   ASSERT_EQ(pairs.size(), want.size());
   for (std::size_t i = 0; i < want.size(); ++i) {
@@ -138,22 +140,31 @@ TEST(TumReader, AccelerometerPointsUpInTheCameraFrame) {
   EXPECT_LT(errors[errors.size() / 2], 12.0);
 }
 
-TEST(TumReader, NineFrameDeskUsesAssociateTxt) {
+TEST(TumReader, NineFrameDeskPairsAllNineByTime) {
   std::string dir = data_dir("tum_fr1_desk_9frames");
   REQUIRE_DATA(dir);
-  // This folder's associate.txt lists only the first 2 of its 9 pairs: a present association file
-  // is the user's choice and wins over pairing by time.
+  // This folder's associate.txt lists only the first 2 of its 9 pairs; rgb.txt and depth.txt list
+  // all 9 (each depth 10-15 ms after its rgb). TUM's convention (input.association: auto) pairs
+  // the lists by time and uses all 9.
   TumSource src(tum_params(dir));
-  EXPECT_EQ(src.size(), 2);
+  ASSERT_EQ(src.size(), 9);
+  std::int64_t n = 0;
   RgbdFrame f;
-  ASSERT_TRUE(src.next(f));
-  EXPECT_DOUBLE_EQ(f.timestamp, 1305031453.359684);
-  EXPECT_TRUE(f.ground_truth);
-  EXPECT_FALSE(f.accelerometer);  // no accelerometer.txt in this folder
-  // Pairing by time finds all 9, and agrees with the file on the 2 it lists.
-  auto pairs = associate(read_tum_list(dir + "/rgb.txt"), read_tum_list(dir + "/depth.txt"));
-  ASSERT_EQ(pairs.size(), 9u);
-  EXPECT_EQ(pairs[1].depth.file, src.pairs()[1].depth.file);
+  while (src.next(f)) {
+    if (n == 0) EXPECT_DOUBLE_EQ(f.timestamp, 1305031453.359684);
+    EXPECT_TRUE(f.ground_truth);
+    EXPECT_FALSE(f.accelerometer);  // no accelerometer.txt in this folder
+    EXPECT_EQ(f.depth.width(), 640);
+    ++n;
+  }
+  EXPECT_EQ(n, 9);
+  EXPECT_DOUBLE_EQ(f.timestamp, 1305031453.627706);  // the last line of rgb.txt
+  // The file, when asked for, gives its 2 pairs, which agree with pairing by time.
+  InputParams p = tum_params(dir);
+  p.association = "file";
+  TumSource file_src(p);
+  ASSERT_EQ(file_src.size(), 2);
+  EXPECT_EQ(file_src.pairs()[1].depth.file, src.pairs()[1].depth.file);
 }
 
 TEST(TumReader, FirstAndMaxFrames) {
