@@ -66,25 +66,30 @@ void ReferenceMaps::set_from_frame(const FramePyramid& frame, const SE3& world_T
 }
 
 void ReferenceMaps::set_from_raycast(const RaycastMaps& maps, const Intrinsics& K, const SE3& world_T_camera,
-                                     int levels, float max_diff) {
+                                     int levels, float max_diff, const FramePyramid* photometric) {
   if (maps.vertex.width() != K.width || maps.vertex.height() != K.height)
     throw Error("raycast maps are " + std::to_string(maps.vertex.width()) + "x" + std::to_string(maps.vertex.height()) +
                 " but the tracker's intrinsics say " + std::to_string(K.width) + "x" + std::to_string(K.height));
-  bool intensity = maps.color.width() == K.width && maps.color.height() == K.height;
+  const bool from_frame = photometric && photometric->level(0).intensity.width() == K.width &&
+                          photometric->levels() >= levels;
+  const bool from_model = !from_frame && maps.color.width() == K.width && maps.color.height() == K.height;
+  const bool intensity = from_frame || from_model;
   Device d = maps.vertex.device();
   resize(K, levels, d, intensity);
   const SE3 camera_T_world = world_T_camera.inverse();
   with_exec(d, [&](const auto& ex) {
     kernels::transform_maps(ex, maps.vertex.cview(), maps.normal.cview(), camera_T_world, levels_[0].vertices.view(),
                             levels_[0].normals.view());
-    if (intensity) kernels::rgb_to_intensity(ex, maps.color.cview(), levels_[0].intensity.view());
+    if (from_model) kernels::rgb_to_intensity(ex, maps.color.cview(), levels_[0].intensity.view());
     for (int l = 1; l < levels; ++l) {
       kernels::pyr_down_maps(ex, levels_[l - 1].vertices.cview(), levels_[l - 1].normals.cview(),
                              levels_[l].vertices.view(), levels_[l].normals.view(), max_diff);
-      if (intensity)
+      if (from_model)
         kernels::pyr_down_intensity(ex, levels_[l - 1].intensity.cview(), levels_[l].intensity.view());
     }
   });
+  if (from_frame)
+    for (int l = 0; l < levels; ++l) levels_[l].intensity.buffer().copy_from(photometric->level(l).intensity.buffer());
   world_T_ref_ = world_T_camera;
 }
 

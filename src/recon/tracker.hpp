@@ -38,8 +38,11 @@ class ReferenceMaps {
   // Frame-to-model: a raycast (world-space maps, full resolution, intrinsics K) rendered from
   // world_T_camera, moved into that camera's coordinates and subsampled into `levels` levels.
   // max_diff: largest depth difference averaged by the subsampling, metres.
+  // photometric: when given (a frame seen from world_T_camera, normally the last tracked one), its
+  // intensity pyramid is the photometric reference instead of the raycast's fused colour; see
+  // TrackerParams::photometric_reference.
   void set_from_raycast(const RaycastMaps& maps, const Intrinsics& K, const SE3& world_T_camera, int levels,
-                        float max_diff = 0.09f);
+                        float max_diff = 0.09f, const FramePyramid* photometric = nullptr);
   const ReferenceLevel& level(int l) const { return levels_.at(l); }
   int levels() const { return static_cast<int>(levels_.size()); }
   bool empty() const { return levels_.empty(); }

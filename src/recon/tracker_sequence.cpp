@@ -135,7 +135,10 @@ void TrackingSession::upload(const RgbdFrame& frame) {
 void TrackingSession::update_reference(const SE3& pose) {
   if (volume_ && p_.tracker.mode == "frame_to_model") {
     volume_->raycast(K_, pose, maps_);
-    ref_.set_from_raycast(maps_, K_, pose, pyr_.levels(), p_.preprocess.pyramid_max_diff);
+    // The current pyramid is the frame just tracked at `pose`, the pose the raycast is seen from.
+    const bool frame_colour = p_.tracker.photometric_reference == "frame";
+    ref_.set_from_raycast(maps_, K_, pose, pyr_.levels(), p_.preprocess.pyramid_max_diff,
+                          frame_colour ? &pyr_ : nullptr);
   } else {
     ref_.set_from_frame(pyr_, pose);
   }
