@@ -21,6 +21,7 @@ SEAMLESS_HD inline float block_exit(vec3 o, vec3 d, int3 b) {
 template <class Acc>
 SEAMLESS_HD inline float refine_crossing(const Acc& a, vec3 o, vec3 d, float ta, float fa, float tb, float fb,
                                          BlockCache& c) {
+#pragma unroll 1  // one copy of the sample code: the kernel is large enough to miss the instruction cache
   for (int it = 0; it < 3; ++it) {
     float tm = ta + (tb - ta) * fa / (fa - fb);
     float fm;

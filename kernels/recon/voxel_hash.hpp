@@ -247,6 +247,13 @@ template <class Acc>
 SEAMLESS_HD inline bool cell_voxels(const Acc& a, int3 g0, BlockCache& c, const Voxel* v[8]) {
   const int3 b0 = block_of_voxel(g0);
   const bool ex = (g0.x & 7) == 7, ey = (g0.y & 7) == 7, ez = (g0.z & 7) == 7;
+  if (!(ex || ey || ez)) {  // 343 of a block's 512 cells: all corners in b0, at fixed offsets
+    const std::int32_t i0 = cached_block(a, b0, c);
+    if (i0 < 0) return false;
+    const Voxel* base = a.voxels + static_cast<std::int64_t>(i0) * kBlockVoxels + local_index(g0);
+    for (int k = 0; k < 8; ++k) v[k] = base + (k & 1) + 8 * ((k >> 1) & 1) + 64 * (k >> 2);
+    return true;
+  }
   // i[k]: block of corner k, i.e. of b0 + (k&1 & ex, (k>>1)&1 & ey, k>>2 & ez).
   std::int32_t i[8];
   i[0] = cached_block(a, b0, c);
@@ -273,17 +280,22 @@ SEAMLESS_HD inline bool sample_tsdf(const Acc& a, vec3 q, BlockCache& c, float* 
   vec3 f = q - to_vec3(g0);
   const Voxel* v[8];
   if (!cell_voxels(a, g0, c, v)) return false;
-  float s = 0.f;
+  float d[8];
+  bool observed = true;
+  for (int k = 0; k < 8; ++k) observed &= v[k]->weight > 0.f, d[k] = v[k]->sdf;
+  if (!observed) return false;
+  // Trilinear as 7 lerps along x, then y, then z (the same weights as the 8-product form).
+  auto lerp = [](float p, float q, float t) { return p + t * (q - p); };
+  const float x0 = lerp(d[0], d[1], f.x), x1 = lerp(d[2], d[3], f.x), x2 = lerp(d[4], d[5], f.x),
+              x3 = lerp(d[6], d[7], f.x);
+  *sdf = lerp(lerp(x0, x1, f.y), lerp(x2, x3, f.y), f.z);
+  if (!color) return true;
   vec3 col{0.f, 0.f, 0.f};
   for (int k = 0; k < 8; ++k) {
-    if (!(v[k]->weight > 0.f)) return false;
-    int3 o{k & 1, (k >> 1) & 1, k >> 2};
-    float w = (o.x ? f.x : 1.f - f.x) * (o.y ? f.y : 1.f - f.y) * (o.z ? f.z : 1.f - f.z);
-    s += w * v[k]->sdf;
-    if (color) col += vec3{float(v[k]->color.x), float(v[k]->color.y), float(v[k]->color.z)} * w;
+    const float w = (k & 1 ? f.x : 1.f - f.x) * ((k >> 1) & 1 ? f.y : 1.f - f.y) * (k >> 2 ? f.z : 1.f - f.z);
+    col += vec3{float(v[k]->color.x), float(v[k]->color.y), float(v[k]->color.z)} * w;
   }
-  *sdf = s;
-  if (color) *color = col;
+  *color = col;
   return true;
 }
 
