@@ -111,6 +111,10 @@ void add_run_command(CLI::App& app, std::function<int()>& action) {
   auto* cmd = app.add_subcommand("run", "run an experiment end to end: input, reconstruction, physics, rendering");
   add_common_options(*cmd, *o);
   cmd->add_flag("--dry-run", o->dry_run, "validate the config and exit");
+  cmd->add_option("--window-frames", o->window_frames,
+                  "render.mode window: close the window after this many frames (scripted runs, tests); "
+                  "the outputs hold the state reached")
+      ->check(CLI::NonNegativeNumber);
   cmd->callback([&action, o] { action = [o] { return run(*o); }; });
 }
 

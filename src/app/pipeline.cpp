@@ -2,11 +2,13 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/progress.hpp"
 #include "io/frame_source.hpp"
 #include "app/render_stage.hpp"
+#include "physics/builders.hpp"
 #include "physics/particle_solver.hpp"
 #include "recon/ply.hpp"
 
@@ -64,6 +66,83 @@ ScanResult scan(RunContext& ctx, bool with_volume) {
   return r;
 }
 
+namespace {
+
+// Spawn entries in the solver's own schedule order (ParticleSolver::schedule: at the start of the
+// first step whose start time reaches their time, in list order), kept here so that the window's
+// key G can take the next one early without it being spawned twice.
+class SpawnQueue {
+ public:
+  SpawnQueue(const std::vector<SpawnParams>& spawns, const SolverParams& p) : pending_(spawns.begin(), spawns.end()) {
+    check_spawn_capacity(spawns, p);  // the whole list fits, or an Error naming the entry
+  }
+  // Before the step that starts at `time` (seconds).
+  void due(ParticleSolver& solver, double time) {
+    for (auto it = pending_.begin(); it != pending_.end();)
+      if (it->time <= time + 1e-9) solver.spawn(*it), it = pending_.erase(it);
+      else ++it;
+  }
+  void next_now(ParticleSolver& solver) {
+    if (pending_.empty()) return spdlog::info("spawn: every configured object is spawned already");
+    auto it = std::min_element(pending_.begin(), pending_.end(),
+                               [](const SpawnParams& a, const SpawnParams& b) { return a.time < b.time; });
+    spdlog::info("spawn: {} (configured for t = {:.2f} s) now", it->kind, it->time);
+    solver.spawn(*it);
+    pending_.erase(it);
+  }
+
+ private:
+  std::vector<SpawnParams> pending_;
+};
+
+// simulate()'s loop: render_every solver steps per displayed frame.
+class SimulationLoop : public FrameLoop {
+ public:
+  SimulationLoop(RunContext& ctx, ParticleSolver& solver, RunRenderer* renderer)
+      : ctx_(ctx), e_(ctx.experiment()), solver_(solver), renderer_(renderer), queue_(e_.spawn, e_.solver),
+        steps_(static_cast<std::int64_t>(std::ceil(e_.duration / e_.solver.dt))),
+        render_every_(std::max<std::int64_t>(1, std::llround(1.0 / (e_.render.fps * e_.solver.dt)))),
+        progress_("simulate", steps_) {}
+
+  std::int64_t steps() const { return steps_; }
+  std::int64_t done_steps() const { return k_; }
+  bool advance() override {
+    for (std::int64_t i = 0; i < render_every_ && k_ < steps_; ++i) step();
+    return k_ < steps_;
+  }
+  void spawn_next() override { queue_.next_now(solver_); }
+  const ParticleSolver& solver() const override { return solver_; }
+  void finish() { progress_.finish(); }
+
+ private:
+  void step() {
+    {
+      StageScope s(ctx_.timer(), "physics");
+      queue_.due(solver_, time_);
+      solver_.step();
+      time_ += e_.solver.dt;
+    }
+    ctx_.timer().end_frame(k_);
+    if (renderer_ && k_ % render_every_ == 0) renderer_->draw(solver_);
+    const int every = e_.output.particles_every;
+    if (every > 0 && (k_ + 1) % every == 0)
+      write_particles_ply(ctx_.out_path("particles_" + std::to_string(k_ + 1) + ".ply"), solver_.download_state());
+    progress_.update(++k_);
+  }
+
+  RunContext& ctx_;
+  const Experiment& e_;
+  ParticleSolver& solver_;
+  RunRenderer* renderer_;
+  SpawnQueue queue_;
+  const std::int64_t steps_, render_every_;
+  Progress progress_;
+  std::int64_t k_ = 0;
+  double time_ = 0.0;  // accumulated like the solver's clock, so spawns fall on the same steps
+};
+
+}  // namespace
+
 void simulate(RunContext& ctx, const std::vector<vec3>& scene_particles, const kernels::SceneSdf* sdf,
               RunRenderer* renderer, const SdfGrid* grid) {
   const Experiment& e = ctx.experiment();
@@ -71,26 +150,18 @@ void simulate(RunContext& ctx, const std::vector<vec3>& scene_particles, const k
   if (!scene_particles.empty()) solver.add_static_particles(scene_particles);
   if (sdf) solver.set_scene_sdf(*sdf);
   if (grid) solver.set_scene_sdf_grid(grid->values, grid->dims, grid->origin, grid->voxel);
-  solver.schedule(e.spawn);  // checks the particle budget up front
-  const auto steps = static_cast<std::int64_t>(std::ceil(e.duration / e.solver.dt));
-  spdlog::info("simulating {:.2f} s in {} steps of {} s on {} scene particles{}{}", e.duration, steps, e.solver.dt,
-               scene_particles.size(), sdf ? ", analytic SDF primitives" : "",
+  SimulationLoop loop(ctx, solver, renderer);  // checks the particle budget up front
+  spdlog::info("simulating {:.2f} s in {} steps of {} s on {} scene particles{}{}", e.duration, loop.steps(),
+               e.solver.dt, scene_particles.size(), sdf ? ", analytic SDF primitives" : "",
                grid ? ", the TSDF sampled on a grid" : "");
-  const auto render_every = std::max<std::int64_t>(1, std::llround(1.0 / (e.render.fps * e.solver.dt)));
-  Progress progress("simulate", steps);
-  for (std::int64_t k = 0; k < steps; ++k) {
-    {
-      StageScope s(ctx.timer(), "physics");
-      solver.step();
+  if (renderer) renderer->run(loop);
+  else
+    while (loop.advance()) {
     }
-    ctx.timer().end_frame(k);
-    if (renderer && k % render_every == 0) renderer->draw(solver);
-    int every = e.output.particles_every;
-    if (every > 0 && (k + 1) % every == 0)
-      write_particles_ply(ctx.out_path("particles_" + std::to_string(k + 1) + ".ply"), solver.download_state());
-    progress.update(k + 1);
-  }
-  progress.finish();
+  loop.finish();
+  if (loop.done_steps() < loop.steps())
+    spdlog::warn("stopped after {} of {} steps (window closed): the outputs hold the state reached", loop.done_steps(),
+                 loop.steps());
   if (renderer) renderer->finish();
   write_particles_ply(ctx.out_path("particles.ply"), solver.download_state());
   write_run_objects(ctx.out_path("objects.txt"), collect_run_objects(solver, e.spawn));  // for `seamless render`
@@ -103,63 +174,106 @@ void simulate(RunContext& ctx, const std::vector<vec3>& scene_particles, const k
     spdlog::warn("some particles had more neighbours than solver.max_neighbours / max_static_neighbours: raise them");
 }
 
-void live(RunContext& ctx, RunRenderer* renderer) {
-  const Experiment& e = ctx.experiment();
-  require_tracker(e.tracker.kind);
-  auto source = make_source(e.input, ctx.device());
-  auto volume = make_volume(e.volume, ctx.device());
-  TrackingSession session(tracking_params(e), ctx.device(), source->intrinsics(), volume.get());
-  ParticleSolver solver(e.solver, ctx.device());
-  solver.schedule(e.spawn);
-  std::unique_ptr<TrajectoryWriter> traj;
-  if (e.output.write_trajectory) traj = std::make_unique<TrajectoryWriter>(ctx.out_path("trajectory.txt"));
-  std::vector<FrameRecord> records;
-  SceneParticleParams sp;
-  sp.spacing = e.solver.particle_diameter;
+namespace {
 
-  std::int64_t total = e.frames > 0 ? e.frames : source->size().value_or(0), fused = 0;
-  Progress progress("live", total);
-  RgbdFrame frame;
-  while ((total == 0 || static_cast<std::int64_t>(records.size()) < total) && source->next(frame)) {
-    FrameRecord rec = session.process(frame);
-    std::int64_t k = static_cast<std::int64_t>(records.size());
-    if (traj) traj->write(frame.timestamp, rec.result.world_T_camera);
-    const bool reextract = rec.fused && (fused++ % e.reextract_every) == 0;
-    if (reextract) {
-      StageScope s(ctx.timer(), "extract");
-      SceneParticles scene = volume->extract_scene_particles(sp);
-      std::vector<vec3> points = scene.positions.to_host();
-      points.resize(static_cast<std::size_t>(scene.count));
-      solver.clear_static_particles();
-      solver.add_static_particles(points);
-    }
-    if (fused > 0) {
-      StageScope s(ctx.timer(), "physics");
-      solver.step();
-    }
-    if (renderer) {
-      renderer->set_kinect_frame(frame, rec.result.world_T_camera);
-      if (reextract && e.render.view == "mesh") renderer->set_scene(volume->extract_mesh(), rec.result.world_T_camera);
-      renderer->draw(solver);
-    }
-    ctx.timer().add(k, "track", rec.track_ms);
-    ctx.timer().add(k, "fuse", rec.fuse_ms);
-    ctx.timer().end_frame(k);
-    if (e.output.particles_every > 0 && (k + 1) % e.output.particles_every == 0)
-      write_particles_ply(ctx.out_path("particles_" + std::to_string(k + 1) + ".ply"), solver.download_state());
-    records.push_back(rec);
-    progress.update(k + 1, to_string(rec.result.status));
+// live()'s loop: one input frame per displayed frame (track, fuse, re-extract, one solver step).
+class LiveLoop : public FrameLoop {
+ public:
+  LiveLoop(RunContext& ctx, RunRenderer* renderer)
+      : ctx_(ctx), e_(ctx.experiment()), renderer_(renderer), source_(make_source(e_.input, ctx.device())),
+        volume_(make_volume(e_.volume, ctx.device())),
+        session_(tracking_params(e_), ctx.device(), source_->intrinsics(), volume_.get()),
+        solver_(e_.solver, ctx.device()), queue_(e_.spawn, e_.solver),
+        total_(e_.frames > 0 ? e_.frames : source_->size().value_or(0)), progress_("live", total_) {
+    if (e_.output.write_trajectory) traj_ = std::make_unique<TrajectoryWriter>(ctx.out_path("trajectory.txt"));
+    sp_.spacing = e_.solver.particle_diameter;
   }
-  progress.finish();
-  if (renderer) renderer->finish();
-  if (e.output.write_stats) write_tracking_stats(ctx.out_path("tracking_stats.csv"), records);
-  write_particles_ply(ctx.out_path("particles.ply"), solver.download_state());
-  write_run_objects(ctx.out_path("objects.txt"), collect_run_objects(solver, e.spawn));  // for `seamless render`
-  spdlog::info("live: {} frames ({} lost), median track {:.3f} ms, physics {:.3f} ms, extraction {:.3f} ms",
-               records.size(), session.lost_frames(), ctx.timer().median_ms("track"), ctx.timer().median_ms("physics"),
-               ctx.timer().median_ms("extract"));
-  log_volume(volume->stats());
-  if (e.output.write_mesh) write_ply(ctx.out_path("mesh.ply"), volume->extract_mesh());
+
+  bool advance() override {
+    if (finished_ || (total_ > 0 && static_cast<std::int64_t>(records_.size()) >= total_) || !source_->next(frame_))
+      return !(finished_ = true);
+    const FrameRecord rec = session_.process(frame_);
+    const auto k = static_cast<std::int64_t>(records_.size());
+    if (traj_) traj_->write(frame_.timestamp, rec.result.world_T_camera);
+    const bool reextract = rec.fused && (fused_++ % e_.reextract_every) == 0;
+    if (reextract) extract_scene();
+    if (fused_ > 0) {
+      StageScope s(ctx_.timer(), "physics");
+      queue_.due(solver_, time_);
+      solver_.step();
+      time_ += e_.solver.dt;
+    }
+    if (renderer_) {
+      renderer_->set_kinect_frame(frame_, rec.result.world_T_camera);
+      // The window switches between the views (key V): it needs the mesh whatever render.view says.
+      if (reextract && (e_.render.view == "mesh" || e_.render.mode == "window"))
+        renderer_->set_scene(volume_->extract_mesh(), rec.result.world_T_camera);
+      renderer_->draw(solver_);
+    }
+    ctx_.timer().add(k, "track", rec.track_ms);
+    ctx_.timer().add(k, "fuse", rec.fuse_ms);
+    ctx_.timer().end_frame(k);
+    if (e_.output.particles_every > 0 && (k + 1) % e_.output.particles_every == 0)
+      write_particles_ply(ctx_.out_path("particles_" + std::to_string(k + 1) + ".ply"), solver_.download_state());
+    records_.push_back(rec);
+    progress_.update(k + 1, to_string(rec.result.status));
+    return true;
+  }
+  void spawn_next() override { queue_.next_now(solver_); }
+  const ParticleSolver& solver() const override { return solver_; }
+
+  void finish() {
+    progress_.finish();
+    if (renderer_) renderer_->finish();
+    if (e_.output.write_stats) write_tracking_stats(ctx_.out_path("tracking_stats.csv"), records_);
+    write_particles_ply(ctx_.out_path("particles.ply"), solver_.download_state());
+    write_run_objects(ctx_.out_path("objects.txt"), collect_run_objects(solver_, e_.spawn));  // for `seamless render`
+    spdlog::info("live: {} frames ({} lost), median track {:.3f} ms, physics {:.3f} ms, extraction {:.3f} ms",
+                 records_.size(), session_.lost_frames(), ctx_.timer().median_ms("track"),
+                 ctx_.timer().median_ms("physics"), ctx_.timer().median_ms("extract"));
+    log_volume(volume_->stats());
+    if (e_.output.write_mesh) write_ply(ctx_.out_path("mesh.ply"), volume_->extract_mesh());
+  }
+
+ private:
+  void extract_scene() {
+    StageScope s(ctx_.timer(), "extract");
+    SceneParticles scene = volume_->extract_scene_particles(sp_);
+    std::vector<vec3> points = scene.positions.to_host();
+    points.resize(static_cast<std::size_t>(scene.count));
+    solver_.clear_static_particles();
+    solver_.add_static_particles(points);
+  }
+
+  RunContext& ctx_;
+  const Experiment& e_;
+  RunRenderer* renderer_;
+  std::unique_ptr<FrameSource> source_;
+  std::unique_ptr<Volume> volume_;
+  TrackingSession session_;
+  ParticleSolver solver_;
+  SpawnQueue queue_;
+  const std::int64_t total_;
+  Progress progress_;
+  std::unique_ptr<TrajectoryWriter> traj_;
+  SceneParticleParams sp_;
+  std::vector<FrameRecord> records_;
+  RgbdFrame frame_;
+  std::int64_t fused_ = 0;
+  double time_ = 0.0;
+  bool finished_ = false;
+};
+
+}  // namespace
+
+void live(RunContext& ctx, RunRenderer* renderer) {
+  require_tracker(ctx.experiment().tracker.kind);
+  LiveLoop loop(ctx, renderer);
+  if (renderer) renderer->run(loop);
+  else
+    while (loop.advance()) {
+    }
+  loop.finish();
 }
 
 }  // namespace seamless::app

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -16,6 +17,12 @@
 #include "render/renderer.hpp"
 #if SEAMLESS_HAS_CUDA
 #include "render/cuda_interop.hpp"
+#endif
+#if SEAMLESS_HAS_GLFW
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+
+#include "render/window.hpp"
 #endif
 #endif
 
@@ -287,6 +294,39 @@ DrawList run_draw_list(const ParticleState& s, const std::vector<RigidFrame>& fr
 
 namespace {
 
+// The solver's objects as drawn: re-collected only when something was spawned (rest shapes,
+// spawn entries, body meshes).
+class RunDrawState {
+ public:
+  void update(const ParticleSolver& solver, const std::vector<SpawnParams>& spawns) {
+    frames_ = solver.rigid_frames();
+    if (frames_.size() == objects_.bodies.size() && solver.cloth_triangles().size() == objects_.cloth_triangles.size())
+      return;
+    objects_ = collect_run_objects(solver, spawns);
+    meshes_ = body_meshes(objects_, spawns, solver.params());
+  }
+  // Host path: the state is downloaded and kept here (the DrawList's spans point into it).
+  DrawList host_list(const ParticleSolver& solver) {
+    state_ = solver.download_state();
+    return run_draw_list(state_, frames_, objects_, meshes_, radius(solver));
+  }
+  // Device path: everything but the particles, which the interop buffer holds.
+  DrawList device_list(const ParticleSolver& solver) const {
+    DrawList list;
+    list.particle_radius = radius(solver);
+    list.rigids = rigid_draws(frames_, objects_, meshes_, list.particle_radius);
+    if (!objects_.cloth_triangles.empty()) list.cloths.push_back({objects_.cloth_triangles});
+    return list;
+  }
+
+ private:
+  static float radius(const ParticleSolver& s) { return 0.5f * s.params().particle_diameter; }
+  std::vector<RigidFrame> frames_;
+  RunObjects objects_;
+  std::vector<std::shared_ptr<const BodyMesh>> meshes_;
+  ParticleState state_;
+};
+
 class GlRunRenderer : public RunRenderer {
  public:
   explicit GlRunRenderer(RunContext& ctx)
@@ -325,27 +365,16 @@ class GlRunRenderer : public RunRenderer {
 
   void draw(const ParticleSolver& solver) override {
     StageScope s(ctx_.timer(), "render");
-    std::vector<RigidFrame> frames = solver.rigid_frames();
-    // Objects change only when something is spawned: re-collect then (rest shapes, spawn entries).
-    if (frames.size() != objects_.bodies.size() || solver.cloth_triangles().size() != objects_.cloth_triangles.size()) {
-      objects_ = collect_run_objects(solver, ctx_.experiment().spawn);
-      meshes_ = body_meshes(objects_, ctx_.experiment().spawn, solver.params());
-    }
-    const float radius = 0.5f * solver.params().particle_diameter;
+    draw_state_.update(solver, ctx_.experiment().spawn);
 #if SEAMLESS_HAS_CUDA
     if (interop_ && solver.device() == Device::CUDA) {
       interop_->copy_from_device(solver.device_positions(), solver.device_phases(), solver.size());
-      DrawList list;
-      list.particle_radius = radius;
-      list.rigids = rigid_draws(frames, objects_, meshes_, radius);
-      if (!objects_.cloth_triangles.empty()) list.cloths.push_back({objects_.cloth_triangles});
-      renderer_.draw_device_particles(list, solver.size(), camera_);
+      renderer_.draw_device_particles(draw_state_.device_list(solver), solver.size(), camera_);
       out_.add(renderer_);
       return;
     }
 #endif
-    ParticleState state = solver.download_state();
-    renderer_.draw(run_draw_list(state, frames, objects_, meshes_, radius), camera_);
+    renderer_.draw(draw_state_.host_list(solver), camera_);
     out_.add(renderer_);
   }
 
@@ -360,12 +389,94 @@ class GlRunRenderer : public RunRenderer {
   Renderer renderer_;
   HeadlessOutput out_;
   RenderCamera camera_{};
-  RunObjects objects_;
-  std::vector<std::shared_ptr<const BodyMesh>> meshes_;
+  RunDrawState draw_state_;
 #if SEAMLESS_HAS_CUDA
   std::unique_ptr<CudaGlParticles> interop_;
 #endif
 };
+
+#if SEAMLESS_HAS_GLFW
+// render.mode: window. The window's loop drives the run (FrameLoop::advance once a shown frame,
+// unless paused) and draws the solver itself; the run's scene changes (mesh, Kinect frame) are
+// kept here and handed to the window's renderer before its next frame.
+class WindowRunRenderer : public RunRenderer {
+ public:
+  explicit WindowRunRenderer(RunContext& ctx) : ctx_(ctx) {}
+
+  void set_scene(const Mesh& mesh, const SE3& scan_camera) override {
+    mesh_ = mesh, mesh_camera_ = scan_camera, new_mesh_ = true;
+  }
+  void set_kinect_frame(const RgbdFrame& frame, const SE3& world_T_camera) override {
+    rgb_ = frame.rgb.clone(Device::CPU), depth_ = frame.depth.clone(Device::CPU);
+    K_ = frame.intrinsics, pose_ = world_T_camera, new_frame_ = true;
+  }
+  void draw(const ParticleSolver&) override {}  // the window pulls its frames
+  void finish() override {}
+
+  void run(FrameLoop& loop) override {
+    const Experiment& e = ctx_.experiment();
+    bool running = true;
+    std::int64_t shown = 0;
+    WindowCallbacks cb;
+    cb.step = [&] {
+      if (running && !(running = loop.advance()))
+        spdlog::info("window: the run is complete; the window stays open to look around (Esc closes it)");
+    };
+    cb.spawn_next = [&] { loop.spawn_next(); };
+    cb.on_start = [&](Renderer& r) { hand_over(r); };
+    cb.before_draw = [&](Renderer& r) { hand_over(r); };
+    cb.draw_list = [&] {
+      StageScope s(ctx_.timer(), "render");
+      ++shown;
+      draw_state_.update(loop.solver(), e.spawn);
+      return draw_state_.host_list(loop.solver());
+    };
+    if (const int n = ctx_.window_frames(); n > 0)  // Esc before frame n-1: n frames are shown
+      cb.scripted_keys = [n](int frame) { return frame == n - 1 ? std::vector<int>{GLFW_KEY_ESCAPE} : std::vector<int>{}; };
+    spdlog::info("window: Space pause, N single step, G spawn the next object, 1-5 layers, F fluid style, "
+                 "V mesh/Kinect view, C orbit/fly, drag/wheel/WASDQE move, Esc quit");
+    run_window(e.render, "seamless: " + e.name, cb, start_view());
+    spdlog::info("window closed after {} frames{}", shown, running ? ", before the run was complete" : "");
+  }
+
+ private:
+  // Orbit around the scanned mesh's centre from about where the headless mesh view looks; without
+  // a mesh yet (live mode), around a point 1.5 m in front of the first camera (the origin, +z).
+  WindowView start_view() const {
+    WindowView v;
+    v.up = {0.f, 1.f, 0.f};  // the tracker's world has gravity along -y
+    v.target = {0.f, 0.f, 1.5f};
+    v.distance = 2.5f;
+    if (!mesh_.positions.empty()) {
+      const SceneCamera c = mesh_view_camera(mesh_, mesh_camera_);
+      v.target = c.target, v.distance = std::max(0.5f, length(c.eye - c.target));
+    }
+    return v;
+  }
+  void hand_over(Renderer& r) {
+    if (new_mesh_) r.set_scene_mesh(mesh_);
+    if (new_frame_) r.set_kinect_view(rgb_, depth_, K_, pose_);
+    new_mesh_ = new_frame_ = false;
+  }
+
+  RunContext& ctx_;
+  RunDrawState draw_state_;
+  Mesh mesh_;
+  SE3 mesh_camera_ = SE3::identity(), pose_ = SE3::identity();
+  Image<uchar3> rgb_;
+  Image<float> depth_;
+  Intrinsics K_{};
+  bool new_mesh_ = false, new_frame_ = false;
+};
+
+// Why no window can be opened here, or "" when one can.
+std::string no_window_reason() {
+  if (!std::getenv("DISPLAY") && !std::getenv("WAYLAND_DISPLAY"))
+    return "no display (DISPLAY and WAYLAND_DISPLAY are unset; over ssh use ssh -X, or run under xvfb-run)";
+  if (!window_available()) return "GLFW cannot connect to the display '" + std::string(std::getenv("DISPLAY") ? std::getenv("DISPLAY") : "") + "'";
+  return "";
+}
+#endif
 
 }  // namespace
 #endif
@@ -374,7 +485,16 @@ std::unique_ptr<RunRenderer> RunRenderer::make(RunContext& ctx) {
   const RenderParams& p = ctx.experiment().render;
   if (p.mode == "none") return nullptr;
 #if SEAMLESS_HAS_GL
-  if (p.mode == "window") spdlog::warn("render.mode window is not wired into `seamless run` yet: rendering headless");
+  if (p.mode == "window") {
+#if SEAMLESS_HAS_GLFW
+    const std::string why = no_window_reason();
+    if (why.empty()) return std::make_unique<WindowRunRenderer>(ctx);
+#else
+    const std::string why = "this build has no GLFW (apt-get install libglfw3-dev, then reconfigure)";
+#endif
+    spdlog::warn("render.mode is window but no window can be opened: {}; rendering headless into {}/frames instead",
+                 why, ctx.out_dir());
+  }
   return std::make_unique<GlRunRenderer>(ctx);
 #else
   spdlog::warn("render.mode is {} but this build has no renderer (GL module off: apt-get install libegl-dev "

@@ -1,6 +1,7 @@
 // Rendering inside a run: the scene (mesh or the Kinect's own view) with the solver's particles,
-// written as frames/NNNNNN.png and video.mp4 into the run's folder (render.mode: headless).
-// Without the GL module the run says so and goes on without pictures.
+// written as frames/NNNNNN.png and video.mp4 into the run's folder (render.mode: headless), or
+// shown live in a window (render.mode: window; falls back to headless, with a message, where no
+// window can be opened). Without the GL module the run says so and goes on without pictures.
 //
 // Also what `seamless render` needs to draw a finished run again (cmd_render.cpp): the run's
 // objects.txt (cloth triangles, rigid bodies' rest shapes) next to its particles_<step>.ply.
@@ -20,10 +21,30 @@
 
 namespace seamless::app {
 
+// A run's main loop, advanced one displayed frame at a time: by a plain loop, or by the window
+// front end, which pulls frames at its own pace (and may pause, single-step or stop early).
+class FrameLoop {
+ public:
+  virtual ~FrameLoop() = default;
+  // One displayed frame's worth of work (some solver steps, or one input frame); false when the
+  // run has nothing left to do (then it does nothing).
+  virtual bool advance() = 0;
+  // The next configured spawn entry that has not been spawned yet, now (window key G).
+  virtual void spawn_next() = 0;
+  virtual const ParticleSolver& solver() const = 0;
+};
+
 class RunRenderer {
  public:
   // nullptr when render.mode is none, or (with a warning) when this build has no renderer.
+  // render.mode window: a window when GLFW is built and a display is there, else headless.
   static std::unique_ptr<RunRenderer> make(RunContext& ctx);
+  // Runs `loop` to its end (headless: every frame; the loop calls draw()) or until the window is
+  // closed (window: the window draws the solver itself, draw() does nothing).
+  virtual void run(FrameLoop& loop) {
+    while (loop.advance()) {
+    }
+  }
   virtual ~RunRenderer() = default;
   // Mesh view: the scanned mesh, seen from a camera placed behind and above `scan_camera`.
   virtual void set_scene(const Mesh& mesh, const SE3& scan_camera) = 0;

@@ -39,7 +39,7 @@ std::string timestamp() {
 }
 }  // namespace
 
-RunContext::RunContext(const CommonOptions& o) {
+RunContext::RunContext(const CommonOptions& o) : window_frames_(o.window_frames) {
   exp_ = load_experiment(o.config, overrides(o));
   device_ = resolve_device(exp_.device);
 

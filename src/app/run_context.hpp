@@ -20,6 +20,7 @@ struct CommonOptions {
   std::string out;                // --out; default <output.dir>/<config stem>-<time>
   std::string device;             // --device; overrides the config's device
   bool dry_run = false;
+  int window_frames = 0;          // run --window-frames: close the window after this many frames
 };
 
 // The config overrides of the options, in order: every --set, then --device as device=...
@@ -41,11 +42,14 @@ class RunContext {
   const std::string& out_dir() const { return out_; }
   std::string out_path(const std::string& file) const { return out_ + "/" + file; }
   StageTimer& timer() { return *timer_; }
+  // render.mode window: close the window after this many frames (0: when the user closes it).
+  int window_frames() const { return window_frames_; }
 
  private:
   Experiment exp_;
   Device device_;
   std::string out_;
+  int window_frames_ = 0;
   std::unique_ptr<StageTimer> timer_;
 };
 
