@@ -279,9 +279,7 @@ SEAMLESS_HD inline void append_run(int a, int e, Lanes g, int* list, std::int64_
     int found = 0;
     const int slot = cnt + g.rank(ok, &found);
     const bool store = ok & (slot < cap);
-    // Only stored entries are written: most candidates are rejected, and a store for each of them
-    // (to a dummy slot) doubled find_neighbors' time at 1M particles, one lane per particle.
-    if (store) list[slot * col] = j;
+    list[(store ? slot : cap) * col] = j;
     kept(j, store);
     cnt += found;
   }
