@@ -81,6 +81,7 @@ int run(const CommonOptions& o) {
   if (e.solver.scene_collision == "sdf") grid = scene_sdf_grid(*scan_result.volume, scan_result.mesh, e);
   SceneParticleParams sp;
   sp.spacing = e.solver.particle_diameter;
+  sp.interior_depth = e.scene_interior_depth;
   SceneParticles scene = scan_result.volume->extract_scene_particles(sp);
   std::vector<vec3> points = scene.positions.to_host();
   points.resize(static_cast<std::size_t>(scene.count));

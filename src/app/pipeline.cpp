@@ -187,6 +187,7 @@ class LiveLoop : public FrameLoop {
         total_(e_.frames > 0 ? e_.frames : source_->size().value_or(0)), progress_("live", total_) {
     if (e_.output.write_trajectory) traj_ = std::make_unique<TrajectoryWriter>(ctx.out_path("trajectory.txt"));
     sp_.spacing = e_.solver.particle_diameter;
+    sp_.interior_depth = e_.scene_interior_depth;
   }
 
   bool advance() override {

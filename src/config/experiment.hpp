@@ -45,6 +45,7 @@ struct Experiment {
   std::int64_t frames = 0;        // 0 = as many as the input gives
   double duration = 3.0;          // simulated seconds after the scan (scan_then_simulate)
   bool floor_plane = true;        // scan_then_simulate: an infinite floor under the scanned floor
+  float scene_interior_depth = 0.f;  // scene particles also fill the solid this deep below the surface
   int reextract_every = 10;       // live mode: scene particles re-extracted every this many fused frames
   InputParams input;
   PreprocessParams preprocess;
@@ -65,6 +66,10 @@ struct Experiment {
     v("frames", frames, "frames to process; 0 = all the input has", Range{0, 1e12});
     v("floor_plane", floor_plane, "collide with an infinite plane at the scanned floor's height (unseen floor "
       "would otherwise let objects fall through)");
+    v("scene_interior_depth", scene_interior_depth,
+      "scene particles also fill the scanned solid this deep below its surface (metres; 0: surface only). A "
+      "second layer stops particles that squeeze between surface particles where the scan is thin or has seams",
+      Range{0.0, 2.0});
     v("reextract_every", reextract_every, "live mode: re-extract the scene particles every this many fused frames",
       Range{1, 1e6});
     v("duration", duration, "simulated seconds after the scan (scan_then_simulate mode, and simulate)", Range{0, 1e6});
