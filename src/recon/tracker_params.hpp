@@ -20,7 +20,9 @@ struct TrackerParams {
   float min_inlier_ratio_vs_last = 0.5f;  // a sudden drop below this fraction of the last good frame's ratio
   double max_condition = 1e6;             // of the finest level's 6x6 system (see docs/TRACKING.md)
   float max_intensity_diff = 0.3f;        // rgbd: larger photometric residuals are outliers
-  std::string photometric_reference = "frame";  // rgbd frame_to_model: previous frame's image or the model's colour
+  // rgbd frame_to_model: the model's colour (consistent with the model geometry) or the last tracked
+  // frame's image (sharper, but tied to that frame's estimated pose: see docs/TRACKING.md).
+  std::string photometric_reference = "model";
   bool constant_velocity = false;         // start each frame from the last motion instead of the last pose
   float max_translation_jump = 0.3f;      // metres per frame
   float max_rotation_jump_deg = 30.f;     // degrees per frame
@@ -48,9 +50,9 @@ struct TrackerParams {
     v("max_intensity_diff", max_intensity_diff, "rgbd: photometric residuals larger than this are outliers",
       Range{0.0, 1.0});
     v("photometric_reference", photometric_reference,
-      "rgbd frame_to_model: the photometric term compares with the last tracked frame's image (sharp) or the "
-      "model raycast's fused colour (averaged over every view of a voxel, blurred at coarse voxels)",
-      Choices{"frame", "model"});
+      "rgbd frame_to_model: the photometric term compares with the model raycast's fused colour or with the "
+      "last tracked frame's image",
+      Choices{"model", "frame"});
     v("constant_velocity", constant_velocity, "predict each pose from the previous motion (else from the last pose)");
     v("max_translation_jump", max_translation_jump, "tracking is lost above this per-frame motion, metres",
       Range{0.0, 100.0});

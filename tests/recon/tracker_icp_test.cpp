@@ -9,6 +9,7 @@
 #include "kernels/io/synthetic_room.hpp"
 #include "recon/tracker.hpp"
 #include "recon/tracker_gravity.hpp"
+#include "recon/volume.hpp"
 #include "tracker_test_util.hpp"
 
 using namespace seamless;
@@ -150,6 +151,28 @@ TEST(Rgbd, FrameToFrameMotionMatchesGroundTruth) {
   TrackResult r = tracker.track(*f[4].pyr, ref, g0);
   ASSERT_TRUE(r.ok()) << to_string(r.status);
   auto [dt, dr] = pose_error(r.world_T_camera, g4);
+  EXPECT_LT(dt, 2e-3);
+  EXPECT_LT(dr, 0.1);
+}
+
+TEST(Rgbd, ModelGeometryWithTheFramesColour) {
+  // tracker.photometric_reference: frame. A "raycast" that is frame 0's own vertex and normal maps
+  // (seen from frame 0, which here defines the world) without any colour, plus frame 0's pyramid as
+  // the photometric reference: every level's intensity is the frame's, and frame 4 is recovered
+  // with the tolerances of the frame-to-frame cases above (same geometry, same images).
+  auto f = synthetic_frames(5, false, true);
+  const PyramidLevel& l0 = f[0].pyr->level(0);
+  RaycastMaps maps{Image<float>(), l0.vertices.clone(Device::CPU), l0.normals.clone(Device::CPU), Image<uchar3>()};
+  ReferenceMaps ref;
+  ref.set_from_raycast(maps, l0.K, SE3::identity(), 3, 0.09f, f[0].pyr.get());
+  ASSERT_TRUE(ref.has_intensity());
+  for (int l = 0; l < 3; ++l)
+    EXPECT_EQ(ref.level(l).intensity.to_host(), f[0].pyr->level(l).intensity.to_host()) << "level " << l;
+  TrackerParams tp;
+  tp.kind = "rgbd";
+  TrackResult r = Tracker(tp, Device::CPU).track(*f[4].pyr, ref, SE3::identity());
+  ASSERT_TRUE(r.ok()) << to_string(r.status);
+  auto [dt, dr] = pose_error(r.world_T_camera, f[0].frame.ground_truth->inverse() * *f[4].frame.ground_truth);
   EXPECT_LT(dt, 2e-3);
   EXPECT_LT(dr, 0.1);
 }
