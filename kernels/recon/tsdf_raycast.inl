@@ -5,14 +5,15 @@
 
 namespace seamless::kernels {
 
-// Ray parameter at which the ray o + t d (voxel units) leaves block b (slab method).
-SEAMLESS_HD inline float block_exit(vec3 o, vec3 d, int3 b) {
+// Ray parameter at which the ray o + t d (voxel units) leaves block b (slab method); inv_d is
+// 1 / d per axis (computed once per ray: a division is a subroutine on the GPU).
+SEAMLESS_HD inline float block_exit(vec3 o, vec3 d, vec3 inv_d, int3 b) {
   float t = 1e30f;
   float lo[3] = {b.x * 8.f, b.y * 8.f, b.z * 8.f};
-  float oo[3] = {o.x, o.y, o.z}, dd[3] = {d.x, d.y, d.z};
+  float oo[3] = {o.x, o.y, o.z}, dd[3] = {d.x, d.y, d.z}, ii[3] = {inv_d.x, inv_d.y, inv_d.z};
   for (int k = 0; k < 3; ++k) {
-    if (dd[k] > 0.f) t = fminf(t, (lo[k] + 8.f - oo[k]) / dd[k]);
-    if (dd[k] < 0.f) t = fminf(t, (lo[k] - oo[k]) / dd[k]);
+    if (dd[k] > 0.f) t = fminf(t, (lo[k] + 8.f - oo[k]) * ii[k]);
+    if (dd[k] < 0.f) t = fminf(t, (lo[k] - oo[k]) * ii[k]);
   }
   return t;
 }
@@ -126,13 +127,15 @@ SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z
   // band from +mu on, see fuse_voxel). Steps of mu/2 through unobserved cells therefore land at
   // least one observed sample in front of the next surface, where the march below takes over.
   const float unobserved_step = fmaxf(min_step, 0.5f * a.geom.truncation / (dlen * a.geom.voxel_size));
+  const float step_per_sdf = 0.8f / (dlen * a.geom.voxel_size);  // see the step below
+  const vec3 inv_d{1.f / d.x, 1.f / d.y, 1.f / d.z};               // +-inf on an axis d does not move along
   float z_prev = 0.f, f_prev = 0.f;
   bool have_prev = false;
   for (int it = 0; it < 8192 && z < z_end; ++it) {
     vec3 q = o + d * z;
     int3 b = block_of_voxel(floor_to_int(q));
     if (cached_block(a, b, c) < 0) {  // empty space: skip the whole block (Niessner section 4.3)
-      z = fmaxf(block_exit(o, d, b), z) + min_step * 0.1f;
+      z = fmaxf(block_exit(o, d, inv_d, b), z) + min_step * 0.1f;
       have_prev = false;
       continue;
     }
@@ -152,7 +155,7 @@ SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z
     // metres per unit of z) cannot jump over one: truncation-sized steps in the band's free-space
     // side (and through the back of a surface a ray enters from behind), shrinking to half a
     // voxel at the surface.
-    z += fmaxf(0.8f * fabsf(f) / (dlen * a.geom.voxel_size), min_step);
+    z += fmaxf(fabsf(f) * step_per_sdf, min_step);
   }
   return false;
 }
