@@ -38,6 +38,12 @@ void CpuExec::for_each_phases(int phases, const std::int64_t* begin, const std::
   }
 }
 
+template <class F, class... T>
+void CpuExec::for_each_phases_staged(int phases, const std::int64_t* begin, const std::int64_t* end, F fn,
+                                     Staged<T>... arrays) const {
+  for_each_phases(phases, begin, end, [&](int p, std::int64_t i) { fn(p, i, arrays.ptr...); });
+}
+
 template <class T>
 T CpuExec::exclusive_scan(const T* in, T* out, std::int64_t n) const {
   T sum{};

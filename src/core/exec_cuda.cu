@@ -5,6 +5,18 @@ namespace seamless {
 
 void CudaExec::synchronize() const { SEAMLESS_CUDA_CHECK(cudaDeviceSynchronize()); }
 
+namespace cuda_detail {
+int max_shared_per_block() {
+  static const int bytes = [] {
+    int dev = 0, b = 0;
+    SEAMLESS_CUDA_CHECK(cudaGetDevice(&dev));
+    SEAMLESS_CUDA_CHECK(cudaDeviceGetAttribute(&b, cudaDevAttrMaxSharedMemoryPerBlockOptin, dev));
+    return b;
+  }();
+  return bytes;
+}
+}  // namespace cuda_detail
+
 int CudaExec::lanes(std::int64_t n, int max_lanes) const {
   // Threads the device holds at once (2048 per multiprocessor on Hopper): fewer elements than
   // that leave multiprocessors idle unless each gets several lanes.

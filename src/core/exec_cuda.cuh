@@ -1,10 +1,12 @@
 // The CUDA executor. Include only from *_cuda.cu instantiation files.
 #pragma once
 #include <cub/cub.cuh>
+#include <cuda/std/tuple>
 
 #include <algorithm>
 #include <cstdint>
 #include <string>
+#include <type_traits>
 
 #include "core/cuda_check.hpp"
 #include "core/exec.hpp"
@@ -17,6 +19,8 @@ void* scratch(std::size_t bytes);
 // A device slot for a host-returned reduction's total, apart from scratch (which holds the partials).
 void* result_slot(std::size_t bytes);
 int multiprocessors();
+// Dynamic shared memory one block may use once the kernel opts in (cudaDevAttrMaxSharedMemoryPerBlockOptin).
+int max_shared_per_block();
 
 template <class F>
 __global__ void for_each_kernel(std::int64_t n, F fn) {
@@ -124,6 +128,67 @@ struct PhaseAt {
   std::int64_t begin;
   __device__ void operator()(std::int64_t i) const { fn(p, begin + i); }
 };
+
+// for_each_phases_staged: one array's place for the sweep, bytes [offset, offset + count x
+// sizeof(T)) of the block's dynamic shared memory if `shared`, else ptr.
+template <class T>
+struct StagedSlot {
+  T* ptr;
+  std::int64_t count;
+  unsigned offset;
+  int shared;
+};
+
+template <class T>
+__device__ T* staged_where(const StagedSlot<T>& s, unsigned char* smem) {
+  return s.shared ? reinterpret_cast<T*>(smem + s.offset) : s.ptr;
+}
+
+template <class T>
+__device__ void stage_in(const StagedSlot<T>& s, unsigned char* smem) {
+  if (!s.shared) return;
+  using U = std::remove_const_t<T>;
+  U* d = reinterpret_cast<U*>(smem + s.offset);
+  for (std::int64_t i = threadIdx.x; i < s.count; i += blockDim.x) d[i] = s.ptr[i];
+}
+
+template <class T>
+__device__ void stage_out(const StagedSlot<T>& s, unsigned char* smem) {
+  if constexpr (!std::is_const_v<T>) {
+    if (!s.shared) return;
+    const T* d = reinterpret_cast<const T*>(smem + s.offset);
+    for (std::int64_t i = threadIdx.x; i < s.count; i += blockDim.x) s.ptr[i] = d[i];
+  }
+}
+
+// for_each_phases_kernel with the staged arrays copied into shared memory before the first phase
+// and the writable ones copied back after the last (whose __syncthreads() orders the copy after
+// every phase's writes); fn sees each array where it lives.
+template <class F, class... T>
+__global__ void __launch_bounds__(1024)
+    for_each_phases_staged_kernel(PhaseChunk c, int first_phase, F fn, StagedSlot<T>... s) {
+  extern __shared__ __align__(16) unsigned char staged_smem[];
+  (stage_in(s, staged_smem), ...);
+  __syncthreads();
+  for (int p = 0; p < c.count; ++p) {
+    for (std::int64_t i = c.begin[p] + threadIdx.x; i < c.end[p]; i += blockDim.x)
+      fn(first_phase + p, i, staged_where(s, staged_smem)...);
+    __syncthreads();
+  }
+  (stage_out(s, staged_smem), ...);
+}
+
+// fn(p, begin + i, a...) with the arrays in global memory: one phase as a plain for_each.
+template <class F, class... T>
+struct StagedPhaseAt {
+  F fn;
+  int p;
+  std::int64_t begin;
+  cuda::std::tuple<T*...> a;
+  __device__ void operator()(std::int64_t i) const {
+    cuda::std::apply([&](T*... x) { fn(p, begin + i, x...); }, a);
+  }
+};
 }  // namespace cuda_detail
 
 template <class F>
@@ -155,6 +220,56 @@ void CudaExec::for_each_phases(int phases, const std::int64_t* begin, const std:
     for (int p = 0; p < c.count; ++p) c.begin[p] = begin[first + p], c.end[p] = end[first + p];
     cuda_detail::for_each_phases_kernel<<<1, kThreads, 0, static_cast<cudaStream_t>(stream)>>>(c, first, fn);
     SEAMLESS_CUDA_CHECK_LAUNCH("for_each_phases");
+  }
+}
+
+template <class F, class... T>
+void CudaExec::for_each_phases_staged(int phases, const std::int64_t* begin, const std::int64_t* end, F fn,
+                                      Staged<T>... arrays) const {
+  // The same split as for_each_phases: phases of up to kOneBlock elements run in one block.
+  constexpr int kThreads = 1024;
+  constexpr std::int64_t kOneBlock = 2 * kThreads;
+  std::int64_t largest = 0;
+  for (int p = 0; p < phases; ++p) largest = std::max(largest, end[p] - begin[p]);
+  if (largest > kOneBlock) {
+    for (int p = 0; p < phases; ++p)
+      for_each(end[p] - begin[p], cuda_detail::StagedPhaseAt<F, T...>{fn, p, begin[p], {arrays.ptr...}});
+    return;
+  }
+  // Shared memory for the arrays that fit, in argument order (16-byte aligned places; a braced
+  // list is evaluated left to right).
+  static const std::size_t budget = static_cast<std::size_t>(cuda_detail::max_shared_per_block());
+  std::size_t used = 0;
+  auto place = [&](auto a) {
+    using E = std::remove_pointer_t<decltype(a.ptr)>;
+    static_assert(std::is_trivially_copyable_v<E>, "Staged<T>: T must be trivially copyable");
+    cuda_detail::StagedSlot<E> s{a.ptr, a.count, 0u, 0};
+    const std::size_t bytes = (static_cast<std::size_t>(a.count) * sizeof(E) + 15) / 16 * 16;
+    if (a.count > 0 && used + bytes <= budget) s.offset = static_cast<unsigned>(used), s.shared = 1, used += bytes;
+    return s;
+  };
+  const cuda::std::tuple<cuda_detail::StagedSlot<T>...> slots{place(arrays)...};
+  auto kernel = cuda_detail::for_each_phases_staged_kernel<F, T...>;
+  if (used > 48 * 1024) {
+    // Over the default 48 KB a kernel must opt in, once (before any graph capture: the first
+    // step of a scene runs directly).
+    static const bool opted_in = [&] {
+      SEAMLESS_CUDA_CHECK(
+          cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, static_cast<int>(budget)));
+      return true;
+    }();
+    (void)opted_in;
+  }
+  for (int first = 0; first < phases; first += cuda_detail::PhaseChunk::kMax) {
+    cuda_detail::PhaseChunk c;
+    c.count = std::min(phases - first, cuda_detail::PhaseChunk::kMax);
+    for (int p = 0; p < c.count; ++p) c.begin[p] = begin[first + p], c.end[p] = end[first + p];
+    cuda::std::apply(
+        [&](auto... s) {
+          kernel<<<1, kThreads, used, static_cast<cudaStream_t>(stream)>>>(c, first, fn, s...);
+        },
+        slots);
+    SEAMLESS_CUDA_CHECK_LAUNCH("for_each_phases_staged");
   }
 }
 
