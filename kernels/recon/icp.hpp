@@ -116,6 +116,11 @@ struct IcpPose {
   double t[3];
   int stalled;     // the solve failed at this level: the level's later steps change nothing
   int steps;       // Gauss-Newton steps taken; a stalled level counts its failing step
+  // RGB-D robust weighting only (kernels/recon/rgbd.hpp, RgbdScale): the geometric (m^2) and
+  // photometric residual variances estimated by the previous step; 0 = not estimated yet. Kept next
+  // to the estimate so that one host copy starts a frame; the ICP kernel never reads them.
+  float geo_var;
+  float photo_var;
 };
 
 // What a frame's Gauss-Newton loop keeps on the device, in one allocation so that the host reads

@@ -16,7 +16,69 @@ struct RgbdLevel {
   float geometric_weight = 1.f;
   float photometric_weight = 0.1f;
   float max_intensity_diff = 0.3f;  // larger photometric residuals are outliers (specularities, occlusions)
+  // > 0: robust, self-balancing weights (tracker.weighting: robust) with a Student t-distribution of
+  // this many degrees of freedom; 0: the fixed weights above (tracker.weighting: fixed).
+  float dof = 0.f;
 };
+
+// ---- Robust, self-balancing weighting (tracker.weighting: robust) --------------------------------
+// Each residual type k (geometric r_g in metres, photometric r_I in intensity units) is modelled as
+// Student-t distributed with its own scale sigma_k^2 (Kerl, Sturm, Cremers, "Robust Odometry
+// Estimation for RGB-D Cameras", ICRA 2013, sec. III-C/IV: the t-distribution's iteratively
+// reweighted least squares; their combined geometric + photometric version, "Dense Visual SLAM for
+// RGB-D Cameras", IROS 2013, sec. III, uses a bivariate t with a 2x2 scale matrix; here its diagonal,
+// so a pixel without a photometric row still has a geometric one). Per residual, the IRLS weight is
+//   w(r) = (nu + 1) / (nu + r^2 / sigma^2),
+// and the scale is the fixed point of
+//   sigma^2 = 1/n sum_i w(r_i) r_i^2,
+// which we iterate once per Gauss-Newton step: the sums of w r^2 and the counts of both types are
+// reduced with the normal equations (three more scalars; no per-pixel sort), and the step's
+// last thread turns them into the next step's sigma_g^2, sigma_I^2 (IcpPose::geo_var / photo_var).
+// Each row is then whitened, weight w / sigma_k^2, which balances the two types by their own noise
+// instead of a fixed photometric_weight (a hundredfold imbalance on Kinect data: intensity
+// gradients of ~10 per metre against unit normals). The whole system is multiplied by sigma_g^2 so
+// that J^T J and the error stay in metres (the solution does not change): the geometric row gets
+// w_g, the photometric row photometric_weight * w_I * sigma_g^2 / sigma_I^2 (photometric_weight 1 =
+// equal trust in one whitened residual of each type). Until a scale is known (a frame's first,
+// scale-only reduction) the t-weights are 1, so the first estimate is the plain RMS.
+template <class S>
+struct RgbdSumsOf {
+  IcpSumsOf<S> icp;  // the combined weighted system, as the ICP's
+  S geo_wr2;         // sum over geometric rows of w_g r_g^2 (robust weighting only)
+  S photo_wr2;       // sum over photometric rows of w_I r_I^2 (robust weighting only)
+  S photo_n;         // photometric rows
+};
+using RgbdSums = RgbdSumsOf<double>;
+using RgbdTerms = RgbdSumsOf<float>;
+
+template <class A, class B>
+SEAMLESS_HD inline RgbdSumsOf<A> operator+(const RgbdSumsOf<A>& a, const RgbdSumsOf<B>& b) {
+  RgbdSumsOf<A> s;
+  s.icp = a.icp + b.icp;
+  s.geo_wr2 = a.geo_wr2 + b.geo_wr2;
+  s.photo_wr2 = a.photo_wr2 + b.photo_wr2;
+  s.photo_n = a.photo_n + b.photo_n;
+  return s;
+}
+
+// Smallest variances the scale estimate may reach, so that residuals of exactly zero (noise-free
+// synthetic data) cannot make a weight infinite: the photometric one is the variance of 8-bit
+// quantisation, (1/255)^2 / 12; the geometric one (10 micrometres)^2, far below any depth sensor's
+// resolution (Kinect v1: ~1 mm at 1 m), so it never binds on real data.
+constexpr float kMinPhotoVar = 1.f / (255.f * 255.f * 12.f);
+constexpr float kMinGeoVar = 1e-10f;
+
+// t-distribution IRLS weight of residual r at variance var (1 while var is unknown, i.e. 0).
+SEAMLESS_HD inline float t_weight(float r, float var, float dof) {
+  return var > 0.f ? (dof + 1.f) / (dof + r * r / var) : 1.f;
+}
+
+// The next step's variances from this step's sums (the fixed point above); unchanged when a type
+// had no residual.
+SEAMLESS_HD inline void update_scale(const RgbdSums& s, IcpPose& p) {
+  if (s.icp.inliers > 0) p.geo_var = fmaxf(static_cast<float>(s.geo_wr2 / s.icp.inliers), kMinGeoVar);
+  if (s.photo_n > 0) p.photo_var = fmaxf(static_cast<float>(s.photo_wr2 / s.photo_n), kMinPhotoVar);
+}
 
 // Bilinear sample; the caller keeps (x, y) inside [0, w-1) x [0, h-1).
 SEAMLESS_HD inline float bilinear(View2D<const float> im, float x, float y) {
@@ -27,27 +89,58 @@ SEAMLESS_HD inline float bilinear(View2D<const float> im, float x, float y) {
   return (1.f - ay) * top + ay * bot;
 }
 
-// Adds the photometric row of a geometric correspondence c of current pixel (x, y). Only pixels
-// that passed the geometric tests get one: that is the occlusion check (the reference pixel shows
-// the same surface), and it keeps the term away from depth edges where intensity means nothing.
-SEAMLESS_HD inline void add_photometric(IcpTerms& s, const RgbdLevel& L, const Correspondence& c, int x, int y) {
+// The photometric residual r and its gradient g = dI_ref/dq of a geometric correspondence c of
+// current pixel (x, y); false when it has none (near the border, or |r| > max_intensity_diff).
+// Only pixels that passed the geometric tests get one: that is the occlusion check (the reference
+// pixel shows the same surface), and it keeps the term away from depth edges where intensity means
+// nothing.
+SEAMLESS_HD inline bool photometric_residual(const RgbdLevel& L, const Correspondence& c, int x, int y, float& r,
+                                             vec3& g) {
   const Intrinsics& K = L.geo.K;
   float u = c.uv.x, v = c.uv.y;
-  if (u < 1.f || v < 1.f || u >= L.ref_intensity.width - 2.f || v >= L.ref_intensity.height - 2.f) return;
-  float r = bilinear(L.ref_intensity, u, v) - L.cur_intensity(x, y);
-  if (fabsf(r) > L.max_intensity_diff) return;
+  if (u < 1.f || v < 1.f || u >= L.ref_intensity.width - 2.f || v >= L.ref_intensity.height - 2.f) return false;
+  r = bilinear(L.ref_intensity, u, v) - L.cur_intensity(x, y);
+  if (fabsf(r) > L.max_intensity_diff) return false;
   float gx = 0.5f * (bilinear(L.ref_intensity, u + 1.f, v) - bilinear(L.ref_intensity, u - 1.f, v));
   float gy = 0.5f * (bilinear(L.ref_intensity, u, v + 1.f) - bilinear(L.ref_intensity, u, v - 1.f));
   float iz = 1.f / c.q.z;
-  vec3 g{gx * K.fx * iz, gy * K.fy * iz, -(gx * K.fx * c.q.x + gy * K.fy * c.q.y) * iz * iz};
-  add_row(s, cross(c.q, g), g, r, L.photometric_weight);
+  g = vec3{gx * K.fx * iz, gy * K.fy * iz, -(gx * K.fx * c.q.x + gy * K.fy * c.q.y) * iz * iz};
+  return true;
 }
 
-// Sums the combined geometric + photometric normal equations over the current level (one pass).
-// error holds the weighted sum of both terms; inliers counts geometric correspondences.
-// (at the estimate *pose, into *out on the device, then `update`, like icp_reduce_into)
+// Both rows of a geometric correspondence c of current pixel (x, y), with the fixed weights
+// (L.dof == 0) or the robust ones at the previous step's variances (see above).
+SEAMLESS_HD inline void add_rgbd_rows(RgbdTerms& s, const RgbdLevel& L, const Correspondence& c, int x, int y,
+                                      float geo_var, float photo_var) {
+  const float rg = dot(c.n, c.q - c.v);
+  float wg = L.geometric_weight;
+  if (L.dof > 0.f) {
+    wg = t_weight(rg, geo_var, L.dof);
+    s.geo_wr2 += wg * rg * rg;
+  }
+  add_row(s.icp, cross(c.q, c.n), c.n, rg, wg);
+  s.icp.inliers += 1.f;
+  float r;
+  vec3 g;
+  if (!photometric_residual(L, c, x, y, r, g)) return;
+  float wi = L.photometric_weight;
+  if (L.dof > 0.f) {
+    const float t = t_weight(r, photo_var, L.dof);
+    s.photo_wr2 += t * r * r;
+    s.photo_n += 1.f;
+    wi *= t * (geo_var > 0.f && photo_var > 0.f ? geo_var / photo_var : 1.f);
+  }
+  add_row(s.icp, cross(c.q, g), g, r, wi);
+}
+
+// Sums the combined geometric + photometric normal equations over the current level (one pass) at
+// the estimate *pose into *out on the device; then, in the same launch, copies the system into
+// *level_sums (where the tracker reads each level's last system), with robust weighting updates the
+// variances in *pose, and applies `update` (like icp_reduce_into). error holds the weighted sum of
+// both terms; inliers counts geometric correspondences.
 template <class Exec>
-void rgbd_reduce_into(const Exec& ex, RgbdLevel level, IcpPose* pose, IcpSums* out, IcpUpdate update);
+void rgbd_reduce_into(const Exec& ex, RgbdLevel level, IcpPose* pose, RgbdSums* out, IcpSums* level_sums,
+                      IcpUpdate update);
 
 // Intensity in [0, 1] from 8-bit RGB (ITU-R BT.601 luma weights).
 template <class Exec>

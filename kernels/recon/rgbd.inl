@@ -6,21 +6,24 @@
 namespace seamless::kernels {
 
 template <class Exec>
-void rgbd_reduce_into(const Exec& ex, RgbdLevel R, IcpPose* pose, IcpSums* out, IcpUpdate update) {
+void rgbd_reduce_into(const Exec& ex, RgbdLevel R, IcpPose* pose, RgbdSums* out, IcpSums* level_sums,
+                      IcpUpdate update) {
   const int w = R.geo.cur_vertex.width;
   ex.transform_reduce_into(R.geo.cur_vertex.count(), [=] SEAMLESS_HD(std::int64_t i) {
     RgbdLevel L = R;
-    L.geo.ref_T_cur = to_se3(*pose);
-    IcpTerms s{};
+    const IcpPose p = *pose;
+    L.geo.ref_T_cur = to_se3(p);
+    RgbdTerms s{};
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
-    if (valid_point(L.geo.cur_vertex(x, y))) s.valid = 1.f;
+    if (valid_point(L.geo.cur_vertex(x, y))) s.icp.valid = 1.f;
     Correspondence c;
-    if (find_correspondence(L.geo, x, y, c)) {
-      add_point_to_plane(s, c, L.geometric_weight);
-      add_photometric(s, L, c, x, y);
-    }
+    if (find_correspondence(L.geo, x, y, c)) add_rgbd_rows(s, L, c, x, y, p.geo_var, p.photo_var);
     return s;
-  }, out, [=] SEAMLESS_HD { gauss_newton_update(*out, *pose, update); });
+  }, out, [=] SEAMLESS_HD {
+    *level_sums = out->icp;
+    gauss_newton_update(out->icp, *pose, update);  // with the variances this system was built with
+    if (R.dof > 0.f) update_scale(*out, *pose);
+  });
 }
 
 template <class Exec>
@@ -37,6 +40,6 @@ void rgb_to_intensity(const Exec& ex, View2D<const uchar3> rgb, View2D<float> ou
 
 #define SEAMLESS_INSTANTIATE_RGBD(EXEC)                                                   \
   namespace seamless::kernels {                                                           \
-  template void rgbd_reduce_into<EXEC>(const EXEC&, RgbdLevel, IcpPose*, IcpSums*, IcpUpdate); \
+  template void rgbd_reduce_into<EXEC>(const EXEC&, RgbdLevel, IcpPose*, RgbdSums*, IcpSums*, IcpUpdate); \
   template void rgb_to_intensity<EXEC>(const EXEC&, View2D<const uchar3>, View2D<float>); \
   }

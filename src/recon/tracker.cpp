@@ -143,6 +143,10 @@ bool Tracker::use_photometric(const FramePyramid& frame, const ReferenceMaps& re
          frame.level(0).intensity.width() > 0;
 }
 
+bool Tracker::robust(const FramePyramid& frame, const ReferenceMaps& ref) const {
+  return params_.weighting == "robust" && use_photometric(frame, ref);
+}
+
 kernels::IcpState* Tracker::state() const {
   if (state_.size() != 1 || state_.device() != device_) state_ = Buffer<kernels::IcpState>(1, device_);
   return state_.data();
@@ -170,14 +174,18 @@ void Tracker::reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, i
   with_exec(device_, [&](const auto& ex) {
     if (!use_photometric(frame, ref)) return kernels::icp_reduce_into(ex, L, pose, out, update);
     kernels::RgbdLevel R{L, cur.intensity.cview(), rl.intensity.cview(), 1.f, params_.photometric_weight,
-                         params_.max_intensity_diff};
-    kernels::rgbd_reduce_into(ex, R, pose, out, update);
+                         params_.max_intensity_diff, robust(frame, ref) ? params_.robust_dof : 0.f};
+    if (rgbd_sums_.size() != 1 || rgbd_sums_.device() != device_) rgbd_sums_ = Buffer<kernels::RgbdSums>(1, device_);
+    kernels::rgbd_reduce_into(ex, R, pose, rgbd_sums_.data(), out, update);
   });
 }
 
 kernels::IcpSums Tracker::reduce(const FramePyramid& frame, const ReferenceMaps& ref, int level,
                                  const SE3& ref_T_cur) const {
   set_pose(ref_T_cur);
+  // Robust weighting: a first reduction estimates the residual scales at this pose, so that the
+  // system returned is weighted as the tracker's own steps are.
+  if (robust(frame, ref)) reduce_into(frame, ref, level, &state()->pose, sums_slot(0), kernels::IcpUpdate::none);
   reduce_into(frame, ref, level, &state()->pose, sums_slot(0), kernels::IcpUpdate::none);
   kernels::IcpSums s;
   memory::copy(&s, Device::CPU, sums_slot(0), device_, sizeof s);
@@ -193,7 +201,11 @@ TrackResult Tracker::track(const FramePyramid& frame, const ReferenceMaps& ref,
   r.world_T_camera = initial_world_T_camera;
   if (ref.empty()) return r;
   const int levels = std::min({frame.levels(), ref.levels(), static_cast<int>(params_.iterations.size())});
-  set_pose(ref.world_T_ref().inverse() * initial_world_T_camera);
+  set_pose(ref.world_T_ref().inverse() * initial_world_T_camera);  // also clears the residual scales
+  // Robust weighting: one scale-only reduction at the coarsest level first (no step), so that the
+  // first step is already balanced; the scales then follow every step (kernels/recon/rgbd.hpp).
+  if (levels > 0 && robust(frame, ref))
+    reduce_into(frame, ref, levels - 1, &state()->pose, sums_slot(levels - 1), kernels::IcpUpdate::none);
   for (int l = levels - 1; l >= 0; --l)
     for (int it = 0; it < params_.iterations[l]; ++it)
       reduce_into(frame, ref, l, &state()->pose, sums_slot(l),

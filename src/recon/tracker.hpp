@@ -14,6 +14,7 @@
 #include "core/camera.hpp"
 #include "core/math.hpp"
 #include "kernels/recon/icp.hpp"
+#include "kernels/recon/rgbd.hpp"
 #include "recon/preprocess.hpp"
 #include "recon/tracker_params.hpp"
 
@@ -92,6 +93,7 @@ class Tracker {
 
  private:
   bool use_photometric(const FramePyramid& frame, const ReferenceMaps& ref) const;
+  bool robust(const FramePyramid& frame, const ReferenceMaps& ref) const;
   void reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, int level, kernels::IcpPose* pose,
                    kernels::IcpSums* out, kernels::IcpUpdate update) const;
   kernels::IcpState* state() const;
@@ -103,6 +105,9 @@ class Tracker {
   // Device state of the Gauss-Newton loop (reused from frame to frame): the estimate and one
   // system per level.
   mutable Buffer<kernels::IcpState> state_;
+  // RGB-D: the full sums of the last reduction (the system plus the residual statistics of the
+  // robust weighting); its system is copied into state_'s level slot on the device.
+  mutable Buffer<kernels::RgbdSums> rgbd_sums_;
 };
 
 // One Gauss-Newton step on the host (tests, statistics): solves J^T J xi = -J^T r with the device

@@ -23,6 +23,11 @@ struct TrackerParams {
   // rgbd frame_to_model: the model's colour (consistent with the model geometry) or the last tracked
   // frame's image (sharper, but tied to that frame's estimated pose: see docs/TRACKING.md).
   std::string photometric_reference = "model";
+  // rgbd: fixed weights (photometric_weight), or robust self-balancing ones: each residual type
+  // whitened by its own scale, estimated every step, with Student-t weights against outliers
+  // (Kerl et al. 2013; docs/TRACKING.md, "RGB-D").
+  std::string weighting = "fixed";
+  float robust_dof = 5.f;                 // degrees of freedom of the t-distribution (Kerl et al. 2013: 5)
   bool constant_velocity = false;         // start each frame from the last motion instead of the last pose
   float max_translation_jump = 0.3f;      // metres per frame
   float max_rotation_jump_deg = 30.f;     // degrees per frame
@@ -53,6 +58,13 @@ struct TrackerParams {
       "rgbd frame_to_model: the photometric term compares with the model raycast's fused colour or with the "
       "last tracked frame's image",
       Choices{"model", "frame"});
+    v("weighting", weighting,
+      "rgbd: fixed (photometric_weight) or robust (each term whitened by its own residual scale, estimated "
+      "every step, with t-distribution weights against outliers; photometric_weight then scales the whitened "
+      "colour term)",
+      Choices{"fixed", "robust"});
+    v("robust_dof", robust_dof, "rgbd weighting robust: degrees of freedom of the t-distribution",
+      Range{0.1, 1e6});
     v("constant_velocity", constant_velocity, "predict each pose from the previous motion (else from the last pose)");
     v("max_translation_jump", max_translation_jump, "tracking is lost above this per-frame motion, metres",
       Range{0.0, 100.0});

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 
 #include "core/device.hpp"
 #include "io/synthetic_source.hpp"
@@ -83,9 +84,21 @@ TEST(TrackerParity, ReductionOfTheNormalEquations) {
 TEST(TrackerParity, TrackedTrajectoriesOverAFewFrames) {
   if (!cuda_available()) GTEST_SKIP() << "no CUDA device";
   auto f = host_frames(6);
-  for (const char* mode : {"frame_to_frame", "frame_to_model"}) {
+  // ICP (the default tracker) in both modes, and RGB-D with robust weighting (its residual scales
+  // are reduced and updated on the device too: kernels/recon/rgbd.hpp).
+  struct Case {
+    const char* mode;
+    const char* kind;
+    const char* weighting;
+  };
+  for (const Case& c : {Case{"frame_to_frame", "icp", "fixed"}, Case{"frame_to_model", "icp", "fixed"},
+                        Case{"frame_to_model", "rgbd", "robust"}}) {
+    const std::string mode = std::string(c.mode) + " " + c.kind + " " + c.weighting;
     TrackSequenceParams p;
-    p.tracker.mode = mode;
+    p.tracker.mode = c.mode;
+    p.tracker.kind = c.kind;
+    p.tracker.weighting = c.weighting;
+    p.tracker.photometric_weight = 1.f;
     p.write_files = false;
     Replay a(f, f[0].intrinsics), b(f, f[0].intrinsics);
     TrackSequenceResult rc = track_sequence(a, p, Device::CPU, "");
