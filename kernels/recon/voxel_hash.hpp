@@ -197,6 +197,16 @@ struct WindowedHashAccess {
     const std::int64_t e = window.index ? window.entry(b) : -1;
     return e >= 0 ? window.index[e] : hash.find_block(b);
   }
+  // The blocks of a cell's 8 corners (see cell_voxels) straight from the window, without the
+  // block cache's bookkeeping: block b0 + (k&1 & ex, (k>>1)&1 & ey, k>>2 & ez) for corner k.
+  // False when the cell's far block is outside the window (the caller then uses find_block).
+  SEAMLESS_HD bool corner_blocks(int3 b0, bool ex, bool ey, bool ez, std::int32_t i[8]) const {
+    const std::int64_t e0 = window.index ? window.entry(b0) : -1;
+    if (e0 < 0 || window.entry(b0 + int3{ex, ey, ez}) < 0) return false;
+    const std::int64_t n = window.side, dx = ex, dy = ey ? n : 0, dz = ez ? n * n : 0;
+    for (int k = 0; k < 8; ++k) i[k] = window.index[e0 + (k & 1 ? dx : 0) + (k & 2 ? dy : 0) + (k & 4 ? dz : 0)];
+    return true;
+  }
 };
 
 // Dense grid access: blocks_per_side^3 blocks starting at block (0,0,0); the dense KinectFusion
@@ -240,6 +250,17 @@ SEAMLESS_HD inline const Voxel* find_voxel(const Acc& a, int3 g, BlockCache& c) 
   return index < 0 ? nullptr : a.voxels + static_cast<std::int64_t>(index) * kBlockVoxels + local_index(g);
 }
 
+// v[k] = corner k of cell g0, in block i[k]; false when a corner's block is missing.
+template <class Acc>
+SEAMLESS_HD inline bool corner_voxels(const Acc& a, int3 g0, const std::int32_t i[8], const Voxel* v[8]) {
+  for (int k = 0; k < 8; ++k) {
+    if (i[k] < 0) return false;
+    int3 g = g0 + int3{k & 1, (k >> 1) & 1, k >> 2};
+    v[k] = a.voxels + static_cast<std::int64_t>(i[k]) * kBlockVoxels + local_index(g);
+  }
+  return true;
+}
+
 // The 8 corner voxels of cell g0 (corner k at g0 + (k&1, (k>>1)&1, k>>2)), each block looked up
 // once: the cell reaches into the next block only along the axes where g0 is a block's last
 // voxel. False when a corner's block is missing.
@@ -256,6 +277,9 @@ SEAMLESS_HD inline bool cell_voxels(const Acc& a, int3 g0, BlockCache& c, const 
   }
   // i[k]: block of corner k, i.e. of b0 + (k&1 & ex, (k>>1)&1 & ey, k>>2 & ez).
   std::int32_t i[8];
+  if constexpr (requires { a.corner_blocks(b0, ex, ey, ez, i); }) {
+    if (a.corner_blocks(b0, ex, ey, ez, i)) return corner_voxels(a, g0, i, v);
+  }
   i[0] = cached_block(a, b0, c);
   i[1] = ex ? cached_block(a, b0 + int3{1, 0, 0}, c) : i[0];
   i[2] = ey ? cached_block(a, b0 + int3{0, 1, 0}, c) : i[0];
@@ -264,12 +288,7 @@ SEAMLESS_HD inline bool cell_voxels(const Acc& a, int3 g0, BlockCache& c, const 
   i[5] = ex && ez ? cached_block(a, b0 + int3{1, 0, 1}, c) : ex ? i[1] : i[4];
   i[6] = ey && ez ? cached_block(a, b0 + int3{0, 1, 1}, c) : ey ? i[2] : i[4];
   i[7] = ex && ey && ez ? cached_block(a, b0 + int3{1, 1, 1}, c) : !ex ? i[6] : !ey ? i[5] : i[3];
-  for (int k = 0; k < 8; ++k) {
-    if (i[k] < 0) return false;
-    int3 g = g0 + int3{k & 1, (k >> 1) & 1, k >> 2};
-    v[k] = a.voxels + static_cast<std::int64_t>(i[k]) * kBlockVoxels + local_index(g);
-  }
-  return true;
+  return corner_voxels(a, g0, i, v);
 }
 
 // Trilinear interpolation of the TSDF (metres) and colour at voxel-space point q. False when any of
