@@ -135,7 +135,8 @@ struct SimViews {
   // length, stiffness and the strain limit (0 = none; Provot 1995) per edge.
   const int *edge_a = nullptr, *edge_b = nullptr;
   const float *edge_len = nullptr, *edge_k = nullptr, *edge_limit = nullptr;
-  // cloth, CSR by id: bending constraints and triangles incident to each particle
+  // cloth, CSR by id: bending constraints and triangles incident to each particle; a bend_list
+  // entry is the slot 4 b + vertex in bend_delta of the particle's correction by constraint b
   const int *bend_off = nullptr, *bend_list = nullptr;
   const Quad* bend_ids = nullptr;
   const float *bend_rest = nullptr, *bend_k = nullptr;

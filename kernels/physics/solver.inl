@@ -644,7 +644,8 @@ void cloth_strain_limit(const Exec& ex, const SimViews& S, const std::int64_t* c
 
 // Bending constraints (Jacobi, averaged through their stiffness on the host): each constraint's
 // four corrections once (bend_delta[4 b + vertex]), then every particle gathers its own, in the
-// order of its incidence list (no float atomics).
+// order of its incidence list (no float atomics), which names the slots directly (one dependent
+// load less than looking the vertex up in the constraint's Quad).
 template <class Exec>
 void cloth_bend(const Exec& ex, const SimViews& S) {
   ex.for_each(S.nbends, [=] SEAMLESS_HD(std::int64_t b) {
@@ -668,12 +669,8 @@ void cloth_bend(const Exec& ex, const SimViews& S) {
     }
     const int id = S.order[s];
     vec3 acc{0.f, 0.f, 0.f};
-    for (int e = S.bend_off[id], end = S.bend_off[id + 1]; e < end; ++e) {
-      int b = S.bend_list[e];
-      Quad q = S.bend_ids[b];
-      int which = q.a == id ? 0 : q.b == id ? 1 : q.c == id ? 2 : 3;
-      acc += S.bend_delta[4 * b + which];
-    }
+    // bend_list holds the slots 4 b + vertex of id's corrections (the host resolved the vertex).
+    for (int e = S.bend_off[id], end = S.bend_off[id + 1]; e < end; ++e) acc += S.bend_delta[S.bend_list[e]];
     S.tmp[s] = p + acc;
   });
 }

@@ -442,7 +442,9 @@ struct ParticleSolver::Impl {
     for (std::size_t i = 0; i < bends.size(); ++i) {
       const K::Quad& q = bends[i];
       bk[i] = bend_k0[i] * scale(std::max({bdeg[q.a], bdeg[q.b], bdeg[q.c], bdeg[q.d]}));
-      for (int id : {q.a, q.b, q.c, q.d}) inc[id].push_back(static_cast<int>(i));
+      // The slot of id's correction, 4 b + vertex (the first vertex that is id, as before).
+      for (int id : {q.a, q.b, q.c, q.d})
+        inc[id].push_back(4 * static_cast<int>(i) + (q.a == id ? 0 : q.b == id ? 1 : q.c == id ? 2 : 3));
     }
     upload_csr(inc, bend_off, bend_list);
     std::vector<std::vector<int>> tinc(N);
