@@ -235,6 +235,8 @@ struct BlockCache {
 // Block index of b (-1: none) through the cache.
 template <class Acc>
 SEAMLESS_HD inline std::int32_t cached_block(const Acc& a, int3 b, BlockCache& c) {
+  // A window lookup is one cached load: cheaper than the cache's compares and shuffling.
+  if constexpr (requires { a.window; }) return a.find_block(b);
   if (b == c.block) return c.index;
   const int3 old_block = c.block;
   const std::int32_t old_index = c.index;
