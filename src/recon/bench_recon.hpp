@@ -43,6 +43,8 @@ class ReconBench {
   ReconBenchResult result();
   // One line for `seamless bench recon`: "stage medians (ms): allocate ... ; blocks N, B bytes/block".
   std::string report();
+  // Median over the timed frames of allocate + visible + fuse + raycast (ms): the 0.5 ms goal.
+  double goal_stages_median_ms() const;
   std::size_t frame_count() const { return frames_.size(); }
 
  private:
