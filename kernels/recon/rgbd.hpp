@@ -19,6 +19,10 @@ struct RgbdLevel {
   // > 0: robust, self-balancing weights (tracker.weighting: robust) with a Student t-distribution of
   // this many degrees of freedom; 0: the fixed weights above (tracker.weighting: fixed).
   float dof = 0.f;
+  // Robust weighting only: the geometric residual's standard deviation grows with depth squared
+  // (structured light, Kinect v1: Khoshelham & Elberink 2012, sigma_z ~ z^2), so each geometric
+  // residual is divided by (z / 1 m)^2 before the scale and the t-weight see it (in metres "at 1 m").
+  bool depth_squared_noise = false;
 };
 
 // ---- Robust, self-balancing weighting (tracker.weighting: robust) --------------------------------
@@ -115,8 +119,12 @@ SEAMLESS_HD inline void add_rgbd_rows(RgbdTerms& s, const RgbdLevel& L, const Co
   const float rg = dot(c.n, c.q - c.v);
   float wg = L.geometric_weight;
   if (L.dof > 0.f) {
-    wg = t_weight(rg, geo_var, L.dof);
-    s.geo_wr2 += wg * rg * rg;
+    // residual rn = rg / z^2 with depth_squared_noise: its row is the original one weighted by 1/z^4
+    const float iz2 = L.depth_squared_noise ? 1.f / (c.q.z * c.q.z) : 1.f;
+    const float rn = rg * iz2;
+    wg = t_weight(rn, geo_var, L.dof);
+    s.geo_wr2 += wg * rn * rn;
+    wg *= iz2 * iz2;
   }
   add_row(s.icp, cross(c.q, c.n), c.n, rg, wg);
   s.icp.inliers += 1.f;

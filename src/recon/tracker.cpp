@@ -174,7 +174,8 @@ void Tracker::reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, i
   with_exec(device_, [&](const auto& ex) {
     if (!use_photometric(frame, ref)) return kernels::icp_reduce_into(ex, L, pose, out, update);
     kernels::RgbdLevel R{L, cur.intensity.cview(), rl.intensity.cview(), 1.f, params_.photometric_weight,
-                         params_.max_intensity_diff, robust(frame, ref) ? params_.robust_dof : 0.f};
+                         params_.max_intensity_diff, robust(frame, ref) ? params_.robust_dof : 0.f,
+                         params_.depth_noise == "depth_squared"};
     if (rgbd_sums_.size() != 1 || rgbd_sums_.device() != device_) rgbd_sums_ = Buffer<kernels::RgbdSums>(1, device_);
     kernels::rgbd_reduce_into(ex, R, pose, rgbd_sums_.data(), out, update);
   });

@@ -28,6 +28,7 @@ struct TrackerParams {
   // (Kerl et al. 2013; docs/TRACKING.md, "RGB-D").
   std::string weighting = "fixed";
   float robust_dof = 5.f;                 // degrees of freedom of the t-distribution (Kerl et al. 2013: 5)
+  std::string depth_noise = "uniform";    // robust: geometric noise uniform or ~ depth^2 (Kinect v1)
   bool constant_velocity = false;         // start each frame from the last motion instead of the last pose
   float max_translation_jump = 0.3f;      // metres per frame
   float max_rotation_jump_deg = 30.f;     // degrees per frame
@@ -65,6 +66,10 @@ struct TrackerParams {
       Choices{"fixed", "robust"});
     v("robust_dof", robust_dof, "rgbd weighting robust: degrees of freedom of the t-distribution",
       Range{0.1, 1e6});
+    v("depth_noise", depth_noise,
+      "rgbd weighting robust: the geometric residual's noise is uniform, or grows with depth squared "
+      "(structured-light sensors such as the Kinect v1)",
+      Choices{"uniform", "depth_squared"});
     v("constant_velocity", constant_velocity, "predict each pose from the previous motion (else from the last pose)");
     v("max_translation_jump", max_translation_jump, "tracking is lost above this per-frame motion, metres",
       Range{0.0, 100.0});

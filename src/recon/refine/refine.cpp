@@ -160,6 +160,8 @@ TrackerParams pair_tracker_params(const RefineParams& p) {
   t.mode = "frame_to_frame";
   t.iterations = p.iterations;
   t.photometric_weight = p.photometric_weight;
+  t.weighting = p.weighting;
+  t.depth_noise = p.depth_noise;
   t.min_inlier_ratio = 0.f;
   t.min_inlier_ratio_vs_last = 0.f;
   t.max_condition = 1e300;

@@ -22,6 +22,8 @@ struct RefineParams {
   std::string pair_tracker = "rgbd";       // dense pairwise alignment (our Tracker, frame to frame)
   std::vector<int> iterations{10, 5, 4};   // pairwise alignment per pyramid level, finest first; 0 skips a level
   float photometric_weight = 1.f;          // rgbd pairwise alignment: colour term weight
+  std::string weighting = "fixed";         // rgbd pairwise alignment: as tracker.weighting
+  std::string depth_noise = "uniform";     // rgbd pairwise alignment, weighting robust: as tracker.depth_noise
   float min_pair_inlier_ratio = 0.3f;      // an aligned pair is kept above this inlier ratio
   float max_pair_correction = 0.1f;        // ... and when it moves the odometry's relative pose less, metres
   float max_pair_correction_deg = 5.f;     // ... and degrees
@@ -53,6 +55,10 @@ struct RefineParams {
     v("iterations", iterations, "pairwise alignment iterations per pyramid level, finest first (0 skips a level: "
       "a subsampled alignment)", Range{0, 1000});
     v("photometric_weight", photometric_weight, "pair_tracker rgbd: weight of the colour term", Range{0.0, 1e6});
+    v("weighting", weighting, "pair_tracker rgbd: fixed (photometric_weight) or robust weights (as tracker.weighting)",
+      Choices{"fixed", "robust"});
+    v("depth_noise", depth_noise, "pair_tracker rgbd, weighting robust: geometric noise uniform or growing with "
+      "depth squared (as tracker.depth_noise)", Choices{"uniform", "depth_squared"});
     v("min_pair_inlier_ratio", min_pair_inlier_ratio, "an aligned pair becomes an edge above this inlier ratio",
       Range{0.0, 1.0});
     v("max_pair_correction", max_pair_correction, "an aligned pair is rejected when it moves the odometry's "
