@@ -188,14 +188,11 @@ struct BlockWindow {
 };
 
 // HashAccess with a BlockWindow in front of the table (same answers, fewer probes).
-struct WindowedHashAccess {
-  HashAccess hash;
+struct WindowedHashAccess : HashAccess {
   BlockWindow window;
-  Voxel* voxels = nullptr;  // = hash.voxels; named like the other accessors' members
-  VoxelGeometry geom;       // = hash.geom
   SEAMLESS_HD std::int32_t find_block(int3 b) const {
     const std::int64_t e = window.index ? window.entry(b) : -1;
-    return e >= 0 ? window.index[e] : hash.find_block(b);
+    return e >= 0 ? window.index[e] : HashAccess::find_block(b);
   }
   // The blocks of a cell's 8 corners (see cell_voxels) straight from the window, without the
   // block cache's bookkeeping: block b0 + (k&1 & ex, (k>>1)&1 & ey, k>>2 & ez) for corner k.

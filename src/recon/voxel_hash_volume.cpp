@@ -310,8 +310,7 @@ void VoxelHashVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, Ra
         return;
       }
       staged(timer, "raycast_window", [&] { kernels::fill_block_window(ex, table(), w); });  // part of "raycast"
-      const kernels::HashAccess h = device_view();
-      kernels::raycast(ex, kernels::WindowedHashAccess{h, w, h.voxels, h.geom}, K, world_T_camera, params_.min_depth,
+      kernels::raycast(ex, kernels::WindowedHashAccess{device_view(), w}, K, world_T_camera, params_.min_depth,
                        params_.max_depth, out, iv);
     });
   });
