@@ -1,10 +1,8 @@
 #include "recon/bench_recon.hpp"
 
-#include <algorithm>
 #include <map>
-#include <vector>
-
 #include <set>
+#include <vector>
 
 namespace seamless {
 
@@ -53,9 +51,7 @@ double ReconBench::goal_stages_median_ms() const {
       sum[row.frame] += row.ms;
   std::vector<double> v;
   for (const auto& [frame, ms] : sum) v.push_back(ms);
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-  return v[v.size() / 2];
+  return median(v);  // core/timing.hpp: the convention of the stage medians
 }
 
 std::string ReconBench::report() {
