@@ -75,6 +75,10 @@ struct IcpLevel {
   SE3 ref_T_cur;         // current estimate
   float dist_threshold;  // metres
   float cos_angle;       // cos of the largest normal angle accepted
+  // A level stops iterating once a step rotates by less than this (radians) and translates by less
+  // than stop_translation (metres); 0 and 0: it always takes all its steps (docs/TRACKING.md).
+  float stop_rotation = 0.f;
+  float stop_translation = 0.f;
 };
 
 // A projective correspondence (KinectFusion eq. 17): the current point moved into the reference
@@ -116,6 +120,7 @@ struct IcpPose {
   double t[3];
   int stalled;     // the solve failed at this level: the level's later steps change nothing
   int steps;       // Gauss-Newton steps taken; a stalled level counts its failing step
+  int converged;   // this level's last step was below the stop thresholds: its later steps are skipped
   // RGB-D robust weighting only (kernels/recon/rgbd.hpp, RgbdScale): the geometric (m^2) and
   // photometric residual variances estimated by the previous step; 0 = not estimated yet. Kept next
   // to the estimate so that one host copy starts a frame; the ICP kernel never reads them.
@@ -129,6 +134,7 @@ constexpr int kIcpMaxLevels = 8;
 struct IcpState {
   IcpPose pose;
   IcpSums sums[kIcpMaxLevels];
+  IcpSums step;  // the ICP reduction's output, copied into sums[level] unless the level is done
 };
 
 SEAMLESS_HD inline IcpPose to_icp_pose(const SE3& T) {
@@ -206,12 +212,20 @@ SEAMLESS_HD inline void left_update(IcpPose& p, const double xi[6]) {
 // What a reduction does with its system once summed: nothing, or one Gauss-Newton step on *pose.
 enum class IcpUpdate { none, step, first_step };
 
-// One Gauss-Newton step: solves the system s and applies the update to p, unless the level has
-// stalled; first_step (a level's first) clears the stall of the previous level.
-SEAMLESS_HD inline void gauss_newton_update(const IcpSums& s, IcpPose& p, IcpUpdate u) {
+// True when a step of this level has nothing left to do: the level stalled (the same estimate
+// would give the same failing system again) or converged. Such a step's reduction skips every
+// pixel and leaves the level's last system and the estimate as they are.
+SEAMLESS_HD inline bool level_done(const IcpPose& p, IcpUpdate u) {
+  return u == IcpUpdate::step && (p.stalled || p.converged);
+}
+
+// One Gauss-Newton step: solves the system s and applies the update to p; first_step (a level's
+// first) clears the stall and convergence of the previous level. A step xi = (omega, upsilon)
+// smaller than L's stop thresholds marks the level converged.
+SEAMLESS_HD inline void gauss_newton_update(const IcpSums& s, IcpPose& p, IcpUpdate u, const IcpLevel& L) {
   if (u == IcpUpdate::none) return;
-  if (u == IcpUpdate::first_step) p.stalled = 0;
-  if (p.stalled) return;  // the same estimate would give the same failing system again
+  if (u == IcpUpdate::first_step) p.stalled = p.converged = 0;
+  if (level_done(p, u)) return;
   ++p.steps;
   double xi[6];
   if (!solve_normal_equations(s, xi)) {
@@ -219,13 +233,20 @@ SEAMLESS_HD inline void gauss_newton_update(const IcpSums& s, IcpPose& p, IcpUpd
     return;
   }
   left_update(p, xi);
+  const double rot2 = xi[0] * xi[0] + xi[1] * xi[1] + xi[2] * xi[2];
+  const double tra2 = xi[3] * xi[3] + xi[4] * xi[4] + xi[5] * xi[5];
+  const double sr = L.stop_rotation, st = L.stop_translation;
+  if (rot2 < sr * sr && tra2 < st * st) p.converged = 1;
 }
 
 // Sums the point-to-plane normal equations over every pixel of the current level (one pass) at the
-// estimate *pose (level.ref_T_cur is ignored) into *out on the device, then applies `update` to
-// *pose in the same launch (after every pixel has read it).
+// estimate *pose (level.ref_T_cur is ignored) into *out on the device, then, in the same launch
+// (after every pixel has read *pose), copies the system into *level_sums (where the tracker reads
+// each level's last system) and applies `update` to *pose. A step of a level already done
+// (level_done) skips both.
 template <class Exec>
-void icp_reduce_into(const Exec& ex, IcpLevel level, IcpPose* pose, IcpSums* out, IcpUpdate update);
+void icp_reduce_into(const Exec& ex, IcpLevel level, IcpPose* pose, IcpSums* out, IcpSums* level_sums,
+                     IcpUpdate update);
 
 // Moves vertex and normal maps into another frame (x -> T x, n -> R n); invalid pixels stay zero.
 // Used to express a world-space raycast in the coordinates of the camera it was rendered from.

@@ -6,21 +6,27 @@
 namespace seamless::kernels {
 
 template <class Exec>
-void icp_reduce_into(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSums* out, IcpUpdate update) {
+void icp_reduce_into(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSums* out, IcpSums* level_sums,
+                     IcpUpdate update) {
   const int w = L.cur_vertex.width;
   ex.transform_reduce_into(
       L.cur_vertex.count(),
       [=] SEAMLESS_HD(std::int64_t i) {
+        IcpTerms s{};
+        if (level_done(*pose, update)) return s;
         IcpLevel l = L;
         l.ref_T_cur = to_se3(*pose);
-        IcpTerms s{};
         int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
         if (valid_point(l.cur_vertex(x, y))) s.valid = 1.f;
         Correspondence c;
         if (find_correspondence(l, x, y, c)) add_point_to_plane(s, c, 1.f);
         return s;
       },
-      out, [=] SEAMLESS_HD { gauss_newton_update(*out, *pose, update); });
+      out, [=] SEAMLESS_HD {
+        if (level_done(*pose, update)) return;
+        *level_sums = *out;
+        gauss_newton_update(*out, *pose, update, L);
+      });
 }
 
 template <class Exec>
@@ -71,7 +77,7 @@ void pyr_down_maps(const Exec& ex, View2D<const vec3> vin, View2D<const vec3> ni
 
 #define SEAMLESS_INSTANTIATE_ICP(EXEC)                                                                             \
   namespace seamless::kernels {                                                                                    \
-  template void icp_reduce_into<EXEC>(const EXEC&, IcpLevel, IcpPose*, IcpSums*, IcpUpdate);                      \
+  template void icp_reduce_into<EXEC>(const EXEC&, IcpLevel, IcpPose*, IcpSums*, IcpSums*, IcpUpdate);            \
   template void transform_maps<EXEC>(const EXEC&, View2D<const vec3>, View2D<const vec3>, SE3, View2D<vec3>,      \
                                      View2D<vec3>);                                                                \
   template void pyr_down_maps<EXEC>(const EXEC&, View2D<const vec3>, View2D<const vec3>, View2D<vec3>,             \

@@ -10,18 +10,20 @@ void rgbd_reduce_into(const Exec& ex, RgbdLevel R, IcpPose* pose, RgbdSums* out,
                       IcpUpdate update) {
   const int w = R.geo.cur_vertex.width;
   ex.transform_reduce_into(R.geo.cur_vertex.count(), [=] SEAMLESS_HD(std::int64_t i) {
+    RgbdTerms s{};
+    if (level_done(*pose, update)) return s;
     RgbdLevel L = R;
     const IcpPose p = *pose;
     L.geo.ref_T_cur = to_se3(p);
-    RgbdTerms s{};
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
     if (valid_point(L.geo.cur_vertex(x, y))) s.icp.valid = 1.f;
     Correspondence c;
     if (find_correspondence(L.geo, x, y, c)) add_rgbd_rows(s, L, c, x, y, p.geo_var, p.photo_var);
     return s;
   }, out, [=] SEAMLESS_HD {
+    if (level_done(*pose, update)) return;
     *level_sums = out->icp;
-    gauss_newton_update(out->icp, *pose, update);  // with the variances this system was built with
+    gauss_newton_update(out->icp, *pose, update, R.geo);  // with the variances this system was built with
     if (R.dof > 0.f) update_scale(*out, *pose);
   });
 }

@@ -72,17 +72,33 @@ struct FrameInput {
   float min_depth = 0.3f, max_depth = 4.f;
 };
 
+// The farthest valid depth reading of every tile x tile pixel tile of a frame, row-major, as
+// float_bits (non-negative floats order as their bits; 0: no reading). A voxel behind it by more
+// than the truncation cannot be changed by the frame. allocate_blocks fills it (it reads every
+// pixel anyway) after clear_depth_tiles.
+struct DepthTiles {
+  std::int32_t* zmax = nullptr;  // nullptr: no tiles, nothing is culled
+  int tile = 8, tiles_x = 0, tiles_y = 0;
+  SEAMLESS_HD std::int64_t count() const { return static_cast<std::int64_t>(tiles_x) * tiles_y; }
+  SEAMLESS_HD std::int32_t* at(int x, int y) const {
+    return zmax + static_cast<std::int64_t>(y / tile) * tiles_x + x / tile;
+  }
+};
+template <class Exec>
+void clear_depth_tiles(const Exec& ex, DepthTiles tiles);
 // Inserts every block that the truncation band [d - mu, d + mu] of each depth ray passes through
 // (Niessner section 4.1), popping a block from the pool for each new key; failures are counted.
+// Raises each tile of `tiles` (when given) to the farthest valid reading in it.
 template <class Exec>
 void allocate_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list, HashCounters* counters,
-                     FrameInput in, VoxelGeometry geom);
-// Appends to visible_slots every allocated block whose voxels may project into the image
-// (counters->visible is the count) and zeroes its keep flag (keep may be empty). Also clamps
+                     FrameInput in, VoxelGeometry geom, DepthTiles tiles = {});
+// Appends to visible_slots every allocated block that the frame may change (counters->visible is
+// the count) and zeroes its keep flag (keep may be empty): blocks whose voxels may project into
+// the image, less those that tiles (when given) show to be occluded or unobserved. Also clamps
 // free_top after a failed allocation pass.
 template <class Exec>
 void find_visible_blocks(const Exec& ex, HashTableView t, HashCounters* counters, FrameInput in, VoxelGeometry geom,
-                         View<std::int32_t> visible_slots, View<std::int32_t> keep);
+                         View<std::int32_t> visible_slots, View<std::int32_t> keep, DepthTiles tiles = {});
 // Fuses one frame into the listed blocks, one thread per voxel. When keep is not empty, keep[j]
 // becomes 1 if block j still has a voxel near a surface afterwards (voxel_keeps_block), so that
 // finding the empty blocks costs no second pass over the voxels.

@@ -63,7 +63,7 @@ SEAMLESS_HD inline void traverse_blocks(vec3 a, vec3 b, F visit) {
 
 template <class Exec>
 void allocate_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list, HashCounters* counters,
-                     FrameInput in, VoxelGeometry geom) {
+                     FrameInput in, VoxelGeometry geom, DepthTiles tiles) {
   const int w = in.depth.width;
   const float mu = geom.truncation;
   const float to_block = 1.f / (geom.voxel_size * kBlockSide);
@@ -73,6 +73,10 @@ void allocate_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> f
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
     float d = in.depth(x, y);
     if (!(d >= in.min_depth && d <= in.max_depth)) return;
+    if (tiles.zmax) {  // the plain read spares most atomics once the tile holds its far reading
+      std::int32_t* tile = tiles.at(x, y);
+      if (float_bits(d) > atomic_load(tile)) atomic_max(tile, float_bits(d));
+    }
     vec3 p = in.K.unproject(static_cast<float>(x), static_cast<float>(y), d);
     float r = mu / length(p);  // the band is +-mu along the ray (Niessner section 4.1)
     vec3 a = (in.world_T_camera * (p * (1.f - r)) - geom.origin) * to_block;
@@ -81,13 +85,29 @@ void allocate_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> f
   });
 }
 
-// Could any voxel of block b project into the image in front of the camera, within max_depth+mu?
+// Does some tile in pixels [u0, u1] x [v0, v1] hold a depth reading at or beyond z? A voxel is
+// changed only where the reading d at its pixel has d - z_voxel >= -mu (fuse_voxel).
+SEAMLESS_HD inline bool tiles_reach(const DepthTiles& t, int u0, int u1, int v0, int v1, float z) {
+  const std::int32_t zb = float_bits(fmaxf(z, 0.f));
+  for (int ty = v0 / t.tile; ty <= v1 / t.tile; ++ty)
+    for (int tx = u0 / t.tile; tx <= u1 / t.tile; ++tx)
+      if (t.zmax[static_cast<std::int64_t>(ty) * t.tiles_x + tx] >= zb) return true;
+  return false;
+}
+
+// Could the frame change block b? It must project into the image in front of the camera within
+// max_depth+mu and, with tiles, some tile under it must have a reading no more than mu in front of
+// its nearest point. The test uses the block's box in voxel units, [8b, 8b + 8] per axis, which
+// holds its voxel centres (8b .. 8b + 7) and is the box allocate_blocks assigns points to. So the
+// voxels, and any depth ray that allocated the block this frame (which must list it, so that a
+// block whose voxels that frame leaves empty is freed as without tiles), project into the rounded
+// bounding box of the box corners' projections, at depths >= the corners' smallest.
 SEAMLESS_HD inline bool block_maybe_visible(int3 b, const FrameInput& in, const SE3& camera_T_world,
-                                            const VoxelGeometry& geom) {
+                                            const VoxelGeometry& geom, const DepthTiles& tiles = {}) {
   float umin = 1e30f, umax = -1e30f, vmin = 1e30f, vmax = -1e30f, zmin = 1e30f;
   bool behind = false;
   for (int k = 0; k < 8; ++k) {
-    int3 g{b.x * 8 + (k & 1) * 7, b.y * 8 + ((k >> 1) & 1) * 7, b.z * 8 + (k >> 2) * 7};
+    int3 g{b.x * 8 + (k & 1) * 8, b.y * 8 + ((k >> 1) & 1) * 8, b.z * 8 + (k >> 2) * 8};
     vec3 pc = camera_T_world * geom.to_world(to_vec3(g));
     zmin = fminf(zmin, pc.z);
     if (pc.z <= 1e-4f) {
@@ -99,18 +119,29 @@ SEAMLESS_HD inline bool block_maybe_visible(int3 b, const FrameInput& in, const 
   }
   if (zmin > in.max_depth + geom.truncation) return false;
   if (behind) return umax > -1e29f;  // straddles the camera plane: keep if any corner is in front
-  return umax >= -0.5f && umin <= in.depth.width - 0.5f && vmax >= -0.5f && vmin <= in.depth.height - 0.5f;
+  if (!(umax >= -0.5f && umin <= in.depth.width - 0.5f && vmax >= -0.5f && vmin <= in.depth.height - 0.5f))
+    return false;
+  if (!tiles.zmax) return true;
+  const float wl = in.depth.width - 1.f, hl = in.depth.height - 1.f;  // clamped, then rounded as fuse_voxel rounds
+  const int u0 = static_cast<int>(floorf(fmaxf(umin, 0.f) + 0.5f)), u1 = static_cast<int>(floorf(fminf(umax, wl) + 0.5f));
+  const int v0 = static_cast<int>(floorf(fmaxf(vmin, 0.f) + 0.5f)), v1 = static_cast<int>(floorf(fminf(vmax, hl) + 0.5f));
+  return tiles_reach(tiles, u0, u1, v0, v1, zmin - geom.truncation);
+}
+
+template <class Exec>
+void clear_depth_tiles(const Exec& ex, DepthTiles tiles) {
+  ex.for_each(tiles.count(), [=] SEAMLESS_HD(std::int64_t i) { tiles.zmax[i] = 0; });
 }
 
 template <class Exec>
 void find_visible_blocks(const Exec& ex, HashTableView t, HashCounters* counters, FrameInput in, VoxelGeometry geom,
-                         View<std::int32_t> visible_slots, View<std::int32_t> keep) {
+                         View<std::int32_t> visible_slots, View<std::int32_t> keep, DepthTiles tiles) {
   const SE3 camera_T_world = in.world_T_camera.inverse();
   ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
     if (i == 0 && counters->free_top < 0) counters->free_top = 0;  // after failed pops
     HashKey k = t.keys[i];
     if (!is_live_key(k) || t.values[i] < 0) return;
-    if (!block_maybe_visible(unpack_block(k), in, camera_T_world, geom)) return;
+    if (!block_maybe_visible(unpack_block(k), in, camera_T_world, geom, tiles)) return;
     const int j = atomic_add(&counters->visible, 1);
     visible_slots[j] = static_cast<std::int32_t>(i);
     if (keep.data) keep[j] = 0;
@@ -227,9 +258,10 @@ void remove_unkept_blocks(const Exec& ex, HashTableView t, View<const std::int32
 #define SEAMLESS_INSTANTIATE_TSDF_FUSION(EXEC)                                                                    \
   namespace seamless::kernels {                                                                                   \
   template void allocate_blocks<EXEC>(const EXEC&, HashTableView, View<const std::int32_t>, HashCounters*,        \
-                                      FrameInput, VoxelGeometry);                                                 \
+                                      FrameInput, VoxelGeometry, DepthTiles);                                     \
   template void find_visible_blocks<EXEC>(const EXEC&, HashTableView, HashCounters*, FrameInput, VoxelGeometry,   \
-                                          View<std::int32_t>, View<std::int32_t>);                                \
+                                          View<std::int32_t>, View<std::int32_t>, DepthTiles);                    \
+  template void clear_depth_tiles<EXEC>(const EXEC&, DepthTiles);                                        \
   template void fuse_hash_blocks<EXEC>(const EXEC&, HashTableView, View<const std::int32_t>, std::int64_t,        \
                                        Voxel*, FrameInput, VoxelGeometry, float, bool, View<std::int32_t>,        \
                                        float);                                                                    \

@@ -45,6 +45,7 @@ TrackBenchCase align_case(const std::string& kind, const std::vector<RgbdFrame>&
   TrackerParams tp;
   tp.kind = kind;
   tp.mode = "frame_to_frame";
+  tp.stop_translation = tp.stop_rotation_deg = 0.f;  // every iteration of 10/5/4, as the goal counts them
   auto tracker = std::make_shared<Tracker>(tp, d);
   auto cur = pyramid(f[2], d), prev = pyramid(f[0], d);
   auto ref = std::make_shared<ReferenceMaps>();
@@ -68,7 +69,8 @@ std::vector<TrackBenchCase> make_track_bench(Device device, const std::string& d
                      session->process((*frames)[*i]);
                      *i = *i % 2 + 1;  // alternate frames 1 and 2 around frame 0's model
                    },
-                   "upload + preprocess + frame-to-model ICP + fuse + raycast, 5 mm hash volume"});
+                   "upload + preprocess + frame-to-model ICP (10/5/4, stopping at the default step thresholds) + fuse + "
+                   "raycast, 5 mm hash volume"});
   return cases;
 }
 

@@ -170,9 +170,10 @@ void Tracker::reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, i
   const ReferenceLevel& rl = ref.level(level);
   kernels::IcpLevel L{cur.vertices.cview(), cur.normals.cview(), rl.vertices.cview(), rl.normals.cview(), rl.K,
                       SE3::identity(), params_.dist_threshold,
-                      static_cast<float>(std::cos(params_.angle_threshold_deg * kPi / 180.0))};
+                      static_cast<float>(std::cos(params_.angle_threshold_deg * kPi / 180.0)),
+                      static_cast<float>(params_.stop_rotation_deg * kPi / 180.0), params_.stop_translation};
   with_exec(device_, [&](const auto& ex) {
-    if (!use_photometric(frame, ref)) return kernels::icp_reduce_into(ex, L, pose, out, update);
+    if (!use_photometric(frame, ref)) return kernels::icp_reduce_into(ex, L, pose, &state()->step, out, update);
     kernels::RgbdLevel R{L, cur.intensity.cview(), rl.intensity.cview(), 1.f, params_.photometric_weight,
                          params_.max_intensity_diff, robust(frame, ref) ? params_.robust_dof : 0.f,
                          params_.depth_noise == "depth_squared"};

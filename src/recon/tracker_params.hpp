@@ -13,6 +13,12 @@ struct TrackerParams {
   std::string kind = "icp";
   std::string mode = "frame_to_model";
   std::vector<int> iterations{10, 5, 4};  // finest level first (KinectFusion, sec. 3.5)
+  // A level stops early once a Gauss-Newton step is below both: a tenth of a millimetre, and a
+  // rotation that moves a point 1.7 m away by as much; an order of magnitude under the Kinect v1's
+  // depth noise at 1 m (~1.4 mm, Khoshelham & Elberink 2012), so the pose it would still gain is far
+  // below what the sensor resolves. 0 and 0: every level takes all its iterations.
+  float stop_translation = 1e-4f;         // metres per step
+  float stop_rotation_deg = 0.0034f;      // degrees per step (6e-5 rad)
   float dist_threshold = 0.1f;            // metres
   float angle_threshold_deg = 20.f;
   float photometric_weight = 0.1f;        // rgbd only: weight of the colour term vs geometry
@@ -42,6 +48,11 @@ struct TrackerParams {
     v("mode", mode, "align to the model raycast or to the previous frame",
       Choices{"frame_to_model", "frame_to_frame"});
     v("iterations", iterations, "ICP iterations per pyramid level, finest first", Range{0, 1000});
+    v("stop_translation", stop_translation,
+      "a pyramid level stops iterating once a step translates less than this (metres) and rotates less than "
+      "stop_rotation_deg; 0 and 0: always all iterations",
+      Range{0.0, 1.0});
+    v("stop_rotation_deg", stop_rotation_deg, "see stop_translation (degrees)", Range{0.0, 180.0});
     v("dist_threshold", dist_threshold, "reject correspondences farther apart, metres", Range{0.0, 10.0});
     v("angle_threshold_deg", angle_threshold_deg, "reject correspondences whose normals differ more, degrees",
       Range{0.0, 180.0});

@@ -25,6 +25,7 @@ struct VolumeParams {
   bool grow_when_full = true;        // double the hash table / block pool instead of dropping blocks
   int raycast_tile = 8;              // pixels per side of a ray-interval tile (Niessner 4.3); 0: none
   int raycast_window = 128;          // blocks per side of the raycast's block-index window; 0: none
+  int occlusion_tile = 8;            // pixels per side of the depth tiles that cull occluded blocks; 0: none
   float stream_radius = 0.f;         // blocks beyond this distance from the camera go to host memory; 0: off
   float stream_step = 0.25f;         // camera travel (metres) between two streaming passes
 
@@ -52,6 +53,11 @@ struct VolumeParams {
       "are indexed densely, so rays find them with one load instead of hash probes (4 bytes per entry: 128 "
       "gives 8 MiB); blocks outside it are still found through the table; 0: off",
       Range{0, 512});
+    v("occlusion_tile", occlusion_tile,
+      "hash layout: a frame skips the blocks it cannot change: those whose nearest point lies more than the "
+      "truncation behind the farthest depth reading of every tile of this many pixels per side that they project "
+      "onto (or onto tiles without a reading); 0 fuses every block in the view frustum",
+      Range{0, 256});
     v("stream_radius", stream_radius,
       "hash layout: blocks whose centre is farther than this from the camera are moved to host memory and brought "
       "back when the camera returns (Niessner 2013, section 5), metres; 0 keeps everything on the device. Must "

@@ -104,14 +104,23 @@ void VoxelHashVolume::integrate(const Image<float>& depth, const Image<uchar3>& 
 // Allocation and the visible list, with the frame's single read of the counters. A pass with
 // failed insertions is repeated after growing what ran out (insertion is idempotent).
 void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTimer* timer) {
+  kernels::DepthTiles tiles;  // empty: every block in the frustum is listed
+  if (params_.occlusion_tile > 0) {
+    tiles.tile = params_.occlusion_tile;
+    tiles.tiles_x = (in.depth.width + tiles.tile - 1) / tiles.tile;
+    tiles.tiles_y = (in.depth.height + tiles.tile - 1) / tiles.tile;
+    depth_tiles_.reserve_discard(tiles.count(), device_);
+    tiles.zmax = depth_tiles_.data();
+  }
   for (int attempt = 0;; ++attempt) {
     with_exec(device_, [&](const auto& ex) {
       kernels::reset_frame_counters(ex, counters_.data());
       staged(timer, "allocate", [&] {
-        kernels::allocate_blocks(ex, table(), free_list_.cview(), counters_.data(), in, geom_);
+        if (tiles.zmax) kernels::clear_depth_tiles(ex, tiles);
+        kernels::allocate_blocks(ex, table(), free_list_.cview(), counters_.data(), in, geom_, tiles);
       });
       staged(timer, "visible", [&] {
-        kernels::find_visible_blocks(ex, table(), counters_.data(), in, geom_, visible_.view(), keep_.view());
+        kernels::find_visible_blocks(ex, table(), counters_.data(), in, geom_, visible_.view(), keep_.view(), tiles);
       });
     });
     last_ = read_counters();
@@ -360,7 +369,7 @@ VolumeStats VoxelHashVolume::stats() {
   s.bytes_per_block = sizeof(kernels::Voxel) * kBlockVoxels;
   s.voxel_bytes = s.bytes_per_block * static_cast<std::size_t>(s.allocated_blocks);
   s.device_bytes = keys_.bytes() + values_.bytes() + scratch_.bytes() + voxels_.bytes() + free_list_.bytes() +
-                   visible_.bytes() + keep_.bytes() + intervals_.bytes() + counters_.bytes();
+                   visible_.bytes() + keep_.bytes() + intervals_.bytes() + depth_tiles_.bytes() + counters_.bytes();
   s.host_blocks = host_count_;
   s.host_bytes = s.bytes_per_block * static_cast<std::size_t>(host_count_);
   s.streamed_out = streamed_out_;

@@ -32,7 +32,7 @@ float corner_factor(const Intrinsics& K) {
 }  // namespace
 
 // A frame allocates and fuses only voxels with camera depth <= max_depth + truncation; the blocks
-// that find_visible_blocks lists (and may free) have a voxel corner there, so their centres lie
+// that find_visible_blocks lists (and may free) have a corner of their box there, so their centres lie
 // within (max_depth + truncation) * corner_factor + one block diagonal of the camera. Passes run
 // every stream_step of travel, so a radius beyond that plus stream_step keeps every block a frame
 // can touch on the device, and fusion with streaming equals fusion without.

@@ -151,6 +151,28 @@ TEST(Icp, FrameToFrameMotionMatchesGroundTruth) {
   expect_pair_within_tolerance(r.world_T_camera, g4);
 }
 
+TEST(Icp, StoppingAtSmallStepsTakesFewerStepsForTheSamePose) {
+  // Frames 0 and 4 again, with and without the default stop thresholds (0.1 mm, 6e-5 rad a step).
+  // Gauss-Newton converges at least linearly here, so after a step below the thresholds the rest of
+  // a level can add at most about as much again: the two poses agree within a few times the
+  // thresholds (0.5 mm, 0.005 degree), and stopping must save steps on this easy pair.
+  auto f = synthetic_frames(5, false, false);
+  TrackerParams stop, all;
+  all.stop_translation = all.stop_rotation_deg = 0.f;
+  Tracker early(stop, Device::CPU), full(all, Device::CPU);
+  ReferenceMaps ref;
+  SE3 g0 = *f[0].frame.ground_truth;
+  ref.set_from_frame(*f[0].pyr, g0);
+  TrackResult a = early.track(*f[4].pyr, ref, g0), b = full.track(*f[4].pyr, ref, g0);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(b.iterations, 10 + 5 + 4);
+  EXPECT_LT(a.iterations, b.iterations);
+  auto [dt, dr] = pose_error(a.world_T_camera, b.world_T_camera);
+  EXPECT_LT(dt, 5e-4);
+  EXPECT_LT(dr, 0.005);
+  EXPECT_NEAR(a.inlier_ratio, b.inlier_ratio, 0.01);  // the statistics come from the last system built
+}
+
 TEST(Rgbd, FrameToFrameMotionMatchesGroundTruth) {
   // As above with the photometric term (the room is textured): same tolerances.
   auto f = synthetic_frames(5, false, true);

@@ -4,11 +4,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include "core/buffer.hpp"
 #include "core/device.hpp"
 #include "core/error.hpp"
 #include "recon/voxel_hash_volume.hpp"
+#include "io/frame_source.hpp"
+#include "io/input_params.hpp"
 #include "tsdf_scene.hpp"
 
 namespace seamless {
@@ -240,6 +243,56 @@ TEST(TsdfFusion, RejectsTruncationBelowTwoVoxels) {
 
 // CPU and CUDA fuse the same frames into the same block set with the same values: the kernels are
 // one source, so only float rounding (FMA contraction on the GPU) may differ, far below 1e-5 m.
+// Culling by depth tiles (volume.occlusion_tile) leaves out only blocks that the frame cannot change
+// (kernels/recon/tsdf_fusion.inl, block_maybe_visible): fusing with and without it must give the
+// same blocks with the same values. The camera swings round the sphere, so that wall blocks fused
+// from one side are hidden behind it from the other, and must be culled (fewer listed blocks).
+TEST(TsdfFusion, CullingOccludedBlocksChangesNothing) {
+  Intrinsics K = test::camera(160, 120, 140.f);
+  Scene s;
+  std::vector<SE3> poses = {test::pose({-0.3f, 0.f, 0.f}, 0.2f), test::pose({0.f, 0.f, 0.f}),
+                            test::pose({0.3f, 0.05f, 0.f}, -0.2f, 0.05f), test::pose({-0.1f, -0.05f, 0.1f}, 0.1f)};
+  VolumeParams culled = test::small_volume_params(), full = culled;
+  full.occlusion_tile = 0;
+  VoxelHashVolume a(culled, Device::CPU), b(full, Device::CPU);
+  std::int64_t listed_a = 0, listed_b = 0;
+  for (const SE3& T : poses) {
+    fuse(a, s, K, {T}, true);
+    fuse(b, s, K, {T}, true);
+    EXPECT_LE(a.stats().visible_blocks, b.stats().visible_blocks);
+    listed_a += a.stats().visible_blocks, listed_b += b.stats().visible_blocks;
+  }
+  EXPECT_LT(listed_a, listed_b);
+  ASSERT_NO_FATAL_FAILURE(test::expect_same_blocks(a.download_blocks(), b.download_blocks(), true));
+}
+
+// The same on real Kinect frames (tum_fr1_rpy, ground-truth poses, 1 cm voxels for speed): holes,
+// far noisy depth and grazing surfaces included, culling leaves the fused blocks as they were.
+TEST(TsdfFusion, CullingChangesNothingOnRealFrames) {
+  const std::string dir = std::string(SEAMLESS_TEST_DATA) + "/tum_fr1_rpy_000-149";
+  if (!std::filesystem::exists(dir)) GTEST_SKIP() << "no test data at " << dir;
+  InputParams in;
+  in.source = "tum";
+  in.path = dir;
+  in.max_frames = 12;
+  auto src = make_source(in, Device::CPU);
+  VolumeParams culled;
+  culled.voxel_size = 0.01f, culled.truncation = 0.04f;
+  VolumeParams full = culled;
+  full.occlusion_tile = 0;
+  VoxelHashVolume a(culled, Device::CPU), b(full, Device::CPU);
+  RgbdFrame f;
+  std::int64_t listed_a = 0, listed_b = 0;
+  while (src->next(f)) {
+    ASSERT_TRUE(f.ground_truth.has_value());
+    a.integrate(f.depth, f.rgb, src->intrinsics(), *f.ground_truth);
+    b.integrate(f.depth, f.rgb, src->intrinsics(), *f.ground_truth);
+    listed_a += a.stats().visible_blocks, listed_b += b.stats().visible_blocks;
+  }
+  EXPECT_LT(listed_a, listed_b);
+  ASSERT_NO_FATAL_FAILURE(test::expect_same_blocks(a.download_blocks(), b.download_blocks(), true));
+}
+
 TEST(TsdfParity, SameBlocksAndValues) {
   if (!cuda_available()) GTEST_SKIP() << "no CUDA device";
   Intrinsics K = test::camera(320, 240, 280.f);
