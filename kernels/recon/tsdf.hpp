@@ -147,15 +147,17 @@ struct RayIntervals {
 };
 constexpr std::int32_t kEmptyNear = 0x7f800000;  // +infinity
 constexpr std::int32_t kEmptyFar = 0;            // +0: no block splatted
-// Empties every tile (near = +inf, far = 0).
+// Empties every tile (near = +inf, far = 0), and window w when given (every entry -1).
 template <class Exec>
-void clear_ray_intervals(const Exec& ex, RayIntervals iv);
+void clear_ray_intervals(const Exec& ex, RayIntervals iv, BlockWindow w = {});
 // One thread per hash slot: each live block's cell box [8b, 8b+8]^3 (voxel units; every sample a
 // ray can take in the block lies in it), clipped to the depth slab [min_depth, max_depth], is
 // projected, and the tiles under its pixel bounding box take the min / max of its depth range.
+// With a window w (cleared by clear_ray_intervals) the same pass fills it, as fill_block_window
+// does: one pass over the slots instead of two.
 template <class Exec>
 void splat_ray_intervals(const Exec& ex, HashTableView t, VoxelGeometry geom, Intrinsics K, SE3 world_T_camera,
-                         float min_depth, float max_depth, RayIntervals iv);
+                         float min_depth, float max_depth, RayIntervals iv, BlockWindow w = {});
 
 // Fills window w from the hash table: -1 everywhere, then the pool index of every live block
 // inside it. Run after the last change to the table and before the kernels that read through it.

@@ -73,8 +73,11 @@ SEAMLESS_HD inline bool block_screen_bounds(int3 b, const VoxelGeometry& g, cons
 }
 
 template <class Exec>
-void clear_ray_intervals(const Exec& ex, RayIntervals iv) {
-  ex.for_each(iv.count(), [=] SEAMLESS_HD(std::int64_t t) {
+void clear_ray_intervals(const Exec& ex, RayIntervals iv, BlockWindow w) {
+  const std::int64_t tiles = iv.count(), entries = w.index ? w.count() : 0;
+  ex.for_each(tiles > entries ? tiles : entries, [=] SEAMLESS_HD(std::int64_t t) {
+    if (t < entries) w.index[t] = -1;
+    if (t >= tiles) return;
     iv.bits[2 * t] = kEmptyNear;
     iv.bits[2 * t + 1] = kEmptyFar;
   });
@@ -82,12 +85,17 @@ void clear_ray_intervals(const Exec& ex, RayIntervals iv) {
 
 template <class Exec>
 void splat_ray_intervals(const Exec& ex, HashTableView t, VoxelGeometry geom, Intrinsics K, SE3 world_T_camera,
-                         float min_depth, float max_depth, RayIntervals iv) {
+                         float min_depth, float max_depth, RayIntervals iv, BlockWindow w) {
   const SE3 camera_T_world = world_T_camera.inverse();
   const float zn = fmaxf(min_depth, 1e-3f);
   ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
     HashKey k = t.keys[i];
-    if (!is_live_key(k) || t.values[i] < 0) return;
+    const std::int32_t block = t.values[i];
+    if (!is_live_key(k) || block < 0) return;
+    if (w.index) {
+      const std::int64_t e = w.entry(unpack_block(k));
+      if (e >= 0) w.index[e] = block;  // keys are unique: one writer per entry
+    }
     ScreenBounds s;
     if (!block_screen_bounds(unpack_block(k), geom, K, camera_T_world, zn, max_depth, &s)) return;
     // Rays go through pixel centres: pixel x can meet the box only if u0 <= x <= u1. Rounding
@@ -259,7 +267,7 @@ void raycast(const Exec& ex, Acc a, Intrinsics K, SE3 world_T_camera, float min_
   template void raycast<EXEC, WindowedHashAccess>(const EXEC&, WindowedHashAccess, Intrinsics, SE3, float, float, \
                                                   RaycastOutput, RayIntervals);                                  \
   template void fill_block_window<EXEC>(const EXEC&, HashTableView, BlockWindow);                                \
-  template void clear_ray_intervals<EXEC>(const EXEC&, RayIntervals);                                            \
+  template void clear_ray_intervals<EXEC>(const EXEC&, RayIntervals, BlockWindow);                               \
   template void splat_ray_intervals<EXEC>(const EXEC&, HashTableView, VoxelGeometry, Intrinsics, SE3, float,     \
-                                          float, RayIntervals);                                                  \
+                                          float, RayIntervals, BlockWindow);                                     \
   }

@@ -307,18 +307,19 @@ void VoxelHashVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, Ra
   }
   with_exec(device_, [&](const auto& ex) {
     staged(timer, "raycast", [&] {
-      if (iv.bits)
-        staged(timer, "raycast_splat", [&] {  // part of "raycast"
-          kernels::clear_ray_intervals(ex, iv);
-          kernels::splat_ray_intervals(ex, table(), geom_, K, world_T_camera, params_.min_depth, params_.max_depth,
-                                       iv);
-        });
       const kernels::BlockWindow w = raycast_window(world_T_camera);
+      if (iv.bits)  // one pass over the slots splats the intervals and fills the window
+        staged(timer, "raycast_splat", [&] {  // part of "raycast"
+          kernels::clear_ray_intervals(ex, iv, w);
+          kernels::splat_ray_intervals(ex, table(), geom_, K, world_T_camera, params_.min_depth, params_.max_depth,
+                                       iv, w);
+        });
       if (!w.index) {
         kernels::raycast(ex, device_view(), K, world_T_camera, params_.min_depth, params_.max_depth, out, iv);
         return;
       }
-      staged(timer, "raycast_window", [&] { kernels::fill_block_window(ex, table(), w); });  // part of "raycast"
+      if (!iv.bits)
+        staged(timer, "raycast_window", [&] { kernels::fill_block_window(ex, table(), w); });  // part of "raycast"
       kernels::raycast(ex, kernels::WindowedHashAccess{device_view(), w}, K, world_T_camera, params_.min_depth,
                        params_.max_depth, out, iv);
     });
