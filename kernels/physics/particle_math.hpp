@@ -24,6 +24,20 @@ SEAMLESS_HD inline bool is(std::uint32_t ph, std::uint32_t flag) { return (ph & 
 
 constexpr float kPi = 3.14159265358979f;
 
+// A position (or vector) and one more word, 16-byte aligned: what a neighbour loop gathers from
+// neighbour j in one 128-bit load on CUDA (a vec3 and a float are four 32-bit loads, four times
+// the L1 requests of a gather whose 32 lanes hit 32 different sectors). The kernels keep packed
+// copies of what each neighbour pass reads (SimViews::spk, spl, svh, cnv).
+struct alignas(16) Packed {
+  float x, y, z, w;
+  SEAMLESS_HD vec3 xyz() const { return {x, y, z}; }
+  SEAMLESS_HD std::uint32_t bits() const { return static_cast<std::uint32_t>(float_bits(w)); }  // a phase in w
+  SEAMLESS_HD static Packed of(vec3 v, float w) { return {v.x, v.y, v.z, w}; }
+  SEAMLESS_HD static Packed of_phase(vec3 v, std::uint32_t ph) {
+    return {v.x, v.y, v.z, bits_float(static_cast<std::int32_t>(ph))};
+  }
+};
+
 // SPH kernels of smoothing radius h with their normalising constants computed once (the
 // constants cost two divisions per call otherwise, and the kernels run for every neighbour pair
 // several times per iteration). Same expressions, same float results as evaluating them inline.

@@ -89,6 +89,12 @@ struct SimViews {
   int* ncontacts = nullptr;
   vec3 *vort = nullptr, *cnormal = nullptr;
   vec4* sdf_at = nullptr;  // scene SDF gradient (xyz) and distance (w) at the last counted positions
+  // Packed copies for the neighbour loops (one 16-byte load per neighbour, kernels::Packed):
+  // spk = (sp, phase bits), refreshed at the start of find_neighbors, prepare_constraints and
+  // velocity_effects; spl = (sp, lambda) by prepare_constraints for solve_contacts_fluid;
+  // svh = (sv, h_rho) by update_velocity and cnv = (cnormal, vort_len) by the vorticity pass,
+  // for velocity_effects.
+  Packed *spk = nullptr, *spl = nullptr, *svh = nullptr, *cnv = nullptr;
 
   // Neighbour grid and lists. Entry k of particle s's list is list[s * row + k * col]: the layout
   // is the executor's choice (the host sets the strides). A CPU thread walks one particle's list,

@@ -17,6 +17,12 @@ SEAMLESS_HD inline bool both_fluid(std::uint32_t a, std::uint32_t b) {
 }
 
 
+// spk = (sp, phase bits): the packed copy that the next neighbour loops gather (Packed).
+template <class Exec>
+void pack_positions(const Exec& ex, const SimViews& S) {
+  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) { S.spk[s] = Packed::of_phase(S.sp[s], S.sphase[s]); });
+}
+
 // Pairs that never interact are left out of the lists: particles of one rigid body, and
 // particles of one cloth unless it collides with itself (then only pairs that are not already
 // close in the rest shape, which the stretch constraints keep apart anyway).
@@ -307,6 +313,7 @@ template <class Exec>
 void find_neighbors(const Exec& ex, const SimViews& S) {
   // A CPU thread walks a particle's runs alone (Lanes{}); CUDA does from about 270k particles.
   constexpr bool kOneLane = Exec::device == Device::CPU;
+  detail::pack_positions(ex, S);
   ex.for_each_grouped(S.n, kSearchLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
     const int s = static_cast<int>(i);
     const vec3 p = S.sp[s];
@@ -324,8 +331,9 @@ void find_neighbors(const Exec& ex, const SimViews& S) {
       for_each_run_in_radius(S.grid, S.cell_start, p, R, [&](int a, int e) {
         int c = cnt, so = solid;
         for (int j = a; j < e; ++j) {
-          const std::uint32_t phj = S.sphase[j];
-          bool ok = (j != s) & (length2(p - S.sp[j]) < R2);
+          const Packed q = S.spk[j];  // position and phase in one load
+          const std::uint32_t phj = q.bits();
+          bool ok = (j != s) & (length2(p - q.xyz()) < R2);
           if (!plain) ok = ok && detail::may_interact(S, ph, phj, s, j);
           const bool store = ok & (c < cap);
           so += store & !(sfluid & phase::is(phj, phase::kFluid));
@@ -338,8 +346,11 @@ void find_neighbors(const Exec& ex, const SimViews& S) {
       for_each_run_in_radius(S.grid, S.cell_start, p, R, [&](int a, int e) {
         detail::append_run(
             a, e, g, list, S.nbr_col, cap, cnt,
-            [&](int j) { return (j != s) & (length2(p - S.sp[j]) < R2) & detail::may_interact(S, ph, S.sphase[j], s, j); },
-            [&](int j, bool stored) { solid += stored & !detail::both_fluid(ph, S.sphase[j]); });
+            [&](int j) {
+              const Packed q = S.spk[j];
+              return (j != s) & (length2(p - q.xyz()) < R2) & detail::may_interact(S, ph, q.bits(), s, j);
+            },
+            [&](int j, bool stored) { solid += stored & !detail::both_fluid(ph, S.spk[j].bits()); });
       });
     }
     int scnt = 0;
@@ -417,11 +428,11 @@ SEAMLESS_HD inline DensitySum density_part(const SimViews& S, int s, Lanes g) {
   DensitySum d{g.lane == 0 ? S.c.W.poly6(0.f) : 0.f, 0.f, {0.f, 0.f, 0.f}};
   const bool mixed = S.nsolid[s] != 0;  // otherwise every neighbour is fluid: no phase loads
   for (int k = g.lane, m = S.nnbr[s]; k < m; k += g.size) {
-    int j = S.nbrs(s)[k * S.nbr_col];
-    vec3 r = p - S.sp[j];
+    const Packed q = S.spk[S.nbrs(s)[k * S.nbr_col]];  // position and phase in one load
+    vec3 r = p - q.xyz();
     float wgt = S.c.W.poly6(length2(r));
     vec3 grad = S.c.W.spiky_grad(r) * inv_rho0;
-    if (!mixed || phase::is(S.sphase[j], phase::kFluid)) {
+    if (!mixed || phase::is(q.bits(), phase::kFluid)) {
       d.rho += wgt;
       d.gi += grad;
       d.sum2 += length2(grad);
@@ -442,6 +453,7 @@ SEAMLESS_HD inline DensitySum density_part(const SimViews& S, int s, Lanes g) {
 template <class Exec>
 void prepare_constraints(const Exec& ex, const SimViews& S) {
   ex.for_each(S.nbodies, [=] SEAMLESS_HD(std::int64_t b) { S.body_contacts[b] = 0; });
+  detail::pack_positions(ex, S);
   ex.for_each_grouped(S.n, kPairLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
     const int s = static_cast<int>(i);
     const int nc = detail::count_contacts(S, s, S.sp, g);
@@ -449,6 +461,7 @@ void prepare_constraints(const Exec& ex, const SimViews& S) {
       if (g.lane != 0) return;
       S.ncontacts[s] = nc;
       S.lambda[s] = 0.f;
+      S.spl[s] = Packed::of(S.sp[s], 0.f);
       S.density[s] = S.c.rest_density;
       S.h_rho[s] = S.c.h / S.c.rest_density;
       return;
@@ -458,7 +471,9 @@ void prepare_constraints(const Exec& ex, const SimViews& S) {
     S.ncontacts[s] = nc;
     float C = d.rho * (1.f / S.c.rest_density) - 1.f;
     if (S.c.unilateral && C < 0.f) C = 0.f;
-    S.lambda[s] = -C / (d.sum2 + length2(d.gi) + S.c.relaxation);
+    const float lambda = -C / (d.sum2 + length2(d.gi) + S.c.relaxation);
+    S.lambda[s] = lambda;
+    S.spl[s] = Packed::of(S.sp[s], lambda);  // what solve_contacts_fluid gathers of a neighbour
     S.density[s] = d.rho;
     S.h_rho[s] = S.c.h / d.rho;  // once here instead of once per neighbour pair in velocity_effects
   });
@@ -480,7 +495,8 @@ SEAMLESS_HD inline vec3 pbf_part(const SimViews& S, int s, Lanes g) {
   vec3 f{0.f, 0.f, 0.f};
   for (int k = g.lane, m = S.nnbr[s]; k < m; k += g.size) {
     int j = S.nbrs(s)[k * S.nbr_col];
-    vec3 r = p - S.sp[j];
+    const Packed pl = S.spl[j];  // position and lambda in one load
+    vec3 r = p - pl.xyz();
     vec3 grad = S.c.W.spiky_grad(r);
     if (!mixed || phase::is(S.sphase[j], phase::kFluid)) {
       float sc = 0.f;
@@ -488,7 +504,7 @@ SEAMLESS_HD inline vec3 pbf_part(const SimViews& S, int s, Lanes g) {
         float q = S.c.W.poly6(length2(r)) * S.c.scorr_inv_wdq;
         sc = -S.c.scorr_k * q * q * q * q;
       }
-      f += grad * (li + S.lambda[j] + sc);
+      f += grad * (li + pl.w + sc);
     } else {
       f += grad * (li * sw);
     }
@@ -506,7 +522,8 @@ SEAMLESS_HD inline vec3 coupling_part(const SimViews& S, int s, Lanes g) {
   for (int k = g.lane, m = S.nnbr[s]; k < m; k += g.size) {
     int j = S.nbrs(s)[k * S.nbr_col];
     if (!phase::is(S.sphase[j], phase::kFluid)) continue;
-    f += S.c.W.spiky_grad(p - S.sp[j]) * (S.lambda[j] * ws / S.sw[j]);
+    const Packed pl = S.spl[j];
+    f += S.c.W.spiky_grad(p - pl.xyz()) * (pl.w * ws / S.sw[j]);
   }
   return f;
 }
@@ -733,6 +750,7 @@ void update_velocity(const Exec& ex, const SimViews& S) {
       if (q.d < S.c.radius * 1.01f && vn0 < 0.f) v += q.grad * (-S.c.restitution * vn0 - vn);
     }
     S.sv[s] = v;
+    S.svh[s] = Packed::of(v, S.h_rho[s]);  // what the vorticity pass gathers of a neighbour
   });
 }
 
@@ -753,13 +771,15 @@ SEAMLESS_HD inline vec3 fluid_forces(const SimViews& S, int s, Lanes g) {
   ForceSum t{{0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}};
   for (int k = g.lane, m = S.nnbr[s]; k < m; k += g.size) {
     int j = S.nbrs(s)[k * S.nbr_col];
-    if (mixed && !phase::is(S.sphase[j], phase::kFluid)) continue;
-    vec3 r = p - S.sp[j];
+    const Packed q = S.spk[j];  // position and phase in one load, normal and |omega| in another
+    if (mixed && !phase::is(q.bits(), phase::kFluid)) continue;
+    const Packed nv = S.cnv[j];
+    vec3 r = p - q.xyz();
     float l = sqrtf(length2(r));
-    t.eta += S.c.W.spiky_grad(r) * (S.vort_len[j] * inv_rho0);
+    t.eta += S.c.W.spiky_grad(r) * (nv.w * inv_rho0);
     float K = 2.f * S.c.rest_density / (S.density[s] + S.density[j]);
     vec3 coh = l > 1e-9f ? r * (-S.c.cohesion * inv_rho0 * S.c.W.akinci(l) / l) : vec3{0.f, 0.f, 0.f};
-    vec3 curv = (ni - S.cnormal[j]) * (-S.c.surface_tension);
+    vec3 curv = (ni - nv.xyz()) * (-S.c.surface_tension);
     t.acc += (coh + curv) * K;
   }
   t = g.sum(t);
@@ -800,11 +820,13 @@ SEAMLESS_HD inline VortSum vorticity_part(const SimViews& S, int s, Lanes g) {
   VortSum t{{0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}};
   for (int k = g.lane, m = S.nnbr[s]; k < m; k += g.size) {
     int j = S.nbrs(s)[k * S.nbr_col];
-    if (mixed && !phase::is(S.sphase[j], phase::kFluid)) continue;
-    vec3 r = p - S.sp[j], vj = S.sv[j];
+    const Packed q = S.spk[j];  // position and phase in one load, velocity and h / rho in another
+    if (mixed && !phase::is(q.bits(), phase::kFluid)) continue;
+    const Packed vh = S.svh[j];
+    vec3 r = p - q.xyz(), vj = vh.xyz();
     vec3 grad = S.c.W.spiky_grad(r);
     t.w += cross(vj - vi, -grad) * inv_rho0;
-    t.n += grad * S.h_rho[j];
+    t.n += grad * vh.w;
     t.dv_visc += (vj - vi) * (S.c.W.poly6(length2(r)) * inv_rho0);
   }
   return t;
@@ -814,6 +836,7 @@ SEAMLESS_HD inline VortSum vorticity_part(const SimViews& S, int s, Lanes g) {
 template <class Exec>
 void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
   if (has_fluid) {
+    detail::pack_positions(ex, S);
     // Vorticity omega_i = sum_j v_ij x grad_j W_ij (PBF eq. 15), Akinci's colour-field normal
     // n_i = h sum_j (1 / rho_j) grad W_ij (Akinci 2013, eq. 4; dissertation eq. 4.21), and the
     // XSPH sum (PBF eq. 17), which needs only this pass's velocities (kept in vtmp for
@@ -824,8 +847,9 @@ void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
       const detail::VortSum t = g.sum(detail::vorticity_part(S, s, g));
       if (g.lane != 0) return;
       S.vort[s] = t.w;
-      S.vort_len[s] = length(t.w);  // read by every neighbour in fluid_forces
+      S.vort_len[s] = length(t.w);
       S.cnormal[s] = t.n;
+      S.cnv[s] = Packed::of(t.n, S.vort_len[s]);  // what fluid_forces gathers of a neighbour
       S.vtmp[s] = t.dv_visc;
     });
   }
