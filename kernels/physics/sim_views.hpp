@@ -95,6 +95,10 @@ struct SimViews {
   // svh = (sv, h_rho) by update_velocity and cnv = (cnormal, vort_len) by the vorticity pass,
   // for velocity_effects.
   Packed *spk = nullptr, *spl = nullptr, *svh = nullptr, *cnv = nullptr;
+  // CPU only (kernels::kCachePairs): per list entry (the lists' layout), the spiky gradient
+  // (xyz) and poly6 value (w) of the pair at prepare_constraints' positions, which
+  // solve_contacts_fluid reuses (the same positions) instead of recomputing them.
+  Packed* pair_w = nullptr;
 
   // Neighbour grid and lists. Entry k of particle s's list is list[s * row + k * col]: the layout
   // is the executor's choice (the host sets the strides). A CPU thread walks one particle's list,

@@ -17,6 +17,14 @@ SEAMLESS_HD inline bool both_fluid(std::uint32_t a, std::uint32_t b) {
   return phase::is(a, phase::kFluid) && phase::is(b, phase::kFluid);
 }
 
+// Whether prepare_constraints keeps each pair's kernel values for solve_contacts_fluid
+// (SimViews::pair_w): on the CPU, where recomputing them (position gather, square root,
+// division: ~25 instructions a pair) costs more than storing and reloading 16 bytes from cache;
+// not on CUDA, where that would be ~0.5 GB of extra memory traffic per iteration at 1M particles
+// against arithmetic a latency-bound kernel gets almost for free.
+template <class Exec>
+inline constexpr bool kCachePairs = Exec::device == Device::CPU;
+
 
 // spk = (sp, phase bits): the packed copy that the next neighbour loops gather (Packed).
 template <class Exec>
@@ -447,7 +455,9 @@ SEAMLESS_HD inline DensitySum operator+(const DensitySum& a, const DensitySum& b
   return {a.rho + b.rho, a.sum2 + b.sum2, a.gi + b.gi};
 }
 
-// Lane g's share of rho_i (starting from W(0) in lane 0), sum_j |grad_j C_i|^2 and grad_i C_i.
+// Lane g's share of rho_i (starting from W(0) in lane 0), sum_j |grad_j C_i|^2 and grad_i C_i;
+// with Cache, each pair's kernel values are kept in pair_w for pbf_part.
+template <bool Cache>
 SEAMLESS_HD inline DensitySum density_part(const SimViews& S, int s, Lanes g) {
   const vec3 p = S.sp[s];
   const float inv_rho0 = 1.f / S.c.rest_density, sw = S.c.solid_density_scale;
@@ -457,7 +467,9 @@ SEAMLESS_HD inline DensitySum density_part(const SimViews& S, int s, Lanes g) {
     const Packed q = S.spk[S.nbrs(s)[k * S.nbr_col]];  // position and phase in one load
     vec3 r = p - q.xyz();
     float wgt = S.c.W.poly6(length2(r));
-    vec3 grad = S.c.W.spiky_grad(r) * inv_rho0;
+    const vec3 gw = S.c.W.spiky_grad(r);
+    if constexpr (Cache) S.pair_w[s * S.nbr_row + k * S.nbr_col] = Packed::of(gw, wgt);
+    vec3 grad = gw * inv_rho0;
     if (!mixed || phase::is(q.bits(), phase::kFluid)) {
       d.rho += wgt;
       d.gi += grad;
@@ -492,7 +504,7 @@ void prepare_constraints(const Exec& ex, const SimViews& S) {
       S.h_rho[s] = S.c.h / S.c.rest_density;
       return;
     }
-    const detail::DensitySum d = g.sum(detail::density_part(S, s, g));
+    const detail::DensitySum d = g.sum(detail::density_part<detail::kCachePairs<Exec>>(S, s, g));
     if (g.lane != 0) return;
     S.ncontacts[s] = nc;
     float C = d.rho * (1.f / S.c.rest_density) - 1.f;
@@ -513,7 +525,9 @@ struct SolveSum {
 SEAMLESS_HD inline SolveSum operator+(const SolveSum& a, const SolveSum& b) { return {a.acc + b.acc, a.f + b.f}; }
 
 // The PBF position update of fluid particle s (eq. 12) with the artificial pressure s_corr
-// (eq. 13, n = 4), before the division by rho_0: lane g's share.
+// (eq. 13, n = 4), before the division by rho_0: lane g's share. With Cached, the pairs' kernel
+// values come from pair_w (prepare_constraints at these positions) instead of the positions.
+template <bool Cached>
 SEAMLESS_HD inline vec3 pbf_part(const SimViews& S, int s, Lanes g) {
   const vec3 p = S.sp[s];
   const float li = S.lambda[s], sw = S.c.solid_density_scale;
@@ -521,16 +535,24 @@ SEAMLESS_HD inline vec3 pbf_part(const SimViews& S, int s, Lanes g) {
   vec3 f{0.f, 0.f, 0.f};
   for (int k = g.lane, m = S.nnbr[s]; k < m; k += g.size) {
     int j = S.nbrs(s)[k * S.nbr_col];
-    const Packed pl = S.spl[j];  // position and lambda in one load
-    vec3 r = p - pl.xyz();
-    vec3 grad = S.c.W.spiky_grad(r);
+    vec3 grad;
+    float wgt, lj;
+    if constexpr (Cached) {
+      const Packed gw = S.pair_w[s * S.nbr_row + k * S.nbr_col];
+      grad = gw.xyz(), wgt = gw.w, lj = S.lambda[j];
+    } else {
+      const Packed pl = S.spl[j];  // position and lambda in one load
+      const vec3 r = p - pl.xyz();
+      grad = S.c.W.spiky_grad(r), lj = pl.w;
+      wgt = S.c.scorr_k > 0.f ? S.c.W.poly6(length2(r)) : 0.f;
+    }
     if (!mixed || phase::is(S.sphase[j], phase::kFluid)) {
       float sc = 0.f;
       if (S.c.scorr_k > 0.f) {
-        float q = S.c.W.poly6(length2(r)) * S.c.scorr_inv_wdq;
+        float q = wgt * S.c.scorr_inv_wdq;
         sc = -S.c.scorr_k * q * q * q * q;
       }
-      f += grad * (li + pl.w + sc);
+      f += grad * (li + lj + sc);
     } else {
       f += grad * (li * sw);
     }
@@ -566,7 +588,7 @@ void solve_contacts_fluid(const Exec& ex, const SimViews& S) {
     }
     const bool fluid = phase::is(S.sphase[s], phase::kFluid), coupled = !fluid && S.c.solid_density_scale > 0.f;
     detail::SolveSum part{detail::contact_part(S, s, S.sp, S.sx, true, g), {0.f, 0.f, 0.f}};
-    if (fluid) part.f = detail::pbf_part(S, s, g);
+    if (fluid) part.f = detail::pbf_part<detail::kCachePairs<Exec>>(S, s, g);
     if (coupled) part.f = detail::coupling_part(S, s, g);
     part = g.sum(part);
     if (g.lane != 0) return;
