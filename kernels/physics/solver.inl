@@ -819,13 +819,12 @@ SEAMLESS_HD inline vec3 fluid_forces(const SimViews& S, int s, Lanes g) {
   ForceSum t{{0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}};
   for (int k = g.lane, m = S.nnbr[s]; k < m; k += g.size) {
     int j = S.nbrs(s)[k * S.nbr_col];
-    const Packed q = S.spk[j];  // position and phase in one load, normal and |omega| in another
-    if (mixed && !phase::is(q.bits(), phase::kFluid)) continue;
-    const Packed nv = S.cnv[j];
+    if (mixed && !phase::is(S.sphase[j], phase::kFluid)) continue;
+    const Packed q = S.spd[j], nv = S.cnv[j];  // position and density, normal and |omega|
     vec3 r = p - q.xyz();
     float l = sqrtf(length2(r));
     t.eta += S.c.W.spiky_grad(r) * (nv.w * inv_rho0);
-    float K = 2.f * S.c.rest_density / (S.density[s] + S.density[j]);
+    float K = 2.f * S.c.rest_density / (S.density[s] + q.w);
     vec3 coh = l > 1e-9f ? r * (-S.c.cohesion * inv_rho0 * S.c.W.akinci(l) / l) : vec3{0.f, 0.f, 0.f};
     vec3 curv = (ni - nv.xyz()) * (-S.c.surface_tension);
     t.acc += (coh + curv) * K;
@@ -868,9 +867,8 @@ SEAMLESS_HD inline VortSum vorticity_part(const SimViews& S, int s, Lanes g) {
   VortSum t{{0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}};
   for (int k = g.lane, m = S.nnbr[s]; k < m; k += g.size) {
     int j = S.nbrs(s)[k * S.nbr_col];
-    const Packed q = S.spk[j];  // position and phase in one load, velocity and h / rho in another
-    if (mixed && !phase::is(q.bits(), phase::kFluid)) continue;
-    const Packed vh = S.svh[j];
+    if (mixed && !phase::is(S.sphase[j], phase::kFluid)) continue;
+    const Packed q = S.spd[j], vh = S.svh[j];  // position (and density), velocity and h / rho
     vec3 r = p - q.xyz(), vj = vh.xyz();
     vec3 grad = S.c.W.spiky_grad(r);
     t.w += cross(vj - vi, -grad) * inv_rho0;
@@ -884,7 +882,9 @@ SEAMLESS_HD inline VortSum vorticity_part(const SimViews& S, int s, Lanes g) {
 template <class Exec>
 void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
   if (has_fluid) {
-    detail::pack_positions(ex, S);
+    // spd = (sp, density): what both loops gather of a neighbour's position (the density for
+    // fluid_forces' K_ij; the phase, needed only among solids, is read from sphase there).
+    ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) { S.spd[s] = Packed::of(S.sp[s], S.density[s]); });
     // Vorticity omega_i = sum_j v_ij x grad_j W_ij (PBF eq. 15), Akinci's colour-field normal
     // n_i = h sum_j (1 / rho_j) grad W_ij (Akinci 2013, eq. 4; dissertation eq. 4.21), and the
     // XSPH sum (PBF eq. 17), which needs only this pass's velocities (kept in vtmp for

@@ -60,7 +60,7 @@ struct ParticleSolver::Impl {
   Buffer<float> w;
   Buffer<std::uint32_t> phase;
   Buffer<vec4> rsdf, sdf_at;
-  Buffer<K::Packed> spk, spl, svh, cnv;  // packed copies for the neighbour loops (sim_views.hpp)
+  Buffer<K::Packed> spk, spl, spd, svh, cnv;  // packed copies for the neighbour loops (sim_views.hpp)
   Buffer<K::Packed> pair_w;              // CPU: kernel values per list entry (SimViews::pair_w)
   // sort and sorted scratch
   Buffer<std::uint32_t> key, sphase;
@@ -158,7 +158,7 @@ struct ParticleSolver::Impl {
     for (auto* b : {&order, &rank, &ncontacts, &nnbr, &nsnbr, &nsolid}) b->reserve_discard(nc, dev);
     for (auto* b : {&sw, &lambda, &density, &h_rho, &vort_len}) b->reserve_discard(nc, dev);
     key.reserve_discard(nc, dev), sphase.reserve_discard(nc, dev), sdf_at.reserve_discard(nc, dev);
-    for (auto* b : {&spk, &spl, &svh, &cnv}) b->reserve_discard(nc, dev);
+    for (auto* b : {&spk, &spl, &spd, &svh, &cnv}) b->reserve_discard(nc, dev);
     nbr.reserve_discard(nc * (P.max_neighbours + 1), dev);  // + 1: the spare slot (sim_views.hpp)
     if (dev == Device::CPU) pair_w.reserve_discard(nc * (P.max_neighbours + 1), dev);  // kernels::kCachePairs
     cap = nc;
@@ -194,7 +194,7 @@ struct ParticleSolver::Impl {
     S.sx = sx.data(), S.sp = sp.data(), S.sp0 = sp0.data(), S.sv = sv.data(), S.tmp = tmp.data(), S.vtmp = vtmp.data();
     S.sw = sw.data(), S.sphase = sphase.data(), S.lambda = lambda.data(), S.density = density.data(), S.h_rho = h_rho.data(), S.vort_len = vort_len.data();
     S.ncontacts = ncontacts.data(), S.vort = vort.data(), S.cnormal = cnormal.data(), S.sdf_at = sdf_at.data(), S.scene_n = scene_n.data();
-    S.spk = spk.data(), S.spl = spl.data(), S.svh = svh.data(), S.cnv = cnv.data(), S.pair_w = pair_w.data();
+    S.spk = spk.data(), S.spl = spl.data(), S.spd = spd.data(), S.svh = svh.data(), S.cnv = cnv.data(), S.pair_w = pair_w.data();
     S.grid = K::GridSpec::for_radius(c.search_radius, bits);
     S.cell_start = cell_start.data();
     S.nbr = nbr.data(), S.nnbr = nnbr.data(), S.snbr = snbr.data(), S.nsnbr = nsnbr.data(), S.nsolid = nsolid.data();
