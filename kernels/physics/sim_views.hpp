@@ -90,10 +90,10 @@ struct SimViews {
   vec3 *vort = nullptr, *cnormal = nullptr;
   vec4* sdf_at = nullptr;  // scene SDF gradient (xyz) and distance (w) at the last counted positions
   // Packed copies for the neighbour loops (one 16-byte load per neighbour, kernels::Packed):
-  // spk = (sp, phase bits), refreshed at the start of find_neighbors and prepare_constraints;
-  // spl = (sp, lambda) by prepare_constraints for solve_contacts_fluid; spd = (sp, density) at
-  // the start of velocity_effects, svh = (sv, h_rho) by update_velocity and cnv = (cnormal,
-  // vort_len) by the vorticity pass, for velocity_effects.
+  // spk = (sp, phase bits), written by reorder (for find_neighbors) and at the start of
+  // prepare_constraints; spl = (sp, lambda) by prepare_constraints for solve_contacts_fluid;
+  // spd = (sp, density) and svh = (sv, h_rho) by update_velocity and cnv = (cnormal, vort_len)
+  // by the vorticity pass, for velocity_effects.
   Packed *spk = nullptr, *spl = nullptr, *spd = nullptr, *svh = nullptr, *cnv = nullptr;
   // CPU only (kernels::kCachePairs): per list entry (the lists' layout), the spiky gradient
   // (xyz) and poly6 value (w) of the pair at prepare_constraints' positions, which

@@ -239,6 +239,7 @@ void reorder(const Exec& ex, const SimViews& S) {
     S.sv[s] = S.v[id];
     S.sw[s] = S.w[id];
     S.sphase[s] = S.phase[id];
+    S.spk[s] = Packed::of_phase(S.pred[id], S.phase[id]);  // for find_neighbors
   });
 }
 
@@ -322,7 +323,6 @@ template <class Exec>
 void find_neighbors(const Exec& ex, const SimViews& S) {
   // A CPU thread walks a particle's runs alone (Lanes{}); CUDA does from about 270k particles.
   constexpr bool kOneLane = Exec::device == Device::CPU;
-  detail::pack_positions(ex, S);
   ex.for_each_grouped(S.n, kSearchLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
     const int s = static_cast<int>(i);
     const vec3 p = S.sp[s];
@@ -798,7 +798,10 @@ void update_velocity(const Exec& ex, const SimViews& S) {
       if (q.d < S.c.radius * 1.01f && vn0 < 0.f) v += q.grad * (-S.c.restitution * vn0 - vn);
     }
     S.sv[s] = v;
-    S.svh[s] = Packed::of(v, S.h_rho[s]);  // what the vorticity pass gathers of a neighbour
+    // What velocity_effects' loops gather of a neighbour (the phase, needed only among solids,
+    // is read from sphase there): (sp, density), the position final here, and (v, h / rho).
+    S.spd[s] = Packed::of(S.sp[s], S.density[s]);
+    S.svh[s] = Packed::of(v, S.h_rho[s]);
   });
 }
 
@@ -882,9 +885,6 @@ SEAMLESS_HD inline VortSum vorticity_part(const SimViews& S, int s, Lanes g) {
 template <class Exec>
 void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
   if (has_fluid) {
-    // spd = (sp, density): what both loops gather of a neighbour's position (the density for
-    // fluid_forces' K_ij; the phase, needed only among solids, is read from sphase there).
-    ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) { S.spd[s] = Packed::of(S.sp[s], S.density[s]); });
     // Vorticity omega_i = sum_j v_ij x grad_j W_ij (PBF eq. 15), Akinci's colour-field normal
     // n_i = h sum_j (1 / rho_j) grad W_ij (Akinci 2013, eq. 4; dissertation eq. 4.21), and the
     // XSPH sum (PBF eq. 17), which needs only this pass's velocities (kept in vtmp for
