@@ -463,12 +463,18 @@ SEAMLESS_HD inline DensitySum density_part(const SimViews& S, int s, Lanes g) {
   const float inv_rho0 = 1.f / S.c.rest_density, sw = S.c.solid_density_scale;
   DensitySum d{g.lane == 0 ? S.c.W.poly6(0.f) : 0.f, 0.f, {0.f, 0.f, 0.f}};
   const bool mixed = S.nsolid[s] != 0;  // otherwise every neighbour is fluid: no phase loads
+  // Local copies: the stores to pair_w (floats) could otherwise alias the kernel constants in S,
+  // which the compiler would then reload for every pair.
+  const SphKernel W = S.c.W;
+  const int* const list = S.nbrs(s);
+  Packed* const cache = S.pair_w + s * S.nbr_row;
+  const std::int64_t col = S.nbr_col;
   for (int k = g.lane, m = S.nnbr[s]; k < m; k += g.size) {
-    const Packed q = S.spk[S.nbrs(s)[k * S.nbr_col]];  // position and phase in one load
+    const Packed q = S.spk[list[k * col]];  // position and phase in one load
     vec3 r = p - q.xyz();
-    float wgt = S.c.W.poly6(length2(r));
-    const vec3 gw = S.c.W.spiky_grad(r);
-    if constexpr (Cache) S.pair_w[s * S.nbr_row + k * S.nbr_col] = Packed::of(gw, wgt);
+    float wgt = W.poly6(length2(r));
+    const vec3 gw = W.spiky_grad(r);
+    if constexpr (Cache) cache[k * col] = Packed::of(gw, wgt);
     vec3 grad = gw * inv_rho0;
     if (!mixed || phase::is(q.bits(), phase::kFluid)) {
       d.rho += wgt;
