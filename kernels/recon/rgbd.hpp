@@ -23,6 +23,16 @@ struct RgbdLevel {
   // (structured light, Kinect v1: Khoshelham & Elberink 2012, sigma_z ~ z^2), so each geometric
   // residual is divided by (z / 1 m)^2 before the scale and the t-weight see it (in metres "at 1 m").
   bool depth_squared_noise = false;
+  // Which pixels get a photometric row. false: only the geometric inliers (the 20-degree normal test
+  // included). true: every pixel whose projection finds a reference vertex within dist_threshold
+  // (visible, not occluded), whatever its normals: the normal test guards the point-to-plane row
+  // against noisy normals, but the colour residual does not use normals, and on far Kinect depth
+  // (normals from ~1 cm noise) the normal test leaves only a quarter of the pixels (docs/TRACKING.md).
+  bool photometric_all_visible = false;
+  // Photometric rows only where the reference intensity gradient (central difference, intensity
+  // [0, 1] per pixel) is at least this large: flat pixels carry no information about the motion
+  // but their noise still enters the photometric scale (OpenCV RgbdOdometry's minGradientMagnitudes).
+  float min_gradient = 0.f;
 };
 
 // ---- Robust, self-balancing weighting (tracker.weighting: robust) --------------------------------
@@ -107,15 +117,15 @@ SEAMLESS_HD inline bool photometric_residual(const RgbdLevel& L, const Correspon
   if (fabsf(r) > L.max_intensity_diff) return false;
   float gx = 0.5f * (bilinear(L.ref_intensity, u + 1.f, v) - bilinear(L.ref_intensity, u - 1.f, v));
   float gy = 0.5f * (bilinear(L.ref_intensity, u, v + 1.f) - bilinear(L.ref_intensity, u, v - 1.f));
+  if (gx * gx + gy * gy < L.min_gradient * L.min_gradient) return false;
   float iz = 1.f / c.q.z;
   g = vec3{gx * K.fx * iz, gy * K.fy * iz, -(gx * K.fx * c.q.x + gy * K.fy * c.q.y) * iz * iz};
   return true;
 }
 
-// Both rows of a geometric correspondence c of current pixel (x, y), with the fixed weights
-// (L.dof == 0) or the robust ones at the previous step's variances (see above).
-SEAMLESS_HD inline void add_rgbd_rows(RgbdTerms& s, const RgbdLevel& L, const Correspondence& c, int x, int y,
-                                      float geo_var, float photo_var) {
+// The point-to-plane row of correspondence c, with the fixed weight (L.dof == 0) or the robust one at
+// the previous step's variance (see above).
+SEAMLESS_HD inline void add_geometric_row(RgbdTerms& s, const RgbdLevel& L, const Correspondence& c, float geo_var) {
   const float rg = dot(c.n, c.q - c.v);
   float wg = L.geometric_weight;
   if (L.dof > 0.f) {
@@ -128,6 +138,14 @@ SEAMLESS_HD inline void add_rgbd_rows(RgbdTerms& s, const RgbdLevel& L, const Co
   }
   add_row(s.icp, cross(c.q, c.n), c.n, rg, wg);
   s.icp.inliers += 1.f;
+}
+
+// The rows of current pixel (x, y) and its projective correspondence c: the geometric one when c
+// passed every geometric test (`geometric`), the photometric one when the pixel has one; weights as
+// above, at the previous step's variances.
+SEAMLESS_HD inline void add_rgbd_rows(RgbdTerms& s, const RgbdLevel& L, const Correspondence& c, int x, int y,
+                                      float geo_var, float photo_var, bool geometric = true) {
+  if (geometric) add_geometric_row(s, L, c, geo_var);
   float r;
   vec3 g;
   if (!photometric_residual(L, c, x, y, r, g)) return;
@@ -139,6 +157,19 @@ SEAMLESS_HD inline void add_rgbd_rows(RgbdTerms& s, const RgbdLevel& L, const Co
     wi *= t * (geo_var > 0.f && photo_var > 0.f ? geo_var / photo_var : 1.f);
   }
   add_row(s.icp, cross(c.q, g), g, r, wi);
+}
+
+// The correspondence of current pixel (x, y) for both rows: false when it has none for either; with
+// L.photometric_all_visible the normal test decides only `geometric` (see RgbdLevel), otherwise a
+// correspondence is a geometric inlier or nothing.
+SEAMLESS_HD inline bool find_rgbd_correspondence(const RgbdLevel& L, int x, int y, Correspondence& c, bool& geometric) {
+  geometric = true;
+  if (!L.photometric_all_visible) return find_correspondence(L.geo, x, y, c);
+  IcpLevel visible = L.geo;
+  visible.cos_angle = -2.f;  // every normal angle passes: the visibility tests only
+  if (!find_correspondence(visible, x, y, c)) return false;
+  geometric = dot(L.geo.ref_T_cur.rotate(L.geo.cur_normal(x, y)), c.n) >= L.geo.cos_angle;
+  return true;
 }
 
 // Sums the combined geometric + photometric normal equations over the current level (one pass) at

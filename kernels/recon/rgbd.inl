@@ -18,7 +18,9 @@ void rgbd_reduce_into(const Exec& ex, RgbdLevel R, IcpPose* pose, RgbdSums* out,
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
     if (valid_point(L.geo.cur_vertex(x, y))) s.icp.valid = 1.f;
     Correspondence c;
-    if (find_correspondence(L.geo, x, y, c)) add_rgbd_rows(s, L, c, x, y, p.geo_var, p.photo_var);
+    bool geometric;
+    if (find_rgbd_correspondence(L, x, y, c, geometric))
+      add_rgbd_rows(s, L, c, x, y, p.geo_var, p.photo_var, geometric);
     return s;
   }, out, [=] SEAMLESS_HD {
     if (level_done(*pose, update)) return;

@@ -177,6 +177,8 @@ void Tracker::reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, i
     kernels::RgbdLevel R{L, cur.intensity.cview(), rl.intensity.cview(), 1.f, params_.photometric_weight,
                          params_.max_intensity_diff, robust(frame, ref) ? params_.robust_dof : 0.f,
                          params_.depth_noise == "depth_squared"};
+    R.photometric_all_visible = params_.photometric_pixels == "visible";
+    R.min_gradient = params_.min_gradient;
     if (rgbd_sums_.size() != 1 || rgbd_sums_.device() != device_) rgbd_sums_ = Buffer<kernels::RgbdSums>(1, device_);
     kernels::rgbd_reduce_into(ex, R, pose, rgbd_sums_.data(), out, update);
   });

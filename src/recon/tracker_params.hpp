@@ -35,6 +35,10 @@ struct TrackerParams {
   std::string weighting = "fixed";
   float robust_dof = 5.f;                 // degrees of freedom of the t-distribution (Kerl et al. 2013: 5)
   std::string depth_noise = "uniform";    // robust: geometric noise uniform or ~ depth^2 (Kinect v1)
+  // rgbd: the pixels that get a photometric row (kernels/recon/rgbd.hpp, RgbdLevel): the geometric
+  // inliers only, or every pixel that sees the reference surface (the normal test left to geometry).
+  std::string photometric_pixels = "inliers";
+  float min_gradient = 0.f;               // rgbd: photometric rows only where |grad I| >= this (per pixel)
   bool constant_velocity = false;         // start each frame from the last motion instead of the last pose
   float max_translation_jump = 0.3f;      // metres per frame
   float max_rotation_jump_deg = 30.f;     // degrees per frame
@@ -81,6 +85,14 @@ struct TrackerParams {
       "rgbd weighting robust: the geometric residual's noise is uniform, or grows with depth squared "
       "(structured-light sensors such as the Kinect v1)",
       Choices{"uniform", "depth_squared"});
+    v("photometric_pixels", photometric_pixels,
+      "rgbd: photometric rows for the geometric inliers only, or for every pixel whose projection sees the "
+      "reference surface within dist_threshold (the normal test then applies to the geometric rows only)",
+      Choices{"inliers", "visible"});
+    v("min_gradient", min_gradient,
+      "rgbd: photometric rows only where the reference intensity gradient is at least this, intensity [0, 1] "
+      "per pixel (central difference); 0: every pixel",
+      Range{0.0, 1.0});
     v("constant_velocity", constant_velocity, "predict each pose from the previous motion (else from the last pose)");
     v("max_translation_jump", max_translation_jump, "tracking is lost above this per-frame motion, metres",
       Range{0.0, 100.0});

@@ -162,6 +162,7 @@ TrackerParams pair_tracker_params(const RefineParams& p) {
   t.photometric_weight = p.photometric_weight;
   t.weighting = p.weighting;
   t.depth_noise = p.depth_noise;
+  t.photometric_pixels = p.photometric_pixels;
   t.min_inlier_ratio = 0.f;
   t.min_inlier_ratio_vs_last = 0.f;
   t.max_condition = 1e300;

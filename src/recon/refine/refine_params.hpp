@@ -24,6 +24,7 @@ struct RefineParams {
   float photometric_weight = 1.f;          // rgbd pairwise alignment: colour term weight
   std::string weighting = "fixed";         // rgbd pairwise alignment: as tracker.weighting
   std::string depth_noise = "uniform";     // rgbd pairwise alignment, weighting robust: as tracker.depth_noise
+  std::string photometric_pixels = "inliers";  // rgbd pairwise alignment: as tracker.photometric_pixels
   float min_pair_inlier_ratio = 0.3f;      // an aligned pair is kept above this inlier ratio
   float max_pair_correction = 0.1f;        // ... and when it moves the odometry's relative pose less, metres
   float max_pair_correction_deg = 5.f;     // ... and degrees
@@ -59,6 +60,9 @@ struct RefineParams {
       Choices{"fixed", "robust"});
     v("depth_noise", depth_noise, "pair_tracker rgbd, weighting robust: geometric noise uniform or growing with "
       "depth squared (as tracker.depth_noise)", Choices{"uniform", "depth_squared"});
+    v("photometric_pixels", photometric_pixels, "pair_tracker rgbd: photometric rows for the geometric inliers "
+      "only, or for every pixel that sees the other keyframe's surface (as tracker.photometric_pixels)",
+      Choices{"inliers", "visible"});
     v("min_pair_inlier_ratio", min_pair_inlier_ratio, "an aligned pair becomes an edge above this inlier ratio",
       Range{0.0, 1.0});
     v("max_pair_correction", max_pair_correction, "an aligned pair is rejected when it moves the odometry's "
