@@ -175,6 +175,25 @@ SEAMLESS_HD inline bool band_sdf(const Acc& a, vec3 p, BlockCache& c, float* v) 
   return sample_tsdf(a, a.geom.to_voxel(p), c, v) && fabsf(*v) < 0.999f * a.geom.truncation;
 }
 
+// What the fused TSDF knows at a sample, for closing the unseen regions (see surface_crossings).
+// kUnallocated: a corner's block was never allocated: no measurement came within the truncation of it
+// (free space far from every surface, or never in view); kUnseen: the blocks exist (a surface was
+// measured within a block of it) but a corner was never observed: in every view it was behind a
+// surface by more than the truncation (tsdf_fusion.inl, fuse_voxel) or outside the image; kFree and
+// kSolid: observed, the trilinear TSDF in *v is >= 0 or < 0.
+enum SampleState : int { kUnallocated = 0, kUnseen = 1, kFree = 2, kSolid = 3 };
+
+template <class Acc>
+SEAMLESS_HD inline int sample_state(const Acc& a, vec3 p, BlockCache& c, float* v) {
+  const vec3 q = a.geom.to_voxel(p);
+  const Voxel* corner[8];
+  if (!cell_voxels(a, floor_to_int(q), c, corner)) return kUnallocated;
+  for (int k = 0; k < 8; ++k)
+    if (!(corner[k]->weight > 0.f)) return kUnseen;
+  sample_tsdf(a, q, c, v);
+  return *v < 0.f ? kSolid : kFree;
+}
+
 // Zero of the TSDF between p0 (value v0) and p1 (v1) of opposite signs: regula falsi. Along an axis
 // the trilinear field is linear inside a cell; a segment of at most one voxel crosses at most one
 // cell face, so two steps reach the zero of the piecewise-linear field to float rounding.
@@ -205,21 +224,93 @@ struct CandidateOut {
   float* score;
 };
 
-// The surface particles owned by lattice point L: crossings on the three segments L -> L + e_axis.
+// Score of the particles that close unseen regions: below every surface particle (>= 1/sqrt(3) *
+// kAxisShare), above the interior fill (0), so the thinning keeps a measured surface where both meet.
+constexpr float kUnseenScore = 0.25f;
+
+// Where observed free space meets space that no camera saw the scan has no surface, yet something
+// hid that space from every view: the backs of the ball and the can on the demo's desk, and the desk
+// behind and under them. Surfaces are open there, and a particle that enters the unseen space finds
+// nothing under it: the demo's fluid fell through the desk inside the ball and the can
+// (tests/app/demo_surfaces_test.py). So unseen space next to seen free space counts as solid, the
+// conservative reading of a scan (what was never seen empty may be full), and each lattice line that
+// passes from a free sample into unseen space gets a particle midway between the two samples, facing
+// the free side. Samples are at most a voxel apart, as for the crossings, on all three axes, so the
+// boundary gets particles at least as densely as a surface (the thinning removes near duplicates).
+// Unseen: the sample's blocks exist but a corner voxel was never observed (behind a surface by more
+// than the truncation in every view, tsdf_fusion.inl). Unallocated space is ambiguous: hashing
+// allocates only the blocks around measured surfaces, so most free space is unallocated too, and its
+// boundary with seen free space (the top of the blocks over a floor) is no surface. It counts as
+// unseen only where the line, within one block, runs on from it into unseen space (the ball's hidden
+// back: seen free above, a layer of unallocated blocks, then blocks behind its visible front).
+
+// Whether the line from sample j (seen free) of lattice point L, stepping by dir (+-1) along axis,
+// enters unseen space: an unseen sample, or unallocated ones up to a block long before an unseen one.
+template <class Acc>
+SEAMLESS_HD inline bool enters_unseen(const Acc& a, int3 L, int axis, int j, int dir, int n, float spacing,
+                                      BlockCache& c) {
+  const int reach = static_cast<int>(ceilf(kBlockSide * a.geom.voxel_size * n / spacing)) + 1;
+  for (int k = 1; k <= reach; ++k) {
+    float v = 0.f;
+    const int st = sample_state(a, line_sample(L, axis, j + dir * k, n, spacing), c, &v);
+    if (st == kUnseen) return true;
+    if (st != kUnallocated) return false;
+  }
+  return false;
+}
+
+// The boundary particles of sample j (at p, state st, TSDF v) of lattice point L's segment along
+// axis, towards its neighbours: sample j - 1 (state sm, at pm) and j + 1 (sp, at pp). A seen free
+// sample next to unseen space gets a particle midway, facing the free side. So does a solid one
+// within half a spacing of the surface (|v| < s/2, the near side of a band) whose surface lies in
+// unseen space: the desk under the ball's overhang, seen from the side at a grazing angle, has its
+// band but no free voxel over it; the particle goes where the TSDF puts the surface, at most one
+// step on, facing the unseen side. (Deeper solid next to unseen space is the inner end of a band,
+// no surface.) Each pair is found once, by the segment that owns sample j (j < n: sample n is the
+// next segment's sample 0).
+template <class Acc>
+SEAMLESS_HD inline int unseen_boundaries(const Acc& a, int3 L, int axis, int j, int n, float spacing, int st, float v,
+                                         vec3 p, vec3 pm, int sm, vec3 pp, int sp, BlockCache& c, CandidateOut out,
+                                         int found) {
+  const bool seen_free = st == kFree;
+  if (!seen_free && !(st == kSolid && fabsf(v) < 0.5f * spacing)) return 0;
+  const vec3 e{axis == 0 ? 1.f : 0.f, axis == 1 ? 1.f : 0.f, axis == 2 ? 1.f : 0.f};
+  const float h = spacing / static_cast<float>(n);
+  int k = 0;
+  for (int dir = -1; dir <= 1; dir += 2) {
+    const int nb = dir < 0 ? sm : sp;
+    if (nb == kFree || nb == kSolid || !enters_unseen(a, L, axis, j, dir, n, spacing, c)) continue;
+    if (out.position) {
+      const vec3 q = dir < 0 ? pm : pp;
+      out.position[found + k] = seen_free ? (p + q) * 0.5f : p + e * (static_cast<float>(dir) * fminf(fabsf(v), h));
+      out.normal[found + k] = e * static_cast<float>(seen_free ? -dir : dir);
+      out.score[found + k] = kUnseenScore;
+    }
+    ++k;
+  }
+  return k;
+}
+
+// The surface particles owned by lattice point L: crossings on the three segments L -> L + e_axis,
+// and the boundaries of unseen space at their samples (unseen_boundaries).
 // Writes them to out (unless out.position is null); returns how many there are.
 template <class Acc>
 SEAMLESS_HD inline int surface_crossings(const Acc& a, int3 L, float spacing, CandidateOut out) {
   const int n = line_steps(a.geom.voxel_size, spacing);
+  const float band = 0.999f * a.geom.truncation;  // as band_sdf
   BlockCache c;
   int found = 0;
   for (int axis = 0; axis < 3; ++axis) {
-    vec3 p0 = line_sample(L, axis, 0, n, spacing);
-    float v0 = 0.f;
-    bool ok0 = band_sdf(a, p0, c, &v0);
+    vec3 pm = line_sample(L, axis, -1, n, spacing), p0 = line_sample(L, axis, 0, n, spacing);
+    float vm = 0.f, v0 = 0.f;
+    int sm = sample_state(a, pm, c, &vm), s0 = sample_state(a, p0, c, &v0);
+    bool ok0 = s0 >= kFree && fabsf(v0) < band;
     for (int j = 1; j <= n; ++j) {
       vec3 p1 = line_sample(L, axis, j, n, spacing);
       float v1 = 0.f;
-      bool ok1 = band_sdf(a, p1, c, &v1);
+      int s1 = sample_state(a, p1, c, &v1);
+      bool ok1 = s1 >= kFree && fabsf(v1) < band;
+      found += unseen_boundaries(a, L, axis, j - 1, n, spacing, s0, v0, p0, pm, sm, p1, s1, c, out, found);
       if (ok0 && ok1 && (v0 < 0.f) != (v1 < 0.f)) {
         vec3 x = line_zero(a, p0, v0, p1, v1, c);
         float vx = 0.f;
@@ -233,7 +324,7 @@ SEAMLESS_HD inline int surface_crossings(const Acc& a, int3 L, float spacing, Ca
           ++found;
         }
       }
-      p0 = p1, v0 = v1, ok0 = ok1;
+      pm = p0, sm = s0, p0 = p1, v0 = v1, ok0 = ok1, s0 = s1;
     }
   }
   return found;
