@@ -321,9 +321,10 @@ SEAMLESS_HD inline void store_candidate(int* list, std::int64_t col, int cap, in
 
 template <class Exec>
 void find_neighbors(const Exec& ex, const SimViews& S) {
-  // A CPU thread walks a particle's runs alone (Lanes{}); CUDA does from about 270k particles.
-  constexpr bool kOneLane = Exec::device == Device::CPU;
   ex.for_each_grouped(S.n, kSearchLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
+    // A CPU thread walks a particle's runs alone (Lanes{}); CUDA does from about 270k particles.
+    // (Declared here: an extended CUDA lambda cannot capture what an if constexpr tests.)
+    constexpr bool kOneLane = Exec::device == Device::CPU;
     const int s = static_cast<int>(i);
     const vec3 p = S.sp[s];
     const float R = S.c.search_radius, R2 = R * R;
