@@ -136,13 +136,16 @@ TEST(TrackSequence, UnavailableTrackerSaysSo) {
 }
 
 // Our best tracker on freiburg1 (the tracker section of configs/tum_fr1.yaml): RGB-D frame-to-model
-// with robust self-balancing weights and the last frame's image as the photometric reference, a
-// constant-velocity prediction, photometric weight 1. Volume at 1 cm (see default_params).
+// with robust self-balancing weights, the Kinect's depth-squared noise, a colour row for every
+// visible pixel and the last frame's image as the photometric reference, a constant-velocity
+// prediction, photometric weight 1. Volume at 1 cm (see default_params).
 TrackSequenceParams best_tum_params() {
   TrackSequenceParams p = default_params("frame_to_model");
   p.tracker.kind = "rgbd";
   p.tracker.photometric_weight = 1.f;
   p.tracker.weighting = "robust";
+  p.tracker.depth_noise = "depth_squared";
+  p.tracker.photometric_pixels = "visible";
   p.tracker.photometric_reference = "frame";
   p.tracker.constant_velocity = true;
   p.write_files = false;
@@ -184,6 +187,8 @@ TEST(TrackSequence, TumFreiburg1RpyBestTrackerWithinThreeCentimetres) {
   refine.enabled = true;
   refine.keyframe_every = 5;
   refine.weighting = "robust";
+  refine.depth_noise = "depth_squared";
+  refine.photometric_pixels = "visible";
   auto again = make_source(test::tum_input(dir));
   RefineResult r = refine_trajectory(*again, t.result.trajectory, refine, p.preprocess, Device::CPU, tracked);
   const Trajectory gt = read_tum_trajectory(dir + "/groundtruth.txt");
