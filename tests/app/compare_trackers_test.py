@@ -1,7 +1,8 @@
 #!/usr/bin/python3
-"""Issue 5: on the real freiburg1_rpy frames our best tracker (the one configs/tum_fr1.yaml selects)
-tracks every frame and has a lower ATE RMSE than every OpenCV odometry on the same frames, asserted
-on the numbers scripts/compare_trackers writes (results.json).
+"""Issue 5: on the real freiburg1_rpy frames our best tracker (configs/tum_fr1.yaml as it is: its
+tracker, and its Ceres refinement when it enables one) tracks every frame and has a lower ATE RMSE
+than every OpenCV odometry on the same frames, both as OpenCV gives it and followed by the same
+refinement as ours, asserted on the numbers scripts/compare_trackers writes (results.json).
 
 usage: compare_trackers_test.py SEAMLESS SOURCE_DIR DATA_DIR OUT_DIR
 Exit 77 (ctest: skipped) when the data folder is absent or no OpenCV odometry is in the build; an
@@ -28,7 +29,8 @@ def main():
         return SKIP
     config = os.path.join(src, "configs", "tum_fr1.yaml")
     with open(config) as f:
-        tracker = yaml.safe_load(f)["tracker"]
+        cfg = yaml.safe_load(f)
+    tracker, refined = cfg["tracker"], bool(cfg.get("refine", {}).get("enabled", False))
     best_kind, best_mode = tracker["kind"], tracker.get("mode", "frame_to_model")
     listing = subprocess.run([seamless, "config", "--list"], capture_output=True, text=True, check=True).stdout
     kind_line = next(l for l in listing.splitlines() if "`tracker.kind`" in l)
@@ -39,18 +41,18 @@ def main():
     t0 = time.monotonic()
     cmd = [sys.executable, os.path.join(src, "scripts", "compare_trackers"), seq, "--seamless", seamless,
            "--config", config, "--out", out, "--kinds", ",".join([best_kind] + opencv), "--modes", best_mode,
-           "--no-ceres", "--no-plots", "--device", "cpu"]
+           "--no-plots", "--device", "cpu"]
     print(" ".join(cmd), flush=True)
     subprocess.run(cmd, check=True)
     print(f"comparison took {time.monotonic() - t0:.0f} s", flush=True)
     with open(os.path.join(out, "results.json")) as f:
         rows = json.load(f)
 
-    best = next(r for r in rows if r["kind"] == best_kind and r["mode"] == best_mode and not r["refined"])
+    best = next(r for r in rows if r["kind"] == best_kind and r["mode"] == best_mode and r["refined"] == refined)
     assert best["status"] == "ok", f"our best tracker ({best_kind} {best_mode}) did not run: {best['status']}"
     assert best["frames"] == FRAMES, f"{best['frames']} frames tracked, expected {FRAMES}"
     assert best["lost"] == 0, f"our best tracker lost {best['lost']} of {FRAMES} frames"
-    print(f"ours ({best_kind} {best_mode}): ATE RMSE {100 * best['ate_rmse_m']:.2f} cm, lost 0")
+    print(f"ours ({best['tracker']}): ATE RMSE {100 * best['ate_rmse_m']:.2f} cm, lost 0")
 
     compared = 0
     for r in rows:
@@ -60,15 +62,15 @@ def main():
             print(f"SKIP row {r['kind']}: not available in this build")
             continue
         assert r["status"] == "ok", f"{r['kind']} did not run: {r['status']}"
-        print(f"{r['kind']}: ATE RMSE {100 * r['ate_rmse_m']:.2f} cm, lost {r['lost']} / {r['frames']}")
+        print(f"{r['tracker']}: ATE RMSE {100 * r['ate_rmse_m']:.2f} cm, lost {r['lost']} / {r['frames']}")
         assert best["ate_rmse_m"] < r["ate_rmse_m"], (
-            f"{r['kind']} has ATE RMSE {100 * r['ate_rmse_m']:.2f} cm, not above ours "
+            f"{r['tracker']} has ATE RMSE {100 * r['ate_rmse_m']:.2f} cm, not above ours "
             f"{100 * best['ate_rmse_m']:.2f} cm")
         compared += 1
     if compared == 0:
         print("SKIP: no OpenCV odometry in this build (OpenCV rgbd contrib module off)")
         return SKIP
-    print(f"ours beats all {compared} OpenCV odometries")
+    print(f"ours beats all {compared} OpenCV rows (4 odometries, alone and with our refinement)")
     return 0
 
 

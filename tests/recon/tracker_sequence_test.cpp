@@ -165,7 +165,7 @@ TEST(TrackSequence, TumFreiburg1RpyBestTrackerTracksEveryFrame) {
   RecordProperty("ate_rmse_m", std::to_string(ate.trans.rmse));
 }
 
-// Issue 5 asks ATE RMSE <= 3 cm here. The tracker alone measures 2.5 cm at 5 mm (session 5: robust
+// Issue 5 asks ATE RMSE <= 3 cm here. The tracker alone measures 2.5 cm at 5 mm (session 4: robust
 // weights, depth-squared noise, colour on every visible pixel; 3.3 cm before them; frame-to-frame RGB-D 3.1 cm, geometric ICP much worse: on these frames the Kinect depth shows about 25 % less rotation
 // between frames than the ground truth and the colour do, see docs/TRACKING.md). Our best tracker
 // is therefore the tracker followed by the Ceres refinement (the refine section of
