@@ -6,16 +6,16 @@
 namespace seamless::kernels {
 
 template <class Exec>
-void icp_reduce_into(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSums* out, IcpSums* level_sums,
-                     IcpUpdate update) {
+void icp_reduce_into(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSums* out, IcpSums* done, IcpUpdate update) {
   const int w = L.cur_vertex.width;
   ex.transform_reduce_into(
       L.cur_vertex.count(),
       [=] SEAMLESS_HD(std::int64_t i) {
         IcpTerms s{};
-        if (level_done(*pose, update)) return s;
+        const IcpPose p = *pose;  // the flags with the estimate: one round trip to memory, not two
+        if (level_done(p, update)) return s;
         IcpLevel l = L;
-        l.ref_T_cur = to_se3(*pose);
+        l.ref_T_cur = to_se3(p);
         int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
         if (valid_point(l.cur_vertex(x, y))) s.valid = 1.f;
         Correspondence c;
@@ -24,8 +24,8 @@ void icp_reduce_into(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSums* out, Ic
       },
       out, [=] SEAMLESS_HD {
         if (level_done(*pose, update)) return;
-        *level_sums = *out;
         gauss_newton_update(*out, *pose, update, L);
+        if (level_done(*pose, IcpUpdate::step)) *done = *out;
       });
 }
 

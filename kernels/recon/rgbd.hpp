@@ -175,10 +175,11 @@ SEAMLESS_HD inline bool find_rgbd_correspondence(const RgbdLevel& L, int x, int 
 // Sums the combined geometric + photometric normal equations over the current level (one pass) at
 // the estimate *pose into *out on the device; then, in the same launch, copies the system into
 // *level_sums (where the tracker reads each level's last system), with robust weighting updates the
-// variances in *pose, and applies `update` (like icp_reduce_into). error holds the weighted sum of
-// both terms; inliers counts geometric correspondences.
+// variances in *pose, and applies `update`, copying the system to *done too when the step makes the
+// level done (like icp_reduce_into). error holds the weighted sum of both terms; inliers counts
+// geometric correspondences.
 template <class Exec>
-void rgbd_reduce_into(const Exec& ex, RgbdLevel level, IcpPose* pose, RgbdSums* out, IcpSums* level_sums,
+void rgbd_reduce_into(const Exec& ex, RgbdLevel level, IcpPose* pose, RgbdSums* out, IcpSums* level_sums, IcpSums* done,
                       IcpUpdate update);
 
 // Intensity in [0, 1] from 8-bit RGB (ITU-R BT.601 luma weights).

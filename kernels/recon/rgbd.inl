@@ -7,13 +7,13 @@ namespace seamless::kernels {
 
 template <class Exec>
 void rgbd_reduce_into(const Exec& ex, RgbdLevel R, IcpPose* pose, RgbdSums* out, IcpSums* level_sums,
-                      IcpUpdate update) {
+                      IcpSums* done, IcpUpdate update) {
   const int w = R.geo.cur_vertex.width;
   ex.transform_reduce_into(R.geo.cur_vertex.count(), [=] SEAMLESS_HD(std::int64_t i) {
     RgbdTerms s{};
-    if (level_done(*pose, update)) return s;
+    const IcpPose p = *pose;  // the flags with the estimate: one round trip to memory, not two
+    if (level_done(p, update)) return s;
     RgbdLevel L = R;
-    const IcpPose p = *pose;
     L.geo.ref_T_cur = to_se3(p);
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
     if (valid_point(L.geo.cur_vertex(x, y))) s.icp.valid = 1.f;
@@ -26,6 +26,7 @@ void rgbd_reduce_into(const Exec& ex, RgbdLevel R, IcpPose* pose, RgbdSums* out,
     if (level_done(*pose, update)) return;
     *level_sums = out->icp;
     gauss_newton_update(out->icp, *pose, update, R.geo);  // with the variances this system was built with
+    if (level_done(*pose, IcpUpdate::step)) *done = out->icp;
     if (R.dof > 0.f) update_scale(*out, *pose);
   });
 }
@@ -44,6 +45,6 @@ void rgb_to_intensity(const Exec& ex, View2D<const uchar3> rgb, View2D<float> ou
 
 #define SEAMLESS_INSTANTIATE_RGBD(EXEC)                                                   \
   namespace seamless::kernels {                                                           \
-  template void rgbd_reduce_into<EXEC>(const EXEC&, RgbdLevel, IcpPose*, RgbdSums*, IcpSums*, IcpUpdate); \
+  template void rgbd_reduce_into<EXEC>(const EXEC&, RgbdLevel, IcpPose*, RgbdSums*, IcpSums*, IcpSums*, IcpUpdate); \
   template void rgb_to_intensity<EXEC>(const EXEC&, View2D<const uchar3>, View2D<float>); \
   }

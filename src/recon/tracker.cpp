@@ -173,14 +173,14 @@ void Tracker::reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, i
                       static_cast<float>(std::cos(params_.angle_threshold_deg * kPi / 180.0)),
                       static_cast<float>(params_.stop_rotation_deg * kPi / 180.0), params_.stop_translation};
   with_exec(device_, [&](const auto& ex) {
-    if (!use_photometric(frame, ref)) return kernels::icp_reduce_into(ex, L, pose, &state()->step, out, update);
+    if (!use_photometric(frame, ref)) return kernels::icp_reduce_into(ex, L, pose, out, &state()->done, update);
     kernels::RgbdLevel R{L, cur.intensity.cview(), rl.intensity.cview(), 1.f, params_.photometric_weight,
                          params_.max_intensity_diff, robust(frame, ref) ? params_.robust_dof : 0.f,
                          params_.depth_noise == "depth_squared"};
     R.photometric_all_visible = params_.photometric_pixels == "visible";
     R.min_gradient = params_.min_gradient;
     if (rgbd_sums_.size() != 1 || rgbd_sums_.device() != device_) rgbd_sums_ = Buffer<kernels::RgbdSums>(1, device_);
-    kernels::rgbd_reduce_into(ex, R, pose, rgbd_sums_.data(), out, update);
+    kernels::rgbd_reduce_into(ex, R, pose, rgbd_sums_.data(), out, &state()->done, update);
   });
 }
 
@@ -220,7 +220,8 @@ TrackResult Tracker::track(const FramePyramid& frame, const ReferenceMaps& ref,
   r.iterations = pose.steps;
   bool degenerate = false;
   if (levels > 0 && params_.iterations[0] > 0) {  // statistics of the finest level's last system
-    const kernels::IcpSums& s = st.sums[0];
+    // a level that converged or stalled keeps its last system in `done` (its skipped steps sum nothing)
+    const kernels::IcpSums& s = pose.converged || pose.stalled ? st.done : st.sums[0];
     IcpStep step = solve_icp_step(s);
     r.inliers = static_cast<std::int64_t>(s.inliers);
     r.inlier_ratio = s.valid > 0 ? s.inliers / s.valid : 0.0;
