@@ -72,17 +72,25 @@ struct FrameInput {
   float min_depth = 0.3f, max_depth = 4.f;
 };
 
-// The farthest valid depth reading of every tile x tile pixel tile of a frame, row-major, as
-// float_bits (non-negative floats order as their bits; 0: no reading). A voxel behind it by more
-// than the truncation cannot be changed by the frame. allocate_blocks fills it (it reads every
-// pixel anyway) after clear_depth_tiles.
-struct DepthTiles {
-  std::int32_t* zmax = nullptr;  // nullptr: no tiles, nothing is culled
+// An image cut into tile x tile pixel tiles, row-major (the last row and column may be partial):
+// the layout of the per-tile arrays below (DepthTiles, RayIntervals).
+struct TileGrid {
   int tile = 8, tiles_x = 0, tiles_y = 0;
-  SEAMLESS_HD std::int64_t count() const { return static_cast<std::int64_t>(tiles_x) * tiles_y; }
-  SEAMLESS_HD std::int32_t* at(int x, int y) const {
-    return zmax + static_cast<std::int64_t>(y / tile) * tiles_x + x / tile;
+  static TileGrid covering(int width, int height, int tile) {
+    return {tile, (width + tile - 1) / tile, (height + tile - 1) / tile};
   }
+  SEAMLESS_HD std::int64_t count() const { return static_cast<std::int64_t>(tiles_x) * tiles_y; }
+  SEAMLESS_HD std::int64_t tile_of(int x, int y) const {
+    return static_cast<std::int64_t>(y / tile) * tiles_x + x / tile;
+  }
+};
+
+// The farthest valid depth reading of every tile of a frame, as float_bits (non-negative floats
+// order as their bits; 0: no reading). A voxel behind it by more than the truncation cannot be
+// changed by the frame. allocate_blocks fills it (it reads every pixel anyway) after
+// clear_depth_tiles.
+struct DepthTiles : TileGrid {
+  std::int32_t* zmax = nullptr;  // nullptr: no tiles, nothing is culled
 };
 template <class Exec>
 void clear_depth_tiles(const Exec& ex, DepthTiles tiles);
@@ -139,11 +147,8 @@ struct RaycastOutput {
 // so that a ray marches only from its tile's near to its far depth and a tile without blocks casts
 // no ray at all. Depths are stored as the bits of positive floats, which order like the floats,
 // so integer atomic_min / atomic_max splat them on both backends.
-struct RayIntervals {
-  std::int32_t* bits = nullptr;  // 2 per tile, row-major: [2t] near, [2t+1] far; nullptr: no intervals
-  int tile = 8, tiles_x = 0, tiles_y = 0;
-  SEAMLESS_HD std::int64_t count() const { return static_cast<std::int64_t>(tiles_x) * tiles_y; }
-  SEAMLESS_HD int tile_of(int x, int y) const { return (y / tile) * tiles_x + x / tile; }
+struct RayIntervals : TileGrid {
+  std::int32_t* bits = nullptr;  // 2 per tile: [2t] near, [2t+1] far; nullptr: no intervals
 };
 constexpr std::int32_t kEmptyNear = 0x7f800000;  // +infinity
 constexpr std::int32_t kEmptyFar = 0;            // +0: no block splatted

@@ -74,7 +74,7 @@ void allocate_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> f
     float d = in.depth(x, y);
     if (!(d >= in.min_depth && d <= in.max_depth)) return;
     if (tiles.zmax) {  // the plain read spares most atomics once the tile holds its far reading
-      std::int32_t* tile = tiles.at(x, y);
+      std::int32_t* tile = tiles.zmax + tiles.tile_of(x, y);
       if (float_bits(d) > atomic_load(tile)) atomic_max(tile, float_bits(d));
     }
     vec3 p = in.K.unproject(static_cast<float>(x), static_cast<float>(y), d);
@@ -91,7 +91,7 @@ SEAMLESS_HD inline bool tiles_reach(const DepthTiles& t, int u0, int u1, int v0,
   const std::int32_t zb = float_bits(fmaxf(z, 0.f));
   for (int ty = v0 / t.tile; ty <= v1 / t.tile; ++ty)
     for (int tx = u0 / t.tile; tx <= u1 / t.tile; ++tx)
-      if (t.zmax[static_cast<std::int64_t>(ty) * t.tiles_x + tx] >= zb) return true;
+      if (t.zmax[t.tile_of(tx * t.tile, ty * t.tile)] >= zb) return true;
   return false;
 }
 

@@ -106,7 +106,7 @@ void splat_ray_intervals(const Exec& ex, HashTableView t, VoxelGeometry geom, In
     const std::int32_t z_near = float_bits(s.z0), z_far = float_bits(s.z1);
     for (int ty = y0 / iv.tile; ty <= y1 / iv.tile; ++ty)
       for (int tx = x0 / iv.tile; tx <= x1 / iv.tile; ++tx) {
-        std::int32_t* tile = iv.bits + 2 * (static_cast<std::int64_t>(ty) * iv.tiles_x + tx);
+        std::int32_t* tile = iv.bits + 2 * iv.tile_of(tx * iv.tile, ty * iv.tile);
         atomic_min(tile, z_near);
         atomic_max(tile + 1, z_far);
       }
@@ -180,7 +180,7 @@ SEAMLESS_HD inline void raycast_pixel(const Acc& a, int x, int y, const Intrinsi
   const float min_step = 0.5f / length(d);  // half a voxel
   float z = min_depth, z_end = max_depth;
   if (iv.bits) {  // march only where blocks are (Niessner section 4.3); no block here: no ray
-    const int t = iv.tile_of(x, y);
+    const std::int64_t t = iv.tile_of(x, y);
     const float z_near = bits_float(iv.bits[2 * t]), z_far = bits_float(iv.bits[2 * t + 1]);
     z = fmaxf(z, z_near - min_step), z_end = z_far > 0.f ? fminf(z_end, z_far + min_step) : 0.f;
   }

@@ -106,11 +106,9 @@ void VoxelHashVolume::integrate(const Image<float>& depth, const Image<uchar3>& 
 void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTimer* timer) {
   kernels::DepthTiles tiles;  // empty: every block in the frustum is listed
   if (params_.occlusion_tile > 0) {
-    tiles.tile = params_.occlusion_tile;
-    tiles.tiles_x = (in.depth.width + tiles.tile - 1) / tiles.tile;
-    tiles.tiles_y = (in.depth.height + tiles.tile - 1) / tiles.tile;
-    depth_tiles_.reserve_discard(tiles.count(), device_);
-    tiles.zmax = depth_tiles_.data();
+    const auto grid = kernels::TileGrid::covering(in.depth.width, in.depth.height, params_.occlusion_tile);
+    depth_tiles_.reserve_discard(grid.count(), device_);
+    tiles = {grid, depth_tiles_.data()};
   }
   for (int attempt = 0;; ++attempt) {
     with_exec(device_, [&](const auto& ex) {
@@ -299,11 +297,9 @@ void VoxelHashVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, Ra
   kernels::RaycastOutput out{maps.depth.view(), maps.vertex.view(), maps.normal.view(), maps.color.view()};
   kernels::RayIntervals iv;  // empty: every ray marches from min_depth
   if (params_.raycast_tile > 0) {
-    iv.tile = params_.raycast_tile;
-    iv.tiles_x = (K.width + iv.tile - 1) / iv.tile;
-    iv.tiles_y = (K.height + iv.tile - 1) / iv.tile;
-    intervals_.reserve_discard(2 * iv.count(), device_);
-    iv.bits = intervals_.data();
+    const auto grid = kernels::TileGrid::covering(K.width, K.height, params_.raycast_tile);
+    intervals_.reserve_discard(2 * grid.count(), device_);
+    iv = {grid, intervals_.data()};
   }
   with_exec(device_, [&](const auto& ex) {
     staged(timer, "raycast", [&] {
