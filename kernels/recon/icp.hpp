@@ -223,22 +223,24 @@ SEAMLESS_HD inline bool level_done(const IcpPose& p, IcpUpdate u) {
 
 // One Gauss-Newton step: solves the system s and applies the update to p; first_step (a level's
 // first) clears the stall and convergence of the previous level. A step xi = (omega, upsilon)
-// smaller than L's stop thresholds marks the level converged.
-SEAMLESS_HD inline void gauss_newton_update(const IcpSums& s, IcpPose& p, IcpUpdate u, const IcpLevel& L) {
-  if (u == IcpUpdate::none) return;
+// smaller than L's stop thresholds marks the level converged. True when this step made the level
+// done (it stalled or converged), so that the caller keeps its system.
+SEAMLESS_HD inline bool gauss_newton_update(const IcpSums& s, IcpPose& p, IcpUpdate u, const IcpLevel& L) {
+  if (u == IcpUpdate::none) return false;
   if (u == IcpUpdate::first_step) p.stalled = p.converged = 0;
-  if (level_done(p, u)) return;
+  if (level_done(p, u)) return false;
   ++p.steps;
   double xi[6];
   if (!solve_normal_equations(s, xi)) {
     p.stalled = 1;
-    return;
+    return true;
   }
   left_update(p, xi);
   const double rot2 = xi[0] * xi[0] + xi[1] * xi[1] + xi[2] * xi[2];
   const double tra2 = xi[3] * xi[3] + xi[4] * xi[4] + xi[5] * xi[5];
   const double sr = L.stop_rotation, st = L.stop_translation;
-  if (rot2 < sr * sr && tra2 < st * st) p.converged = 1;
+  p.converged = rot2 < sr * sr && tra2 < st * st;
+  return p.converged;
 }
 
 // Sums the point-to-plane normal equations over every pixel of the current level (one pass) at the

@@ -23,9 +23,7 @@ void icp_reduce_into(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSums* out, Ic
         return s;
       },
       out, [=] SEAMLESS_HD {
-        if (level_done(*pose, update)) return;
-        gauss_newton_update(*out, *pose, update, L);
-        if (level_done(*pose, IcpUpdate::step)) *done = *out;
+        if (gauss_newton_update(*out, *pose, update, L)) *done = *out;
       });
 }
 

@@ -25,8 +25,8 @@ void rgbd_reduce_into(const Exec& ex, RgbdLevel R, IcpPose* pose, RgbdSums* out,
   }, out, [=] SEAMLESS_HD {
     if (level_done(*pose, update)) return;
     *level_sums = out->icp;
-    gauss_newton_update(out->icp, *pose, update, R.geo);  // with the variances this system was built with
-    if (level_done(*pose, IcpUpdate::step)) *done = out->icp;
+    // with the variances this system was built with
+    if (gauss_newton_update(out->icp, *pose, update, R.geo)) *done = out->icp;
     if (R.dof > 0.f) update_scale(*out, *pose);
   });
 }
