@@ -5,11 +5,13 @@ than every OpenCV odometry on the same frames, both as OpenCV gives it and follo
 refinement as ours, asserted on the numbers scripts/compare_trackers writes (results.json).
 
 usage: compare_trackers_test.py SEAMLESS SOURCE_DIR DATA_DIR OUT_DIR
-Exit 77 (ctest: skipped) when the data folder is absent or no OpenCV odometry is in the build; an
+Exit 77 (ctest: skipped) when the data folder is absent, snakemake (which compare_trackers runs its
+grid through) is not installed, or no OpenCV odometry is in the build; an
 OpenCV row that is "not available in this build" is skipped on its own. Debian python3 + python3-yaml.
 """
 import json
 import os
+import shutil
 import subprocess
 import sys
 import time
@@ -26,6 +28,9 @@ def main():
     seq = os.path.join(data, SEQ)
     if not os.path.isdir(seq):
         print(f"SKIP: {seq} is absent (shared test data)")
+        return SKIP
+    if not shutil.which("snakemake"):
+        print("SKIP: snakemake is not installed (apt-get install snakemake); compare_trackers needs it")
         return SKIP
     config = os.path.join(src, "configs", "tum_fr1.yaml")
     with open(config) as f:
