@@ -17,6 +17,14 @@ namespace memory {
 void* allocate(std::size_t bytes, Device d);  // throws Error naming the size when out of memory
 void release(void* p, Device d) noexcept;
 void copy(void* dst, Device dst_dev, const void* src, Device src_dev, std::size_t bytes);
+// Page-locked host memory (cudaMallocHost), so that host-device copies run at full PCIe speed and
+// can be asynchronous; ordinary host memory where CUDA is not built or no GPU is usable.
+void* allocate_pinned(std::size_t bytes);
+bool is_pinned(const void* p);  // allocated by allocate_pinned and actually page-locked
+// A copy queued on a CUDA stream (null: the legacy default stream); returns before it is done
+// when the host side is page-locked, so that memory must stay untouched until the stream gets
+// there. Host-to-host copies are plain memcpy.
+void copy_async(void* dst, Device dst_dev, const void* src, Device src_dev, std::size_t bytes, void* stream = nullptr);
 void fill_zero(void* p, Device d, std::size_t bytes);
 std::size_t bytes_in_use(Device d);  // live bytes allocated through Buffer on this device
 }  // namespace memory
@@ -29,6 +37,14 @@ class Buffer {
   Buffer() = default;
   Buffer(std::int64_t n, Device d) : device_(d), size_(n) {
     if (n > 0) data_ = static_cast<T*>(memory::allocate(sizeof(T) * n, d));
+  }
+  // Host memory that is page-locked when a GPU is usable (memory::allocate_pinned): for data that
+  // is uploaded often, such as camera frames.
+  static Buffer pinned_host(std::int64_t n) {
+    Buffer b;
+    b.size_ = n;
+    if (n > 0) b.data_ = static_cast<T*>(memory::allocate_pinned(sizeof(T) * n));
+    return b;
   }
   static Buffer from_host(const std::vector<T>& v, Device d) {
     Buffer b(static_cast<std::int64_t>(v.size()), d);
@@ -55,6 +71,10 @@ class Buffer {
   void zero() { memory::fill_zero(data_, device_, bytes()); }
   void copy_from_host(const T* src, std::int64_t n) { memory::copy(data_, device_, src, Device::CPU, sizeof(T) * n); }
   void copy_from(const Buffer& o) { memory::copy(data_, device_, o.data_, o.device_, std::min(bytes(), o.bytes())); }
+  // memory::copy_async's rules: o must stay unchanged until the stream has done the copy.
+  void copy_from_async(const Buffer& o, void* stream = nullptr) {
+    memory::copy_async(data_, device_, o.data_, o.device_, std::min(bytes(), o.bytes()), stream);
+  }
   std::vector<T> to_host() const {
     std::vector<T> v(static_cast<std::size_t>(size_));
     memory::copy(v.data(), Device::CPU, data_, device_, bytes());
@@ -88,6 +108,12 @@ class Image {
  public:
   Image() = default;
   Image(int w, int h, Device d) : buf_(static_cast<std::int64_t>(w) * h, d), w_(w), h_(h) {}
+  static Image pinned_host(int w, int h) {
+    Image im;
+    im.buf_ = Buffer<T>::pinned_host(static_cast<std::int64_t>(w) * h);
+    im.w_ = w, im.h_ = h;
+    return im;
+  }
   static Image from_host(const std::vector<T>& v, int w, int h, Device d) {
     Image im(w, h, d);
     im.buf_.copy_from_host(v.data(), im.buf_.size());

@@ -15,25 +15,29 @@ namespace {
 struct Ledger {
   std::mutex mutex;
   std::unordered_map<void*, std::size_t> sizes;
+  std::unordered_map<void*, bool> pinned;  // host allocations from cudaMallocHost (freed by cudaFreeHost)
   std::size_t bytes[2] = {0, 0};
 };
 Ledger& ledger() {
   static Ledger l;
   return l;
 }
-void record(void* p, std::size_t bytes, Device d) {
+void record(void* p, std::size_t bytes, Device d, bool pinned = false) {
   Ledger& l = ledger();
   std::lock_guard lock(l.mutex);
   l.sizes[p] = bytes;
   l.bytes[static_cast<int>(d)] += bytes;
+  if (pinned) l.pinned[p] = true;
 }
-void forget(void* p, Device d) {
+// Forgets p; true when it was page-locked host memory.
+bool forget(void* p, Device d) {
   Ledger& l = ledger();
   std::lock_guard lock(l.mutex);
   auto it = l.sizes.find(p);
-  if (it == l.sizes.end()) return;
+  if (it == l.sizes.end()) return false;
   l.bytes[static_cast<int>(d)] -= it->second;
   l.sizes.erase(it);
+  return l.pinned.erase(p) > 0;
 }
 [[noreturn]] void out_of_memory(std::size_t bytes, Device d) {
   throw Error("out of " + std::string(device_name(d)) + " memory allocating " + std::to_string(bytes >> 20) +
@@ -64,9 +68,34 @@ void* allocate(std::size_t bytes, Device d) {
   return p;
 }
 
+void* allocate_pinned(std::size_t bytes) {
+  if (bytes == 0) return nullptr;
+#if SEAMLESS_HAS_CUDA
+  void* p = nullptr;
+  if (cudaMallocHost(&p, bytes) == cudaSuccess) {
+    record(p, bytes, Device::CPU, /*pinned=*/true);
+    return p;
+  }
+  cudaGetLastError();  // no GPU or no page-locked memory left: ordinary memory still works
+#endif
+  return allocate(bytes, Device::CPU);
+}
+
+bool is_pinned(const void* p) {
+  Ledger& l = ledger();
+  std::lock_guard lock(l.mutex);
+  return l.pinned.count(const_cast<void*>(p)) > 0;
+}
+
 void release(void* p, Device d) noexcept {
   if (!p) return;
-  forget(p, d);
+  bool pinned = forget(p, d);
+#if SEAMLESS_HAS_CUDA
+  if (pinned) {
+    cudaFreeHost(p);
+    return;
+  }
+#endif
   if (d == Device::CPU) {
     std::free(p);
     return;
@@ -85,6 +114,21 @@ void copy(void* dst, Device dst_dev, const void* src, Device src_dev, std::size_
 #if SEAMLESS_HAS_CUDA
   SEAMLESS_CUDA_CHECK(cudaMemcpy(dst, src, bytes, cudaMemcpyDefault));
 #else
+  throw Error("CUDA copy requested in a build without CUDA");
+#endif
+}
+
+void copy_async(void* dst, Device dst_dev, const void* src, Device src_dev, std::size_t bytes, void* stream) {
+  if (bytes == 0) return;
+  if (dst_dev == Device::CPU && src_dev == Device::CPU) {
+    std::memcpy(dst, src, bytes);
+    return;
+  }
+#if SEAMLESS_HAS_CUDA
+  cudaStream_t s = stream ? static_cast<cudaStream_t>(stream) : cudaStreamLegacy;
+  SEAMLESS_CUDA_CHECK(cudaMemcpyAsync(dst, src, bytes, cudaMemcpyDefault, s));
+#else
+  (void)stream;
   throw Error("CUDA copy requested in a build without CUDA");
 #endif
 }

@@ -83,6 +83,47 @@ void StageTimer::write_csv(const std::string& path) const {
   for (const Row& r : rows_) f << r.frame << ',' << r.stage << ',' << r.ms << '\n';
 }
 
+DeviceMarks::DeviceMarks(Device d, int count) : device_(d), host_(count), events_(count, nullptr) {
+#if SEAMLESS_HAS_CUDA
+  if (d == Device::CUDA)
+    for (void*& e : events_) {
+      cudaEvent_t ev = nullptr;
+      SEAMLESS_CUDA_CHECK(cudaEventCreate(&ev));
+      e = ev;
+    }
+#endif
+}
+
+DeviceMarks::~DeviceMarks() {
+#if SEAMLESS_HAS_CUDA
+  for (void* e : events_)
+    if (e) cudaEventDestroy(static_cast<cudaEvent_t>(e));
+#endif
+}
+
+void DeviceMarks::mark(int k) {
+#if SEAMLESS_HAS_CUDA
+  if (device_ == Device::CUDA) {
+    SEAMLESS_CUDA_CHECK(cudaEventRecord(static_cast<cudaEvent_t>(events_.at(k)), cudaStreamLegacy));
+    return;
+  }
+#endif
+  host_.at(k) = std::chrono::steady_clock::now();
+}
+
+double DeviceMarks::ms(int a, int b) const {
+#if SEAMLESS_HAS_CUDA
+  if (device_ == Device::CUDA) {
+    auto ea = static_cast<cudaEvent_t>(events_.at(a)), eb = static_cast<cudaEvent_t>(events_.at(b));
+    SEAMLESS_CUDA_CHECK(cudaEventSynchronize(eb));
+    float f = 0;
+    SEAMLESS_CUDA_CHECK(cudaEventElapsedTime(&f, ea, eb));
+    return f;
+  }
+#endif
+  return std::chrono::duration<double, std::milli>(host_.at(b) - host_.at(a)).count();
+}
+
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());

@@ -58,6 +58,24 @@ class StageScope {
 
 double median(std::vector<double> v);
 
+// Points on the device's timeline, for a pipeline that times its stages without waiting for each:
+// mark(k) records CUDA event k on the legacy default stream (the host clock on the CPU), and
+// ms(a, b) waits for mark b and returns the time between marks a and b. The events are made once.
+class DeviceMarks {
+ public:
+  DeviceMarks(Device d, int count);
+  ~DeviceMarks();
+  DeviceMarks(const DeviceMarks&) = delete;
+  DeviceMarks& operator=(const DeviceMarks&) = delete;
+  void mark(int k);
+  double ms(int a, int b) const;
+
+ private:
+  Device device_;
+  std::vector<std::chrono::steady_clock::time_point> host_;
+  std::vector<void*> events_;  // cudaEvent_t
+};
+
 }  // namespace seamless
 
 namespace seamless {

@@ -41,7 +41,14 @@ class FrameSource {
   virtual std::int64_t skipped_frames() const { return 0; }
 };
 
-// Builds the source `params.source` names. The synthetic room renders on `device` (CPU or CUDA).
+// Builds the source `params.source` names. The synthetic room renders on `device` (CPU or CUDA);
+// for CUDA, every source delivers its frames in page-locked host memory (a quarter of the upload
+// time of ordinary memory, and the upload can be asynchronous).
 std::unique_ptr<FrameSource> make_source(const InputParams& params, Device device = Device::CPU);
+
+// Makes frame.depth and frame.rgb w x h host images, keeping their memory when it already fits, so
+// that a source decoding frame after frame into the same RgbdFrame allocates once. pinned: in
+// page-locked memory (Image::pinned_host), for frames that go to a GPU.
+void reserve_frame_images(RgbdFrame& frame, int w, int h, bool pinned);
 
 }  // namespace seamless

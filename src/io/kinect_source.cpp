@@ -28,7 +28,7 @@ vec3 camera_accel(freenect_raw_tilt_state* s) {
 
 }  // namespace
 
-KinectSource::KinectSource(const InputParams& params) : params_(params) {
+KinectSource::KinectSource(const InputParams& params, bool pinned) : params_(params), pinned_(pinned) {
   K_ = resolve_intrinsics(params.intrinsics);
   if (K_.width != kW || K_.height != kH)
     throw Error("input.intrinsics width/height must be 640x480 for a Kinect v1 (got " + std::to_string(K_.width) + "x" +
@@ -167,11 +167,10 @@ bool KinectSource::next(RgbdFrame& frame) {
   frame.index = delivered_++;
   frame.timestamp = raw.timestamp;
   frame.intrinsics = K_;
-  frame.depth = Image<float>(kW, kH, Device::CPU);
+  reserve_frame_images(frame, kW, kH, pinned_);
   float* d = frame.depth.buffer().data();
   // FREENECT_DEPTH_NO_VALUE is 0: no reading stays 0.
   for (int i = 0; i < kW * kH; ++i) d[i] = raw.depth_mm[i] * 1e-3f;
-  frame.rgb = Image<uchar3>(kW, kH, Device::CPU);
   std::memcpy(frame.rgb.buffer().data(), raw.rgb.data(), raw.rgb.size());
   frame.accelerometer.reset();
   if (raw.has_accel) frame.accelerometer = raw.accel;

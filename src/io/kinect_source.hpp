@@ -27,7 +27,8 @@ class KinectSource : public FrameSource {
  public:
   // Opens device params.kinect.device_index and starts streaming. Throws seamless::Error when
   // libfreenect cannot start or no such Kinect is connected.
-  explicit KinectSource(const InputParams& params);
+  // pinned: frames in page-locked host memory (for a GPU pipeline; make_source decides).
+  explicit KinectSource(const InputParams& params, bool pinned = false);
   ~KinectSource() override;  // stops the streams and the capture thread, closes the device
   KinectSource(const KinectSource&) = delete;
   KinectSource& operator=(const KinectSource&) = delete;
@@ -56,6 +57,7 @@ class KinectSource : public FrameSource {
   void check_replay_is_millimetres(const std::vector<std::uint16_t>& depth) const;
 
   InputParams params_;
+  bool pinned_ = false;  // frames in page-locked host memory
   Intrinsics K_;
   _freenect_context* ctx_ = nullptr;
   _freenect_device* dev_ = nullptr;

@@ -1,3 +1,5 @@
+#include "core/buffer.hpp"
+#include "core/device.hpp"
 #include "core/error.hpp"
 #include "io/frame_source.hpp"
 #include "io/input_params.hpp"
@@ -11,16 +13,32 @@
 namespace seamless {
 
 std::unique_ptr<FrameSource> make_source(const InputParams& params, Device device) {
-  if (params.source == "tum") return std::make_unique<TumSource>(params);
+  const bool pinned = device == Device::CUDA;
+  if (params.source == "tum") return std::make_unique<TumSource>(params, pinned);
   if (params.source == "synthetic") return std::make_unique<SyntheticSource>(params, device);
   if (params.source == "kinect") {
 #if SEAMLESS_HAS_FREENECT
-    return std::make_unique<KinectSource>(params);
+    return std::make_unique<KinectSource>(params, pinned);
 #else
     throw Error("input.source is kinect but this build has no libfreenect: apt-get install libfreenect-dev, reconfigure");
 #endif
   }
   throw Error("unknown input.source '" + params.source + "': use synthetic, tum or kinect");
+}
+
+namespace {
+template <class T>
+void reserve_host_image(Image<T>& im, int w, int h, bool pinned) {
+  // Without a usable GPU, pinned_host falls back to ordinary memory: that fits as well.
+  bool fits = im.width() == w && im.height() == h && im.device() == Device::CPU &&
+              (!pinned || memory::is_pinned(im.buffer().data()) || !cuda_available());
+  if (!fits) im = pinned ? Image<T>::pinned_host(w, h) : Image<T>(w, h, Device::CPU);
+}
+}  // namespace
+
+void reserve_frame_images(RgbdFrame& frame, int w, int h, bool pinned) {
+  reserve_host_image(frame.depth, w, h, pinned);
+  reserve_host_image(frame.rgb, w, h, pinned);
 }
 
 }  // namespace seamless

@@ -110,8 +110,8 @@ void SyntheticSource::render(const SE3& T, std::uint32_t frame_number, Image<flo
     kernels::render_room(ex, K_, T, noise, seed, frame_number, scratch_.view(), depth_dev_.view(), rgb_dev_.view());
     ex.synchronize();
   });
-  depth = depth_dev_.clone(Device::CPU);
-  rgb = rgb_dev_.clone(Device::CPU);
+  depth.buffer().copy_from(depth_dev_.buffer());
+  rgb.buffer().copy_from(rgb_dev_.buffer());
 }
 
 bool SyntheticSource::next(RgbdFrame& frame) {
@@ -119,6 +119,7 @@ bool SyntheticSource::next(RgbdFrame& frame) {
   std::int64_t k = first_ + next_;
   double t = k / p_.fps;
   SE3 T = synthetic_camera_pose(p_, t);
+  reserve_frame_images(frame, K_.width, K_.height, device_ == Device::CUDA);
   render(T, static_cast<std::uint32_t>(k), frame.depth, frame.rgb);
   frame.index = next_++;
   frame.timestamp = t;

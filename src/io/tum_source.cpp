@@ -173,7 +173,7 @@ std::vector<TumPair> tum_folder_pairs(const std::string& folder, const InputPara
   return pairs;
 }
 
-TumSource::TumSource(const InputParams& params) : params_(params), folder_(params.path) {
+TumSource::TumSource(const InputParams& params, bool pinned) : params_(params), folder_(params.path), pinned_(pinned) {
   if (folder_.empty()) throw Error("input.path is empty: set it to a TUM RGB-D folder (source: tum)");
   if (!fs::is_directory(folder_))
     throw Error("input.path '" + folder_ + "' is not a folder: download one with datasets/download_tum.sh");
@@ -223,7 +223,13 @@ void TumSource::load_frame(const TumPair& pair, RgbdFrame& frame) {
   if (rgb.width() != raw.width() || rgb.height() != raw.height())
     throw Error("colour image '" + rgb_path + "' is " + std::to_string(rgb.width()) + "x" + std::to_string(rgb.height()) +
                 ", its depth image '" + depth_path + "' " + std::to_string(raw.width()) + "x" + std::to_string(raw.height()));
-  Image<float> depth(raw.width(), raw.height(), Device::CPU);
+  // Decoded straight into the frame's (reused, possibly page-locked) images; undistortion reads
+  // from scratch images instead.
+  Intrinsics K = intrinsics();
+  const bool undistort = K.dist[0] == 0.f && K_.dist[0] != 0.f;
+  reserve_frame_images(frame, raw.width(), raw.height(), pinned_);
+  if (undistort && scratch_.width() != raw.width()) scratch_ = Image<float>(raw.width(), raw.height(), Device::CPU);
+  Image<float>& depth = undistort ? scratch_ : frame.depth;
   const float inv = static_cast<float>(1.0 / params_.depth_scale);
   for (std::int64_t i = 0; i < depth.buffer().size(); ++i) depth.buffer().data()[i] = raw.buffer().data()[i] * inv;
   float med = median_depth(depth);
@@ -232,23 +238,18 @@ void TumSource::load_frame(const TumPair& pair, RgbdFrame& frame) {
                 std::to_string(params_.depth_scale) + " is implausible for a Kinect (0.2-10 m); TUM uses 5000, " +
                 "millimetre depth needs 1000 (a scale of about " +
                 std::to_string(params_.depth_scale * med / 2.0) + " would put the median at 2 m)");
-  Intrinsics K = intrinsics();
-  if (K.dist[0] == 0.f && K_.dist[0] != 0.f) {  // undistort (on the host: this is input decoding)
-    Image<float> d2(depth.width(), depth.height(), Device::CPU);
-    Image<uchar3> c2(rgb.width(), rgb.height(), Device::CPU);
+  if (undistort) {  // on the host: this is input decoding
     with_exec(Device::CPU, [&](const auto& ex) {
       if (undistort_map_.width() != depth.width()) {
         undistort_map_ = Image<vec2>(depth.width(), depth.height(), Device::CPU);
         kernels::undistort_map(ex, K_, undistort_map_.view());
       }
-      kernels::remap_depth(ex, undistort_map_.cview(), depth.cview(), d2.view());
-      kernels::remap_rgb(ex, undistort_map_.cview(), rgb.cview(), c2.view());
+      kernels::remap_depth(ex, undistort_map_.cview(), depth.cview(), frame.depth.view());
+      kernels::remap_rgb(ex, undistort_map_.cview(), rgb.cview(), frame.rgb.view());
     });
-    depth = std::move(d2);
-    rgb = std::move(c2);
+  } else {
+    frame.rgb.buffer().copy_from(rgb.buffer());
   }
-  frame.depth = std::move(depth);
-  frame.rgb = std::move(rgb);
   fill_metadata(pair, frame);
 }
 

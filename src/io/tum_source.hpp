@@ -33,7 +33,8 @@ std::vector<TumPair> tum_folder_pairs(const std::string& folder, const InputPara
 
 class TumSource : public FrameSource {
  public:
-  explicit TumSource(const InputParams& params);
+  // pinned: frames in page-locked host memory (for a GPU pipeline; make_source decides).
+  explicit TumSource(const InputParams& params, bool pinned = false);
   bool next(RgbdFrame& frame) override;
   std::optional<std::int64_t> size() const override { return static_cast<std::int64_t>(pairs_.size()); }
   std::string name() const override { return "tum:" + folder_; }
@@ -56,6 +57,9 @@ class TumSource : public FrameSource {
   Trajectory groundtruth_;
   std::vector<std::pair<double, vec3>> accel_;  // camera-frame specific force
   Image<vec2> undistort_map_;                   // where each undistorted pixel comes from
+  Image<uchar3> rgb_scratch_;                   // undistortion's source
+  Image<float> scratch_;                        // depth before undistortion
+  bool pinned_ = false;
   std::size_t next_ = 0;
   std::int64_t delivered_ = 0;
   std::int64_t skipped_ = 0;

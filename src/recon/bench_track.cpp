@@ -14,7 +14,7 @@ namespace seamless {
 
 namespace {
 
-std::vector<RgbdFrame> first_frames(const std::string& data_dir, int n) {
+std::vector<RgbdFrame> first_frames(const std::string& data_dir, int n, Device device) {
   InputParams in;
   if (data_dir.empty()) {
     in.source = "synthetic";
@@ -24,7 +24,7 @@ std::vector<RgbdFrame> first_frames(const std::string& data_dir, int n) {
     in.path = data_dir;
     in.max_frames = n;
   }
-  auto src = make_source(in);
+  auto src = make_source(in, device);  // frames in page-locked memory for CUDA, as a GPU run gets them
   std::vector<RgbdFrame> out(n);
   for (auto& f : out)
     if (!src->next(f)) throw Error("the benchmark needs " + std::to_string(n) + " frames of " + src->name());
@@ -57,7 +57,7 @@ TrackBenchCase align_case(const std::string& kind, const std::vector<RgbdFrame>&
 }  // namespace
 
 std::vector<TrackBenchCase> make_track_bench(Device device, const std::string& data_dir) {
-  auto frames = std::make_shared<std::vector<RgbdFrame>>(first_frames(data_dir, 3));
+  auto frames = std::make_shared<std::vector<RgbdFrame>>(first_frames(data_dir, 3, device));
   std::vector<TrackBenchCase> cases = {align_case("icp", *frames, device), align_case("rgbd", *frames, device)};
   TrackSequenceParams p;  // frame-to-model ICP, 5 mm voxels: the default pipeline
   p.tracker.gravity = "none";

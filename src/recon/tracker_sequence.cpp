@@ -15,15 +15,19 @@
 
 namespace seamless {
 
+// Where a frame's stages end on the device's timeline (TrackingSession::marks_).
 namespace {
-using Clock = std::chrono::steady_clock;
-
-// Host time after the device finished: every stage below ends with a download or a sync anyway.
-double ms_since(Clock::time_point t0, Device d) {
-  with_exec(d, [](const auto& ex) { ex.synchronize(); });
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
+enum Mark { kStart, kPreprocessed, kTracked, kEnd, kMarks };
 }  // namespace
+
+// The colour image goes up on a stream of its own: only fusion (and the RGB-D tracker's intensity)
+// reads it, so its copy overlaps preprocessing and tracking instead of delaying them.
+struct TrackingSession::ColourUpload {
+#if SEAMLESS_HAS_CUDA
+  CudaStream stream;
+#endif
+  bool pending = false;
+};
 
 // ---- registry -----------------------------------------------------------------------------------
 
@@ -90,7 +94,8 @@ RgbdFrame host_copy(const RgbdFrame& f) {
 
 TrackingSession::TrackingSession(const TrackSequenceParams& params, Device device, const Intrinsics& K,
                                  Volume* volume)
-    : p_(params), device_(device), K_(K), volume_(volume), pyr_(device, K, params.preprocess.levels) {
+    : p_(params), device_(device), K_(K), volume_(volume), pyr_(device, K, params.preprocess.levels),
+      marks_(device, kMarks), colour_upload_(std::make_unique<ColourUpload>()) {
   const TrackerInfo& info = tracker_info(p_.tracker.kind);
   if (info.make_external) {
     odometry_ = info.make_external(K, p_.tracker);
@@ -116,20 +121,44 @@ void TrackingSession::upload(const RgbdFrame& frame) {
     throw Error("frame " + std::to_string(frame.index) + " is " + std::to_string(frame.depth.width()) + "x" +
                 std::to_string(frame.depth.height()) + " but the source's intrinsics say " +
                 std::to_string(K_.width) + "x" + std::to_string(K_.height));
-  // Persistent device images: one host-to-device copy a frame, no allocation.
+  // Persistent device images: one host-to-device copy a frame, no allocation. The copies are
+  // asynchronous when the frame is in page-locked memory (what make_source gives a GPU pipeline);
+  // process() waits for them before it returns, so the caller may then reuse the frame.
   if (depth_.width() != K_.width) depth_ = Image<float>(K_.width, K_.height, device_);
-  depth_.buffer().copy_from(frame.depth.buffer());
+  depth_.buffer().copy_from_async(frame.depth.buffer());
   bool colour = frame.rgb.width() == K_.width && frame.rgb.height() == K_.height;
   if (colour && rgb_.width() != K_.width) rgb_ = Image<uchar3>(K_.width, K_.height, device_);
-  if (colour) rgb_.buffer().copy_from(frame.rgb.buffer());
+  if (colour) upload_colour(frame);
   if (!colour) rgb_ = Image<uchar3>();
   const Image<float>* intensity = nullptr;
   if (colour && p_.tracker.kind == "rgbd") {
     if (intensity_.width() != K_.width) intensity_ = Image<float>(K_.width, K_.height, device_);
+    join_colour();
     with_exec(device_, [&](const auto& ex) { kernels::rgb_to_intensity(ex, rgb_.cview(), intensity_.view()); });
     intensity = &intensity_;
   }
   pyr_.build(depth_, intensity, p_.preprocess);
+}
+
+void TrackingSession::upload_colour(const RgbdFrame& frame) {
+#if SEAMLESS_HAS_CUDA
+  if (device_ == Device::CUDA) {
+    CudaStream& s = colour_upload_->stream;
+    s.after_default();  // the last frame's fusion has read rgb_
+    rgb_.buffer().copy_from_async(frame.rgb.buffer(), s.get());
+    colour_upload_->pending = true;
+    return;
+  }
+#endif
+  rgb_.buffer().copy_from(frame.rgb.buffer());
+}
+
+void TrackingSession::join_colour() {
+  if (!colour_upload_->pending) return;
+#if SEAMLESS_HAS_CUDA
+  colour_upload_->stream.before_default();
+#endif
+  colour_upload_->pending = false;
 }
 
 void TrackingSession::update_reference(const SE3& pose) {
@@ -145,14 +174,13 @@ void TrackingSession::update_reference(const SE3& pose) {
 }
 
 void TrackingSession::accept(const RgbdFrame& frame, const SE3& pose, FrameRecord& rec) {
-  auto t0 = Clock::now();
   if (volume_) {
+    join_colour();
     volume_->integrate(depth_, rgb_, K_, pose);
     rec.fused = true;
   }
   if (tracker_) update_reference(pose);
   if (odometry_) last_good_frame_ = host_copy(frame);
-  rec.fuse_ms = ms_since(t0, device_);
   prev_good_ = started_ ? last_good_ : pose;
   last_good_ = pose;
 }
@@ -231,22 +259,24 @@ TrackResult TrackingSession::track_external(const RgbdFrame& frame) {
   return r;
 }
 
+// Stage times come from marks on the device's timeline, read once at the end: waiting after each
+// stage would leave the GPU idle while the host queues the next one.
 FrameRecord TrackingSession::process(const RgbdFrame& frame) {
   FrameRecord rec;
   rec.frame = frame.index;
   rec.timestamp = frame.timestamp;
-  auto t0 = Clock::now();
+  marks_.mark(kStart);
   // External trackers read the host frame; our pyramid is needed only for the floor-plane gravity
   // of the first frame and for a volume to fuse into.
   if (!odometry_ || !started_ || volume_) upload(frame);
-  rec.preprocess_ms = ms_since(t0, device_);
+  marks_.mark(kPreprocessed);
+  const bool tracked = started_;
   if (!started_) {
     first_frame(frame, rec);
   } else {
-    auto t1 = Clock::now();
     rec.result = track_frame(frame);
-    rec.track_ms = ms_since(t1, device_);
   }
+  marks_.mark(kTracked);
   if (rec.result.ok()) {
     accept(frame, rec.result.world_T_camera, rec);
   } else {
@@ -254,11 +284,14 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
     rec.result.world_T_camera = last_good_;  // the estimate was not trusted: keep the last good pose
   }
   started_ = true;
-  rec.frame_ms = ms_since(t0, device_);
+  join_colour();  // a lost frame's colour copy too: the caller may reuse the frame after we return
+  marks_.mark(kEnd);
+  rec.preprocess_ms = marks_.ms(kStart, kPreprocessed);
+  if (tracked) rec.track_ms = marks_.ms(kPreprocessed, kTracked);
+  if (rec.result.ok()) rec.fuse_ms = marks_.ms(kTracked, kEnd);  // accept() ran: fusion and the next reference
+  rec.frame_ms = marks_.ms(kStart, kEnd);
   return rec;
 }
-
-// ---- whole sequences ----------------------------------------------------------------------------
 
 void write_tracking_stats(const std::string& path, const std::vector<FrameRecord>& frames) {
   std::FILE* f = std::fopen(path.c_str(), "w");

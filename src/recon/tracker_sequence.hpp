@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/timing.hpp"
 #include "io/frame_source.hpp"
 #include "io/trajectory.hpp"
 #include "recon/external/odometry.hpp"
@@ -36,6 +37,8 @@ struct FrameRecord {
   double timestamp = 0;
   TrackResult result;          // result.world_T_camera is the pose written for this frame
   bool fused = false;          // integrated into the volume (never when tracking was lost)
+  // Times on the device's timeline (CUDA events; the host clock on the CPU): preprocess includes
+  // the upload, fuse the raycast of the next reference view.
   double preprocess_ms = 0, track_ms = 0, fuse_ms = 0, frame_ms = 0;
 };
 
@@ -62,6 +65,8 @@ class TrackingSession {
  private:
   bool uses_volume() const;
   void upload(const RgbdFrame& frame);
+  void upload_colour(const RgbdFrame& frame);
+  void join_colour();  // the default stream waits for the colour upload
   void first_frame(const RgbdFrame& frame, FrameRecord& rec);
   TrackResult track_frame(const RgbdFrame& frame);
   TrackResult track_external(const RgbdFrame& frame);
@@ -82,6 +87,9 @@ class TrackingSession {
   Image<float> depth_, intensity_;
   Image<uchar3> rgb_;
   GravityEstimate gravity_;
+  DeviceMarks marks_;
+  struct ColourUpload;
+  std::unique_ptr<ColourUpload> colour_upload_;
   bool started_ = false;
   SE3 last_good_ = SE3::identity(), prev_good_ = SE3::identity();
   SE3 world_T_gt_ = SE3::identity();  // ground_truth tracker: maps the source's poses into our world

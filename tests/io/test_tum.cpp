@@ -3,7 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
+
+#include "core/buffer.hpp"
+#include "core/device.hpp"
 
 #include "io/input_params.hpp"
 #include "io/tum_source.hpp"
@@ -179,4 +183,38 @@ TEST(TumReader, FirstAndMaxFrames) {
   ASSERT_TRUE(src.next(f));
   EXPECT_EQ(f.index, 0);
   EXPECT_DOUBLE_EQ(f.timestamp, src.pairs()[0].rgb.timestamp);
+}
+
+// Frames for a GPU pipeline are decoded into page-locked memory that the source keeps from frame
+// to frame (one allocation, then asynchronous uploads). That must not change a single pixel, with
+// and without undistortion (the two decoding paths), and the memory must really be reused.
+TEST(TumReader, PinnedFramesEqualOrdinaryOnesAndKeepTheirMemory) {
+  std::string dir = data_dir("tum_fr1_rpy_000-149");
+  REQUIRE_DATA(dir);
+  for (bool undistort : {true, false}) {
+    InputParams p = tum_params(dir);
+    p.undistort = undistort;
+    p.max_frames = 3;
+    TumSource plain(p), pinned(p, /*pinned=*/true);
+    RgbdFrame a, b;
+    const float* depth_memory = nullptr;
+    const uchar3* rgb_memory = nullptr;
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_TRUE(plain.next(a));
+      ASSERT_TRUE(pinned.next(b));
+      ASSERT_EQ(a.depth.width(), b.depth.width());
+      ASSERT_EQ(a.rgb.buffer().bytes(), b.rgb.buffer().bytes());
+      EXPECT_EQ(0, std::memcmp(a.depth.buffer().data(), b.depth.buffer().data(), a.depth.buffer().bytes()));
+      EXPECT_EQ(0, std::memcmp(a.rgb.buffer().data(), b.rgb.buffer().data(), a.rgb.buffer().bytes()));
+      if (k > 0) {
+        EXPECT_EQ(b.depth.buffer().data(), depth_memory) << "frame " << k << " reallocated its depth image";
+        EXPECT_EQ(b.rgb.buffer().data(), rgb_memory) << "frame " << k << " reallocated its colour image";
+      }
+      depth_memory = b.depth.buffer().data();
+      rgb_memory = b.rgb.buffer().data();
+      if (cuda_available()) {
+        EXPECT_TRUE(memory::is_pinned(depth_memory));
+      }
+    }
+  }
 }
