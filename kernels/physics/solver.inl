@@ -317,6 +317,26 @@ SEAMLESS_HD inline void store_candidate(int* list, std::int64_t col, int cap, in
   list[(cnt < cap ? cnt : cap) * col] = j;
 #endif
 }
+
+// The CPU's candidate loop over the entries [a, e) of a run, none of them s (find_neighbors):
+// every candidate is written to its slot (list row-major, col = 1 on the CPU), where the next
+// one overwrites it unless it was kept (store_candidate's branch-free store). Clamp: whether the
+// slot must be clamped to the spare one at cap (only where the run can reach the cap). General:
+// the rigid/cloth pair test (may_interact). Everything in locals, so that the stores to list
+// cannot make the compiler reload s, cap or the count. Returns the count.
+template <bool General, bool Clamp>
+SEAMLESS_HD inline int scan_candidates(const SimViews& S, vec3 p, float R2, std::uint32_t ph, int s, int a, int e, int* list,
+                                       int cap, int c) {
+  const Packed* const spk = S.spk;
+  for (int j = a; j < e; ++j) {
+    const Packed q = spk[j];  // position and phase in one load
+    bool ok = length2(p - q.xyz()) < R2;
+    if constexpr (General) ok = ok && may_interact(S, ph, q.bits(), s, j);
+    list[Clamp ? (c < cap ? c : cap) : c] = j;
+    c += ok;
+  }
+  return c;
+}
 }  // namespace detail
 
 template <class Exec>
@@ -342,16 +362,21 @@ void find_neighbors(const Exec& ex, const SimViews& S) {
       // particle are counted afterwards over the ~30 stored entries instead of the ~70
       // candidates.
       auto walk = [&](auto general) {
+        constexpr bool kGeneral = decltype(general)::value;
         for_each_run_in_radius(S.grid, S.cell_start, p, R, [&](int a, int e) {
-          int c = cnt;
-          for (int j = a; j < e; ++j) {
-            const Packed q = S.spk[j];  // position and phase in one load
-            bool ok = (j != s) & (length2(p - q.xyz()) < R2);
-            if constexpr (decltype(general)::value) ok = ok && detail::may_interact(S, ph, q.bits(), s, j);
-            detail::store_candidate(list, S.nbr_col, cap, c, j, true);
-            c += ok;
+          // s itself sits in one run (its own row): the run is split around it instead of
+          // testing j != s for every candidate. Where the run cannot reach the cap, the slot
+          // needs no clamp.
+          const bool self = a <= s && s < e;
+          if (cnt + (e - a) <= cap) {
+            if (self) cnt = detail::scan_candidates<kGeneral, false>(S, p, R2, ph, s, s + 1, e, list, cap,
+                                                                     detail::scan_candidates<kGeneral, false>(S, p, R2, ph, s, a, s, list, cap, cnt));
+            else cnt = detail::scan_candidates<kGeneral, false>(S, p, R2, ph, s, a, e, list, cap, cnt);
+          } else {
+            if (self) cnt = detail::scan_candidates<kGeneral, true>(S, p, R2, ph, s, s + 1, e, list, cap,
+                                                                    detail::scan_candidates<kGeneral, true>(S, p, R2, ph, s, a, s, list, cap, cnt));
+            else cnt = detail::scan_candidates<kGeneral, true>(S, p, R2, ph, s, a, e, list, cap, cnt);
           }
-          cnt = c;
         });
       };
       if (plain) walk(std::false_type{});
