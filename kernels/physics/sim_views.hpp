@@ -98,6 +98,9 @@ struct SimViews {
   // CPU only (kernels::kCachePairs): per list entry (the lists' layout), the spiky gradient
   // (xyz) and poly6 value (w) of the pair at prepare_constraints' positions, which
   // solve_contacts_fluid reuses (the same positions) instead of recomputing them.
+  // velocity_effects reuses it (free after the last solve) for the spiky gradient (xyz) and the
+  // Akinci cohesion factor (w) at the final positions: the vorticity pass computes them, the
+  // forces pass reads them.
   Packed* pair_w = nullptr;
 
   // Neighbour grid and lists. Entry k of particle s's list is list[s * row + k * col]: the layout

@@ -847,21 +847,42 @@ struct ForceSum {
 };
 SEAMLESS_HD inline ForceSum operator+(const ForceSum& a, const ForceSum& b) { return {a.eta + b.eta, a.acc + b.acc}; }
 
+// Akinci's cohesion term of the pair r = p_i - p_j (eq. 1, before K_ij) is r times this factor
+// of l = |r| (0 for coincident particles); coh_c = -cohesion / rho_0.
+SEAMLESS_HD inline float cohesion_factor(const SphKernel& W, float coh_c, float l) {
+  return l > 1e-9f ? coh_c * W.akinci(l) / l : 0.f;
+}
+
+// With Cached, each pair's spiky gradient and cohesion factor come from pair_w (vorticity_part,
+// at the same positions) instead of a square root, a division and both kernels.
+template <bool Cached>
 SEAMLESS_HD inline vec3 fluid_forces(const SimViews& S, int s, Lanes g) {
   const float inv_rho0 = 1.f / S.c.rest_density;
   const vec3 p = S.sp[s], ni = S.cnormal[s];
   const bool mixed = S.nsolid[s] != 0;  // otherwise every neighbour is fluid: no phase loads
+  // Locals: nothing here is reloaded for every pair.
+  const float two_rho0 = 2.f * S.c.rest_density, rho_i = S.density[s], coh_c = -S.c.cohesion * inv_rho0;
+  const float st = -S.c.surface_tension;
+  const int* const list = S.nbrs(s);
+  const std::int64_t col = S.nbr_col, row = s * S.nbr_row;
   ForceSum t{{0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}};
   for (int k = g.lane, m = S.nnbr[s]; k < m; k += g.size) {
-    int j = S.nbrs(s)[k * S.nbr_col];
+    int j = list[k * col];
     if (mixed && !phase::is(S.sphase[j], phase::kFluid)) continue;
     const Packed q = S.spd[j], nv = S.cnv[j];  // position and density, normal and |omega|
-    vec3 r = p - q.xyz();
-    float l = sqrtf(length2(r));
-    t.eta += S.c.W.spiky_grad(r) * (nv.w * inv_rho0);
-    float K = 2.f * S.c.rest_density / (S.density[s] + q.w);
-    vec3 coh = l > 1e-9f ? r * (-S.c.cohesion * inv_rho0 * S.c.W.akinci(l) / l) : vec3{0.f, 0.f, 0.f};
-    vec3 curv = (ni - nv.xyz()) * (-S.c.surface_tension);
+    const vec3 r = p - q.xyz();
+    vec3 grad;
+    float cf;
+    if constexpr (Cached) {
+      const Packed gw = S.pair_w[row + k * col];
+      grad = gw.xyz(), cf = gw.w;
+    } else {
+      grad = S.c.W.spiky_grad(r), cf = cohesion_factor(S.c.W, coh_c, sqrtf(length2(r)));
+    }
+    t.eta += grad * (nv.w * inv_rho0);
+    float K = two_rho0 / (rho_i + q.w);
+    vec3 coh = r * cf;
+    vec3 curv = (ni - nv.xyz()) * st;
     t.acc += (coh + curv) * K;
   }
   t = g.sum(t);
@@ -895,20 +916,31 @@ SEAMLESS_HD inline VortSum operator+(const VortSum& a, const VortSum& b) {
   return {a.w + b.w, a.n + b.n, a.dv_visc + b.dv_visc};
 }
 
+// With Cache, each pair's spiky gradient and cohesion factor are kept in pair_w for
+// fluid_forces, which runs next at the same positions.
+template <bool Cache>
 SEAMLESS_HD inline VortSum vorticity_part(const SimViews& S, int s, Lanes g) {
   const float inv_rho0 = 1.f / S.c.rest_density;
   const vec3 p = S.sp[s], vi = S.sv[s];
   const bool mixed = S.nsolid[s] != 0;  // otherwise every neighbour is fluid: no phase loads
+  // Locals: the stores to the caches could otherwise alias the constants in S (reloaded per pair).
+  const SphKernel W = S.c.W;
+  const float coh_c = -S.c.cohesion * inv_rho0;
+  const int* const list = S.nbrs(s);
+  const std::int64_t col = S.nbr_col, row = s * S.nbr_row;
   VortSum t{{0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}};
   for (int k = g.lane, m = S.nnbr[s]; k < m; k += g.size) {
-    int j = S.nbrs(s)[k * S.nbr_col];
+    int j = list[k * col];
     if (mixed && !phase::is(S.sphase[j], phase::kFluid)) continue;
     const Packed q = S.spd[j], vh = S.svh[j];  // position (and density), velocity and h / rho
     vec3 r = p - q.xyz(), vj = vh.xyz();
-    vec3 grad = S.c.W.spiky_grad(r);
+    vec3 grad = W.spiky_grad(r);
+    if constexpr (Cache) {
+      S.pair_w[row + k * col] = Packed::of(grad, cohesion_factor(W, coh_c, sqrtf(length2(r))));
+    }
     t.w += cross(vj - vi, -grad) * inv_rho0;
     t.n += grad * vh.w;
-    t.dv_visc += (vj - vi) * (S.c.W.poly6(length2(r)) * inv_rho0);
+    t.dv_visc += (vj - vi) * (W.poly6(length2(r)) * inv_rho0);
   }
   return t;
 }
@@ -924,7 +956,7 @@ void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
     ex.for_each_grouped(S.n, kPairLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
       const int s = static_cast<int>(i);
       if (!phase::is(S.sphase[s], phase::kFluid)) return;
-      const detail::VortSum t = g.sum(detail::vorticity_part(S, s, g));
+      const detail::VortSum t = g.sum(detail::vorticity_part<detail::kCachePairs<Exec>>(S, s, g));
       if (g.lane != 0) return;
       S.vort[s] = t.w;
       S.vort_len[s] = length(t.w);
@@ -939,7 +971,7 @@ void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
     const std::uint32_t ph = S.sphase[s];
     const bool fluid = has_fluid && phase::is(ph, phase::kFluid);
     vec3 forces{0.f, 0.f, 0.f};
-    if (fluid) forces = detail::fluid_forces(S, s, g);
+    if (fluid) forces = detail::fluid_forces<detail::kCachePairs<Exec>>(S, s, g);
     if (g.lane != 0) return;  // vtmp[s] is read and written by lane 0 only
     vec3 v = S.sv[s];
     if (fluid) v += S.vtmp[s] * S.c.viscosity + forces * S.c.dt;
