@@ -50,7 +50,8 @@ SEAMLESS_HD inline float sg(float v) { return v < 0.f ? -1.f : 1.f; }
 
 SEAMLESS_HD inline SdfSample3 sdf_local_box(vec3 l, vec3 h) {
   vec3 e{fabsf(l.x) - h.x, fabsf(l.y) - h.y, fabsf(l.z) - h.z};
-  vec3 out = vmax(e, vec3{0.f, 0.f, 0.f});
+  // max(e, 0) by comparisons: fmaxf is a libm call on x86-64 (its NaN rules), three per sample.
+  vec3 out{e.x > 0.f ? e.x : 0.f, e.y > 0.f ? e.y : 0.f, e.z > 0.f ? e.z : 0.f};
   float lo = length(out);
   if (lo > 0.f) return {lo, vec3{sg(l.x) * out.x, sg(l.y) * out.y, sg(l.z) * out.z} / lo};
   if (e.x >= e.y && e.x >= e.z) return {e.x, {sg(l.x), 0.f, 0.f}};

@@ -253,6 +253,21 @@ void cell_starts(const Exec& ex, const std::uint32_t* keys, std::int64_t n, int*
   // made 33 blocks of threads that each waited on 32 of them (19 us on an H200, 40 of 132
   // multiprocessors busy), with 4 it is 256 blocks of 4 (the binary searches' upper levels are
   // shared in cache).
+  //
+  // The CPU instead gives each entry i the cells (keys[i - 1], keys[i]] (entry 0 those up to
+  // keys[0], entry n those after the last key) and stores i there: the cells of a task are one
+  // run, which the compiler stores 4 at a time, and every cell is written once by one task. Most
+  // cells are empty (2^18 cells for 10k particles), so this is ~0.3 instructions a cell instead
+  // of a compare and a store (4.7 M of a 10k fluid step). Not on CUDA: one thread would fill a
+  // long empty run alone. The same values either way (start[k] = number of keys below k).
+  if constexpr (Exec::device == Device::CPU) {
+    ex.for_each(n + 1, [=] SEAMLESS_HD(std::int64_t i) {
+      const std::int64_t lo = i == 0 ? 0 : static_cast<std::int64_t>(keys[i - 1]) + 1;
+      const std::int64_t hi = i == n ? cells : static_cast<std::int64_t>(keys[i]);  // inclusive
+      for (std::int64_t k = lo; k <= hi; ++k) start[k] = static_cast<int>(i);
+    });
+    return;
+  }
   constexpr std::int64_t kBlock = Exec::device == Device::CUDA ? 4 : 32;
   const std::int64_t total = cells + 1;
   ex.for_each((total + kBlock - 1) / kBlock, [=] SEAMLESS_HD(std::int64_t b) {
