@@ -19,7 +19,9 @@ void bilateral_filter(const Exec& ex, View2D<const float> depth, View2D<float> o
 template <class Exec>
 void pyr_down_depth(const Exec& ex, View2D<const float> in, View2D<float> out, float max_diff);
 
-// Half resolution intensity (plain 2x2 mean) for a photometric tracker's pyramid.
+// Half resolution intensity (plain 2x2 mean) for a photometric tracker's pyramid. A negative
+// intensity is no reading (kernels/recon/rgbd.hpp, kNoIntensity): a block with one has none either
+// (-1), so no coarse pixel mixes the undistortion border's missing colour into real colour.
 template <class Exec>
 void pyr_down_intensity(const Exec& ex, View2D<const float> in, View2D<float> out);
 

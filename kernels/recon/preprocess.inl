@@ -60,7 +60,8 @@ void pyr_down_intensity(const Exec& ex, View2D<const float> in, View2D<float> ou
   const int w = out.width;
   ex.for_each(out.count(), [=] SEAMLESS_HD(std::int64_t i) {
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
-    out(x, y) = 0.25f * (in(2 * x, 2 * y) + in(2 * x + 1, 2 * y) + in(2 * x, 2 * y + 1) + in(2 * x + 1, 2 * y + 1));
+    const float a = in(2 * x, 2 * y), b = in(2 * x + 1, 2 * y), c = in(2 * x, 2 * y + 1), d = in(2 * x + 1, 2 * y + 1);
+    out(x, y) = fminf(fminf(a, b), fminf(c, d)) < 0.f ? -1.f : 0.25f * (a + b + c + d);
   });
 }
 

@@ -94,29 +94,43 @@ SEAMLESS_HD inline void update_scale(const RgbdSums& s, IcpPose& p) {
   if (s.photo_n > 0) p.photo_var = fmaxf(static_cast<float>(s.photo_wr2 / s.photo_n), kMinPhotoVar);
 }
 
-// Bilinear sample; the caller keeps (x, y) inside [0, w-1) x [0, h-1).
-SEAMLESS_HD inline float bilinear(View2D<const float> im, float x, float y) {
+// An intensity pixel without a colour reading. RGB (0, 0, 0) means no reading, as depth 0 does:
+// the undistortion of freiburg1/2 images (kernels/io/undistort.hpp) writes it where the lens saw
+// nothing, a 6-25 pixel border. Used as colour, that border is a sharp black edge fixed in the
+// image: every photometric row that samples it pulls the estimate towards no motion (the 4-5 %
+// too small yaw of frame-to-model tracking on fr1_rpy, docs/TRACKING.md "Session 6").
+constexpr float kNoIntensity = -1.f;
+
+// Bilinear sample into v; false when one of the four pixels has no reading (kNoIntensity). The
+// caller keeps (x, y) inside [0, w-1) x [0, h-1).
+SEAMLESS_HD inline bool bilinear(View2D<const float> im, float x, float y, float& v) {
   int x0 = static_cast<int>(floorf(x)), y0 = static_cast<int>(floorf(y));
   float ax = x - x0, ay = y - y0;
-  float top = (1.f - ax) * im(x0, y0) + ax * im(x0 + 1, y0);
-  float bot = (1.f - ax) * im(x0, y0 + 1) + ax * im(x0 + 1, y0 + 1);
-  return (1.f - ay) * top + ay * bot;
+  const float a = im(x0, y0), b = im(x0 + 1, y0), c = im(x0, y0 + 1), d = im(x0 + 1, y0 + 1);
+  v = (1.f - ay) * ((1.f - ax) * a + ax * b) + ay * ((1.f - ax) * c + ax * d);
+  return fminf(fminf(a, b), fminf(c, d)) >= 0.f;
 }
 
 // The photometric residual r and its gradient g = dI_ref/dq of a geometric correspondence c of
-// current pixel (x, y); false when it has none (near the border, or |r| > max_intensity_diff).
-// Only pixels that passed the geometric tests get one: that is the occlusion check (the reference
-// pixel shows the same surface), and it keeps the term away from depth edges where intensity means
-// nothing.
+// current pixel (x, y); false when it has none (near the border, a sample without a colour reading,
+// or |r| > max_intensity_diff). Only pixels that passed the geometric tests get one: that is the
+// occlusion check (the reference pixel shows the same surface), and it keeps the term away from
+// depth edges where intensity means nothing.
 SEAMLESS_HD inline bool photometric_residual(const RgbdLevel& L, const Correspondence& c, int x, int y, float& r,
                                              vec3& g) {
   const Intrinsics& K = L.geo.K;
   float u = c.uv.x, v = c.uv.y;
   if (u < 1.f || v < 1.f || u >= L.ref_intensity.width - 2.f || v >= L.ref_intensity.height - 2.f) return false;
-  r = bilinear(L.ref_intensity, u, v) - L.cur_intensity(x, y);
+  const float cur = L.cur_intensity(x, y);
+  float ref, xp, xm, yp, ym;
+  if (!(cur >= 0.f) || !bilinear(L.ref_intensity, u, v, ref)) return false;
+  r = ref - cur;
   if (fabsf(r) > L.max_intensity_diff) return false;
-  float gx = 0.5f * (bilinear(L.ref_intensity, u + 1.f, v) - bilinear(L.ref_intensity, u - 1.f, v));
-  float gy = 0.5f * (bilinear(L.ref_intensity, u, v + 1.f) - bilinear(L.ref_intensity, u, v - 1.f));
+  if (!bilinear(L.ref_intensity, u + 1.f, v, xp) || !bilinear(L.ref_intensity, u - 1.f, v, xm) ||
+      !bilinear(L.ref_intensity, u, v + 1.f, yp) || !bilinear(L.ref_intensity, u, v - 1.f, ym))
+    return false;
+  float gx = 0.5f * (xp - xm);
+  float gy = 0.5f * (yp - ym);
   if (gx * gx + gy * gy < L.min_gradient * L.min_gradient) return false;
   float iz = 1.f / c.q.z;
   g = vec3{gx * K.fx * iz, gy * K.fy * iz, -(gx * K.fx * c.q.x + gy * K.fy * c.q.y) * iz * iz};
@@ -182,7 +196,8 @@ template <class Exec>
 void rgbd_reduce_into(const Exec& ex, RgbdLevel level, IcpPose* pose, RgbdSums* out, IcpSums* level_sums, IcpSums* done,
                       IcpUpdate update);
 
-// Intensity in [0, 1] from 8-bit RGB (ITU-R BT.601 luma weights).
+// Intensity in [0, 1] from 8-bit RGB (ITU-R BT.601 luma weights); kNoIntensity where RGB is
+// (0, 0, 0), no colour reading (see kNoIntensity).
 template <class Exec>
 void rgb_to_intensity(const Exec& ex, View2D<const uchar3> rgb, View2D<float> out);
 

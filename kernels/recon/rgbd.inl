@@ -37,7 +37,8 @@ void rgb_to_intensity(const Exec& ex, View2D<const uchar3> rgb, View2D<float> ou
   ex.for_each(rgb.count(), [=] SEAMLESS_HD(std::int64_t i) {
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
     uchar3 c = rgb(x, y);
-    out(x, y) = (0.299f * c.x + 0.587f * c.y + 0.114f * c.z) * (1.f / 255.f);
+    const bool none = c.x == 0 && c.y == 0 && c.z == 0;
+    out(x, y) = none ? kNoIntensity : (0.299f * c.x + 0.587f * c.y + 0.114f * c.z) * (1.f / 255.f);
   });
 }
 
