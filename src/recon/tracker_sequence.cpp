@@ -24,7 +24,7 @@ enum Mark { kStart, kPreprocessed, kTracked, kEnd, kMarks };
 // reads it, so its copy overlaps preprocessing and tracking instead of delaying them.
 struct TrackingSession::ColourUpload {
 #if SEAMLESS_HAS_CUDA
-  CudaStream stream;
+  std::unique_ptr<CudaStream> stream;  // made on the first CUDA upload: a CPU run needs no driver
 #endif
   bool pending = false;
 };
@@ -143,7 +143,8 @@ void TrackingSession::upload(const RgbdFrame& frame) {
 void TrackingSession::upload_colour(const RgbdFrame& frame) {
 #if SEAMLESS_HAS_CUDA
   if (device_ == Device::CUDA) {
-    CudaStream& s = colour_upload_->stream;
+    if (!colour_upload_->stream) colour_upload_->stream = std::make_unique<CudaStream>();
+    CudaStream& s = *colour_upload_->stream;
     s.after_default();  // the last frame's fusion has read rgb_
     rgb_.buffer().copy_from_async(frame.rgb.buffer(), s.get());
     colour_upload_->pending = true;
@@ -156,7 +157,7 @@ void TrackingSession::upload_colour(const RgbdFrame& frame) {
 void TrackingSession::join_colour() {
   if (!colour_upload_->pending) return;
 #if SEAMLESS_HAS_CUDA
-  colour_upload_->stream.before_default();
+  colour_upload_->stream->before_default();  // pending: made by upload_colour
 #endif
   colour_upload_->pending = false;
 }
