@@ -129,14 +129,12 @@ struct IcpPose {
 };
 
 // What a frame's Gauss-Newton loop keeps on the device, in one allocation so that the host reads
-// the result with one copy: the estimate and the last system of each pyramid level.
+// the result with one copy: the estimate and the last system summed at each pyramid level (a
+// level's steps end once it is done, so that is the system of its converging or stalling step).
 constexpr int kIcpMaxLevels = 8;
 struct IcpState {
   IcpPose pose;
   IcpSums sums[kIcpMaxLevels];
-  // The system of the step that made the current level done (converged or stalled): the level's
-  // later, skipped steps sum nothing, so sums[level] then holds zeros (see level_done).
-  IcpSums done;
 };
 
 SEAMLESS_HD inline IcpPose to_icp_pose(const SE3& T) {
@@ -215,42 +213,43 @@ SEAMLESS_HD inline void left_update(IcpPose& p, const double xi[6]) {
 enum class IcpUpdate { none, step, first_step };
 
 // True when a step of this level has nothing left to do: the level stalled (the same estimate
-// would give the same failing system again) or converged. Such a step's reduction skips every
-// pixel and leaves the level's last system and the estimate as they are.
-SEAMLESS_HD inline bool level_done(const IcpPose& p, IcpUpdate u) {
-  return u == IcpUpdate::step && (p.stalled || p.converged);
-}
+// would give the same failing system again) or converged.
+SEAMLESS_HD inline bool level_done(const IcpPose& p) { return p.stalled || p.converged; }
 
 // One Gauss-Newton step: solves the system s and applies the update to p; first_step (a level's
 // first) clears the stall and convergence of the previous level. A step xi = (omega, upsilon)
-// smaller than L's stop thresholds marks the level converged. True when this step made the level
-// done (it stalled or converged), so that the caller keeps its system.
-SEAMLESS_HD inline bool gauss_newton_update(const IcpSums& s, IcpPose& p, IcpUpdate u, const IcpLevel& L) {
-  if (u == IcpUpdate::none) return false;
+// smaller than L's stop thresholds marks the level converged; a failed solve marks it stalled.
+SEAMLESS_HD inline void gauss_newton_update(const IcpSums& s, IcpPose& p, IcpUpdate u, const IcpLevel& L) {
+  if (u == IcpUpdate::none) return;
   if (u == IcpUpdate::first_step) p.stalled = p.converged = 0;
-  if (level_done(p, u)) return false;
   ++p.steps;
   double xi[6];
   if (!solve_normal_equations(s, xi)) {
     p.stalled = 1;
-    return true;
+    return;
   }
   left_update(p, xi);
   const double rot2 = xi[0] * xi[0] + xi[1] * xi[1] + xi[2] * xi[2];
   const double tra2 = xi[3] * xi[3] + xi[4] * xi[4] + xi[5] * xi[5];
   const double sr = L.stop_rotation, st = L.stop_translation;
   p.converged = rot2 < sr * sr && tra2 < st * st;
-  return p.converged;
 }
 
+// The step of round `step` of a level's loop: its first clears the previous level's flags.
+SEAMLESS_HD inline IcpUpdate level_step(int step) { return step == 0 ? IcpUpdate::first_step : IcpUpdate::step; }
+
 // Sums the point-to-plane normal equations over every pixel of the current level (one pass) at the
-// estimate *pose (level.ref_T_cur is ignored) into *out on the device, then, in the same launch
-// (after every pixel has read *pose), applies `update` to *pose; when that step makes the level
-// done, its system is also copied to *done (once per level: a copy every step, one thread moving
-// 30 doubles, cost 10 % of the loop). A step of a level already done sums nothing and changes
-// nothing.
+// estimate *pose (level.ref_T_cur is ignored) into *out on the device, without a step (tests,
+// statistics).
 template <class Exec>
-void icp_reduce_into(const Exec& ex, IcpLevel level, IcpPose* pose, IcpSums* out, IcpSums* done, IcpUpdate update);
+void icp_reduce_into(const Exec& ex, IcpLevel level, IcpPose* pose, IcpSums* out);
+
+// Up to `steps` Gauss-Newton steps of one level in one device launch (transform_reduce_rounds):
+// each sums the system at *pose into *out and applies it (gauss_newton_update), and the steps end
+// once the level is done, so a converged level's remaining steps cost nothing. *out then holds the
+// last system summed. The host queues the whole coarse-to-fine loop, a launch per level.
+template <class Exec>
+void icp_level_steps(const Exec& ex, IcpLevel level, IcpPose* pose, IcpSums* out, int steps);
 
 // Moves vertex and normal maps into another frame (x -> T x, n -> R n); invalid pixels stay zero.
 // Used to express a world-space raycast in the coordinates of the camera it was rendered from.

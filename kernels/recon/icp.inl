@@ -5,25 +5,32 @@
 
 namespace seamless::kernels {
 
+// One pixel's point-to-plane terms at the estimate p (level.ref_T_cur is ignored).
+SEAMLESS_HD inline IcpTerms icp_pixel_terms(const IcpLevel& level, const IcpPose& p, std::int64_t i) {
+  IcpTerms s{};
+  IcpLevel l = level;
+  l.ref_T_cur = to_se3(p);
+  const int w = l.cur_vertex.width;
+  int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
+  if (valid_point(l.cur_vertex(x, y))) s.valid = 1.f;
+  Correspondence c;
+  if (find_correspondence(l, x, y, c)) add_point_to_plane(s, c, 1.f);
+  return s;
+}
+
 template <class Exec>
-void icp_reduce_into(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSums* out, IcpSums* done, IcpUpdate update) {
-  const int w = L.cur_vertex.width;
+void icp_reduce_into(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSums* out) {
   ex.transform_reduce_into(
-      L.cur_vertex.count(),
-      [=] SEAMLESS_HD(std::int64_t i) {
-        IcpTerms s{};
-        const IcpPose p = *pose;  // the flags with the estimate: one round trip to memory, not two
-        if (level_done(p, update)) return s;
-        IcpLevel l = L;
-        l.ref_T_cur = to_se3(p);
-        int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
-        if (valid_point(l.cur_vertex(x, y))) s.valid = 1.f;
-        Correspondence c;
-        if (find_correspondence(l, x, y, c)) add_point_to_plane(s, c, 1.f);
-        return s;
-      },
-      out, [=] SEAMLESS_HD {
-        if (gauss_newton_update(*out, *pose, update, L)) *done = *out;
+      L.cur_vertex.count(), [=] SEAMLESS_HD(std::int64_t i) { return icp_pixel_terms(L, *pose, i); }, out);
+}
+
+template <class Exec>
+void icp_level_steps(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSums* out, int steps) {
+  ex.transform_reduce_rounds(
+      L.cur_vertex.count(), steps, [=] SEAMLESS_HD(std::int64_t i) { return icp_pixel_terms(L, *pose, i); }, out,
+      [=] SEAMLESS_HD(int step) {
+        gauss_newton_update(*out, *pose, level_step(step), L);
+        return level_done(*pose);
       });
 }
 
@@ -75,7 +82,8 @@ void pyr_down_maps(const Exec& ex, View2D<const vec3> vin, View2D<const vec3> ni
 
 #define SEAMLESS_INSTANTIATE_ICP(EXEC)                                                                             \
   namespace seamless::kernels {                                                                                    \
-  template void icp_reduce_into<EXEC>(const EXEC&, IcpLevel, IcpPose*, IcpSums*, IcpSums*, IcpUpdate);            \
+  template void icp_reduce_into<EXEC>(const EXEC&, IcpLevel, IcpPose*, IcpSums*);                                 \
+  template void icp_level_steps<EXEC>(const EXEC&, IcpLevel, IcpPose*, IcpSums*, int);                            \
   template void transform_maps<EXEC>(const EXEC&, View2D<const vec3>, View2D<const vec3>, SE3, View2D<vec3>,      \
                                      View2D<vec3>);                                                                \
   template void pyr_down_maps<EXEC>(const EXEC&, View2D<const vec3>, View2D<const vec3>, View2D<vec3>,             \

@@ -188,13 +188,16 @@ SEAMLESS_HD inline bool find_rgbd_correspondence(const RgbdLevel& L, int x, int 
 
 // Sums the combined geometric + photometric normal equations over the current level (one pass) at
 // the estimate *pose into *out on the device; then, in the same launch, copies the system into
-// *level_sums (where the tracker reads each level's last system), with robust weighting updates the
-// variances in *pose, and applies `update`, copying the system to *done too when the step makes the
-// level done (like icp_reduce_into). error holds the weighted sum of both terms; inliers counts
+// *level_sums (where the tracker reads each level's last system) and, with robust weighting,
+// re-estimates the variances in *pose. error holds the weighted sum of both terms; inliers counts
 // geometric correspondences.
 template <class Exec>
-void rgbd_reduce_into(const Exec& ex, RgbdLevel level, IcpPose* pose, RgbdSums* out, IcpSums* level_sums, IcpSums* done,
-                      IcpUpdate update);
+void rgbd_reduce_into(const Exec& ex, RgbdLevel level, IcpPose* pose, RgbdSums* out, IcpSums* level_sums);
+
+// Up to `steps` Gauss-Newton steps of one level in one device launch, like icp_level_steps: each
+// sums at *pose, keeps the system in *level_sums, steps, and re-estimates the variances.
+template <class Exec>
+void rgbd_level_steps(const Exec& ex, RgbdLevel level, IcpPose* pose, RgbdSums* out, IcpSums* level_sums, int steps);
 
 // Intensity in [0, 1] from 8-bit RGB (ITU-R BT.601 luma weights); kNoIntensity where RGB is
 // (0, 0, 0), no colour reading (see kNoIntensity).

@@ -5,30 +5,44 @@
 
 namespace seamless::kernels {
 
+// One pixel's geometric and photometric terms at the estimate p (R.geo.ref_T_cur is ignored).
+SEAMLESS_HD inline RgbdTerms rgbd_pixel_terms(const RgbdLevel& R, const IcpPose& p, std::int64_t i) {
+  RgbdTerms s{};
+  RgbdLevel L = R;
+  L.geo.ref_T_cur = to_se3(p);
+  const int w = L.geo.cur_vertex.width;
+  int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
+  if (valid_point(L.geo.cur_vertex(x, y))) s.icp.valid = 1.f;
+  Correspondence c;
+  bool geometric;
+  if (find_rgbd_correspondence(L, x, y, c, geometric)) add_rgbd_rows(s, L, c, x, y, p.geo_var, p.photo_var, geometric);
+  return s;
+}
+
+// What a reduction does with its summed system: keeps it as the level's, applies `update` (with
+// the variances this system was built with), then re-estimates the variances (robust weighting).
+SEAMLESS_HD inline void rgbd_update(const RgbdLevel& R, const RgbdSums& out, IcpPose& pose, IcpSums& level_sums,
+                                    IcpUpdate update) {
+  level_sums = out.icp;
+  gauss_newton_update(out.icp, pose, update, R.geo);
+  if (R.dof > 0.f) update_scale(out, pose);
+}
+
 template <class Exec>
-void rgbd_reduce_into(const Exec& ex, RgbdLevel R, IcpPose* pose, RgbdSums* out, IcpSums* level_sums,
-                      IcpSums* done, IcpUpdate update) {
-  const int w = R.geo.cur_vertex.width;
-  ex.transform_reduce_into(R.geo.cur_vertex.count(), [=] SEAMLESS_HD(std::int64_t i) {
-    RgbdTerms s{};
-    const IcpPose p = *pose;  // the flags with the estimate: one round trip to memory, not two
-    if (level_done(p, update)) return s;
-    RgbdLevel L = R;
-    L.geo.ref_T_cur = to_se3(p);
-    int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
-    if (valid_point(L.geo.cur_vertex(x, y))) s.icp.valid = 1.f;
-    Correspondence c;
-    bool geometric;
-    if (find_rgbd_correspondence(L, x, y, c, geometric))
-      add_rgbd_rows(s, L, c, x, y, p.geo_var, p.photo_var, geometric);
-    return s;
-  }, out, [=] SEAMLESS_HD {
-    if (level_done(*pose, update)) return;
-    *level_sums = out->icp;
-    // with the variances this system was built with
-    if (gauss_newton_update(out->icp, *pose, update, R.geo)) *done = out->icp;
-    if (R.dof > 0.f) update_scale(*out, *pose);
-  });
+void rgbd_reduce_into(const Exec& ex, RgbdLevel R, IcpPose* pose, RgbdSums* out, IcpSums* level_sums) {
+  ex.transform_reduce_into(
+      R.geo.cur_vertex.count(), [=] SEAMLESS_HD(std::int64_t i) { return rgbd_pixel_terms(R, *pose, i); }, out,
+      [=] SEAMLESS_HD { rgbd_update(R, *out, *pose, *level_sums, IcpUpdate::none); });
+}
+
+template <class Exec>
+void rgbd_level_steps(const Exec& ex, RgbdLevel R, IcpPose* pose, RgbdSums* out, IcpSums* level_sums, int steps) {
+  ex.transform_reduce_rounds(
+      R.geo.cur_vertex.count(), steps, [=] SEAMLESS_HD(std::int64_t i) { return rgbd_pixel_terms(R, *pose, i); },
+      out, [=] SEAMLESS_HD(int step) {
+        rgbd_update(R, *out, *pose, *level_sums, level_step(step));
+        return level_done(*pose);
+      });
 }
 
 template <class Exec>
@@ -46,6 +60,7 @@ void rgb_to_intensity(const Exec& ex, View2D<const uchar3> rgb, View2D<float> ou
 
 #define SEAMLESS_INSTANTIATE_RGBD(EXEC)                                                   \
   namespace seamless::kernels {                                                           \
-  template void rgbd_reduce_into<EXEC>(const EXEC&, RgbdLevel, IcpPose*, RgbdSums*, IcpSums*, IcpSums*, IcpUpdate); \
+  template void rgbd_reduce_into<EXEC>(const EXEC&, RgbdLevel, IcpPose*, RgbdSums*, IcpSums*);                     \
+  template void rgbd_level_steps<EXEC>(const EXEC&, RgbdLevel, IcpPose*, RgbdSums*, IcpSums*, int);                \
   template void rgb_to_intensity<EXEC>(const EXEC&, View2D<const uchar3>, View2D<float>); \
   }

@@ -12,6 +12,11 @@
 //                                        a loop of kernels (ICP's Gauss-Newton steps) never waits;
 //                                        then(), if given, runs once on the device after *out is
 //                                        written (in the same launch on CUDA)
+//   ex.transform_reduce_rounds(n, rounds, fn, out, then)
+//                                        up to `rounds` rounds of: *out = sum of fn(i), then
+//                                        bool then(round) on the device; a round's fn sees what
+//                                        the previous round's then wrote, and the rounds stop once
+//                                        then returns true (a Gauss-Newton loop in one launch)
 //   ex.for_each_grouped(n, max_lanes, fn)
 //                                        fn(i, lanes) for i in [0, n), each i by a group of
 //                                        lanes.size lanes (a power of two <= max_lanes, chosen
@@ -124,6 +129,7 @@ struct CpuExec {
   template <class K, class V> void sort_by_key(K* keys, V* values, std::int64_t n, int key_bits = 8 * sizeof(K)) const;
   template <class T, class F> T transform_reduce(std::int64_t n, T init, F fn) const;
   template <class T, class F, class G = NoThen> void transform_reduce_into(std::int64_t n, F fn, T* out, G then = {}) const;
+  template <class T, class F, class G> void transform_reduce_rounds(std::int64_t n, int rounds, F fn, T* out, G then) const;
   // One thread per element on the CPU: the groups are single lanes.
   int lanes(std::int64_t, int) const { return 1; }
   template <class F> void for_each_grouped(std::int64_t n, int max_lanes, F fn) const;
@@ -153,6 +159,7 @@ struct CudaExec {
   template <class K, class V> void sort_by_key(K* keys, V* values, std::int64_t n, int key_bits = 8 * sizeof(K)) const;
   template <class T, class F> T transform_reduce(std::int64_t n, T init, F fn) const;
   template <class T, class F, class G = NoThen> void transform_reduce_into(std::int64_t n, F fn, T* out, G then = {}) const;
+  template <class T, class F, class G> void transform_reduce_rounds(std::int64_t n, int rounds, F fn, T* out, G then) const;
   // Lanes per element: the smallest power of two that puts n x lanes threads on the device at
   // once (so that a small n still fills every multiprocessor), at most max_lanes (how far the
   // caller's per-element work splits usefully), at least 1. Defined in core/exec_cuda.cu.

@@ -107,4 +107,12 @@ void CpuExec::transform_reduce_into(std::int64_t n, F fn, T* out, G then) const 
   then();
 }
 
+template <class T, class F, class G>
+void CpuExec::transform_reduce_rounds(std::int64_t n, int rounds, F fn, T* out, G then) const {
+  for (int r = 0; r < rounds; ++r) {
+    *out = transform_reduce(n, T{}, fn);
+    if (then(r)) return;
+  }
+}
+
 }  // namespace seamless

@@ -164,23 +164,28 @@ kernels::IcpSums* Tracker::sums_slot(int level) const {
   return &state()->sums[level];
 }
 
-void Tracker::reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, int level, kernels::IcpPose* pose,
-                          kernels::IcpSums* out, kernels::IcpUpdate update) const {
+void Tracker::reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, int level, int steps) const {
   const PyramidLevel& cur = frame.level(level);
   const ReferenceLevel& rl = ref.level(level);
   kernels::IcpLevel L{cur.vertices.cview(), cur.normals.cview(), rl.vertices.cview(), rl.normals.cview(), rl.K,
                       SE3::identity(), params_.dist_threshold,
                       static_cast<float>(std::cos(params_.angle_threshold_deg * kPi / 180.0)),
                       static_cast<float>(params_.stop_rotation_deg * kPi / 180.0), params_.stop_translation};
+  kernels::IcpState* st = state();
+  kernels::IcpSums* out = sums_slot(level);
   with_exec(device_, [&](const auto& ex) {
-    if (!use_photometric(frame, ref)) return kernels::icp_reduce_into(ex, L, pose, out, &state()->done, update);
+    if (!use_photometric(frame, ref)) {
+      if (steps == 0) return kernels::icp_reduce_into(ex, L, &st->pose, out);
+      return kernels::icp_level_steps(ex, L, &st->pose, out, steps);
+    }
     kernels::RgbdLevel R{L, cur.intensity.cview(), rl.intensity.cview(), 1.f, params_.photometric_weight,
                          params_.max_intensity_diff, robust(frame, ref) ? params_.robust_dof : 0.f,
                          params_.depth_noise == "depth_squared"};
     R.photometric_all_visible = params_.photometric_pixels == "visible";
     R.min_gradient = params_.min_gradient;
     if (rgbd_sums_.size() != 1 || rgbd_sums_.device() != device_) rgbd_sums_ = Buffer<kernels::RgbdSums>(1, device_);
-    kernels::rgbd_reduce_into(ex, R, pose, rgbd_sums_.data(), out, &state()->done, update);
+    if (steps == 0) return kernels::rgbd_reduce_into(ex, R, &st->pose, rgbd_sums_.data(), out);
+    kernels::rgbd_level_steps(ex, R, &st->pose, rgbd_sums_.data(), out, steps);
   });
 }
 
@@ -189,16 +194,16 @@ kernels::IcpSums Tracker::reduce(const FramePyramid& frame, const ReferenceMaps&
   set_pose(ref_T_cur);
   // Robust weighting: a first reduction estimates the residual scales at this pose, so that the
   // system returned is weighted as the tracker's own steps are.
-  if (robust(frame, ref)) reduce_into(frame, ref, level, &state()->pose, sums_slot(0), kernels::IcpUpdate::none);
-  reduce_into(frame, ref, level, &state()->pose, sums_slot(0), kernels::IcpUpdate::none);
+  if (robust(frame, ref)) reduce_into(frame, ref, level, 0);
+  reduce_into(frame, ref, level, 0);
   kernels::IcpSums s;
-  memory::copy(&s, Device::CPU, sums_slot(0), device_, sizeof s);
+  memory::copy(&s, Device::CPU, sums_slot(level), device_, sizeof s);
   return s;
 }
 
-// The whole coarse-to-fine loop is queued on the device, one launch per iteration (reduce, then
-// solve and update in the same kernel); the host waits once, for the final estimate and the
-// finest level's last system.
+// The whole coarse-to-fine loop is queued on the device, one launch per pyramid level (each
+// holds the level's Gauss-Newton steps: reduce, solve, update, and the stop once converged); the
+// host waits once, for the final estimate and the finest level's last system.
 TrackResult Tracker::track(const FramePyramid& frame, const ReferenceMaps& ref,
                            const SE3& initial_world_T_camera) const {
   TrackResult r;
@@ -208,20 +213,16 @@ TrackResult Tracker::track(const FramePyramid& frame, const ReferenceMaps& ref,
   set_pose(ref.world_T_ref().inverse() * initial_world_T_camera);  // also clears the residual scales
   // Robust weighting: one scale-only reduction at the coarsest level first (no step), so that the
   // first step is already balanced; the scales then follow every step (kernels/recon/rgbd.hpp).
-  if (levels > 0 && robust(frame, ref))
-    reduce_into(frame, ref, levels - 1, &state()->pose, sums_slot(levels - 1), kernels::IcpUpdate::none);
+  if (levels > 0 && robust(frame, ref)) reduce_into(frame, ref, levels - 1, 0);
   for (int l = levels - 1; l >= 0; --l)
-    for (int it = 0; it < params_.iterations[l]; ++it)
-      reduce_into(frame, ref, l, &state()->pose, sums_slot(l),
-                  it == 0 ? kernels::IcpUpdate::first_step : kernels::IcpUpdate::step);
+    if (params_.iterations[l] > 0) reduce_into(frame, ref, l, params_.iterations[l]);
   kernels::IcpState st;  // one copy back, which waits for the loop
   memory::copy(&st, Device::CPU, state(), device_, sizeof st);
   const kernels::IcpPose& pose = st.pose;
   r.iterations = pose.steps;
   bool degenerate = false;
   if (levels > 0 && params_.iterations[0] > 0) {  // statistics of the finest level's last system
-    // a level that converged or stalled keeps its last system in `done` (its skipped steps sum nothing)
-    const kernels::IcpSums& s = pose.converged || pose.stalled ? st.done : st.sums[0];
+    const kernels::IcpSums& s = st.sums[0];  // the last system summed (a done level stops there)
     IcpStep step = solve_icp_step(s);
     r.inliers = static_cast<std::int64_t>(s.inliers);
     r.inlier_ratio = s.valid > 0 ? s.inliers / s.valid : 0.0;

@@ -94,8 +94,9 @@ class Tracker {
  private:
   bool use_photometric(const FramePyramid& frame, const ReferenceMaps& ref) const;
   bool robust(const FramePyramid& frame, const ReferenceMaps& ref) const;
-  void reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, int level, kernels::IcpPose* pose,
-                   kernels::IcpSums* out, kernels::IcpUpdate update) const;
+  // steps = 0: one reduction of the level's system at the device estimate, no step; else up to
+  // `steps` Gauss-Newton steps of the level in one launch. The system goes to sums_slot(level).
+  void reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, int level, int steps) const;
   kernels::IcpState* state() const;
   kernels::IcpSums* sums_slot(int level) const;
   void set_pose(const SE3& ref_T_cur) const;

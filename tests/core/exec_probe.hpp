@@ -19,6 +19,15 @@ template <class Exec> void square(const Exec& ex, View<const float> in, View<flo
 template <class Exec> Moments moments(const Exec& ex, View<const float> in);
 // The same sum left on the device in *out (transform_reduce_into).
 template <class Exec> void moments_into(const Exec& ex, View<const float> in, Moments* out);
+// transform_reduce_rounds: each round sums in[i] x scale into out->sum, then doubles the scale
+// and logs the round's sum; the rounds stop after `rounds` or once a sum exceeds stop_above.
+struct RoundsLog {
+  double scale = 1;
+  int rounds_run = 0;
+  double sums[16] = {};
+};
+template <class Exec>
+void doubling_rounds(const Exec& ex, View<const float> in, int rounds, double stop_above, Moments* out, RoundsLog* log);
 template <class Exec> std::uint32_t scan(const Exec& ex, View<const std::uint32_t> in, View<std::uint32_t> out);
 template <class Exec> void sort(const Exec& ex, View<std::uint32_t> keys, View<std::int32_t> values, int bits);
 // Histogram with atomics: counts[v % bins]++ for every v.

@@ -25,6 +25,22 @@ void moments_into(const Exec& ex, View<const float> in, Moments* out) {
 }
 
 template <class Exec>
+void doubling_rounds(const Exec& ex, View<const float> in, int rounds, double stop_above, Moments* out, RoundsLog* log) {
+  ex.transform_reduce_rounds(
+      in.size, rounds,
+      [=] SEAMLESS_HD(std::int64_t i) {
+        double v = in[i] * log->scale;  // the scale the previous round's `then` left
+        return Moments{v, v * v, 1};
+      },
+      out, [=] SEAMLESS_HD(int r) {
+        log->sums[r] = out->sum;
+        log->rounds_run = r + 1;
+        log->scale *= 2;
+        return out->sum > stop_above;
+      });
+}
+
+template <class Exec>
 std::uint32_t scan(const Exec& ex, View<const std::uint32_t> in, View<std::uint32_t> out) {
   return ex.exclusive_scan(in.data, out.data, in.size);
 }
@@ -52,6 +68,7 @@ void atomic_float_sum(const Exec& ex, View<const float> in, float* total) {
   template void square<EXEC>(const EXEC&, View<const float>, View<float>);                                   \
   template Moments moments<EXEC>(const EXEC&, View<const float>);                                            \
   template void moments_into<EXEC>(const EXEC&, View<const float>, Moments*);                                \
+  template void doubling_rounds<EXEC>(const EXEC&, View<const float>, int, double, Moments*, RoundsLog*);       \
   template std::uint32_t scan<EXEC>(const EXEC&, View<const std::uint32_t>, View<std::uint32_t>);           \
   template void sort<EXEC>(const EXEC&, View<std::uint32_t>, View<std::int32_t>, int);                       \
   template void histogram<EXEC>(const EXEC&, View<const std::uint32_t>, View<std::uint32_t>);               \

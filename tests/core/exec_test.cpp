@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <random>
 
@@ -71,6 +72,31 @@ TEST_P(ExecTest, TransformReduceIntoLeavesTheSumOnTheDevice) {
     probe::Moments m = out.to_host()[0];
     EXPECT_EQ(m.count, n);
     EXPECT_EQ(m.sum, sum);
+  }
+}
+
+// Rounds of reductions in one call: every round must see the state the previous round's `then`
+// wrote (the sum doubles), and the rounds must stop at the first `then` that says so. The sums are
+// of small integers times powers of two, so they are exact in any order.
+TEST_P(ExecTest, TransformReduceRoundsSeesEachRoundsUpdateAndStops) {
+  for (std::int64_t n : {std::int64_t{250001}, std::int64_t{1000}, std::int64_t{1}}) {
+    std::vector<float> h(static_cast<std::size_t>(n));
+    double sum = 0;
+    for (std::int64_t i = 0; i < n; ++i) sum += h[i] = static_cast<float>(i % 13);
+    auto in = Buffer<float>::from_host(h, dev());
+    for (int stop_after : {3, 10}) {  // stops early (3 of 10 rounds), or runs all 10
+      auto out = Buffer<probe::Moments>::from_host({probe::Moments{-1.0, -1.0, -1}}, dev());
+      auto log = Buffer<probe::RoundsLog>::from_host({probe::RoundsLog{}}, dev());
+      // the sum of round r is sum x 2^r: exceeding sum x 2^(stop_after - 1.5) stops after stop_after rounds
+      const double stop_above = sum * std::ldexp(1.0, stop_after - 1) * 0.75;
+      with_exec(dev(), [&](const auto& ex) {
+        probe::doubling_rounds(ex, in.cview(), 10, stop_above, out.data(), log.data());
+      });
+      const probe::RoundsLog l = log.to_host()[0];
+      ASSERT_EQ(l.rounds_run, sum > 0 ? stop_after : 10) << "n " << n;
+      for (int r = 0; r < l.rounds_run; ++r) EXPECT_EQ(l.sums[r], sum * std::ldexp(1.0, r)) << "round " << r;
+      EXPECT_EQ(out.to_host()[0].count, n);
+    }
   }
 }
 
