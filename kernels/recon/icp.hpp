@@ -154,34 +154,47 @@ SEAMLESS_HD inline SE3 to_se3(const IcpPose& p) {
 
 // Solves J^T J x = -J^T r by Cholesky (the system is symmetric positive definite whenever it is
 // solvable at all). False when a pivot is not positive or the result is not finite. It runs in one
-// GPU thread per Gauss-Newton step, on the critical path: one reciprocal per pivot, then only
-// multiplications (double division is a long instruction sequence on the GPU).
+// GPU thread per Gauss-Newton step, on the critical path: one reciprocal square root per pivot,
+// then only multiplications (double sqrt and division are long instruction sequences on the GPU).
 SEAMLESS_HD inline bool solve_normal_equations(const IcpSums& s, double x[6]) {
-  double A[6][6], L[6][6] = {}, inv[6], y[6];
-  for (int i = 0, k = 0; i < 6; ++i)
-    for (int j = i; j < 6; ++j, ++k) A[i][j] = A[j][i] = s.jtj[k];
+  // Every loop fully unrolled: constant indices keep the arrays in registers (a run-time index
+  // would put them in local memory).
+  double L[6][6], inv[6];  // the lower triangle of J^T J, overwritten column by column by its factor
+#pragma unroll
+  for (int i = 0; i < 6; ++i)
+#pragma unroll
+    for (int j = i; j < 6; ++j) L[j][i] = s.jtj[i * 6 - i * (i - 1) / 2 + (j - i)];  // row i of the upper triangle
+#pragma unroll
   for (int j = 0; j < 6; ++j) {
-    double d = A[j][j];
+    double d = L[j][j];
+#pragma unroll
     for (int k = 0; k < j; ++k) d -= L[j][k] * L[j][k];
     if (!(d > 0.0)) return false;
-    L[j][j] = sqrt(d);
-    inv[j] = 1.0 / L[j][j];
+    inv[j] = rsqrt_d(d);
+    L[j][j] = d * inv[j];
+#pragma unroll
     for (int i = j + 1; i < 6; ++i) {
-      double v = A[i][j];
+      double v = L[i][j];
+#pragma unroll
       for (int k = 0; k < j; ++k) v -= L[i][k] * L[j][k];
       L[i][j] = v * inv[j];
     }
   }
-  for (int i = 0; i < 6; ++i) {  // L y = -J^T r
+#pragma unroll
+  for (int i = 0; i < 6; ++i) {  // L y = -J^T r, y in x
     double v = -s.jtr[i];
-    for (int k = 0; k < i; ++k) v -= L[i][k] * y[k];
-    y[i] = v * inv[i];
+#pragma unroll
+    for (int k = 0; k < i; ++k) v -= L[i][k] * x[k];
+    x[i] = v * inv[i];
   }
-  for (int i = 5; i >= 0; --i) {  // L^T x = y
-    double v = y[i];
+#pragma unroll
+  for (int i = 5; i >= 0; --i) {  // L^T x = y, in place (x[k > i] are final, x[i] still y[i])
+    double v = x[i];
+#pragma unroll
     for (int k = i + 1; k < 6; ++k) v -= L[k][i] * x[k];
     x[i] = v * inv[i];
   }
+#pragma unroll
   for (int i = 0; i < 6; ++i)
     if (!is_finite(x[i])) return false;
   return true;
@@ -190,10 +203,10 @@ SEAMLESS_HD inline bool solve_normal_equations(const IcpSums& s, double x[6]) {
 // p <- exp(xi) p with exp(xi) = (Rodrigues rotation of omega, translation upsilon): the left
 // update of the header comment, first order in xi like KinectFusion eq. 19, kept exactly rigid.
 SEAMLESS_HD inline void left_update(IcpPose& p, const double xi[6]) {
-  const double th = sqrt(xi[0] * xi[0] + xi[1] * xi[1] + xi[2] * xi[2]);
+  const double th2 = xi[0] * xi[0] + xi[1] * xi[1] + xi[2] * xi[2];
   double D[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-  if (th > 0.0) {
-    const double r = 1.0 / th, k[3] = {xi[0] * r, xi[1] * r, xi[2] * r};
+  if (th2 > 0.0) {
+    const double r = rsqrt_d(th2), th = th2 * r, k[3] = {xi[0] * r, xi[1] * r, xi[2] * r};
     const double s = sin(th), c = 1.0 - cos(th);  // nvcc merges the two into one sincos
     // R = I + sin(th) K + (1 - cos(th)) K^2, K the cross-product matrix of the unit axis k.
     D[0] = 1 - c * (k[1] * k[1] + k[2] * k[2]), D[1] = -s * k[2] + c * k[0] * k[1], D[2] = s * k[1] + c * k[0] * k[2];

@@ -28,8 +28,8 @@ template <class Exec>
 void icp_level_steps(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSums* out, int steps) {
   ex.transform_reduce_rounds(
       L.cur_vertex.count(), steps, [=] SEAMLESS_HD(std::int64_t i) { return icp_pixel_terms(L, *pose, i); }, out,
-      [=] SEAMLESS_HD(int step) {
-        gauss_newton_update(*out, *pose, level_step(step), L);
+      [=] SEAMLESS_HD(int step, const IcpSums& sum) {
+        gauss_newton_update(sum, *pose, level_step(step), L);
         return level_done(*pose);
       });
 }

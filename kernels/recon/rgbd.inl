@@ -39,8 +39,8 @@ template <class Exec>
 void rgbd_level_steps(const Exec& ex, RgbdLevel R, IcpPose* pose, RgbdSums* out, IcpSums* level_sums, int steps) {
   ex.transform_reduce_rounds(
       R.geo.cur_vertex.count(), steps, [=] SEAMLESS_HD(std::int64_t i) { return rgbd_pixel_terms(R, *pose, i); },
-      out, [=] SEAMLESS_HD(int step) {
-        rgbd_update(R, *out, *pose, *level_sums, level_step(step));
+      out, [=] SEAMLESS_HD(int step, const RgbdSums& sum) {
+        rgbd_update(R, sum, *pose, *level_sums, level_step(step));
         return level_done(*pose);
       });
 }

@@ -14,9 +14,11 @@
 //                                        written (in the same launch on CUDA)
 //   ex.transform_reduce_rounds(n, rounds, fn, out, then)
 //                                        up to `rounds` rounds of: *out = sum of fn(i), then
-//                                        bool then(round) on the device; a round's fn sees what
-//                                        the previous round's then wrote, and the rounds stop once
-//                                        then returns true (a Gauss-Newton loop in one launch)
+//                                        bool then(round, *out) on the device; a round's fn sees
+//                                        what the previous round's then wrote, and the rounds stop
+//                                        once then returns true (a Gauss-Newton loop in one
+//                                        launch); fn returns a struct of floats, summed component
+//                                        by component, widened into T (T{} + sum) once a round
 //   ex.for_each_grouped(n, max_lanes, fn)
 //                                        fn(i, lanes) for i in [0, n), each i by a group of
 //                                        lanes.size lanes (a power of two <= max_lanes, chosen

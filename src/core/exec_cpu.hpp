@@ -111,7 +111,7 @@ template <class T, class F, class G>
 void CpuExec::transform_reduce_rounds(std::int64_t n, int rounds, F fn, T* out, G then) const {
   for (int r = 0; r < rounds; ++r) {
     *out = transform_reduce(n, T{}, fn);
-    if (then(r)) return;
+    if (then(r, *out)) return;
   }
 }
 

@@ -77,39 +77,111 @@ __global__ void transform_reduce_kernel(std::int64_t n, F fn, decltype(fn(std::i
   }
 }
 
+// The float components of a transform_reduce_rounds term, padded to whole warps: kQ per lane.
+template <class Local>
+struct RoundWords {
+  static_assert(sizeof(Local) % sizeof(float) == 0 && alignof(Local) == alignof(float),
+                "transform_reduce_rounds: fn must return a struct of floats (summed component by component)");
+  static constexpr int kWords = sizeof(Local) / sizeof(float);
+  static constexpr int kQ = (kWords + 31) / 32;
+};
+
+// One butterfly step of warp_reduce_scatter over the first M entries of v: the lanes whose bit o
+// is set keep the upper half, the others the lower, and each adds its partner's half of the kept
+// part. M is a template argument so that every index is a constant (v stays in registers).
+template <int M, int N>
+__device__ __forceinline__ void butterfly_step(float (&v)[N], unsigned lane, int o) {
+  const bool upper = lane & static_cast<unsigned>(o);
+#pragma unroll
+  for (int j = 0; j < M / 2; ++j) {
+    const float keep = upper ? v[j + M / 2] : v[j], give = upper ? v[j] : v[j + M / 2];
+    v[j] = keep + __shfl_xor_sync(0xFFFFFFFFu, give, o);
+  }
+}
+
+// A warp's reduce-scatter of 32 x kQ floats: five butterfly steps (16 + 8 + 4 + 2 + 1 shuffles
+// x kQ, not 5 x 32 x kQ for a shuffle tree per component). Lane l ends with the warp's sums of
+// components [l kQ, l kQ + kQ) in v[0, kQ): each step's upper half goes with that step's lane bit.
+template <int kQ>
+__device__ __forceinline__ void warp_reduce_scatter(float (&v)[32 * kQ], unsigned lane) {
+  butterfly_step<32 * kQ>(v, lane, 16);
+  butterfly_step<16 * kQ>(v, lane, 8);
+  butterfly_step<8 * kQ>(v, lane, 4);
+  butterfly_step<4 * kQ>(v, lane, 2);
+  butterfly_step<2 * kQ>(v, lane, 1);
+}
+
 // transform_reduce_rounds in one cooperative launch (every block resident at once, so that the
-// grid can wait for itself): each round, every block writes its partial and the grid waits; block
-// 0 adds the partials, writes *out and runs then(round) in its thread 0 while the others wait
-// again; then every block reads the same stop flag, so the grid leaves the loop together. A round
-// costs two grid barriers instead of a launch and the "last block" counter, fence and atomic of
-// transform_reduce_kernel (about 10-15 us a Gauss-Newton step on an H200, docs/PERFORMANCE.md).
+// grid can wait for itself). Each round, a block sums its terms component by component (a warp
+// reduce-scatter, then the warps' sums in shared memory) into partial[c x blocks + block]
+// (component-major), and the grid waits; block 0 then sums each component over the blocks, a
+// warp per component with coalesced loads, and its thread 0 writes *out and runs then(round, sum)
+// while the others wait again; every block then reads the same stop flag, so the grid leaves
+// the loop together. A round costs two grid barriers instead of a launch and the "last block"
+// counter of transform_reduce_kernel, and the sums of a 30-float term take a few hundred cycles
+// where a block reduction of the struct took thousands (docs/PERFORMANCE.md, session 6).
 template <int kThreads, class T, class F, class G>
-__global__ void __launch_bounds__(kThreads)
-    transform_reduce_rounds_kernel(std::int64_t n, int rounds, F fn, decltype(fn(std::int64_t{}))* partial,
-                                   int* stop, T* out, G then) {
+__global__ void __launch_bounds__(kThreads, 2)
+    transform_reduce_rounds_kernel(std::int64_t n, int rounds, F fn, float* partial, int* stop, T* out, G then) {
   using Local = decltype(fn(std::int64_t{}));
-  using BlockReduce = cub::BlockReduce<Local, kThreads>;
-  __shared__ typename BlockReduce::TempStorage tmp;
+  using W = RoundWords<Local>;
+  constexpr int kWarps = kThreads / 32;
+  __shared__ float warp_sums[kWarps][32 * W::kQ];
+  __shared__ float total_words[W::kWords];
+  const unsigned lane = threadIdx.x & 31u, warp = threadIdx.x >> 5;
   const cooperative_groups::grid_group grid = cooperative_groups::this_grid();
   for (int r = 0; r < rounds; ++r) {
     Local local{};
     for (std::int64_t i = static_cast<std::int64_t>(blockIdx.x) * kThreads + threadIdx.x; i < n;
          i += static_cast<std::int64_t>(gridDim.x) * kThreads)
       local = local + fn(i);
-    Local block = BlockReduce(tmp).Reduce(local, Plus{});
-    if (threadIdx.x == 0) partial[blockIdx.x] = block;
+    float v[32 * W::kQ];
+#pragma unroll
+    for (int k = 0; k < 32 * W::kQ; ++k) v[k] = k < W::kWords ? reinterpret_cast<const float*>(&local)[k] : 0.f;
+    warp_reduce_scatter<W::kQ>(v, lane);
+#pragma unroll
+    for (int q = 0; q < W::kQ; ++q) warp_sums[warp][lane * W::kQ + q] = v[q];
+    __syncthreads();
+    for (int c = threadIdx.x; c < W::kWords; c += kThreads) {
+      float sum = 0.f;
+#pragma unroll
+      for (int w = 0; w < kWarps; ++w) sum += warp_sums[w][c];
+      partial[static_cast<std::int64_t>(c) * gridDim.x + blockIdx.x] = sum;
+    }
     grid.sync();  // every partial written (the barrier orders memory grid-wide)
     if (blockIdx.x == 0) {
-      Local sum{};
-      for (unsigned i = threadIdx.x; i < gridDim.x; i += kThreads) sum = sum + partial[i];
-      __syncthreads();  // tmp is reused
-      Local total = BlockReduce(tmp).Reduce(sum, Plus{});
+      // Warp w sums components w, w + kWarps, ...; its lanes stride over the blocks, kBatch
+      // loads per component in flight at once (one trip of the outer loop up to 32 x kBatch
+      // blocks), then a shuffle tree per component.
+      constexpr int kPerWarp = (W::kWords + kWarps - 1) / kWarps, kBatch = 16;
+      float acc[kPerWarp] = {};
+      for (unsigned b0 = lane; b0 < gridDim.x; b0 += 32 * kBatch) {
+#pragma unroll
+        for (int m = 0; m < kPerWarp; ++m) {
+          const int c = static_cast<int>(warp) + kWarps * m;
+          const float* p = partial + static_cast<std::int64_t>(c) * gridDim.x;
+#pragma unroll
+          for (int k = 0; k < kBatch; ++k) {
+            const unsigned b = b0 + 32u * k;
+            acc[m] += c < W::kWords && b < gridDim.x ? p[b] : 0.f;
+          }
+        }
+      }
+#pragma unroll
+      for (int m = 0; m < kPerWarp; ++m) {
+        const int c = static_cast<int>(warp) + kWarps * m;
+#pragma unroll
+        for (int o = 16; o >= 1; o >>= 1) acc[m] += __shfl_xor_sync(0xFFFFFFFFu, acc[m], o);
+        if (lane == 0 && c < W::kWords) total_words[c] = acc[m];
+      }
+      __syncthreads();
       if (threadIdx.x == 0) {
-        *out = T{} + total;
-        *stop = then(r) ? 1 : 0;
+        const T sum = T{} + *reinterpret_cast<const Local*>(total_words);
+        *out = sum;
+        *stop = then(r, sum) ? 1 : 0;
       }
     }
-    grid.sync();  // then's writes seen by every block's next round; partials free again
+    grid.sync();  // then's writes seen by every block's next round; partials and warp_sums free again
     if (*static_cast<volatile int*>(stop)) break;
   }
 }
@@ -391,7 +463,7 @@ void CudaExec::transform_reduce_into(std::int64_t n, F fn, T* out, G then) const
 template <class T, class F, class G>
 void CudaExec::transform_reduce_rounds(std::int64_t n, int rounds, F fn, T* out, G then) const {
   if (rounds <= 0) return;
-  constexpr int kThreads = 128;
+  constexpr int kThreads = 256;
   auto kernel = cuda_detail::transform_reduce_rounds_kernel<kThreads, T, F, G>;
   // A cooperative launch must fit on the device at once: at most the resident blocks.
   static const int resident = [&] {
@@ -401,11 +473,12 @@ void CudaExec::transform_reduce_rounds(std::int64_t n, int rounds, F fn, T* out,
   }();
   std::int64_t wanted = std::max<std::int64_t>(1, (n + kThreads - 1) / kThreads);
   int blocks = static_cast<int>(std::min<std::int64_t>(wanted, resident));
-  using Local = decltype(fn(std::int64_t{}));
-  // The partials and, after them, the stop flag, in the shared scratch (one collective at a time).
-  const std::size_t flag_at = (sizeof(Local) * blocks + alignof(int) - 1) / alignof(int) * alignof(int);
+  using W = cuda_detail::RoundWords<decltype(fn(std::int64_t{}))>;
+  // The partials (component-major) and, after them, the stop flag, in the shared scratch (one
+  // collective at a time).
+  const std::size_t flag_at = sizeof(float) * W::kWords * static_cast<std::size_t>(blocks);
   auto* base = static_cast<unsigned char*>(cuda_detail::scratch(flag_at + sizeof(int)));
-  Local* partial = reinterpret_cast<Local*>(base);
+  float* partial = reinterpret_cast<float*>(base);
   int* stop = reinterpret_cast<int*>(base + flag_at);
   void* args[] = {&n, &rounds, &fn, &partial, &stop, &out, &then};
   SEAMLESS_CUDA_CHECK(cudaLaunchCooperativeKernel(reinterpret_cast<const void*>(kernel), dim3(blocks), dim3(kThreads),

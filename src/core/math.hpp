@@ -74,6 +74,16 @@ SEAMLESS_HD inline bool is_finite(T v) {
   return std::isfinite(v);
 #endif
 }
+// 1 / sqrt(v): one approximate reciprocal square root and Newton steps on the GPU (its double
+// sqrt and division are long instruction sequences, felt on one-thread critical paths such as
+// the ICP solve), the exact expression on the CPU; they agree to about an ulp.
+SEAMLESS_HD inline double rsqrt_d(double v) {
+#ifdef __CUDA_ARCH__
+  return rsqrt(v);
+#else
+  return 1.0 / std::sqrt(v);
+#endif
+}
 SEAMLESS_HD inline bool is_finite(vec3 a) { return is_finite(a.x) && is_finite(a.y) && is_finite(a.z); }
 
 // int3

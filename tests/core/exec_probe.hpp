@@ -21,13 +21,36 @@ template <class Exec> Moments moments(const Exec& ex, View<const float> in);
 template <class Exec> void moments_into(const Exec& ex, View<const float> in, Moments* out);
 // transform_reduce_rounds: each round sums in[i] x scale into out->sum, then doubles the scale
 // and logs the round's sum; the rounds stop after `rounds` or once a sum exceeds stop_above.
+// The per-element terms are floats (the rounds sum float components), 40 of them so that the
+// term spans more than one warp's 32 lanes; term k is in[i] x scale x (k + 1).
+struct RoundTerms {
+  float v[40];
+  SEAMLESS_HD RoundTerms operator+(const RoundTerms& o) const {
+    RoundTerms s;
+    for (int k = 0; k < 40; ++k) s.v[k] = v[k] + o.v[k];
+    return s;
+  }
+};
+struct RoundSums {
+  double v[40] = {};
+  SEAMLESS_HD RoundSums operator+(const RoundTerms& o) const {
+    RoundSums s;
+    for (int k = 0; k < 40; ++k) s.v[k] = v[k] + o.v[k];
+    return s;
+  }
+  SEAMLESS_HD RoundSums operator+(const RoundSums& o) const {
+    RoundSums s;
+    for (int k = 0; k < 40; ++k) s.v[k] = v[k] + o.v[k];
+    return s;
+  }
+};
 struct RoundsLog {
   double scale = 1;
   int rounds_run = 0;
-  double sums[16] = {};
+  double sums[16][40] = {};
 };
 template <class Exec>
-void doubling_rounds(const Exec& ex, View<const float> in, int rounds, double stop_above, Moments* out, RoundsLog* log);
+void doubling_rounds(const Exec& ex, View<const float> in, int rounds, double stop_above, RoundSums* out, RoundsLog* log);
 template <class Exec> std::uint32_t scan(const Exec& ex, View<const std::uint32_t> in, View<std::uint32_t> out);
 template <class Exec> void sort(const Exec& ex, View<std::uint32_t> keys, View<std::int32_t> values, int bits);
 // Histogram with atomics: counts[v % bins]++ for every v.

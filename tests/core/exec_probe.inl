@@ -25,18 +25,21 @@ void moments_into(const Exec& ex, View<const float> in, Moments* out) {
 }
 
 template <class Exec>
-void doubling_rounds(const Exec& ex, View<const float> in, int rounds, double stop_above, Moments* out, RoundsLog* log) {
+void doubling_rounds(const Exec& ex, View<const float> in, int rounds, double stop_above, RoundSums* out,
+                     RoundsLog* log) {
   ex.transform_reduce_rounds(
       in.size, rounds,
       [=] SEAMLESS_HD(std::int64_t i) {
-        double v = in[i] * log->scale;  // the scale the previous round's `then` left
-        return Moments{v, v * v, 1};
+        const float v = in[i] * static_cast<float>(log->scale);  // the scale the previous round's `then` left
+        RoundTerms t;
+        for (int k = 0; k < 40; ++k) t.v[k] = v * static_cast<float>(k + 1);
+        return t;
       },
-      out, [=] SEAMLESS_HD(int r) {
-        log->sums[r] = out->sum;
+      out, [=] SEAMLESS_HD(int r, const RoundSums& sum) {
+        for (int k = 0; k < 40; ++k) log->sums[r][k] = sum.v[k];
         log->rounds_run = r + 1;
         log->scale *= 2;
-        return out->sum > stop_above;
+        return sum.v[0] > stop_above;
       });
 }
 
@@ -68,7 +71,7 @@ void atomic_float_sum(const Exec& ex, View<const float> in, float* total) {
   template void square<EXEC>(const EXEC&, View<const float>, View<float>);                                   \
   template Moments moments<EXEC>(const EXEC&, View<const float>);                                            \
   template void moments_into<EXEC>(const EXEC&, View<const float>, Moments*);                                \
-  template void doubling_rounds<EXEC>(const EXEC&, View<const float>, int, double, Moments*, RoundsLog*);       \
+  template void doubling_rounds<EXEC>(const EXEC&, View<const float>, int, double, RoundSums*, RoundsLog*);       \
   template std::uint32_t scan<EXEC>(const EXEC&, View<const std::uint32_t>, View<std::uint32_t>);           \
   template void sort<EXEC>(const EXEC&, View<std::uint32_t>, View<std::int32_t>, int);                       \
   template void histogram<EXEC>(const EXEC&, View<const std::uint32_t>, View<std::uint32_t>);               \

@@ -76,26 +76,30 @@ TEST_P(ExecTest, TransformReduceIntoLeavesTheSumOnTheDevice) {
 }
 
 // Rounds of reductions in one call: every round must see the state the previous round's `then`
-// wrote (the sum doubles), and the rounds must stop at the first `then` that says so. The sums are
-// of small integers times powers of two, so they are exact in any order.
+// wrote (the sums double), and the rounds must stop at the first `then` that says so; every one of
+// the 40 components must be summed (more than a warp's 32 lanes). The terms are small integers
+// times (k + 1) times powers of two, and every partial sum stays below 2^24 times that power of
+// two, so the float sums are exact in any order.
 TEST_P(ExecTest, TransformReduceRoundsSeesEachRoundsUpdateAndStops) {
-  for (std::int64_t n : {std::int64_t{250001}, std::int64_t{1000}, std::int64_t{1}}) {
+  for (std::int64_t n : {std::int64_t{25001}, std::int64_t{1000}, std::int64_t{1}}) {
     std::vector<float> h(static_cast<std::size_t>(n));
     double sum = 0;
     for (std::int64_t i = 0; i < n; ++i) sum += h[i] = static_cast<float>(i % 13);
     auto in = Buffer<float>::from_host(h, dev());
     for (int stop_after : {3, 10}) {  // stops early (3 of 10 rounds), or runs all 10
-      auto out = Buffer<probe::Moments>::from_host({probe::Moments{-1.0, -1.0, -1}}, dev());
+      auto out = Buffer<probe::RoundSums>::from_host({probe::RoundSums{}}, dev());
       auto log = Buffer<probe::RoundsLog>::from_host({probe::RoundsLog{}}, dev());
-      // the sum of round r is sum x 2^r: exceeding sum x 2^(stop_after - 1.5) stops after stop_after rounds
+      // the sum of round r is sum x 2^r: exceeding sum x 2^(stop_after - 1) x 0.75 stops after stop_after rounds
       const double stop_above = sum * std::ldexp(1.0, stop_after - 1) * 0.75;
       with_exec(dev(), [&](const auto& ex) {
         probe::doubling_rounds(ex, in.cview(), 10, stop_above, out.data(), log.data());
       });
       const probe::RoundsLog l = log.to_host()[0];
       ASSERT_EQ(l.rounds_run, sum > 0 ? stop_after : 10) << "n " << n;
-      for (int r = 0; r < l.rounds_run; ++r) EXPECT_EQ(l.sums[r], sum * std::ldexp(1.0, r)) << "round " << r;
-      EXPECT_EQ(out.to_host()[0].count, n);
+      for (int r = 0; r < l.rounds_run; ++r)
+        for (int k = 0; k < 40; ++k)
+          ASSERT_EQ(l.sums[r][k], sum * (k + 1) * std::ldexp(1.0, r)) << "round " << r << " component " << k;
+      EXPECT_EQ(out.to_host()[0].v[39], sum * 40 * std::ldexp(1.0, l.rounds_run - 1));
     }
   }
 }
