@@ -32,31 +32,60 @@ SEAMLESS_HD inline bool both_fluid(std::uint32_t a, std::uint32_t b) {
 template <class Exec>
 inline constexpr bool kCachePairs = Exec::device == Device::CPU;
 
-// Calls fn(k, j) with j = list[k * col] for a lane's entries k = g.lane, g.lane + g.size, ...
-// below m, in k order (so sums keep the order of a plain loop). The indices are loaded 4 at a
-// time before fn runs on any of them: at 1M particles CUDA runs a thread per particle, whose
-// pair loop was one chain of dependent loads (index, then the neighbour's data) per entry, and
-// the passes were latency-bound (Nsight, H200: 45-55% active warps, 10-20% of DRAM bandwidth).
-// With fn free of branches the 4 entries are one basic block, so the compiler issues their
-// 4 gathers together: 4 loads in flight per thread instead of 1.
-#ifndef SEAMLESS_PAIR_BATCH
-#define SEAMLESS_PAIR_BATCH 4
+// Calls use(k, j, gather(j)) with j = list[k * col] for a lane's entries k = g.lane,
+// g.lane + g.size, ... below m, in k order (sums keep the order of a plain loop). gather(j)
+// loads what the pair needs of neighbour j; use does the math. On CUDA the entries come in
+// batches of kPairBatch: their indices, then all their gathers, then the math. At 1M particles
+// CUDA runs one thread per particle, whose pair loop was a chain of dependent loads (index, then
+// the neighbour's data) per entry, and the passes were latency-bound (Nsight, H200: 45-55%
+// active warps, 10-20% of DRAM bandwidth); the math cannot be relied on to leave loads free
+// to move (IEEE square roots and divisions have slow-path branches), so the batch is explicit.
+// On the CPU one entry at a time (kPairBatch 1), the plain loop.
+// Batch sizes (CUDA) of the passes that gather one packed word per pair (density, PBF) and two
+// (vorticity, forces: 8 more registers per entry of a batch).
+#ifndef SEAMLESS_BATCH1
+#define SEAMLESS_BATCH1 4
 #endif
-constexpr int kPairBatch = SEAMLESS_PAIR_BATCH;
-template <class F>
-SEAMLESS_HD inline void for_each_entry(const int* list, std::int64_t col, int m, Lanes g, F&& fn) {
+#ifndef SEAMLESS_BATCH2
+#define SEAMLESS_BATCH2 4
+#endif
+#if defined(__CUDA_ARCH__)
+constexpr int kPairBatch1 = SEAMLESS_BATCH1, kPairBatch2 = SEAMLESS_BATCH2;
+#else
+constexpr int kPairBatch1 = 1, kPairBatch2 = 1;
+#endif
+template <int kPairBatch, class Gather, class Use>
+SEAMLESS_HD inline void for_each_entry(const int* list, std::int64_t col, int m, Lanes g, Gather&& gather, Use&& use) {
+  using D = decltype(gather(0));
   const int d = g.size;
   int k = g.lane;
-  for (; k + (kPairBatch - 1) * d < m; k += kPairBatch * d) {
-    int j[kPairBatch];
-    SEAMLESS_PHYS_UNROLL
-    for (int u = 0; u < kPairBatch; ++u) j[u] = list[(k + u * d) * col];
-    SEAMLESS_PHYS_UNROLL
-    for (int u = 0; u < kPairBatch; ++u) fn(k + u * d, j[u]);
+  if constexpr (kPairBatch > 1) {
+    for (; k + (kPairBatch - 1) * d < m; k += kPairBatch * d) {
+      int j[kPairBatch];
+      D v[kPairBatch];
+      SEAMLESS_PHYS_UNROLL
+      for (int u = 0; u < kPairBatch; ++u) j[u] = list[(k + u * d) * col];
+      SEAMLESS_PHYS_UNROLL
+      for (int u = 0; u < kPairBatch; ++u) v[u] = gather(j[u]);
+      SEAMLESS_PHYS_UNROLL
+      for (int u = 0; u < kPairBatch; ++u) use(k + u * d, j[u], v[u]);
+    }
   }
-  for (; k < m; k += d) fn(k, list[k * col]);
+  for (; k < m; k += d) {
+    const int j = list[k * col];
+    use(k, j, gather(j));
+  }
 }
 
+// What a pair loop gathers of neighbour j: one or two packed words and whether j is fluid.
+struct Gather1 {
+  Packed a;
+  bool fluid;
+};
+struct Gather2 {
+  Packed a, b;
+  bool fluid;
+};
 
 // spk = (sp, phase bits): the packed copy that the next neighbour loops gather (Packed).
 template <class Exec>
@@ -551,8 +580,8 @@ SEAMLESS_HD inline DensitySum density_part(const SimViews& S, int s, Lanes g) {
   const int* const list = S.nbrs(s);
   Packed* const cache = S.pair_w + s * S.nbr_row;
   const std::int64_t col = S.nbr_col;
-  for_each_entry(list, col, S.nnbr[s], g, [&](int k, int j) {
-    const Packed q = S.spk[j];  // position and phase in one load
+  const auto gather = [&](int j) { return S.spk[j]; };  // position and phase in one load
+  for_each_entry<kPairBatch1>(list, col, S.nnbr[s], g, gather, [&](int k, int, const Packed& q) {
     vec3 r = p - q.xyz();
     float wgt = W.poly6(length2(r));
     const vec3 gw = W.spiky_grad(r);
@@ -620,14 +649,19 @@ SEAMLESS_HD inline vec3 pbf_part(const SimViews& S, int s, Lanes g) {
   const float li = S.lambda[s], sw = S.c.solid_density_scale;
   const bool mixed = S.nsolid[s] != 0;  // otherwise every neighbour is fluid: no phase loads
   vec3 f{0.f, 0.f, 0.f};
-  for_each_entry(S.nbrs(s), S.nbr_col, S.nnbr[s], g, [&](int k, int j) {
+  // Position and lambda in one load (Cached: lambda alone), and whether j is fluid.
+  const auto gather = [&](int j) {
+    const bool fluid = !mixed || phase::is(S.sphase[j], phase::kFluid);
+    return Gather1{Cached ? Packed{0.f, 0.f, 0.f, S.lambda[j]} : S.spl[j], fluid};
+  };
+  for_each_entry<kPairBatch1>(S.nbrs(s), S.nbr_col, S.nnbr[s], g, gather, [&](int k, int, const Gather1& n) {
     vec3 grad;
     float wgt, lj;
     if constexpr (Cached) {
       const Packed gw = S.pair_w[s * S.nbr_row + k * S.nbr_col];
-      grad = gw.xyz(), wgt = gw.w, lj = S.lambda[j];
+      grad = gw.xyz(), wgt = gw.w, lj = n.a.w;
     } else {
-      const Packed pl = S.spl[j];  // position and lambda in one load
+      const Packed pl = n.a;
       const vec3 r = p - pl.xyz();
       grad = S.c.W.spiky_grad(r), lj = pl.w;
       wgt = S.c.scorr_k > 0.f ? S.c.W.poly6(length2(r)) : 0.f;
@@ -637,9 +671,7 @@ SEAMLESS_HD inline vec3 pbf_part(const SimViews& S, int s, Lanes g) {
       float q = wgt * S.c.scorr_inv_wdq;
       sc = -S.c.scorr_k * q * q * q * q;
     }
-    // A solid neighbour pushes with li * sw alone (a select, not a branch: for_each_entry).
-    const bool fluid = !mixed || phase::is(S.sphase[j], phase::kFluid);
-    f += grad * (fluid ? li + lj + sc : li * sw);
+    f += grad * (n.fluid ? li + lj + sc : li * sw);  // a solid neighbour: li * sw alone
   });
   for (int k = g.lane, m = S.nsnbr[s]; k < m; k += g.size) f += S.c.W.spiky_grad(p - S.stat[S.snbrs(s)[k * S.snbr_col]]) * (li * sw);
   return f;
@@ -918,11 +950,14 @@ SEAMLESS_HD inline vec3 fluid_forces(const SimViews& S, int s, Lanes g) {
   const int* const list = S.nbrs(s);
   const std::int64_t col = S.nbr_col, row = s * S.nbr_row;
   ForceSum t{{0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}};
-  for_each_entry(list, col, S.nnbr[s], g, [&](int k, int j) {
-    // Solid neighbours add nothing (a select, not a branch: for_each_entry).
-    const bool use = !mixed || phase::is(S.sphase[j], phase::kFluid);
-    // Position and density, normal and |omega| (cnv is written for fluid particles only).
-    const Packed q = S.spd[j], nv = use ? S.cnv[j] : Packed{0.f, 0.f, 0.f, 0.f};
+  // Position and density, normal and |omega| (cnv is written for fluid particles only).
+  const auto gather = [&](int j) {
+    const bool fluid = !mixed || phase::is(S.sphase[j], phase::kFluid);
+    return Gather2{S.spd[j], fluid ? S.cnv[j] : Packed{0.f, 0.f, 0.f, 0.f}, fluid};
+  };
+  for_each_entry<kPairBatch2>(list, col, S.nnbr[s], g, gather, [&](int k, int, const Gather2& nb) {
+    const bool use = nb.fluid;  // solid neighbours add nothing
+    const Packed q = nb.a, nv = nb.b;
     const vec3 r = p - q.xyz();
     vec3 grad;
     float cf;
@@ -984,10 +1019,13 @@ SEAMLESS_HD inline VortSum vorticity_part(const SimViews& S, int s, Lanes g) {
   const int* const list = S.nbrs(s);
   const std::int64_t col = S.nbr_col, row = s * S.nbr_row;
   VortSum t{{0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}};
-  for_each_entry(list, col, S.nnbr[s], g, [&](int k, int j) {
-    // Solid neighbours add nothing (a select, not a branch: for_each_entry).
-    const bool use = !mixed || phase::is(S.sphase[j], phase::kFluid);
-    const Packed q = S.spd[j], vh = S.svh[j];  // position (and density), velocity and h / rho
+  // Position (and density), velocity and h / rho, and whether j is fluid.
+  const auto gather = [&](int j) {
+    return Gather2{S.spd[j], S.svh[j], !mixed || phase::is(S.sphase[j], phase::kFluid)};
+  };
+  for_each_entry<kPairBatch2>(list, col, S.nnbr[s], g, gather, [&](int k, int, const Gather2& nb) {
+    const bool use = nb.fluid;  // solid neighbours add nothing
+    const Packed q = nb.a, vh = nb.b;
     vec3 r = p - q.xyz(), vj = vh.xyz();
     vec3 grad = W.spiky_grad(r);
     if constexpr (Cache) {
