@@ -42,12 +42,13 @@ inline constexpr bool kCachePairs = Exec::device == Device::CPU;
 // to move (IEEE square roots and divisions have slow-path branches), so the batch is explicit.
 // On the CPU one entry at a time (kPairBatch 1), the plain loop.
 // Batch sizes (CUDA) of the passes that gather one packed word per pair (density, PBF) and two
-// (vorticity, forces: 8 more registers per entry of a batch).
+// (vorticity, forces: 8 more registers per entry of a batch; at 4 the two velocity passes took
+// 71 and 80 registers, 3 blocks of 256 threads per multiprocessor, and ran slower than at 2).
 #ifndef SEAMLESS_BATCH1
 #define SEAMLESS_BATCH1 4
 #endif
 #ifndef SEAMLESS_BATCH2
-#define SEAMLESS_BATCH2 4
+#define SEAMLESS_BATCH2 2
 #endif
 #if defined(__CUDA_ARCH__)
 constexpr int kPairBatch1 = SEAMLESS_BATCH1, kPairBatch2 = SEAMLESS_BATCH2;
