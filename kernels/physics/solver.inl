@@ -7,6 +7,13 @@
 #include "kernels/physics/constraints.hpp"
 #include "kernels/physics/solver.hpp"
 
+// Full unrolling of a loop over a register array (CUDA; GCC would warn on the pragma).
+#if defined(__CUDA_ARCH__)
+#define SEAMLESS_PHYS_UNROLL _Pragma("unroll")
+#else
+#define SEAMLESS_PHYS_UNROLL
+#endif
+
 namespace seamless::kernels {
 
 namespace detail {
@@ -25,6 +32,61 @@ SEAMLESS_HD inline bool both_fluid(std::uint32_t a, std::uint32_t b) {
 template <class Exec>
 inline constexpr bool kCachePairs = Exec::device == Device::CPU;
 
+// Calls use(k, j, gather(j)) with j = list[k * col] for a lane's entries k = g.lane,
+// g.lane + g.size, ... below m, in k order (sums keep the order of a plain loop). gather(j)
+// loads what the pair needs of neighbour j; use does the math. On CUDA the entries come in
+// batches of kPairBatch: their indices, then all their gathers, then the math. At 1M particles
+// CUDA runs one thread per particle, whose pair loop was a chain of dependent loads (index, then
+// the neighbour's data) per entry, and the passes were latency-bound (Nsight, H200: 45-55%
+// active warps, 10-20% of DRAM bandwidth); the math cannot be relied on to leave loads free
+// to move (IEEE square roots and divisions have slow-path branches), so the batch is explicit.
+// On the CPU one entry at a time (kPairBatch 1), the plain loop.
+// Batch sizes (CUDA) of the passes that gather one packed word per pair (density, PBF) and two
+// (vorticity, forces: 8 more registers per entry of a batch; at 4 the two velocity passes took
+// 71 and 80 registers, 3 blocks of 256 threads per multiprocessor, and ran slower than at 2).
+#ifndef SEAMLESS_BATCH1
+#define SEAMLESS_BATCH1 4
+#endif
+#ifndef SEAMLESS_BATCH2
+#define SEAMLESS_BATCH2 2
+#endif
+#if defined(__CUDA_ARCH__)
+constexpr int kPairBatch1 = SEAMLESS_BATCH1, kPairBatch2 = SEAMLESS_BATCH2;
+#else
+constexpr int kPairBatch1 = 1, kPairBatch2 = 1;
+#endif
+template <int kPairBatch, class Gather, class Use>
+SEAMLESS_HD inline void for_each_entry(const int* list, std::int64_t col, int m, Lanes g, Gather&& gather, Use&& use) {
+  using D = decltype(gather(0));
+  const int d = g.size;
+  int k = g.lane;
+  if constexpr (kPairBatch > 1) {
+    for (; k + (kPairBatch - 1) * d < m; k += kPairBatch * d) {
+      int j[kPairBatch];
+      D v[kPairBatch];
+      SEAMLESS_PHYS_UNROLL
+      for (int u = 0; u < kPairBatch; ++u) j[u] = list[(k + u * d) * col];
+      SEAMLESS_PHYS_UNROLL
+      for (int u = 0; u < kPairBatch; ++u) v[u] = gather(j[u]);
+      SEAMLESS_PHYS_UNROLL
+      for (int u = 0; u < kPairBatch; ++u) use(k + u * d, j[u], v[u]);
+    }
+  }
+  for (; k < m; k += d) {
+    const int j = list[k * col];
+    use(k, j, gather(j));
+  }
+}
+
+// What a pair loop gathers of neighbour j: one or two packed words and whether j is fluid.
+struct Gather1 {
+  Packed a;
+  bool fluid;
+};
+struct Gather2 {
+  Packed a, b;
+  bool fluid;
+};
 
 // spk = (sp, phase bits): the packed copy that the next neighbour loops gather (Packed).
 template <class Exec>
@@ -403,17 +465,26 @@ void find_neighbors(const Exec& ex, const SimViews& S) {
     } else if (g.size == 1) {  // (if constexpr ... else if: the CUDA instantiation)
       // CUDA, one lane: as above, the non-fluid entries counted on the way (the phase is loaded
       // anyway) and only kept candidates stored.
+      // The candidates of a run 4 at a time, loaded before any is tested (lanes past the run
+      // load its last entry and reject it): 4 loads in flight instead of one chain of
+      // load-test-store per candidate (see for_each_entry).
       for_each_run_in_radius(S.grid, S.cell_start, p, R, [&](int a, int e) {
         int c = cnt, so = solid;
-        for (int j = a; j < e; ++j) {
-          const Packed q = S.spk[j];  // position and phase in one load
-          const std::uint32_t phj = q.bits();
-          bool ok = (j != s) & (length2(p - q.xyz()) < R2);
-          if (!plain) ok = ok && detail::may_interact(S, ph, phj, s, j);
-          const bool store = ok & (c < cap);
-          so += store & !(sfluid & phase::is(phj, phase::kFluid));
-          detail::store_candidate(list, S.nbr_col, cap, c, j, store);
-          c += ok;
+        for (int b = a; b < e; b += 4) {
+          Packed q[4];
+          SEAMLESS_PHYS_UNROLL
+          for (int u = 0; u < 4; ++u) q[u] = S.spk[b + u < e ? b + u : e - 1];  // position and phase
+          SEAMLESS_PHYS_UNROLL
+          for (int u = 0; u < 4; ++u) {
+            const int j = b + u;
+            const std::uint32_t phj = q[u].bits();
+            bool ok = (j < e) & (j != s) & (length2(p - q[u].xyz()) < R2);
+            if (!plain) ok = ok && detail::may_interact(S, ph, phj, s, j);
+            const bool store = ok & (c < cap);
+            so += store & !(sfluid & phase::is(phj, phase::kFluid));
+            detail::store_candidate(list, S.nbr_col, cap, c, j, store);
+            c += ok;
+          }
         }
         cnt = c, solid = so;
       });
@@ -510,22 +581,21 @@ SEAMLESS_HD inline DensitySum density_part(const SimViews& S, int s, Lanes g) {
   const int* const list = S.nbrs(s);
   Packed* const cache = S.pair_w + s * S.nbr_row;
   const std::int64_t col = S.nbr_col;
-  for (int k = g.lane, m = S.nnbr[s]; k < m; k += g.size) {
-    const Packed q = S.spk[list[k * col]];  // position and phase in one load
+  const auto gather = [&](int j) { return S.spk[j]; };  // position and phase in one load
+  for_each_entry<kPairBatch1>(list, col, S.nnbr[s], g, gather, [&](int k, int, const Packed& q) {
     vec3 r = p - q.xyz();
     float wgt = W.poly6(length2(r));
     const vec3 gw = W.spiky_grad(r);
     if constexpr (Cache) cache[k * col] = Packed::of(gw, wgt);
     vec3 grad = gw * inv_rho0;
-    if (!mixed || phase::is(q.bits(), phase::kFluid)) {
-      d.rho += wgt;
-      d.gi += grad;
-      d.sum2 += length2(grad);
-    } else {
-      d.rho += sw * wgt;
-      d.gi += grad * sw;
-    }
-  }
+    // A solid neighbour's terms are scaled by sw and add nothing to sum2 (selects, not branches:
+    // for_each_entry; x 1 and + 0 leave a fluid pair's sums bit for bit as they were).
+    const bool fluid = !mixed || phase::is(q.bits(), phase::kFluid);
+    const float f = fluid ? 1.f : sw;
+    d.rho += f * wgt;
+    d.gi += grad * f;
+    d.sum2 += fluid ? length2(grad) : 0.f;
+  });
   for (int k = g.lane, m = S.nsnbr[s]; k < m; k += g.size) {
     vec3 r = p - S.stat[S.snbrs(s)[k * S.snbr_col]];
     d.rho += sw * S.c.W.poly6(length2(r));
@@ -580,30 +650,30 @@ SEAMLESS_HD inline vec3 pbf_part(const SimViews& S, int s, Lanes g) {
   const float li = S.lambda[s], sw = S.c.solid_density_scale;
   const bool mixed = S.nsolid[s] != 0;  // otherwise every neighbour is fluid: no phase loads
   vec3 f{0.f, 0.f, 0.f};
-  for (int k = g.lane, m = S.nnbr[s]; k < m; k += g.size) {
-    int j = S.nbrs(s)[k * S.nbr_col];
+  // Position and lambda in one load (Cached: lambda alone), and whether j is fluid.
+  const auto gather = [&](int j) {
+    const bool fluid = !mixed || phase::is(S.sphase[j], phase::kFluid);
+    return Gather1{Cached ? Packed{0.f, 0.f, 0.f, S.lambda[j]} : S.spl[j], fluid};
+  };
+  for_each_entry<kPairBatch1>(S.nbrs(s), S.nbr_col, S.nnbr[s], g, gather, [&](int k, int, const Gather1& n) {
     vec3 grad;
     float wgt, lj;
     if constexpr (Cached) {
       const Packed gw = S.pair_w[s * S.nbr_row + k * S.nbr_col];
-      grad = gw.xyz(), wgt = gw.w, lj = S.lambda[j];
+      grad = gw.xyz(), wgt = gw.w, lj = n.a.w;
     } else {
-      const Packed pl = S.spl[j];  // position and lambda in one load
+      const Packed pl = n.a;
       const vec3 r = p - pl.xyz();
       grad = S.c.W.spiky_grad(r), lj = pl.w;
       wgt = S.c.scorr_k > 0.f ? S.c.W.poly6(length2(r)) : 0.f;
     }
-    if (!mixed || phase::is(S.sphase[j], phase::kFluid)) {
-      float sc = 0.f;
-      if (S.c.scorr_k > 0.f) {
-        float q = wgt * S.c.scorr_inv_wdq;
-        sc = -S.c.scorr_k * q * q * q * q;
-      }
-      f += grad * (li + lj + sc);
-    } else {
-      f += grad * (li * sw);
+    float sc = 0.f;
+    if (S.c.scorr_k > 0.f) {
+      float q = wgt * S.c.scorr_inv_wdq;
+      sc = -S.c.scorr_k * q * q * q * q;
     }
-  }
+    f += grad * (n.fluid ? li + lj + sc : li * sw);  // a solid neighbour: li * sw alone
+  });
   for (int k = g.lane, m = S.nsnbr[s]; k < m; k += g.size) f += S.c.W.spiky_grad(p - S.stat[S.snbrs(s)[k * S.snbr_col]]) * (li * sw);
   return f;
 }
@@ -881,10 +951,14 @@ SEAMLESS_HD inline vec3 fluid_forces(const SimViews& S, int s, Lanes g) {
   const int* const list = S.nbrs(s);
   const std::int64_t col = S.nbr_col, row = s * S.nbr_row;
   ForceSum t{{0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}};
-  for (int k = g.lane, m = S.nnbr[s]; k < m; k += g.size) {
-    int j = list[k * col];
-    if (mixed && !phase::is(S.sphase[j], phase::kFluid)) continue;
-    const Packed q = S.spd[j], nv = S.cnv[j];  // position and density, normal and |omega|
+  // Position and density, normal and |omega| (cnv is written for fluid particles only).
+  const auto gather = [&](int j) {
+    const bool fluid = !mixed || phase::is(S.sphase[j], phase::kFluid);
+    return Gather2{S.spd[j], fluid ? S.cnv[j] : Packed{0.f, 0.f, 0.f, 0.f}, fluid};
+  };
+  for_each_entry<kPairBatch2>(list, col, S.nnbr[s], g, gather, [&](int k, int, const Gather2& nb) {
+    const bool use = nb.fluid;  // solid neighbours add nothing
+    const Packed q = nb.a, nv = nb.b;
     const vec3 r = p - q.xyz();
     vec3 grad;
     float cf;
@@ -894,12 +968,14 @@ SEAMLESS_HD inline vec3 fluid_forces(const SimViews& S, int s, Lanes g) {
     } else {
       grad = S.c.W.spiky_grad(r), cf = cohesion_factor(S.c.W, coh_c, sqrtf(length2(r)));
     }
-    t.eta += grad * (nv.w * inv_rho0);
+    const vec3 eta = grad * (nv.w * inv_rho0);
     float K = two_rho0 / (rho_i + q.w);
     vec3 coh = r * cf;
     vec3 curv = (ni - nv.xyz()) * st;
-    t.acc += (coh + curv) * K;
-  }
+    const vec3 acc = (coh + curv) * K, zero{0.f, 0.f, 0.f};
+    t.eta += use ? eta : zero;
+    t.acc += use ? acc : zero;
+  });
   t = g.sum(t);
   // Vorticity confinement (PBF eqs. 15-16): f = eps (N x omega), N = eta / |eta|.
   float el = length(t.eta);
@@ -944,19 +1020,24 @@ SEAMLESS_HD inline VortSum vorticity_part(const SimViews& S, int s, Lanes g) {
   const int* const list = S.nbrs(s);
   const std::int64_t col = S.nbr_col, row = s * S.nbr_row;
   VortSum t{{0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}};
-  for (int k = g.lane, m = S.nnbr[s]; k < m; k += g.size) {
-    int j = list[k * col];
-    if (mixed && !phase::is(S.sphase[j], phase::kFluid)) continue;
-    const Packed q = S.spd[j], vh = S.svh[j];  // position (and density), velocity and h / rho
+  // Position (and density), velocity and h / rho, and whether j is fluid.
+  const auto gather = [&](int j) {
+    return Gather2{S.spd[j], S.svh[j], !mixed || phase::is(S.sphase[j], phase::kFluid)};
+  };
+  for_each_entry<kPairBatch2>(list, col, S.nnbr[s], g, gather, [&](int k, int, const Gather2& nb) {
+    const bool use = nb.fluid;  // solid neighbours add nothing
+    const Packed q = nb.a, vh = nb.b;
     vec3 r = p - q.xyz(), vj = vh.xyz();
     vec3 grad = W.spiky_grad(r);
     if constexpr (Cache) {
       S.pair_w[row + k * col] = Packed::of(grad, cohesion_factor(W, coh_c, sqrtf(length2(r))));
     }
-    t.w += cross(vj - vi, -grad) * inv_rho0;
-    t.n += grad * vh.w;
-    t.dv_visc += (vj - vi) * (W.poly6(length2(r)) * inv_rho0);
-  }
+    const vec3 w = cross(vj - vi, -grad) * inv_rho0, n = grad * vh.w;
+    const vec3 visc = (vj - vi) * (W.poly6(length2(r)) * inv_rho0), zero{0.f, 0.f, 0.f};
+    t.w += use ? w : zero;
+    t.n += use ? n : zero;
+    t.dv_visc += use ? visc : zero;
+  });
   return t;
 }
 }  // namespace detail
