@@ -24,6 +24,11 @@ SEAMLESS_HD inline bool is(std::uint32_t ph, std::uint32_t flag) { return (ph & 
 
 constexpr float kPi = 3.14159265358979f;
 
+// c ? a : b, for code written once over a float type (SphKernel): the SIMD lanes of the CPU
+// (kernels/physics/simd.hpp) select lane by lane.
+SEAMLESS_HD inline float select(bool c, float a, float b) { return c ? a : b; }
+SEAMLESS_HD inline vec3 select(bool c, vec3 a, vec3 b) { return c ? a : b; }
+
 // A position (or vector) and one more word, 16-byte aligned: what a neighbour loop gathers from
 // neighbour j in one 128-bit load on CUDA (a vec3 and a float are four 32-bit loads, four times
 // the L1 requests of a gather whose 32 lanes hit 32 different sectors). The kernels keep packed
@@ -59,27 +64,31 @@ struct SphKernel {
     return k;
   }
 
+  // The kernels are templates over the float type F (float, or the CPU's SIMD lanes simd::vf,
+  // with V its vec3) with selects instead of early returns; for float the same results as the
+  // early returns.
+
   // Poly6 (Mueller 2003, used for density in Macklin & Mueller 2013, eq. 2).
-  SEAMLESS_HD float poly6(float r2) const {
-    if (r2 >= h2) return 0.f;
-    float t = h2 - r2;
-    return poly6_c * t * t * t;
+  template <class F>
+  SEAMLESS_HD F poly6(F r2) const {
+    const F t = h2 - r2;
+    return select(r2 < h2, poly6_c * t * t * t, F(0.f));
   }
 
   // Gradient of the spiky kernel with respect to p_i for r = p_i - p_j (Mueller 2003; PBF eq. 8).
-  SEAMLESS_HD vec3 spiky_grad(vec3 r) const {
-    float l = length(r);
-    if (l >= h || l <= 1e-12f) return {0.f, 0.f, 0.f};
-    float t = h - l;
-    return r * (spiky_c * t * t / l);
+  template <class V>
+  SEAMLESS_HD V spiky_grad(V r) const {
+    const auto l = length(r);
+    const auto t = h - l;
+    return select((l < h) & (l > 1e-12f), r * (spiky_c * t * t / l), V{});
   }
 
   // Akinci 2013 cohesion spline C(r) (eq. 2 there), zero beyond h.
-  SEAMLESS_HD float akinci(float r) const {
-    if (r >= h || r <= 0.f) return 0.f;
-    float a = (h - r) * (h - r) * (h - r) * r * r * r;
-    if (2.f * r > h) return akinci_c * a;
-    return akinci_c * (2.f * a - h6_64);
+  template <class F>
+  SEAMLESS_HD F akinci(F r) const {
+    const F a = (h - r) * (h - r) * (h - r) * r * r * r;
+    const F c = select(2.f * r > h, akinci_c * a, akinci_c * (2.f * a - h6_64));
+    return select((r < h) & (r > 0.f), c, F(0.f));
   }
 };
 

@@ -5,6 +5,7 @@
 #include "core/atomics.hpp"
 #include "core/exec.hpp"
 #include "kernels/physics/constraints.hpp"
+#include "kernels/physics/simd.hpp"
 #include "kernels/physics/solver.hpp"
 
 namespace seamless::kernels {
@@ -864,8 +865,9 @@ SEAMLESS_HD inline ForceSum operator+(const ForceSum& a, const ForceSum& b) { re
 
 // Akinci's cohesion term of the pair r = p_i - p_j (eq. 1, before K_ij) is r times this factor
 // of l = |r| (0 for coincident particles); coh_c = -cohesion / rho_0.
-SEAMLESS_HD inline float cohesion_factor(const SphKernel& W, float coh_c, float l) {
-  return l > 1e-9f ? coh_c * W.akinci(l) / l : 0.f;
+template <class F>
+SEAMLESS_HD inline F cohesion_factor(const SphKernel& W, float coh_c, F l) {
+  return select(l > 1e-9f, coh_c * W.akinci(l) / l, F(0.f));
 }
 
 // With Cached, each pair's spiky gradient and cohesion factor come from pair_w (vorticity_part,
@@ -931,6 +933,25 @@ SEAMLESS_HD inline VortSum operator+(const VortSum& a, const VortSum& b) {
   return {a.w + b.w, a.n + b.n, a.dv_visc + b.dv_visc};
 }
 
+// One pair's terms of VortSum for r = p_i - p_j, the velocities v_i, v_j and h / rho_j (hj), and
+// (With) the pair's spiky gradient and cohesion factor for pair_w; F is float or the CPU's SIMD
+// lanes (V their vec3).
+template <class F, class V>
+struct VortPair {
+  V grad, w, n, dv;
+  F cf;
+};
+template <bool With, class F, class V>
+SEAMLESS_HD inline VortPair<F, V> vorticity_pair(const SphKernel& W, float inv_rho0, float coh_c, V r, V vi, V vj, F hj) {
+  VortPair<F, V> d;
+  d.grad = W.spiky_grad(r);
+  if constexpr (With) d.cf = cohesion_factor(W, coh_c, length(r));
+  d.w = cross(vj - vi, -d.grad) * inv_rho0;
+  d.n = d.grad * hj;
+  d.dv = (vj - vi) * (W.poly6(length2(r)) * inv_rho0);
+  return d;
+}
+
 // With Cache, each pair's spiky gradient and cohesion factor are kept in pair_w for
 // fluid_forces, which runs next at the same positions.
 template <bool Cache>
@@ -948,18 +969,139 @@ SEAMLESS_HD inline VortSum vorticity_part(const SimViews& S, int s, Lanes g) {
     int j = list[k * col];
     if (mixed && !phase::is(S.sphase[j], phase::kFluid)) continue;
     const Packed q = S.spd[j], vh = S.svh[j];  // position (and density), velocity and h / rho
-    vec3 r = p - q.xyz(), vj = vh.xyz();
-    vec3 grad = W.spiky_grad(r);
-    if constexpr (Cache) {
-      S.pair_w[row + k * col] = Packed::of(grad, cohesion_factor(W, coh_c, sqrtf(length2(r))));
-    }
-    t.w += cross(vj - vi, -grad) * inv_rho0;
-    t.n += grad * vh.w;
-    t.dv_visc += (vj - vi) * (W.poly6(length2(r)) * inv_rho0);
+    const VortPair<float, vec3> d = vorticity_pair<Cache>(W, inv_rho0, coh_c, p - q.xyz(), vi, vh.xyz(), vh.w);
+    if constexpr (Cache) S.pair_w[row + k * col] = Packed::of(d.grad, d.cf);
+    t.w += d.w;
+    t.n += d.n;
+    t.dv_visc += d.dv;
   }
   return t;
 }
 }  // namespace detail
+
+#if !defined(__CUDACC__)
+// ---- the CPU's SIMD tiles (kernels/physics/simd.hpp) ------------------------------------------
+// A tile is 8 consecutive sorted particles, one per lane, each walking its own list in list
+// order; the pair terms are the scalar loops' functions over simd::vf, so the sums and states are
+// bit-identical to the scalar loops. A tile takes the vector path only where all 8 particles are
+// fluid with fluid-only lists (the fluid's interior and surface; mixed tiles run the scalar
+// loops). Compiled for AVX2 (simd::cpu_simd() checks the CPU at run time).
+#if SEAMLESS_SIMD_X86
+#pragma GCC push_options
+#pragma GCC target("avx2")
+#endif
+namespace detail {
+// The tile at s0 if it can take the vector path: its list lengths, the shortest and the longest.
+struct Tile {
+  int s0, m[simd::kWidth], kmin, kmax;
+};
+inline bool fluid_tile(const SimViews& S, int s0, Tile& t) {
+  if (s0 + simd::kWidth > S.n) return false;
+  t.s0 = s0, t.kmin = 1 << 30, t.kmax = 0;
+  for (int l = 0; l < simd::kWidth; ++l) {
+    const int s = s0 + l;
+    if (!phase::is(S.sphase[s], phase::kFluid) || S.nsolid[s] != 0 || S.nsnbr[s] != 0) return false;
+    t.m[l] = S.nnbr[s];
+    t.kmin = t.m[l] < t.kmin ? t.m[l] : t.kmin;
+    t.kmax = t.m[l] > t.kmax ? t.m[l] : t.kmax;
+  }
+  return true;
+}
+
+// Entry k of each lane's list (the lane's own particle where k is past its list: a valid index
+// whose terms the mask drops); in: the lanes whose list has an entry k.
+template <bool Masked>
+SEAMLESS_SIMD_INL void tile_entries(const SimViews& S, const Tile& t, int k, int* j, simd::vm& in) {
+  for (int l = 0; l < simd::kWidth; ++l) {
+    const int* list = S.nbrs(t.s0 + l);
+    if constexpr (Masked) {
+      const bool has = k < t.m[l];
+      j[l] = has ? list[k * S.nbr_col] : t.s0 + l;
+      in.v[l] = has ? -1 : 0;
+    } else {
+      j[l] = list[k * S.nbr_col];
+    }
+  }
+}
+
+// Gathers of entries j of a packed array: (xyz, w) of each lane.
+SEAMLESS_SIMD_INL void gather_packed(const Packed* a, const int* j, simd::v3& xyz, simd::vf& w) {
+  const void* e[simd::kWidth];
+  for (int l = 0; l < simd::kWidth; ++l) e[l] = a + j[l];
+  simd::load_transpose(e, xyz.x, xyz.y, xyz.z, w);
+}
+
+// acc += d where the lanes are in (all of them unless Masked).
+template <bool Masked>
+SEAMLESS_SIMD_INL void tile_add(simd::v3& acc, const simd::v3& d, simd::vm in) {
+  if constexpr (Masked) acc = select(in, acc + d, acc);
+  else acc += d;
+}
+
+// vorticity_part of the tile's 8 particles (velocity_effects); with Cache the pairs' gradients
+// and cohesion factors go to pair_w as there. False where the tile needs the scalar loops.
+template <bool Cache>
+bool vorticity_tile(const SimViews& S, int s0) {
+  Tile t;
+  if (!fluid_tile(S, s0, t)) return false;
+  using simd::v3;
+  const float inv_rho0 = 1.f / S.c.rest_density, coh_c = -S.c.cohesion * inv_rho0;
+  const SphKernel W = S.c.W;
+  const v3 p = simd::load_v3(S.sp + s0), vi = simd::load_v3(S.sv + s0);
+  v3 tw{}, tn{}, tdv{};
+  auto step = [&](int k, auto masked) {
+    constexpr bool kMasked = decltype(masked)::value;
+    int j[simd::kWidth];
+    simd::vm in;
+    tile_entries<kMasked>(S, t, k, j, in);
+    v3 q, vj;
+    simd::vf rho, hj;
+    gather_packed(S.spd, j, q, rho);
+    gather_packed(S.svh, j, vj, hj);
+    const auto d = vorticity_pair<Cache>(W, inv_rho0, coh_c, p - q, vi, vj, hj);
+    if constexpr (Cache) {
+      void* e[simd::kWidth];
+      for (int l = 0; l < simd::kWidth; ++l) e[l] = S.pair_w + (s0 + l) * S.nbr_row + k * S.nbr_col;
+      simd::transpose_store(e, d.grad.x, d.grad.y, d.grad.z, d.cf);
+    }
+    tile_add<kMasked>(tw, d.w, in);
+    tile_add<kMasked>(tn, d.n, in);
+    tile_add<kMasked>(tdv, d.dv, in);
+  };
+  for (int k = 0; k < t.kmin; ++k) step(k, std::false_type{});
+  for (int k = t.kmin; k < t.kmax; ++k) step(k, std::true_type{});
+  for (int l = 0; l < simd::kWidth; ++l) {
+    const int s = s0 + l;
+    S.vort[s] = simd::lane(tw, l);
+    S.vort_len[s] = length(S.vort[s]);
+    S.cnormal[s] = simd::lane(tn, l);
+    S.cnv[s] = Packed::of(S.cnormal[s], S.vort_len[s]);
+    S.vtmp[s] = simd::lane(tdv, l);
+  }
+  return true;
+}
+}  // namespace detail
+#if SEAMLESS_SIMD_X86
+#pragma GCC pop_options
+#endif
+
+// Runs tile(S, s0) for the tiles of 8 particles and one(s) for the particles of tiles it
+// declines, on the CPU when the SIMD lanes are available; false otherwise (the caller then runs
+// its loop). Each tile is taken by the task of its first particle (for_each's threshold and
+// schedule stay those of the particles).
+template <class Exec, class Tile, class One>
+bool cpu_tiles(const Exec& ex, const SimViews& S, Tile tile, One one) {
+  if constexpr (Exec::device != Device::CPU) return false;
+  if (!simd::cpu_simd()) return false;
+  ex.for_each(S.n, [=](std::int64_t i) {
+    if (i % simd::kWidth != 0) return;
+    const int s0 = static_cast<int>(i);
+    if (tile(S, s0)) return;
+    for (int s = s0, e = s0 + simd::kWidth < S.n ? s0 + simd::kWidth : S.n; s < e; ++s) one(s);
+  });
+  return true;
+}
+#endif
 
 template <class Exec>
 void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
@@ -968,7 +1110,7 @@ void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
     // n_i = h sum_j (1 / rho_j) grad W_ij (Akinci 2013, eq. 4; dissertation eq. 4.21), and the
     // XSPH sum (PBF eq. 17), which needs only this pass's velocities (kept in vtmp for
     // fluid_forces: one neighbour loop fewer that gathers velocities).
-    ex.for_each_grouped(S.n, kPairLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
+    auto vort = [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
       const int s = static_cast<int>(i);
       if (!phase::is(S.sphase[s], phase::kFluid)) return;
       const detail::VortSum t = g.sum(detail::vorticity_part<detail::kCachePairs<Exec>>(S, s, g));
@@ -978,7 +1120,11 @@ void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
       S.cnormal[s] = t.n;
       S.cnv[s] = Packed::of(t.n, S.vort_len[s]);  // what fluid_forces gathers of a neighbour
       S.vtmp[s] = t.dv_visc;
-    });
+    };
+#if !defined(__CUDACC__)
+    if (!cpu_tiles(ex, S, detail::vorticity_tile<detail::kCachePairs<Exec>>, [=](int s) { vort(s, Lanes{}); }))
+#endif
+      ex.for_each_grouped(S.n, kPairLanes, vort);
   }
   const bool aero = S.has_cloth_constraints && (S.c.drag > 0.f || S.c.lift > 0.f);
   ex.for_each_grouped(S.n, kPairLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {

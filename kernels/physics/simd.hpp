@@ -1,0 +1,156 @@
+// SIMD lanes for the CPU's pair loops (kernels/physics/solver.inl): a vector of 8 floats (vf), a
+// lane mask (vm) and a vec3 of vectors (v3), with the operators that the SPH kernels of
+// particle_math.hpp (templates over the float type) and the pair terms of solver.inl use, so that
+// one expression serves the scalar code (CUDA, and the CPU where a tile of particles cannot take
+// the vector path) and 8 particles at once on the CPU.
+//
+// Lanes are particles, not neighbours: lane l of a tile of 8 consecutive sorted particles walks
+// its own neighbour list in list order (the CUDA loops' one lane per particle), so every sum is
+// formed in the scalar order and the states stay bit-identical to the scalar loops (no FMA
+// contraction: the vector code is compiled for AVX2 without FMA, and a * b + c stays two
+// roundings as in the scalar code).
+//
+// GCC vector extensions (generic code): the tile functions that use them are compiled for AVX2
+// (kSimdTarget, chosen at run time by cpu_simd()); everything here is always_inline, so it takes
+// the caller's instruction set. Never seen by nvcc.
+#pragma once
+#if !defined(__CUDACC__)
+#include <atomic>
+#include <cstdint>
+#include <cstring>
+
+#include "core/math.hpp"
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define SEAMLESS_SIMD_TARGET __attribute__((target("avx2")))
+#define SEAMLESS_SIMD_X86 1
+#elif defined(__GNUC__) || defined(__clang__)
+#define SEAMLESS_SIMD_TARGET
+#define SEAMLESS_SIMD_X86 0
+#endif
+#define SEAMLESS_SIMD_INL __attribute__((always_inline)) inline
+
+namespace seamless::kernels::simd {
+
+constexpr int kWidth = 8;
+typedef float f8 __attribute__((vector_size(32)));
+typedef std::int32_t i8 __attribute__((vector_size(32)));
+typedef float f4 __attribute__((vector_size(16)));
+
+// Whether the tile functions may run: AVX2 on x86-64 (checked once), always elsewhere (generic
+// vectors); set_cpu_simd(false) forces the scalar loops (tests compare both).
+inline std::atomic<int>& cpu_simd_flag() {
+  static std::atomic<int> flag{-1};
+  return flag;
+}
+inline bool cpu_simd() {
+  int f = cpu_simd_flag().load(std::memory_order_relaxed);
+  if (f < 0) {
+#if SEAMLESS_SIMD_X86
+    f = __builtin_cpu_supports("avx2") ? 1 : 0;
+#else
+    f = 1;
+#endif
+    cpu_simd_flag().store(f, std::memory_order_relaxed);
+  }
+  return f != 0;
+}
+inline void set_cpu_simd(bool on) {
+  cpu_simd_flag().store(-1);
+  if (!on) cpu_simd_flag().store(0);
+}
+
+struct vm {
+  i8 v;  // all bits set: true
+};
+SEAMLESS_SIMD_INL vm operator&(vm a, vm b) { return {a.v & b.v}; }
+SEAMLESS_SIMD_INL vm operator|(vm a, vm b) { return {a.v | b.v}; }
+
+struct vf {
+  f8 v;
+  vf() = default;
+  SEAMLESS_SIMD_INL vf(f8 x) : v(x) {}
+  SEAMLESS_SIMD_INL vf(float s) : v(f8{} + s) {}  // broadcast
+  SEAMLESS_SIMD_INL float operator[](int l) const { return v[l]; }
+};
+SEAMLESS_SIMD_INL vf operator+(vf a, vf b) { return a.v + b.v; }
+SEAMLESS_SIMD_INL vf operator-(vf a, vf b) { return a.v - b.v; }
+SEAMLESS_SIMD_INL vf operator*(vf a, vf b) { return a.v * b.v; }
+SEAMLESS_SIMD_INL vf operator/(vf a, vf b) { return a.v / b.v; }
+SEAMLESS_SIMD_INL vf operator-(vf a) { return -a.v; }
+SEAMLESS_SIMD_INL vm operator<(vf a, vf b) { return {a.v < b.v}; }
+SEAMLESS_SIMD_INL vm operator>(vf a, vf b) { return {a.v > b.v}; }
+SEAMLESS_SIMD_INL vm operator<=(vf a, vf b) { return {a.v <= b.v}; }
+SEAMLESS_SIMD_INL vm operator>=(vf a, vf b) { return {a.v >= b.v}; }
+SEAMLESS_SIMD_INL vf select(vm m, vf a, vf b) { return m.v ? a.v : b.v; }
+// Lane by lane (the compiler makes it one vector square root; solver_cpu.cpp has no errno).
+SEAMLESS_SIMD_INL vf sqrt(vf a) {
+  vf r;
+  for (int l = 0; l < kWidth; ++l) r.v[l] = __builtin_sqrtf(a.v[l]);
+  return r;
+}
+
+struct v3 {
+  vf x, y, z;
+};
+SEAMLESS_SIMD_INL v3 operator+(v3 a, v3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+SEAMLESS_SIMD_INL v3 operator-(v3 a, v3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+SEAMLESS_SIMD_INL v3 operator-(v3 a) { return {-a.x, -a.y, -a.z}; }
+SEAMLESS_SIMD_INL v3 operator*(v3 a, vf s) { return {a.x * s, a.y * s, a.z * s}; }
+SEAMLESS_SIMD_INL v3 operator*(v3 a, float s) { return a * vf(s); }
+SEAMLESS_SIMD_INL v3& operator+=(v3& a, v3 b) { return a = a + b; }
+// The expressions (and so the roundings) of core/math.hpp's vec3 functions.
+SEAMLESS_SIMD_INL vf dot(v3 a, v3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+SEAMLESS_SIMD_INL v3 cross(v3 a, v3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+SEAMLESS_SIMD_INL vf length2(v3 a) { return dot(a, a); }
+SEAMLESS_SIMD_INL vf length(v3 a) { return sqrt(dot(a, a)); }
+SEAMLESS_SIMD_INL v3 select(vm m, v3 a, v3 b) { return {select(m, a.x, b.x), select(m, a.y, b.y), select(m, a.z, b.z)}; }
+SEAMLESS_SIMD_INL v3 broadcast(vec3 a) { return {vf(a.x), vf(a.y), vf(a.z)}; }
+SEAMLESS_SIMD_INL vec3 lane(const v3& a, int l) { return {a.x[l], a.y[l], a.z[l]}; }
+
+// Lane l of the result: the 16-byte element e[l] of a Packed-like array (4 floats), as four
+// vectors (x, y, z, w): 128-bit loads and a 4x4 transpose in each half.
+SEAMLESS_SIMD_INL void load_transpose(const void* const* e, vf& x, vf& y, vf& z, vf& w) {
+  f4 a[kWidth];
+  for (int l = 0; l < kWidth; ++l) std::memcpy(&a[l], e[l], sizeof(f4));
+  const f8 c0 = __builtin_shufflevector(a[0], a[4], 0, 1, 2, 3, 4, 5, 6, 7);
+  const f8 c1 = __builtin_shufflevector(a[1], a[5], 0, 1, 2, 3, 4, 5, 6, 7);
+  const f8 c2 = __builtin_shufflevector(a[2], a[6], 0, 1, 2, 3, 4, 5, 6, 7);
+  const f8 c3 = __builtin_shufflevector(a[3], a[7], 0, 1, 2, 3, 4, 5, 6, 7);
+  const f8 t0 = __builtin_shufflevector(c0, c1, 0, 8, 1, 9, 4, 12, 5, 13);   // x0 x1 y0 y1 | x4 x5 y4 y5
+  const f8 t1 = __builtin_shufflevector(c2, c3, 0, 8, 1, 9, 4, 12, 5, 13);   // x2 x3 y2 y3 | ...
+  const f8 t2 = __builtin_shufflevector(c0, c1, 2, 10, 3, 11, 6, 14, 7, 15);  // z0 z1 w0 w1 | ...
+  const f8 t3 = __builtin_shufflevector(c2, c3, 2, 10, 3, 11, 6, 14, 7, 15);
+  x = __builtin_shufflevector(t0, t1, 0, 1, 8, 9, 4, 5, 12, 13);
+  y = __builtin_shufflevector(t0, t1, 2, 3, 10, 11, 6, 7, 14, 15);
+  z = __builtin_shufflevector(t2, t3, 0, 1, 8, 9, 4, 5, 12, 13);
+  w = __builtin_shufflevector(t2, t3, 2, 3, 10, 11, 6, 7, 14, 15);
+}
+
+// The inverse: lane l of (x, y, z, w) to the 16 bytes at e[l].
+SEAMLESS_SIMD_INL void transpose_store(void* const* e, vf x, vf y, vf z, vf w) {
+  const f8 t0 = __builtin_shufflevector(x.v, y.v, 0, 8, 1, 9, 4, 12, 5, 13);   // x0 y0 x1 y1 | x4 y4 x5 y5
+  const f8 t1 = __builtin_shufflevector(x.v, y.v, 2, 10, 3, 11, 6, 14, 7, 15);  // x2 y2 x3 y3 | ...
+  const f8 t2 = __builtin_shufflevector(z.v, w.v, 0, 8, 1, 9, 4, 12, 5, 13);
+  const f8 t3 = __builtin_shufflevector(z.v, w.v, 2, 10, 3, 11, 6, 14, 7, 15);
+  const f8 c0 = __builtin_shufflevector(t0, t2, 0, 1, 8, 9, 4, 5, 12, 13);  // P0 | P4
+  const f8 c1 = __builtin_shufflevector(t0, t2, 2, 3, 10, 11, 6, 7, 14, 15);  // P1 | P5
+  const f8 c2 = __builtin_shufflevector(t1, t3, 0, 1, 8, 9, 4, 5, 12, 13);  // P2 | P6
+  const f8 c3 = __builtin_shufflevector(t1, t3, 2, 3, 10, 11, 6, 7, 14, 15);  // P3 | P7
+  const f8 c[4] = {c0, c1, c2, c3};
+  for (int l = 0; l < 4; ++l) {
+    const f4 lo = __builtin_shufflevector(c[l], c[l], 0, 1, 2, 3), hi = __builtin_shufflevector(c[l], c[l], 4, 5, 6, 7);
+    std::memcpy(e[l], &lo, sizeof(f4));
+    std::memcpy(e[l + 4], &hi, sizeof(f4));
+  }
+}
+
+// 8 consecutive vec3 (12 bytes each) as a v3.
+SEAMLESS_SIMD_INL v3 load_v3(const vec3* a) {
+  v3 r;
+  for (int l = 0; l < kWidth; ++l) r.x.v[l] = a[l].x, r.y.v[l] = a[l].y, r.z.v[l] = a[l].z;
+  return r;
+}
+
+}  // namespace seamless::kernels::simd
+#endif
