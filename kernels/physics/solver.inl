@@ -10,6 +10,40 @@
 
 namespace seamless::kernels {
 
+#if !defined(__CUDACC__)
+// The CPU's SIMD tiles (defined at the end of this file).
+#if SEAMLESS_SIMD_X86
+#pragma GCC push_options
+#pragma GCC target("avx2")
+#endif
+namespace detail {
+template <bool Cache>
+bool vorticity_tile(const SimViews& S, int s0);
+template <bool Cache>
+bool density_tile(const SimViews& S, int s0);
+}  // namespace detail
+#if SEAMLESS_SIMD_X86
+#pragma GCC pop_options
+#endif
+
+// Runs tile(S, s0) for the tiles of 8 particles and one(s) for the particles of tiles it
+// declines, on the CPU when the SIMD lanes are available; false otherwise (the caller then runs
+// its loop). Each tile is taken by the task of its first particle (for_each's threshold and
+// schedule stay those of the particles).
+template <class Exec, class Tile, class One>
+bool cpu_tiles(const Exec& ex, const SimViews& S, Tile tile, One one) {
+  if constexpr (Exec::device != Device::CPU) return false;
+  if (!simd::cpu_simd()) return false;
+  ex.for_each(S.n, [=](std::int64_t i) {
+    if (i % simd::kWidth != 0) return;
+    const int s0 = static_cast<int>(i);
+    if (tile(S, s0)) return;
+    for (int s = s0, e = s0 + simd::kWidth < S.n ? s0 + simd::kWidth : S.n; s < e; ++s) one(s);
+  });
+  return true;
+}
+#endif
+
 namespace detail {
 
 SEAMLESS_HD inline int max(int a, int b) { return a > b ? a : b; }
@@ -497,6 +531,22 @@ SEAMLESS_HD inline DensitySum operator+(const DensitySum& a, const DensitySum& b
   return {a.rho + b.rho, a.sum2 + b.sum2, a.gi + b.gi};
 }
 
+// One pair's kernel values for r = p_i - p_j (poly6 wgt, spiky gradient gw) and grad_j C_i =
+// gw / rho_0; F is float or the CPU's SIMD lanes (V their vec3).
+template <class F, class V>
+struct DensityPair {
+  V gw, grad;
+  F wgt;
+};
+template <class F, class V>
+SEAMLESS_HD inline DensityPair<F, V> density_pair(const SphKernel& W, float inv_rho0, V r) {
+  DensityPair<F, V> d;
+  d.wgt = W.poly6(length2(r));
+  d.gw = W.spiky_grad(r);
+  d.grad = d.gw * inv_rho0;
+  return d;
+}
+
 // Lane g's share of rho_i (starting from W(0) in lane 0), sum_j |grad_j C_i|^2 and grad_i C_i;
 // with Cache, each pair's kernel values are kept in pair_w for pbf_part.
 template <bool Cache>
@@ -513,11 +563,10 @@ SEAMLESS_HD inline DensitySum density_part(const SimViews& S, int s, Lanes g) {
   const std::int64_t col = S.nbr_col;
   for (int k = g.lane, m = S.nnbr[s]; k < m; k += g.size) {
     const Packed q = S.spk[list[k * col]];  // position and phase in one load
-    vec3 r = p - q.xyz();
-    float wgt = W.poly6(length2(r));
-    const vec3 gw = W.spiky_grad(r);
+    const DensityPair<float, vec3> dp = density_pair<float>(W, inv_rho0, p - q.xyz());
+    const float wgt = dp.wgt;
+    const vec3 gw = dp.gw, grad = dp.grad;
     if constexpr (Cache) cache[k * col] = Packed::of(gw, wgt);
-    vec3 grad = gw * inv_rho0;
     if (!mixed || phase::is(q.bits(), phase::kFluid)) {
       d.rho += wgt;
       d.gi += grad;
@@ -534,13 +583,25 @@ SEAMLESS_HD inline DensitySum density_part(const SimViews& S, int s, Lanes g) {
   }
   return d;
 }
+
+// Fluid particle s's constraint from its sums d and its contact count nc.
+SEAMLESS_HD inline void finish_density(const SimViews& S, int s, int nc, const DensitySum& d) {
+  S.ncontacts[s] = nc;
+  float C = d.rho * (1.f / S.c.rest_density) - 1.f;
+  if (S.c.unilateral && C < 0.f) C = 0.f;
+  const float lambda = -C / (d.sum2 + length2(d.gi) + S.c.relaxation);
+  S.lambda[s] = lambda;
+  S.spl[s] = Packed::of(S.sp[s], lambda);  // what solve_contacts_fluid gathers of a neighbour
+  S.density[s] = d.rho;
+  S.h_rho[s] = S.c.h / d.rho;  // once here instead of once per neighbour pair in velocity_effects
+}
 }  // namespace detail
 
 template <class Exec>
 void prepare_constraints(const Exec& ex, const SimViews& S) {
   ex.for_each(S.nbodies, [=] SEAMLESS_HD(std::int64_t b) { S.body_contacts[b] = 0; });
   detail::pack_positions(ex, S);
-  ex.for_each_grouped(S.n, kPairLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
+  auto one = [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
     const int s = static_cast<int>(i);
     const int nc = detail::count_contacts(S, s, S.sp, g);
     if (!phase::is(S.sphase[s], phase::kFluid)) {
@@ -554,15 +615,12 @@ void prepare_constraints(const Exec& ex, const SimViews& S) {
     }
     const detail::DensitySum d = g.sum(detail::density_part<detail::kCachePairs<Exec>>(S, s, g));
     if (g.lane != 0) return;
-    S.ncontacts[s] = nc;
-    float C = d.rho * (1.f / S.c.rest_density) - 1.f;
-    if (S.c.unilateral && C < 0.f) C = 0.f;
-    const float lambda = -C / (d.sum2 + length2(d.gi) + S.c.relaxation);
-    S.lambda[s] = lambda;
-    S.spl[s] = Packed::of(S.sp[s], lambda);  // what solve_contacts_fluid gathers of a neighbour
-    S.density[s] = d.rho;
-    S.h_rho[s] = S.c.h / d.rho;  // once here instead of once per neighbour pair in velocity_effects
-  });
+    detail::finish_density(S, s, nc, d);
+  };
+#if !defined(__CUDACC__)
+  if (!cpu_tiles(ex, S, detail::density_tile<detail::kCachePairs<Exec>>, [=](int s) { one(s, Lanes{}); }))
+#endif
+    ex.for_each_grouped(S.n, kPairLanes, one);
 }
 
 namespace detail {
@@ -979,6 +1037,58 @@ SEAMLESS_HD inline VortSum vorticity_part(const SimViews& S, int s, Lanes g) {
 }
 }  // namespace detail
 
+template <class Exec>
+void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
+  if (has_fluid) {
+    // Vorticity omega_i = sum_j v_ij x grad_j W_ij (PBF eq. 15), Akinci's colour-field normal
+    // n_i = h sum_j (1 / rho_j) grad W_ij (Akinci 2013, eq. 4; dissertation eq. 4.21), and the
+    // XSPH sum (PBF eq. 17), which needs only this pass's velocities (kept in vtmp for
+    // fluid_forces: one neighbour loop fewer that gathers velocities).
+    auto vort = [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
+      const int s = static_cast<int>(i);
+      if (!phase::is(S.sphase[s], phase::kFluid)) return;
+      const detail::VortSum t = g.sum(detail::vorticity_part<detail::kCachePairs<Exec>>(S, s, g));
+      if (g.lane != 0) return;
+      S.vort[s] = t.w;
+      S.vort_len[s] = length(t.w);
+      S.cnormal[s] = t.n;
+      S.cnv[s] = Packed::of(t.n, S.vort_len[s]);  // what fluid_forces gathers of a neighbour
+      S.vtmp[s] = t.dv_visc;
+    };
+#if !defined(__CUDACC__)
+    if (!cpu_tiles(ex, S, detail::vorticity_tile<detail::kCachePairs<Exec>>, [=](int s) { vort(s, Lanes{}); }))
+#endif
+      ex.for_each_grouped(S.n, kPairLanes, vort);
+  }
+  const bool aero = S.has_cloth_constraints && (S.c.drag > 0.f || S.c.lift > 0.f);
+  ex.for_each_grouped(S.n, kPairLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
+    const int s = static_cast<int>(i);
+    const std::uint32_t ph = S.sphase[s];
+    const bool fluid = has_fluid && phase::is(ph, phase::kFluid);
+    vec3 forces{0.f, 0.f, 0.f};
+    if (fluid) forces = detail::fluid_forces<detail::kCachePairs<Exec>>(S, s, g);
+    if (g.lane != 0) return;  // vtmp[s] is read and written by lane 0 only
+    vec3 v = S.sv[s];
+    if (fluid) v += S.vtmp[s] * S.c.viscosity + forces * S.c.dt;
+    if (aero && phase::is(ph, phase::kCloth)) v += detail::cloth_aero(S, s);
+    S.vtmp[s] = v;
+  });
+}
+
+template <class Exec>
+void write_back(const Exec& ex, const SimViews& S) {
+  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
+    int id = S.order[s];
+    S.x[id] = S.sp[s];
+    S.v[id] = S.sv[s];
+    // Largest |v|^2 for stats() without a reduction: the bits of non-negative floats order like
+    // ints. Read first: the shared maximum rarely changes, so most particles only load it.
+    const int v2 = float_bits(length2(S.sv[s]));
+    if (v2 > atomic_load(&S.counters[4])) atomic_max(&S.counters[4], v2);
+  });
+}
+
+
 #if !defined(__CUDACC__)
 // ---- the CPU's SIMD tiles (kernels/physics/simd.hpp) ------------------------------------------
 // A tile is 8 consecutive sorted particles, one per lane, each walking its own list in list
@@ -1080,79 +1190,56 @@ bool vorticity_tile(const SimViews& S, int s0) {
   }
   return true;
 }
+
+// prepare_constraints of the tile's 8 fluid particles: count_contacts lane by lane (no lists:
+// the tile's lists hold fluid only, its SDF sample), density_part 8 lanes at once (with Cache the
+// pairs' kernel values go to pair_w as there), then finish_density.
+template <bool Cache>
+bool density_tile(const SimViews& S, int s0) {
+  Tile t;
+  if (!fluid_tile(S, s0, t)) return false;
+  using simd::v3;
+  using simd::vf;
+  int nc[simd::kWidth];
+  for (int l = 0; l < simd::kWidth; ++l) nc[l] = count_contacts(S, s0 + l, S.sp, Lanes{});
+  const float inv_rho0 = 1.f / S.c.rest_density;
+  const SphKernel W = S.c.W;
+  const v3 p = simd::load_v3(S.sp + s0);
+  vf rho(W.poly6(0.f)), sum2(0.f);
+  v3 gi{};
+  auto step = [&](int k, auto masked) {
+    constexpr bool kMasked = decltype(masked)::value;
+    int j[simd::kWidth];
+    simd::vm in;
+    tile_entries<kMasked>(S, t, k, j, in);
+    v3 q;
+    vf ph;
+    gather_packed(S.spk, j, q, ph);
+    const auto d = density_pair<vf>(W, inv_rho0, p - q);
+    if constexpr (Cache) {
+      void* e[simd::kWidth];
+      for (int l = 0; l < simd::kWidth; ++l) e[l] = S.pair_w + (s0 + l) * S.nbr_row + k * S.nbr_col;
+      simd::transpose_store(e, d.gw.x, d.gw.y, d.gw.z, d.wgt);
+    }
+    if constexpr (kMasked) {
+      rho = select(in, rho + d.wgt, rho);
+      sum2 = select(in, sum2 + length2(d.grad), sum2);
+    } else {
+      rho = rho + d.wgt;
+      sum2 = sum2 + length2(d.grad);
+    }
+    tile_add<kMasked>(gi, d.grad, in);
+  };
+  for (int k = 0; k < t.kmin; ++k) step(k, std::false_type{});
+  for (int k = t.kmin; k < t.kmax; ++k) step(k, std::true_type{});
+  for (int l = 0; l < simd::kWidth; ++l) finish_density(S, s0 + l, nc[l], DensitySum{rho[l], sum2[l], simd::lane(gi, l)});
+  return true;
+}
 }  // namespace detail
 #if SEAMLESS_SIMD_X86
 #pragma GCC pop_options
 #endif
 
-// Runs tile(S, s0) for the tiles of 8 particles and one(s) for the particles of tiles it
-// declines, on the CPU when the SIMD lanes are available; false otherwise (the caller then runs
-// its loop). Each tile is taken by the task of its first particle (for_each's threshold and
-// schedule stay those of the particles).
-template <class Exec, class Tile, class One>
-bool cpu_tiles(const Exec& ex, const SimViews& S, Tile tile, One one) {
-  if constexpr (Exec::device != Device::CPU) return false;
-  if (!simd::cpu_simd()) return false;
-  ex.for_each(S.n, [=](std::int64_t i) {
-    if (i % simd::kWidth != 0) return;
-    const int s0 = static_cast<int>(i);
-    if (tile(S, s0)) return;
-    for (int s = s0, e = s0 + simd::kWidth < S.n ? s0 + simd::kWidth : S.n; s < e; ++s) one(s);
-  });
-  return true;
-}
 #endif
-
-template <class Exec>
-void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
-  if (has_fluid) {
-    // Vorticity omega_i = sum_j v_ij x grad_j W_ij (PBF eq. 15), Akinci's colour-field normal
-    // n_i = h sum_j (1 / rho_j) grad W_ij (Akinci 2013, eq. 4; dissertation eq. 4.21), and the
-    // XSPH sum (PBF eq. 17), which needs only this pass's velocities (kept in vtmp for
-    // fluid_forces: one neighbour loop fewer that gathers velocities).
-    auto vort = [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
-      const int s = static_cast<int>(i);
-      if (!phase::is(S.sphase[s], phase::kFluid)) return;
-      const detail::VortSum t = g.sum(detail::vorticity_part<detail::kCachePairs<Exec>>(S, s, g));
-      if (g.lane != 0) return;
-      S.vort[s] = t.w;
-      S.vort_len[s] = length(t.w);
-      S.cnormal[s] = t.n;
-      S.cnv[s] = Packed::of(t.n, S.vort_len[s]);  // what fluid_forces gathers of a neighbour
-      S.vtmp[s] = t.dv_visc;
-    };
-#if !defined(__CUDACC__)
-    if (!cpu_tiles(ex, S, detail::vorticity_tile<detail::kCachePairs<Exec>>, [=](int s) { vort(s, Lanes{}); }))
-#endif
-      ex.for_each_grouped(S.n, kPairLanes, vort);
-  }
-  const bool aero = S.has_cloth_constraints && (S.c.drag > 0.f || S.c.lift > 0.f);
-  ex.for_each_grouped(S.n, kPairLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
-    const int s = static_cast<int>(i);
-    const std::uint32_t ph = S.sphase[s];
-    const bool fluid = has_fluid && phase::is(ph, phase::kFluid);
-    vec3 forces{0.f, 0.f, 0.f};
-    if (fluid) forces = detail::fluid_forces<detail::kCachePairs<Exec>>(S, s, g);
-    if (g.lane != 0) return;  // vtmp[s] is read and written by lane 0 only
-    vec3 v = S.sv[s];
-    if (fluid) v += S.vtmp[s] * S.c.viscosity + forces * S.c.dt;
-    if (aero && phase::is(ph, phase::kCloth)) v += detail::cloth_aero(S, s);
-    S.vtmp[s] = v;
-  });
-}
-
-template <class Exec>
-void write_back(const Exec& ex, const SimViews& S) {
-  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
-    int id = S.order[s];
-    S.x[id] = S.sp[s];
-    S.v[id] = S.sv[s];
-    // Largest |v|^2 for stats() without a reduction: the bits of non-negative floats order like
-    // ints. Read first: the shared maximum rarely changes, so most particles only load it.
-    const int v2 = float_bits(length2(S.sv[s]));
-    if (v2 > atomic_load(&S.counters[4])) atomic_max(&S.counters[4], v2);
-  });
-}
-
 
 }  // namespace seamless::kernels
