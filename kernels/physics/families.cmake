@@ -5,4 +5,4 @@ seamless_kernel_family(physics/solver)
 # (the SIMD tiles' lane-by-lane square roots become one vector instruction). -Wno-psabi: the tiles
 # pass 32-byte vectors between always_inline functions, whose ABI note does not apply.
 set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/physics/solver_cpu.cpp
-  PROPERTIES COMPILE_OPTIONS "$<$<CXX_COMPILER_ID:GNU,Clang>:-fno-math-errno;-Wno-psabi>")
+  PROPERTIES COMPILE_OPTIONS "$<$<CXX_COMPILER_ID:GNU,Clang>:-fno-math-errno;-Wno-psabi;--param=inline-unit-growth=200>")

@@ -21,6 +21,10 @@ template <bool Cache>
 bool vorticity_tile(const SimViews& S, int s0);
 template <bool Cache>
 bool density_tile(const SimViews& S, int s0);
+template <bool Cached>
+bool solve_tile(const SimViews& S, int s0);
+template <bool Cached>
+bool forces_tile(const SimViews& S, int s0);
 }  // namespace detail
 #if SEAMLESS_SIMD_X86
 #pragma GCC pop_options
@@ -630,6 +634,18 @@ struct SolveSum {
 };
 SEAMLESS_HD inline SolveSum operator+(const SolveSum& a, const SolveSum& b) { return {a.acc + b.acc, a.f + b.f}; }
 
+// One fluid pair's term of the PBF sum: grad (lambda_i + lambda_j + s_corr), s_corr from the
+// pair's poly6 wgt (eq. 13, n = 4); F is float or the CPU's SIMD lanes (V their vec3).
+template <class F, class V>
+SEAMLESS_HD inline V pbf_pair(const SimConstants& c, V grad, F wgt, F li, F lj) {
+  F sc = 0.f;
+  if (c.scorr_k > 0.f) {
+    F q = wgt * c.scorr_inv_wdq;
+    sc = -c.scorr_k * q * q * q * q;
+  }
+  return grad * (li + lj + sc);
+}
+
 // The PBF position update of fluid particle s (eq. 12) with the artificial pressure s_corr
 // (eq. 13, n = 4), before the division by rho_0: lane g's share. With Cached, the pairs' kernel
 // values come from pair_w (prepare_constraints at these positions) instead of the positions.
@@ -653,18 +669,22 @@ SEAMLESS_HD inline vec3 pbf_part(const SimViews& S, int s, Lanes g) {
       wgt = S.c.scorr_k > 0.f ? S.c.W.poly6(length2(r)) : 0.f;
     }
     if (!mixed || phase::is(S.sphase[j], phase::kFluid)) {
-      float sc = 0.f;
-      if (S.c.scorr_k > 0.f) {
-        float q = wgt * S.c.scorr_inv_wdq;
-        sc = -S.c.scorr_k * q * q * q * q;
-      }
-      f += grad * (li + lj + sc);
+      f += pbf_pair(S.c, grad, wgt, li, lj);
     } else {
       f += grad * (li * sw);
     }
   }
   for (int k = g.lane, m = S.nsnbr[s]; k < m; k += g.size) f += S.c.W.spiky_grad(p - S.stat[S.snbrs(s)[k * S.snbr_col]]) * (li * sw);
   return f;
+}
+
+// s's new position from its sums (the contacts' part.acc, the PBF or coupling sum part.f).
+SEAMLESS_HD inline void finish_solve(const SimViews& S, int s, const SolveSum& part, bool fluid, bool coupled) {
+  vec3 acc = part.acc;
+  add_sdf_contact(S, s, S.sp, S.sx, true, acc);
+  if (fluid) acc += part.f * (1.f / S.c.rest_density);
+  if (coupled) acc += part.f * (S.c.solid_density_scale / S.c.rest_density);
+  S.tmp[s] = S.sp[s] + acc;
 }
 
 // Two-way coupling of solid particle s: the reaction of the density correction a fluid neighbour
@@ -685,7 +705,7 @@ SEAMLESS_HD inline vec3 coupling_part(const SimViews& S, int s, Lanes g) {
 
 template <class Exec>
 void solve_contacts_fluid(const Exec& ex, const SimViews& S) {
-  ex.for_each_grouped(S.n, kPairLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
+  auto one = [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
     const int s = static_cast<int>(i);
     const vec3 p = S.sp[s];
     if (!(S.sw[s] > 0.f)) {
@@ -698,12 +718,12 @@ void solve_contacts_fluid(const Exec& ex, const SimViews& S) {
     if (coupled) part.f = detail::coupling_part(S, s, g);
     part = g.sum(part);
     if (g.lane != 0) return;
-    vec3 acc = part.acc;
-    detail::add_sdf_contact(S, s, S.sp, S.sx, true, acc);
-    if (fluid) acc += part.f * (1.f / S.c.rest_density);
-    if (coupled) acc += part.f * (S.c.solid_density_scale / S.c.rest_density);
-    S.tmp[s] = p + acc;
-  });
+    detail::finish_solve(S, s, part, fluid, coupled);
+  };
+#if !defined(__CUDACC__)
+  if (!cpu_tiles(ex, S, detail::solve_tile<detail::kCachePairs<Exec>>, [=](int s) { one(s, Lanes{}); }))
+#endif
+    ex.for_each_grouped(S.n, kPairLanes, one);
 }
 
 // Static friction of a rigid body as a whole (Macklin 2014, section 6.1, applied to the body):
@@ -928,6 +948,32 @@ SEAMLESS_HD inline F cohesion_factor(const SphKernel& W, float coh_c, F l) {
   return select(l > 1e-9f, coh_c * W.akinci(l) / l, F(0.f));
 }
 
+// One fluid pair's terms of ForceSum: r = p_i - p_j, the pair's spiky gradient and cohesion
+// factor cf, n_i, n_j, |omega_j| (wj), rho_i, rho_j; F is float or the CPU's SIMD lanes (V their
+// vec3).
+template <class F, class V>
+SEAMLESS_HD inline void force_pair(float inv_rho0, float two_rho0, float st, V r, V grad, F cf, V ni, V nj, F wj, F rho_i,
+                                   F rho_j, V& eta, V& acc) {
+  eta = grad * (wj * inv_rho0);
+  F K = two_rho0 / (rho_i + rho_j);
+  V coh = r * cf;
+  V curv = (ni - nj) * st;
+  acc = (coh + curv) * K;
+}
+
+// The fluid force of s from its sums t: t.acc plus vorticity confinement (PBF eqs. 15-16):
+// f = eps (N x omega), N = eta / |eta|.
+SEAMLESS_HD inline vec3 finish_forces(const SimViews& S, int s, ForceSum t) {
+  float el = length(t.eta);
+  if (el > 1e-9f && S.c.vorticity > 0.f) t.acc += cross(t.eta / el, S.vort[s]) * S.c.vorticity;
+  return t.acc;
+}
+
+// The velocity of fluid particle s after viscosity (its XSPH sum in vtmp) and its forces.
+SEAMLESS_HD inline vec3 fluid_velocity(const SimViews& S, int s, vec3 forces) {
+  return S.sv[s] + (S.vtmp[s] * S.c.viscosity + forces * S.c.dt);
+}
+
 // With Cached, each pair's spiky gradient and cohesion factor come from pair_w (vorticity_part,
 // at the same positions) instead of a square root, a division and both kernels.
 template <bool Cached>
@@ -954,17 +1000,12 @@ SEAMLESS_HD inline vec3 fluid_forces(const SimViews& S, int s, Lanes g) {
     } else {
       grad = S.c.W.spiky_grad(r), cf = cohesion_factor(S.c.W, coh_c, sqrtf(length2(r)));
     }
-    t.eta += grad * (nv.w * inv_rho0);
-    float K = two_rho0 / (rho_i + q.w);
-    vec3 coh = r * cf;
-    vec3 curv = (ni - nv.xyz()) * st;
-    t.acc += (coh + curv) * K;
+    vec3 eta, acc;
+    force_pair(inv_rho0, two_rho0, st, r, grad, cf, ni, nv.xyz(), nv.w, rho_i, q.w, eta, acc);
+    t.eta += eta;
+    t.acc += acc;
   }
-  t = g.sum(t);
-  // Vorticity confinement (PBF eqs. 15-16): f = eps (N x omega), N = eta / |eta|.
-  float el = length(t.eta);
-  if (el > 1e-9f && S.c.vorticity > 0.f) t.acc += cross(t.eta / el, S.vort[s]) * S.c.vorticity;
-  return t.acc;
+  return finish_forces(S, s, g.sum(t));
 }
 
 // Keckeisen 2004 drag and lift of the triangles around cloth particle s, a third each.
@@ -1061,7 +1102,7 @@ void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
       ex.for_each_grouped(S.n, kPairLanes, vort);
   }
   const bool aero = S.has_cloth_constraints && (S.c.drag > 0.f || S.c.lift > 0.f);
-  ex.for_each_grouped(S.n, kPairLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
+  auto one = [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
     const int s = static_cast<int>(i);
     const std::uint32_t ph = S.sphase[s];
     const bool fluid = has_fluid && phase::is(ph, phase::kFluid);
@@ -1069,10 +1110,14 @@ void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
     if (fluid) forces = detail::fluid_forces<detail::kCachePairs<Exec>>(S, s, g);
     if (g.lane != 0) return;  // vtmp[s] is read and written by lane 0 only
     vec3 v = S.sv[s];
-    if (fluid) v += S.vtmp[s] * S.c.viscosity + forces * S.c.dt;
+    if (fluid) v = detail::fluid_velocity(S, s, forces);
     if (aero && phase::is(ph, phase::kCloth)) v += detail::cloth_aero(S, s);
     S.vtmp[s] = v;
-  });
+  };
+#if !defined(__CUDACC__)
+  if (!has_fluid || !cpu_tiles(ex, S, detail::forces_tile<detail::kCachePairs<Exec>>, [=](int s) { one(s, Lanes{}); }))
+#endif
+    ex.for_each_grouped(S.n, kPairLanes, one);
 }
 
 template <class Exec>
@@ -1233,6 +1278,98 @@ bool density_tile(const SimViews& S, int s0) {
   for (int k = 0; k < t.kmin; ++k) step(k, std::false_type{});
   for (int k = t.kmin; k < t.kmax; ++k) step(k, std::true_type{});
   for (int l = 0; l < simd::kWidth; ++l) finish_density(S, s0 + l, nc[l], DensitySum{rho[l], sum2[l], simd::lane(gi, l)});
+  return true;
+}
+
+// The pair_w entries k of the tile's lanes (kept by an earlier pass at these positions).
+SEAMLESS_SIMD_INL void tile_pair_w(const SimViews& S, int s0, int k, simd::v3& gw, simd::vf& w) {
+  const void* e[simd::kWidth];
+  for (int l = 0; l < simd::kWidth; ++l) e[l] = S.pair_w + (s0 + l) * S.nbr_row + k * S.nbr_col;
+  simd::load_transpose(e, gw.x, gw.y, gw.z, w);
+}
+
+// solve_contacts_fluid of the tile's 8 fluid particles: pbf_part 8 lanes at once (the contact
+// part lane by lane: without solid or static neighbours only the scene SDF's contact).
+template <bool Cached>
+bool solve_tile(const SimViews& S, int s0) {
+  Tile t;
+  if (!fluid_tile(S, s0, t)) return false;
+  for (int l = 0; l < simd::kWidth; ++l)
+    if (!(S.sw[s0 + l] > 0.f)) return false;
+  using simd::v3;
+  using simd::vf;
+  const v3 p = simd::load_v3(S.sp + s0);
+  vf li;
+  for (int l = 0; l < simd::kWidth; ++l) li.v[l] = S.lambda[s0 + l];
+  v3 f{};
+  auto step = [&](int k, auto masked) {
+    constexpr bool kMasked = decltype(masked)::value;
+    int j[simd::kWidth];
+    simd::vm in;
+    tile_entries<kMasked>(S, t, k, j, in);
+    v3 grad;
+    vf wgt, lj;
+    if constexpr (Cached) {
+      tile_pair_w(S, s0, k, grad, wgt);
+      for (int l = 0; l < simd::kWidth; ++l) lj.v[l] = S.lambda[j[l]];
+    } else {
+      v3 q;
+      gather_packed(S.spl, j, q, lj);
+      const v3 r = p - q;
+      grad = S.c.W.spiky_grad(r);
+      wgt = S.c.scorr_k > 0.f ? S.c.W.poly6(length2(r)) : vf(0.f);
+    }
+    tile_add<kMasked>(f, pbf_pair(S.c, grad, wgt, li, lj), in);
+  };
+  for (int k = 0; k < t.kmin; ++k) step(k, std::false_type{});
+  for (int k = t.kmin; k < t.kmax; ++k) step(k, std::true_type{});
+  for (int l = 0; l < simd::kWidth; ++l) {
+    const int s = s0 + l;
+    finish_solve(S, s, SolveSum{contact_part(S, s, S.sp, S.sx, true, Lanes{}), simd::lane(f, l)}, true, false);
+  }
+  return true;
+}
+
+// velocity_effects' second pass for the tile's 8 fluid particles: fluid_forces 8 lanes at once.
+template <bool Cached>
+bool forces_tile(const SimViews& S, int s0) {
+  Tile t;
+  if (!fluid_tile(S, s0, t)) return false;
+  using simd::v3;
+  using simd::vf;
+  const float inv_rho0 = 1.f / S.c.rest_density, two_rho0 = 2.f * S.c.rest_density;
+  const float coh_c = -S.c.cohesion * inv_rho0, st = -S.c.surface_tension;
+  const SphKernel W = S.c.W;
+  const v3 p = simd::load_v3(S.sp + s0), ni = simd::load_v3(S.cnormal + s0);
+  vf rho_i;
+  for (int l = 0; l < simd::kWidth; ++l) rho_i.v[l] = S.density[s0 + l];
+  v3 eta{}, acc{};
+  auto step = [&](int k, auto masked) {
+    constexpr bool kMasked = decltype(masked)::value;
+    int j[simd::kWidth];
+    simd::vm in;
+    tile_entries<kMasked>(S, t, k, j, in);
+    v3 q, nj, grad;
+    vf rho_j, wj, cf;
+    gather_packed(S.spd, j, q, rho_j);
+    gather_packed(S.cnv, j, nj, wj);
+    const v3 r = p - q;
+    if constexpr (Cached) {
+      tile_pair_w(S, s0, k, grad, cf);
+    } else {
+      grad = W.spiky_grad(r), cf = cohesion_factor(W, coh_c, length(r));
+    }
+    v3 e, a;
+    force_pair(inv_rho0, two_rho0, st, r, grad, cf, ni, nj, wj, rho_i, rho_j, e, a);
+    tile_add<kMasked>(eta, e, in);
+    tile_add<kMasked>(acc, a, in);
+  };
+  for (int k = 0; k < t.kmin; ++k) step(k, std::false_type{});
+  for (int k = t.kmin; k < t.kmax; ++k) step(k, std::true_type{});
+  for (int l = 0; l < simd::kWidth; ++l) {
+    const int s = s0 + l;
+    S.vtmp[s] = fluid_velocity(S, s, finish_forces(S, s, ForceSum{simd::lane(eta, l), simd::lane(acc, l)}));
+  }
   return true;
 }
 }  // namespace detail
