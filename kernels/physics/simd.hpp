@@ -90,6 +90,44 @@ SEAMLESS_SIMD_INL vf sqrt(vf a) {
   return r;
 }
 
+// Bit l set where lane l of m is true.
+// (For the tile functions only: on x86 one AVX instruction, which a function not compiled for
+// AVX2 cannot inline.)
+#if SEAMLESS_SIMD_X86
+#pragma GCC push_options
+#pragma GCC target("avx2")
+SEAMLESS_SIMD_INL int bits(vm m) { return __builtin_ia32_movmskps256(reinterpret_cast<f8>(m.v)); }
+#pragma GCC pop_options
+#else
+SEAMLESS_SIMD_INL int bits(vm m) {
+  int b = 0;
+  for (int l = 0; l < kWidth; ++l) b |= (m.v[l] & 1) << l;
+  return b;
+}
+#endif
+
+// Left-packing of the lanes that a mask keeps (in lane order): lane[bits] moves them to the front
+// (the other lanes follow), count[bits] is how many.
+struct alignas(32) PackTable {
+  std::int32_t lane[256][kWidth];
+  std::uint8_t count[256];
+  constexpr PackTable() : lane{}, count{} {
+    for (int b = 0; b < 256; ++b) {
+      int c = 0;
+      for (int l = 0; l < kWidth; ++l)
+        if (b >> l & 1) lane[b][c++] = l;
+      count[b] = static_cast<std::uint8_t>(c);
+      for (int l = c; l < kWidth; ++l) lane[b][l] = 0;
+    }
+  }
+};
+inline constexpr PackTable kPack{};
+SEAMLESS_SIMD_INL i8 pack_lanes(int bits) {
+  i8 r;
+  std::memcpy(&r, kPack.lane[bits], sizeof r);
+  return r;
+}
+
 struct v3 {
   vf x, y, z;
 };

@@ -25,10 +25,28 @@ template <bool Cached>
 bool solve_tile(const SimViews& S, int s0);
 template <bool Cached>
 bool forces_tile(const SimViews& S, int s0);
+int scan_candidates_simd(const SimViews& S, vec3 p, float R2, int s, const int* run, int nruns, int* list, int cap);
 }  // namespace detail
 #if SEAMLESS_SIMD_X86
 #pragma GCC pop_options
 #endif
+
+namespace detail {
+// find_neighbors' candidates of a particle s at p without the rigid/cloth test on the CPU's SIMD
+// lanes: the runs of for_each_run_in_radius are collected (at most 2 per row of cells), then
+// their entries tested 8 at a time, runs joined (scan_candidates_simd); the same list as
+// scan_candidates. Returns the count.
+inline int scan_runs_simd(const SimViews& S, vec3 p, float R, int s, int* list, int cap) {
+  constexpr int kWidth = 2 * GridSpec::reach + 1;
+  int run[2 * 2 * kWidth * kWidth];
+  int nr = 0;
+  for_each_run_in_radius(S.grid, S.cell_start, p, R, [&](int a, int e) {
+    run[nr] = a, run[nr + 1] = e;
+    nr += a < e ? 2 : 0;
+  });
+  return scan_candidates_simd(S, p, R * R, s, run, nr / 2, list, cap);
+}
+}  // namespace detail
 
 // Runs tile(S, s0) for the tiles of 8 particles and one(s) for the particles of tiles it
 // declines, on the CPU when the SIMD lanes are available; false otherwise (the caller then runs
@@ -433,6 +451,10 @@ void find_neighbors(const Exec& ex, const SimViews& S) {
           }
         });
       };
+#if !defined(__CUDACC__)
+      if (plain && simd::cpu_simd()) cnt = detail::scan_runs_simd(S, p, R, s, list, cap);
+      else
+#endif
       if (plain) walk(std::false_type{});
       else walk(std::true_type{});
       const int stored = cnt < cap ? cnt : cap;
@@ -1371,6 +1393,61 @@ bool forces_tile(const SimViews& S, int s0) {
     S.vtmp[s] = fluid_velocity(S, s, finish_forces(S, s, ForceSum{simd::lane(eta, l), simd::lane(acc, l)}));
   }
   return true;
+}
+
+// The entries of the runs [run[2 r], run[2 r + 1]) of s, in order, 8 at a time (runs joined in
+// a buffer): the distance test of scan_candidates on 8 lanes (s itself rejected), then the kept
+// ones left-packed and stored at slot cnt (simd::kPack), or where the 8 could reach the cap each
+// candidate stored at slot min(cnt, cap) and counted where it passed (scan_candidates'
+// branch-free store). Returns the count.
+int scan_candidates_simd(const SimViews& S, vec3 p, float R2, int s, const int* run, int nruns, int* list, int cap) {
+  constexpr int kBuf = 128;
+  int buf[kBuf + 2 * simd::kWidth];
+  const simd::v3 pv = simd::broadcast(p);
+  simd::i8 self{}, iota{0, 1, 2, 3, 4, 5, 6, 7};
+  self += s;
+  int cnt = 0;
+  // Tests the first nb (a multiple of kWidth) entries of buf.
+  auto test = [&](int nb) {
+    for (int b = 0; b < nb; b += simd::kWidth) {
+      const int* j = buf + b;
+      simd::i8 jv;
+      std::memcpy(&jv, j, sizeof jv);
+      simd::v3 q;
+      simd::vf w;
+      gather_packed(S.spk, j, q, w);
+      const simd::vm ok = (length2(pv - q) < simd::vf(R2)) & simd::vm{jv != self};
+      const int m = simd::bits(ok);
+      if (cnt + simd::kWidth <= cap) {
+        const simd::i8 kept = __builtin_shuffle(jv, simd::pack_lanes(m));
+        std::memcpy(list + cnt, &kept, sizeof kept);
+        cnt += simd::kPack.count[m];
+      } else {
+        for (int l = 0; l < simd::kWidth; ++l) {
+          list[cnt < cap ? cnt : cap] = j[l];
+          cnt += m >> l & 1;
+        }
+      }
+    }
+  };
+  int nb = 0;
+  for (int r = 0; r < nruns; ++r) {
+    for (int a = run[2 * r], e = run[2 * r + 1]; a < e;) {
+      const int take = e - a < kBuf - nb ? e - a : kBuf - nb;
+      simd::i8 v = iota + a;
+      for (int k = 0; k < take; k += simd::kWidth, v += simd::kWidth) std::memcpy(buf + nb + k, &v, sizeof v);
+      nb += take, a += take;
+      if (nb >= kBuf - simd::kWidth) {  // test the full groups, keep the rest
+        const int full = nb & ~(simd::kWidth - 1);
+        test(full);
+        for (int k = full; k < nb; ++k) buf[k - full] = buf[k];
+        nb -= full;
+      }
+    }
+  }
+  for (int l = 0; l < simd::kWidth; ++l) buf[nb + l] = s;  // padding: rejected as s itself
+  test((nb + simd::kWidth - 1) & ~(simd::kWidth - 1));
+  return cnt;
 }
 }  // namespace detail
 #if SEAMLESS_SIMD_X86
