@@ -165,24 +165,6 @@ SEAMLESS_SIMD_INL void load_transpose(const void* const* e, vf& x, vf& y, vf& z,
   w = __builtin_shufflevector(t2, t3, 2, 3, 10, 11, 6, 7, 14, 15);
 }
 
-// The inverse: lane l of (x, y, z, w) to the 16 bytes at e[l].
-SEAMLESS_SIMD_INL void transpose_store(void* const* e, vf x, vf y, vf z, vf w) {
-  const f8 t0 = __builtin_shufflevector(x.v, y.v, 0, 8, 1, 9, 4, 12, 5, 13);   // x0 y0 x1 y1 | x4 y4 x5 y5
-  const f8 t1 = __builtin_shufflevector(x.v, y.v, 2, 10, 3, 11, 6, 14, 7, 15);  // x2 y2 x3 y3 | ...
-  const f8 t2 = __builtin_shufflevector(z.v, w.v, 0, 8, 1, 9, 4, 12, 5, 13);
-  const f8 t3 = __builtin_shufflevector(z.v, w.v, 2, 10, 3, 11, 6, 14, 7, 15);
-  const f8 c0 = __builtin_shufflevector(t0, t2, 0, 1, 8, 9, 4, 5, 12, 13);  // P0 | P4
-  const f8 c1 = __builtin_shufflevector(t0, t2, 2, 3, 10, 11, 6, 7, 14, 15);  // P1 | P5
-  const f8 c2 = __builtin_shufflevector(t1, t3, 0, 1, 8, 9, 4, 5, 12, 13);  // P2 | P6
-  const f8 c3 = __builtin_shufflevector(t1, t3, 2, 3, 10, 11, 6, 7, 14, 15);  // P3 | P7
-  const f8 c[4] = {c0, c1, c2, c3};
-  for (int l = 0; l < 4; ++l) {
-    const f4 lo = __builtin_shufflevector(c[l], c[l], 0, 1, 2, 3), hi = __builtin_shufflevector(c[l], c[l], 4, 5, 6, 7);
-    std::memcpy(e[l], &lo, sizeof(f4));
-    std::memcpy(e[l + 4], &hi, sizeof(f4));
-  }
-}
-
 // 8 consecutive vec3 (12 bytes each) as a v3.
 SEAMLESS_SIMD_INL v3 load_v3(const vec3* a) {
   v3 r;
