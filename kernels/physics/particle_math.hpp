@@ -27,6 +27,8 @@ constexpr float kPi = 3.14159265358979f;
 // c ? a : b, for code written once over a float type (SphKernel): the SIMD lanes of the CPU
 // (kernels/physics/simd.hpp) select lane by lane.
 SEAMLESS_HD inline float select(bool c, float a, float b) { return c ? a : b; }
+SEAMLESS_HD inline int select(bool c, int a, int b) { return c ? a : b; }
+SEAMLESS_HD inline float fsqrt(float x) { return sqrtf(x); }
 SEAMLESS_HD inline vec3 select(bool c, vec3 a, vec3 b) { return c ? a : b; }
 
 // A position (or vector) and one more word, 16-byte aligned: what a neighbour loop gathers from
@@ -136,6 +138,17 @@ SEAMLESS_HD inline float slab_gap(float v, int i, float cs, float pad) {
   return g > 0.f ? g : 0.f;
 }
 
+// The cells [lo, hi] along x (not yet wrapped) of the row of cells at squared y-z distance d2
+// from p that the sphere of radius R2 = R^2 around p crosses, within reach of p's cell cx, made
+// larger by pad (for_each_run_in_radius). F, I: float and int, or the CPU's SIMD lanes.
+template <class F, class I>
+SEAMLESS_HD inline void row_cells(const GridSpec& g, float px, int cx, float R2, float pad, F d2, I& lo, I& hi) {
+  const F rx = fsqrt(R2 - d2) + pad;
+  const I a = floor_int((px - rx) * g.inv_cell), b = floor_int((px + rx) * g.inv_cell);
+  lo = select(a > cx - GridSpec::reach, a, I(cx - GridSpec::reach));
+  hi = select(b < cx + GridSpec::reach, b, I(cx + GridSpec::reach));
+}
+
 // Calls fn(a, e) for every run [a, e) of grid entries in the cells that can hold a point within
 // R of p. For each row of cells along x (fixed y, z within reach) only the x range that the
 // sphere of radius R crosses at the row's nearest y-z distance is visited. Keys run along x within
@@ -162,10 +175,9 @@ SEAMLESS_HD inline void for_each_run_in_radius(const GridSpec& g, const int* sta
       const float d2 = ey2[dy] + ez2[dz];
       if (d2 >= R2) continue;
       const std::uint32_t row = ((static_cast<std::uint32_t>(c.y + dy - kReach) & m) << g.bits) | slab;
-      const float rx = sqrtf(R2 - d2) + pad;
-      const int lo = floor_int((p.x - rx) * g.inv_cell), hi = floor_int((p.x + rx) * g.inv_cell);
-      const std::uint32_t x0 = static_cast<std::uint32_t>(lo > c.x - kReach ? lo : c.x - kReach) & m;
-      const std::uint32_t x1 = static_cast<std::uint32_t>(hi < c.x + kReach ? hi : c.x + kReach) & m;
+      int lo, hi;
+      row_cells(g, p.x, c.x, R2, pad, d2, lo, hi);
+      const std::uint32_t x0 = static_cast<std::uint32_t>(lo) & m, x1 = static_cast<std::uint32_t>(hi) & m;
       if (x0 <= x1) {
         fn(start[row | x0], start[(row | x1) + 1]);
       } else {  // the x range wraps: [x0, m] and [0, x1]

@@ -83,12 +83,30 @@ SEAMLESS_SIMD_INL vm operator>(vf a, vf b) { return {a.v > b.v}; }
 SEAMLESS_SIMD_INL vm operator<=(vf a, vf b) { return {a.v <= b.v}; }
 SEAMLESS_SIMD_INL vm operator>=(vf a, vf b) { return {a.v >= b.v}; }
 SEAMLESS_SIMD_INL vf select(vm m, vf a, vf b) { return m.v ? a.v : b.v; }
+
+struct vi {
+  i8 v;
+  vi() = default;
+  SEAMLESS_SIMD_INL vi(i8 x) : v(x) {}
+  SEAMLESS_SIMD_INL vi(int s) : v(i8{} + s) {}  // broadcast
+  SEAMLESS_SIMD_INL int operator[](int l) const { return v[l]; }
+};
+SEAMLESS_SIMD_INL vi operator-(vi a, vi b) { return a.v - b.v; }
+SEAMLESS_SIMD_INL vm operator<(vi a, vi b) { return {a.v < b.v}; }
+SEAMLESS_SIMD_INL vm operator>(vi a, vi b) { return {a.v > b.v}; }
+SEAMLESS_SIMD_INL vi select(vm m, vi a, vi b) { return m.v ? a.v : b.v; }
+// kernels::floor_int lane by lane (truncation, then one down where that rounded up).
+SEAMLESS_SIMD_INL vi floor_int(vf x) {
+  const i8 i = __builtin_convertvector(x.v, i8);
+  return select(vm{__builtin_convertvector(i, f8) > x.v}, vi(i - 1), vi(i));
+}
 // Lane by lane (the compiler makes it one vector square root; solver_cpu.cpp has no errno).
 SEAMLESS_SIMD_INL vf sqrt(vf a) {
   vf r;
   for (int l = 0; l < kWidth; ++l) r.v[l] = __builtin_sqrtf(a.v[l]);
   return r;
 }
+SEAMLESS_SIMD_INL vf fsqrt(vf a) { return sqrt(a); }
 
 // Bit l set where lane l of m is true.
 // (For the tile functions only: on x86 one AVX instruction, which a function not compiled for

@@ -22,26 +22,13 @@ bool density_tile(const SimViews& S, int s0);
 bool solve_tile(const SimViews& S, int s0);
 bool forces_tile(const SimViews& S, int s0);
 int scan_candidates_simd(const SimViews& S, vec3 p, float R2, int s, const int* run, int nruns, int* list, int cap);
+int scan_runs_simd(const SimViews& S, vec3 p, float R, int s, int* list, int cap);
 }  // namespace detail
 #if SEAMLESS_SIMD_X86
 #pragma GCC pop_options
 #endif
 
 namespace detail {
-// find_neighbors' candidates of a particle s at p without the rigid/cloth test on the CPU's SIMD
-// lanes: the runs of for_each_run_in_radius are collected (at most 2 per row of cells), then
-// their entries tested 8 at a time, runs joined (scan_candidates_simd); the same list as
-// scan_candidates. Returns the count.
-inline int scan_runs_simd(const SimViews& S, vec3 p, float R, int s, int* list, int cap) {
-  constexpr int kWidth = 2 * GridSpec::reach + 1;
-  int run[2 * 2 * kWidth * kWidth];
-  int nr = 0;
-  for_each_run_in_radius(S.grid, S.cell_start, p, R, [&](int a, int e) {
-    run[nr] = a, run[nr + 1] = e;
-    nr += a < e ? 2 : 0;
-  });
-  return scan_candidates_simd(S, p, R * R, s, run, nr / 2, list, cap);
-}
 }  // namespace detail
 
 // Runs tile(S, s0) for the tiles of 8 particles and one(s) for the particles of tiles it
@@ -1420,6 +1407,57 @@ int scan_candidates_simd(const SimViews& S, vec3 p, float R2, int s, const int* 
   for (int l = 0; l < simd::kWidth; ++l) buf[nb + l] = s;  // padding: rejected as s itself
   test((nb + simd::kWidth - 1) & ~(simd::kWidth - 1));
   return cnt;
+}
+
+// find_neighbors' candidates of a particle s at p without the rigid/cloth test on the CPU's SIMD
+// lanes: the runs of for_each_run_in_radius (the same rows, row_cells on 8 rows at once, then the
+// runs in its order), then their entries 8 at a time (scan_candidates_simd); the same list as
+// scan_candidates. Returns the count.
+int scan_runs_simd(const SimViews& S, vec3 p, float R, int s, int* list, int cap) {
+  constexpr int kReach = GridSpec::reach, kW = 2 * kReach + 1, kRows = kW * kW;
+  constexpr int kVecs = (kRows + simd::kWidth - 1) / simd::kWidth;
+  const GridSpec& g = S.grid;
+  const int3 c = g.cell_of(p);
+  const float R2 = R * R, pad = 1e-3f * g.cell;
+  const std::uint32_t m = (1u << g.bits) - 1u;
+  float ey2[kW], ez2[kW];
+  for (int d = 0; d < kW; ++d) {
+    const float ey = slab_gap(p.y, c.y + d - kReach, g.cell, pad), ez = slab_gap(p.z, c.z + d - kReach, g.cell, pad);
+    ey2[d] = ey * ey, ez2[d] = ez * ez;
+  }
+  // Row r = dz kW + dy; lanes past the rows get R2 (no row).
+  alignas(32) float d2[kVecs * simd::kWidth];
+  for (int r = 0; r < kVecs * simd::kWidth; ++r) d2[r] = r < kRows ? ey2[r % kW] + ez2[r / kW] : R2;
+  alignas(32) int lo[kVecs * simd::kWidth], hi[kVecs * simd::kWidth];
+  for (int v = 0; v < kVecs; ++v) {
+    simd::vf dv;
+    std::memcpy(&dv.v, d2 + v * simd::kWidth, sizeof dv.v);
+    simd::vi a, b;
+    row_cells(g, p.x, c.x, R2, pad, dv, a, b);
+    std::memcpy(lo + v * simd::kWidth, &a.v, sizeof a.v);
+    std::memcpy(hi + v * simd::kWidth, &b.v, sizeof b.v);
+  }
+  int run[4 * kRows];
+  int nr = 0;
+  const int* start = S.cell_start;
+  for (int dz = 0; dz < kW; ++dz) {
+    const std::uint32_t slab = (static_cast<std::uint32_t>(c.z + dz - kReach) & m) << (2 * g.bits);
+    for (int dy = 0; dy < kW; ++dy) {
+      const int r = dz * kW + dy;
+      if (d2[r] >= R2) continue;
+      const std::uint32_t row = ((static_cast<std::uint32_t>(c.y + dy - kReach) & m) << g.bits) | slab;
+      const std::uint32_t x0 = static_cast<std::uint32_t>(lo[r]) & m, x1 = static_cast<std::uint32_t>(hi[r]) & m;
+      if (x0 <= x1) {
+        run[nr] = start[row | x0], run[nr + 1] = start[(row | x1) + 1];
+        nr += 2;
+      } else {  // the x range wraps: [x0, m] and [0, x1]
+        run[nr] = start[row | x0], run[nr + 1] = start[(row | m) + 1];
+        run[nr + 2] = start[row], run[nr + 3] = start[(row | x1) + 1];
+        nr += 4;
+      }
+    }
+  }
+  return scan_candidates_simd(S, p, R2, s, run, nr / 2, list, cap);
 }
 }  // namespace detail
 #if SEAMLESS_SIMD_X86
