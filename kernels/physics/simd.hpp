@@ -10,24 +10,20 @@
 // contraction: the vector code is compiled for AVX2 without FMA, and a * b + c stays two
 // roundings as in the scalar code).
 //
-// GCC vector extensions (generic code): the tile functions that use them are compiled for AVX2
-// (kSimdTarget, chosen at run time by cpu_simd()); everything here is always_inline, so it takes
-// the caller's instruction set. Never seen by nvcc.
+// GCC vector extensions (generic code, GCC 12 or Clang): the tile functions that use them are
+// compiled for AVX2 on x86-64 (a `#pragma GCC target` region in solver.inl, taken where
+// cpu_simd() finds AVX2 at run time; the scalar loops otherwise), for the baseline elsewhere;
+// everything here is always_inline, so it takes the caller's instruction set (the compiler turns
+// the lane loops into vector instructions: solver_cpu.cpp has -fno-math-errno). Never seen by
+// nvcc.
 #pragma once
 #if !defined(__CUDACC__)
-#include <atomic>
 #include <cstdint>
 #include <cstring>
 
 #include "core/math.hpp"
+#include "kernels/physics/cpu_simd.hpp"
 
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#define SEAMLESS_SIMD_TARGET __attribute__((target("avx2")))
-#define SEAMLESS_SIMD_X86 1
-#elif defined(__GNUC__) || defined(__clang__)
-#define SEAMLESS_SIMD_TARGET
-#define SEAMLESS_SIMD_X86 0
-#endif
 #define SEAMLESS_SIMD_INL __attribute__((always_inline)) inline
 
 namespace seamless::kernels::simd {
@@ -36,29 +32,6 @@ constexpr int kWidth = 8;
 typedef float f8 __attribute__((vector_size(32)));
 typedef std::int32_t i8 __attribute__((vector_size(32)));
 typedef float f4 __attribute__((vector_size(16)));
-
-// Whether the tile functions may run: AVX2 on x86-64 (checked once), always elsewhere (generic
-// vectors); set_cpu_simd(false) forces the scalar loops (tests compare both).
-inline std::atomic<int>& cpu_simd_flag() {
-  static std::atomic<int> flag{-1};
-  return flag;
-}
-inline bool cpu_simd() {
-  int f = cpu_simd_flag().load(std::memory_order_relaxed);
-  if (f < 0) {
-#if SEAMLESS_SIMD_X86
-    f = __builtin_cpu_supports("avx2") ? 1 : 0;
-#else
-    f = 1;
-#endif
-    cpu_simd_flag().store(f, std::memory_order_relaxed);
-  }
-  return f != 0;
-}
-inline void set_cpu_simd(bool on) {
-  cpu_simd_flag().store(-1);
-  if (!on) cpu_simd_flag().store(0);
-}
 
 struct vm {
   i8 v;  // all bits set: true
