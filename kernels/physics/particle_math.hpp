@@ -132,17 +132,20 @@ struct GridSpec {
 
 // Distance along one axis from coordinate v to cell i's slab [i cs, (i + 1) cs), made smaller by
 // pad so that rounding never drops a cell that holds a neighbour.
-SEAMLESS_HD inline float slab_gap(float v, int i, float cs, float pad) {
-  float lo = static_cast<float>(i) * cs, a = lo - v, b = v - (lo + cs);  // at most one is > 0
-  float g = (a > b ? a : b) - pad;  // max, without a branch
-  return g > 0.f ? g : 0.f;
+// F: float, or the CPU's SIMD lanes.
+template <class F>
+SEAMLESS_HD inline F slab_gap(F v, int i, float cs, float pad) {
+  const float lo = static_cast<float>(i) * cs;
+  const F a = lo - v, b = v - (lo + cs);  // at most one is > 0
+  const F g = select(a > b, a, b) - pad;  // max, without a branch
+  return select(g > 0.f, g, F(0.f));
 }
 
 // The cells [lo, hi] along x (not yet wrapped) of the row of cells at squared y-z distance d2
 // from p that the sphere of radius R2 = R^2 around p crosses, within reach of p's cell cx, made
 // larger by pad (for_each_run_in_radius). F, I: float and int, or the CPU's SIMD lanes.
 template <class F, class I>
-SEAMLESS_HD inline void row_cells(const GridSpec& g, float px, int cx, float R2, float pad, F d2, I& lo, I& hi) {
+SEAMLESS_HD inline void row_cells(const GridSpec& g, F px, I cx, float R2, float pad, F d2, I& lo, I& hi) {
   const F rx = fsqrt(R2 - d2) + pad;
   const I a = floor_int((px - rx) * g.inv_cell), b = floor_int((px + rx) * g.inv_cell);
   lo = select(a > cx - GridSpec::reach, a, I(cx - GridSpec::reach));

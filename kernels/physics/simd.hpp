@@ -64,7 +64,10 @@ struct vi {
   SEAMLESS_SIMD_INL vi(int s) : v(i8{} + s) {}  // broadcast
   SEAMLESS_SIMD_INL int operator[](int l) const { return v[l]; }
 };
+SEAMLESS_SIMD_INL vi operator+(vi a, vi b) { return a.v + b.v; }
 SEAMLESS_SIMD_INL vi operator-(vi a, vi b) { return a.v - b.v; }
+SEAMLESS_SIMD_INL vm operator==(vi a, vi b) { return {a.v == b.v}; }
+SEAMLESS_SIMD_INL vm operator!=(vi a, vi b) { return {a.v != b.v}; }
 SEAMLESS_SIMD_INL vm operator<(vi a, vi b) { return {a.v < b.v}; }
 SEAMLESS_SIMD_INL vm operator>(vi a, vi b) { return {a.v > b.v}; }
 SEAMLESS_SIMD_INL vi select(vm m, vi a, vi b) { return m.v ? a.v : b.v; }
@@ -88,8 +91,21 @@ SEAMLESS_SIMD_INL vf fsqrt(vf a) { return sqrt(a); }
 #pragma GCC push_options
 #pragma GCC target("avx2")
 SEAMLESS_SIMD_INL int bits(vm m) { return __builtin_ia32_movmskps256(reinterpret_cast<f8>(m.v)); }
+// Bit k set where bit b of byte k of the 32 bytes at p is set.
+SEAMLESS_SIMD_INL unsigned byte_bits(const std::uint8_t* p, int b) {
+  typedef char c32 __attribute__((vector_size(32)));
+  typedef long long q4 __attribute__((vector_size(32)));
+  q4 v;
+  std::memcpy(&v, p, sizeof v);
+  return static_cast<unsigned>(__builtin_ia32_pmovmskb256(reinterpret_cast<c32>(v << (7 - b))));
+}
 #pragma GCC pop_options
 #else
+SEAMLESS_SIMD_INL unsigned byte_bits(const std::uint8_t* p, int b) {
+  unsigned r = 0;
+  for (int k = 0; k < 32; ++k) r |= static_cast<unsigned>(p[k] >> b & 1) << k;
+  return r;
+}
 SEAMLESS_SIMD_INL int bits(vm m) {
   int b = 0;
   for (int l = 0; l < kWidth; ++l) b |= (m.v[l] & 1) << l;

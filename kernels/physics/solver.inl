@@ -23,6 +23,7 @@ bool solve_tile(const SimViews& S, int s0);
 bool forces_tile(const SimViews& S, int s0);
 int scan_candidates_simd(const SimViews& S, vec3 p, float R2, int s, const int* run, int nruns, int* list, int cap);
 int scan_runs_simd(const SimViews& S, vec3 p, float R, int s, int* list, int cap);
+bool neighbors_tile(const SimViews& S, int s0);
 }  // namespace detail
 #if SEAMLESS_SIMD_X86
 #pragma GCC pop_options
@@ -394,9 +395,26 @@ SEAMLESS_HD inline int scan_candidates(const SimViews& S, vec3 p, float R2, std:
 }
 }  // namespace detail
 
+namespace detail {
+// s's list lengths (cnt candidates kept, solid of them not fluid, scnt static ones) and the
+// overflow counters.
+SEAMLESS_HD inline void finish_neighbors(const SimViews& S, int s, int cnt, int solid, int scnt) {
+  if (cnt > S.c.max_neighbors) atomic_add(&S.counters[0], 1);
+  // Read first: the shared maximum rarely changes, so most particles only load it.
+  if (cnt > atomic_load(&S.counters[2])) atomic_max(&S.counters[2], cnt);
+  S.nnbr[s] = cnt < S.c.max_neighbors ? cnt : S.c.max_neighbors;
+  S.nsolid[s] = solid;
+  if (S.ns > 0) {
+    if (scnt > S.c.max_static_neighbors) atomic_add(&S.counters[1], 1);
+    if (scnt > atomic_load(&S.counters[3])) atomic_max(&S.counters[3], scnt);
+  }
+  S.nsnbr[s] = scnt < S.c.max_static_neighbors ? scnt : S.c.max_static_neighbors;
+}
+}  // namespace detail
+
 template <class Exec>
 void find_neighbors(const Exec& ex, const SimViews& S) {
-  ex.for_each_grouped(S.n, kSearchLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
+  auto one = [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
     // A CPU thread walks a particle's runs alone (Lanes{}); CUDA does from about 270k particles.
     // (Declared here: an extended CUDA lambda cannot capture what an if constexpr tests.)
     constexpr bool kOneLane = Exec::device == Device::CPU;
@@ -483,17 +501,12 @@ void find_neighbors(const Exec& ex, const SimViews& S) {
     }
     solid = g.sum(solid);
     if (g.lane != 0) return;
-    if (cnt > S.c.max_neighbors) atomic_add(&S.counters[0], 1);
-    // Read first: the shared maximum rarely changes, so most particles only load it.
-    if (cnt > atomic_load(&S.counters[2])) atomic_max(&S.counters[2], cnt);
-    S.nnbr[s] = cnt < S.c.max_neighbors ? cnt : S.c.max_neighbors;
-    S.nsolid[s] = solid;
-    if (S.ns > 0) {
-      if (scnt > S.c.max_static_neighbors) atomic_add(&S.counters[1], 1);
-      if (scnt > atomic_load(&S.counters[3])) atomic_max(&S.counters[3], scnt);
-    }
-    S.nsnbr[s] = scnt < S.c.max_static_neighbors ? scnt : S.c.max_static_neighbors;
-  });
+    detail::finish_neighbors(S, s, cnt, solid, scnt);
+  };
+#if !defined(__CUDACC__)
+  if (!cpu_tiles(ex, S, detail::neighbors_tile, [=](int s) { one(s, Lanes{}); }))
+#endif
+    ex.for_each_grouped(S.n, kSearchLanes, one);
 }
 
 // Macklin 2014, section 4.4: contacts that already exist at the start positions are resolved on
@@ -1433,7 +1446,7 @@ int scan_runs_simd(const SimViews& S, vec3 p, float R, int s, int* list, int cap
     simd::vf dv;
     std::memcpy(&dv.v, d2 + v * simd::kWidth, sizeof dv.v);
     simd::vi a, b;
-    row_cells(g, p.x, c.x, R2, pad, dv, a, b);
+    row_cells(g, simd::vf(p.x), simd::vi(c.x), R2, pad, dv, a, b);
     std::memcpy(lo + v * simd::kWidth, &a.v, sizeof a.v);
     std::memcpy(hi + v * simd::kWidth, &b.v, sizeof b.v);
   }
@@ -1458,6 +1471,124 @@ int scan_runs_simd(const SimViews& S, vec3 p, float R, int s, int* list, int cap
     }
   }
   return scan_candidates_simd(S, p, R2, s, run, nr / 2, list, cap);
+}
+
+// find_neighbors of the tile's 8 particles, one per lane, where none of them needs the
+// rigid/cloth test, the scene has no static particles, and all 8 share their cell's y and z
+// (consecutive sorted particles along a row of cells) within a few cells along x: the rows of
+// cells (for_each_run_in_radius) once for the tile, each row's x range the union of the lanes'
+// ranges, and each candidate tested against the 8 particles at once. The union holds every
+// lane's own candidates in its own order (the same rows in the same order, x ascending within a
+// row, wrapping at the same place: the union spans fewer cells than the grid) and only
+// candidates that fail its distance test besides (outside a lane's padded rows and ranges), so
+// each lane's list is the one scan_candidates makes. Then each lane's kept candidates are
+// left-packed into its list (simd::kPack) and find_neighbors' epilogue runs.
+bool neighbors_tile(const SimViews& S, int s0) {
+  constexpr int kReach = GridSpec::reach, kW = 2 * kReach + 1, kSpan = 8, kBlock = 256;
+  if (s0 + simd::kWidth > S.n || S.ns > 0) return false;
+  for (int l = 0; l < simd::kWidth; ++l)
+    if (phase::is(S.sphase[s0 + l], phase::kRigid | phase::kCloth)) return false;
+  using simd::vf;
+  using simd::vi;
+  const GridSpec& g = S.grid;
+  const float R = S.c.search_radius, R2 = R * R, pad = 1e-3f * g.cell;
+  const simd::v3 p = simd::load_v3(S.sp + s0);
+  const vi cx = floor_int(p.x * g.inv_cell), cy = floor_int(p.y * g.inv_cell), cz = floor_int(p.z * g.inv_cell);
+  int xmin = cx[0], xmax = cx[0];
+  for (int l = 0; l < simd::kWidth; ++l) {
+    if (cy[l] != cy[0] || cz[l] != cz[0]) return false;
+    xmin = cx[l] < xmin ? cx[l] : xmin, xmax = cx[l] > xmax ? cx[l] : xmax;
+  }
+  if (xmax - xmin > kSpan) return false;
+  const int m = (1 << g.bits) - 1;
+  vf ey2[kW], ez2[kW];
+  for (int d = 0; d < kW; ++d) {
+    const vf ey = slab_gap(p.y, cy[0] + d - kReach, g.cell, pad), ez = slab_gap(p.z, cz[0] + d - kReach, g.cell, pad);
+    ey2[d] = ey * ey, ez2[d] = ez * ez;
+  }
+  // The runs of the rows' unions, in for_each_run_in_radius' order.
+  int ra[2 * kW * kW], re[2 * kW * kW], nr = 0;
+  for (int dz = 0; dz < kW; ++dz) {
+    const int slab = ((cz[0] + dz - kReach) & m) << (2 * g.bits);
+    for (int dy = 0; dy < kW; ++dy) {
+      const vf d2 = ey2[dy] + ez2[dz];
+      const simd::vm in = d2 < vf(R2);
+      const int rows = simd::bits(in);
+      if (rows == 0) continue;
+      vi lo, hi;
+      row_cells(g, p.x, cx, R2, pad, d2, lo, hi);
+      int u0 = 1 << 30, u1 = -(1 << 30);
+      for (int l = 0; l < simd::kWidth; ++l) {
+        if (!(rows >> l & 1)) continue;
+        u0 = lo[l] < u0 ? lo[l] : u0, u1 = hi[l] > u1 ? hi[l] : u1;
+      }
+      const int row = (((cy[0] + dy - kReach) & m) << g.bits) | slab;
+      const int x0 = u0 & m, x1 = u1 & m;
+      if (x0 <= x1) {
+        ra[nr] = S.cell_start[row | x0], re[nr++] = S.cell_start[(row | x1) + 1];
+      } else {  // the x range wraps: [x0, m] and [0, x1]
+        ra[nr] = S.cell_start[row | x0], re[nr++] = S.cell_start[(row | m) + 1];
+        ra[nr] = S.cell_start[row], re[nr++] = S.cell_start[(row | x1) + 1];
+      }
+    }
+  }
+  // Candidates in blocks: each one's lane mask (bit l: kept by lane l), then the lanes' lists.
+  alignas(32) int cand[kBlock + 32];
+  alignas(32) std::uint8_t keep[kBlock + 32];
+  int* list[simd::kWidth];
+  int cnt[simd::kWidth];
+  for (int l = 0; l < simd::kWidth; ++l) list[l] = S.nbr + (s0 + l) * S.nbr_row, cnt[l] = 0;
+  const int cap = S.c.max_neighbors;
+  vi self;
+  for (int l = 0; l < simd::kWidth; ++l) self.v[l] = s0 + l;
+  int nc = 0;
+  auto flush = [&]() {
+    for (int k = nc; k < nc + 32; ++k) cand[k] = 0, keep[k] = 0;
+    for (int l = 0; l < simd::kWidth; ++l) {
+      int c = cnt[l];
+      for (int k = 0; k < nc; k += 32) {
+        const unsigned b32 = simd::byte_bits(keep + k, l);
+        for (int q = 0; q < 32 && k + q < nc; q += simd::kWidth) {
+          const int b = static_cast<int>(b32 >> q & 0xFFu);
+          if (c + simd::kWidth <= cap) {
+            simd::i8 j;
+            std::memcpy(&j, cand + k + q, sizeof j);
+            const simd::i8 kept = __builtin_shuffle(j, simd::pack_lanes(b));
+            std::memcpy(list[l] + c, &kept, sizeof kept);
+            c += simd::kPack.count[b];
+          } else {
+            for (int i = 0; i < simd::kWidth; ++i) {
+              list[l][c < cap ? c : cap] = cand[k + q + i];
+              c += b >> i & 1;
+            }
+          }
+        }
+      }
+      cnt[l] = c;
+    }
+    nc = 0;
+  };
+  const Packed* const spk = S.spk;
+  for (int r = 0; r < nr; ++r) {
+    for (int j = ra[r], e = re[r]; j < e; ++j) {
+      const Packed q = spk[j];
+      const simd::v3 d = p - simd::broadcast(q.xyz());
+      const simd::vm ok = (length2(d) < vf(R2)) & (self != vi(j));
+      cand[nc] = j, keep[nc] = static_cast<std::uint8_t>(simd::bits(ok));
+      if (++nc == kBlock) flush();
+    }
+  }
+  flush();
+  for (int l = 0; l < simd::kWidth; ++l) {
+    const int s = s0 + l, stored = cnt[l] < cap ? cnt[l] : cap;
+    int solid = stored;
+    if (phase::is(S.sphase[s], phase::kFluid)) {
+      solid = 0;
+      for (int k = 0; k < stored; ++k) solid += !phase::is(spk[list[l][k]].bits(), phase::kFluid);
+    }
+    finish_neighbors(S, s, cnt[l], solid, 0);
+  }
+  return true;
 }
 }  // namespace detail
 #if SEAMLESS_SIMD_X86
