@@ -1539,8 +1539,6 @@ bool neighbors_tile(const SimViews& S, int s0) {
   int cnt[simd::kWidth];
   for (int l = 0; l < simd::kWidth; ++l) list[l] = S.nbr + (s0 + l) * S.nbr_row, cnt[l] = 0;
   const int cap = S.c.max_neighbors;
-  vi self;
-  for (int l = 0; l < simd::kWidth; ++l) self.v[l] = s0 + l;
   int nc = 0;
   auto flush = [&]() {
     for (int k = nc; k < nc + 32; ++k) cand[k] = 0, keep[k] = 0;
@@ -1569,12 +1567,15 @@ bool neighbors_tile(const SimViews& S, int s0) {
     nc = 0;
   };
   const Packed* const spk = S.spk;
+  std::uint32_t all = ~0u;  // the phase bits that every candidate has
   for (int r = 0; r < nr; ++r) {
     for (int j = ra[r], e = re[r]; j < e; ++j) {
       const Packed q = spk[j];
+      all &= q.bits();
       const simd::v3 d = p - simd::broadcast(q.xyz());
-      const simd::vm ok = (length2(d) < vf(R2)) & (self != vi(j));
-      cand[nc] = j, keep[nc] = static_cast<std::uint8_t>(simd::bits(ok));
+      const unsigned own = static_cast<unsigned>(j - s0);  // a lane's own particle: not kept
+      const unsigned b = static_cast<unsigned>(simd::bits(length2(d) < vf(R2))) & (own < 8u ? ~(1u << own) : ~0u);
+      cand[nc] = j, keep[nc] = static_cast<std::uint8_t>(b);
       if (++nc == kBlock) flush();
     }
   }
@@ -1584,7 +1585,8 @@ bool neighbors_tile(const SimViews& S, int s0) {
     int solid = stored;
     if (phase::is(S.sphase[s], phase::kFluid)) {
       solid = 0;
-      for (int k = 0; k < stored; ++k) solid += !phase::is(spk[list[l][k]].bits(), phase::kFluid);
+      if (!phase::is(all, phase::kFluid))  // (otherwise every candidate is fluid)
+        for (int k = 0; k < stored; ++k) solid += !phase::is(spk[list[l][k]].bits(), phase::kFluid);
     }
     finish_neighbors(S, s, cnt[l], solid, 0);
   }
