@@ -28,8 +28,9 @@ constexpr float kPi = 3.14159265358979f;
 // (kernels/physics/simd.hpp) select lane by lane.
 SEAMLESS_HD inline float select(bool c, float a, float b) { return c ? a : b; }
 SEAMLESS_HD inline int select(bool c, int a, int b) { return c ? a : b; }
-SEAMLESS_HD inline float fsqrt(float x) { return sqrtf(x); }
 SEAMLESS_HD inline vec3 select(bool c, vec3 a, vec3 b) { return c ? a : b; }
+// The square root of such code (sqrtf for float: no promotion to double).
+SEAMLESS_HD inline float fsqrt(float x) { return sqrtf(x); }
 
 // A position (or vector) and one more word, 16-byte aligned: what a neighbour loop gathers from
 // neighbour j in one 128-bit load on CUDA (a vec3 and a float are four 32-bit loads, four times

@@ -1485,7 +1485,7 @@ int scan_runs_simd(const SimViews& S, vec3 p, float R, int s, int* list, int cap
 // left-packed into its list (simd::kPack) and find_neighbors' epilogue runs.
 bool neighbors_tile(const SimViews& S, int s0) {
   constexpr int kReach = GridSpec::reach, kW = 2 * kReach + 1, kSpan = 8, kBlock = 256;
-  if (s0 + simd::kWidth > S.n || S.ns > 0) return false;
+  if (s0 + simd::kWidth > S.n || S.ns > 0 || S.nbr_col != 1) return false;  // (the CPU's lists are rows)
   for (int l = 0; l < simd::kWidth; ++l)
     if (phase::is(S.sphase[s0 + l], phase::kRigid | phase::kCloth)) return false;
   using simd::vf;
