@@ -24,6 +24,14 @@ SEAMLESS_HD inline bool is(std::uint32_t ph, std::uint32_t flag) { return (ph & 
 
 constexpr float kPi = 3.14159265358979f;
 
+// c ? a : b, for code written once over a float type (SphKernel): the SIMD lanes of the CPU
+// (kernels/physics/simd.hpp) select lane by lane.
+SEAMLESS_HD inline float select(bool c, float a, float b) { return c ? a : b; }
+SEAMLESS_HD inline int select(bool c, int a, int b) { return c ? a : b; }
+SEAMLESS_HD inline vec3 select(bool c, vec3 a, vec3 b) { return c ? a : b; }
+// The square root of such code (sqrtf for float: no promotion to double).
+SEAMLESS_HD inline float fsqrt(float x) { return sqrtf(x); }
+
 // A position (or vector) and one more word, 16-byte aligned: what a neighbour loop gathers from
 // neighbour j in one 128-bit load on CUDA (a vec3 and a float are four 32-bit loads, four times
 // the L1 requests of a gather whose 32 lanes hit 32 different sectors). The kernels keep packed
@@ -59,27 +67,31 @@ struct SphKernel {
     return k;
   }
 
+  // The kernels are templates over the float type F (float, or the CPU's SIMD lanes simd::vf,
+  // with V its vec3) with selects instead of early returns; for float the same results as the
+  // early returns.
+
   // Poly6 (Mueller 2003, used for density in Macklin & Mueller 2013, eq. 2).
-  SEAMLESS_HD float poly6(float r2) const {
-    if (r2 >= h2) return 0.f;
-    float t = h2 - r2;
-    return poly6_c * t * t * t;
+  template <class F>
+  SEAMLESS_HD F poly6(F r2) const {
+    const F t = h2 - r2;
+    return select(r2 < h2, poly6_c * t * t * t, F(0.f));
   }
 
   // Gradient of the spiky kernel with respect to p_i for r = p_i - p_j (Mueller 2003; PBF eq. 8).
-  SEAMLESS_HD vec3 spiky_grad(vec3 r) const {
-    float l = length(r);
-    if (l >= h || l <= 1e-12f) return {0.f, 0.f, 0.f};
-    float t = h - l;
-    return r * (spiky_c * t * t / l);
+  template <class V>
+  SEAMLESS_HD V spiky_grad(V r) const {
+    const auto l = length(r);
+    const auto t = h - l;
+    return select((l < h) & (l > 1e-12f), r * (spiky_c * t * t / l), V{});
   }
 
   // Akinci 2013 cohesion spline C(r) (eq. 2 there), zero beyond h.
-  SEAMLESS_HD float akinci(float r) const {
-    if (r >= h || r <= 0.f) return 0.f;
-    float a = (h - r) * (h - r) * (h - r) * r * r * r;
-    if (2.f * r > h) return akinci_c * a;
-    return akinci_c * (2.f * a - h6_64);
+  template <class F>
+  SEAMLESS_HD F akinci(F r) const {
+    const F a = (h - r) * (h - r) * (h - r) * r * r * r;
+    const F c = select(2.f * r > h, akinci_c * a, akinci_c * (2.f * a - h6_64));
+    return select((r < h) & (r > 0.f), c, F(0.f));
   }
 };
 
@@ -121,10 +133,24 @@ struct GridSpec {
 
 // Distance along one axis from coordinate v to cell i's slab [i cs, (i + 1) cs), made smaller by
 // pad so that rounding never drops a cell that holds a neighbour.
-SEAMLESS_HD inline float slab_gap(float v, int i, float cs, float pad) {
-  float lo = static_cast<float>(i) * cs, a = lo - v, b = v - (lo + cs);  // at most one is > 0
-  float g = (a > b ? a : b) - pad;  // max, without a branch
-  return g > 0.f ? g : 0.f;
+// F: float, or the CPU's SIMD lanes.
+template <class F>
+SEAMLESS_HD inline F slab_gap(F v, int i, float cs, float pad) {
+  const float lo = static_cast<float>(i) * cs;
+  const F a = lo - v, b = v - (lo + cs);  // at most one is > 0
+  const F g = select(a > b, a, b) - pad;  // max, without a branch
+  return select(g > 0.f, g, F(0.f));
+}
+
+// The cells [lo, hi] along x (not yet wrapped) of the row of cells at squared y-z distance d2
+// from p that the sphere of radius R2 = R^2 around p crosses, within reach of p's cell cx, made
+// larger by pad (for_each_run_in_radius). F, I: float and int, or the CPU's SIMD lanes.
+template <class F, class I>
+SEAMLESS_HD inline void row_cells(const GridSpec& g, F px, I cx, float R2, float pad, F d2, I& lo, I& hi) {
+  const F rx = fsqrt(R2 - d2) + pad;
+  const I a = floor_int((px - rx) * g.inv_cell), b = floor_int((px + rx) * g.inv_cell);
+  lo = select(a > cx - GridSpec::reach, a, I(cx - GridSpec::reach));
+  hi = select(b < cx + GridSpec::reach, b, I(cx + GridSpec::reach));
 }
 
 // Calls fn(a, e) for every run [a, e) of grid entries in the cells that can hold a point within
@@ -153,10 +179,9 @@ SEAMLESS_HD inline void for_each_run_in_radius(const GridSpec& g, const int* sta
       const float d2 = ey2[dy] + ez2[dz];
       if (d2 >= R2) continue;
       const std::uint32_t row = ((static_cast<std::uint32_t>(c.y + dy - kReach) & m) << g.bits) | slab;
-      const float rx = sqrtf(R2 - d2) + pad;
-      const int lo = floor_int((p.x - rx) * g.inv_cell), hi = floor_int((p.x + rx) * g.inv_cell);
-      const std::uint32_t x0 = static_cast<std::uint32_t>(lo > c.x - kReach ? lo : c.x - kReach) & m;
-      const std::uint32_t x1 = static_cast<std::uint32_t>(hi < c.x + kReach ? hi : c.x + kReach) & m;
+      int lo, hi;
+      row_cells(g, p.x, c.x, R2, pad, d2, lo, hi);
+      const std::uint32_t x0 = static_cast<std::uint32_t>(lo) & m, x1 = static_cast<std::uint32_t>(hi) & m;
       if (x0 <= x1) {
         fn(start[row | x0], start[(row | x1) + 1]);
       } else {  // the x range wraps: [x0, m] and [0, x1]

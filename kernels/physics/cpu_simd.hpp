@@ -1,0 +1,36 @@
+// Whether the CPU's particle solver runs its SIMD tiles (kernels/physics/simd.hpp): AVX2 on
+// x86-64 (checked once), always elsewhere (generic vectors). set_cpu_simd(false) forces the scalar
+// loops, which give bit-identical states (tests compare both). Host code only.
+#pragma once
+#include <atomic>
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define SEAMLESS_SIMD_X86 1
+#else
+#define SEAMLESS_SIMD_X86 0
+#endif
+
+namespace seamless::kernels::simd {
+
+inline std::atomic<int>& cpu_simd_flag() {
+  static std::atomic<int> flag{-1};
+  return flag;
+}
+inline bool cpu_simd() {
+  int f = cpu_simd_flag().load(std::memory_order_relaxed);
+  if (f < 0) {
+#if SEAMLESS_SIMD_X86
+    f = __builtin_cpu_supports("avx2") ? 1 : 0;
+#else
+    f = 1;
+#endif
+    cpu_simd_flag().store(f, std::memory_order_relaxed);
+  }
+  return f != 0;
+}
+inline void set_cpu_simd(bool on) {
+  cpu_simd_flag().store(-1);
+  if (!on) cpu_simd_flag().store(0);
+}
+
+}  // namespace seamless::kernels::simd
