@@ -66,13 +66,14 @@ void ReferenceMaps::set_from_frame(const FramePyramid& frame, const SE3& world_T
 }
 
 void ReferenceMaps::set_from_raycast(const RaycastMaps& maps, const Intrinsics& K, const SE3& world_T_camera,
-                                     int levels, float max_diff, const FramePyramid* photometric) {
+                                     int levels, float max_diff, const FramePyramid* photometric, bool with_intensity) {
   if (maps.vertex.width() != K.width || maps.vertex.height() != K.height)
     throw Error("raycast maps are " + std::to_string(maps.vertex.width()) + "x" + std::to_string(maps.vertex.height()) +
                 " but the tracker's intrinsics say " + std::to_string(K.width) + "x" + std::to_string(K.height));
-  const bool from_frame = photometric && photometric->level(0).intensity.width() == K.width &&
+  const bool from_frame = with_intensity && photometric && photometric->level(0).intensity.width() == K.width &&
                           photometric->levels() >= levels;
-  const bool from_model = !from_frame && maps.color.width() == K.width && maps.color.height() == K.height;
+  const bool from_model =
+      with_intensity && !from_frame && maps.color.width() == K.width && maps.color.height() == K.height;
   const bool intensity = from_frame || from_model;
   Device d = maps.vertex.device();
   resize(K, levels, d, intensity);
@@ -139,7 +140,7 @@ Tracker::Tracker(const TrackerParams& params, Device device) : params_(params), 
 }
 
 bool Tracker::use_photometric(const FramePyramid& frame, const ReferenceMaps& ref) const {
-  return params_.kind == "rgbd" && params_.photometric_weight > 0 && ref.has_intensity() &&
+  return reads_intensity() && ref.has_intensity() &&
          frame.level(0).intensity.width() > 0;
 }
 

@@ -168,7 +168,7 @@ void TrackingSession::update_reference(const SE3& pose) {
     // The current pyramid is the frame just tracked at `pose`, the pose the raycast is seen from.
     const bool frame_colour = p_.tracker.photometric_reference == "frame";
     ref_.set_from_raycast(maps_, K_, pose, pyr_.levels(), p_.preprocess.pyramid_max_diff,
-                          frame_colour ? &pyr_ : nullptr);
+                          frame_colour ? &pyr_ : nullptr, tracker_->reads_intensity());
   } else {
     ref_.set_from_frame(pyr_, pose);
   }
