@@ -36,6 +36,8 @@ struct RenderOptions {
   bool stage_images = false, video = false, last_only = false;
 };
 
+#if SEAMLESS_HAS_GL  // everything below needs the renderer
+
 // The saved particle states by step: particles_<step>.ply, or the final particles.ply alone.
 std::map<std::int64_t, std::string> snapshots(const std::string& dir, bool last_only) {
   std::map<std::int64_t, std::string> out;
@@ -66,8 +68,6 @@ Experiment load_run_config(const RenderOptions& o) {
   p.mode = "headless";
   return e;
 }
-
-#if SEAMLESS_HAS_GL
 
 // The Kinect frame shown behind each snapshot: in live mode the frame of that step (one solver
 // step per frame), otherwise the scan's last frame; each at its pose in trajectory.txt.
