@@ -3,6 +3,7 @@
 #include <mutex>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "core/buffer.hpp"
 #include "core/cuda_check.hpp"
@@ -15,7 +16,7 @@ namespace {
 struct Ledger {
   std::mutex mutex;
   std::unordered_map<void*, std::size_t> sizes;
-  std::unordered_map<void*, bool> pinned;  // host allocations from cudaMallocHost (freed by cudaFreeHost)
+  std::unordered_set<void*> pinned;  // host allocations from cudaMallocHost (freed by cudaFreeHost)
   std::size_t bytes[2] = {0, 0};
 };
 Ledger& ledger() {
@@ -27,7 +28,7 @@ void record(void* p, std::size_t bytes, Device d, bool pinned = false) {
   std::lock_guard lock(l.mutex);
   l.sizes[p] = bytes;
   l.bytes[static_cast<int>(d)] += bytes;
-  if (pinned) l.pinned[p] = true;
+  if (pinned) l.pinned.insert(p);
 }
 // Forgets p; true when it was page-locked host memory.
 bool forget(void* p, Device d) {
