@@ -90,7 +90,7 @@ bool is_pinned(const void* p) {
 
 void release(void* p, Device d) noexcept {
   if (!p) return;
-  bool pinned = forget(p, d);
+  [[maybe_unused]] const bool pinned = forget(p, d);  // page-locked memory exists only with CUDA
 #if SEAMLESS_HAS_CUDA
   if (pinned) {
     cudaFreeHost(p);
