@@ -55,12 +55,49 @@ constexpr int kPairBatch1 = SEAMLESS_BATCH1, kPairBatch2 = SEAMLESS_BATCH2;
 #else
 constexpr int kPairBatch1 = 1, kPairBatch2 = 1;
 #endif
+// Blocks of the executor's threads that the heavy pair passes (prepare_constraints,
+// solve_contacts_fluid, velocity_effects) ask to keep resident per multiprocessor (a register cap
+// on CUDA, MinBlocks; 0: none).
+#ifndef SEAMLESS_PAIR_MIN_BLOCKS
+#define SEAMLESS_PAIR_MIN_BLOCKS 0
+#endif
+constexpr MinBlocks<SEAMLESS_PAIR_MIN_BLOCKS> kPairOccupancy{};
+#ifndef SEAMLESS_ENTRY_PREFETCH
+#define SEAMLESS_ENTRY_PREFETCH 0
+#endif
+constexpr bool kEntryPrefetch = SEAMLESS_ENTRY_PREFETCH != 0;
 template <int kPairBatch, class Gather, class Use>
 SEAMLESS_HD inline void for_each_entry(const int* list, std::int64_t col, int m, Lanes g, Gather&& gather, Use&& use) {
   using D = decltype(gather(0));
   const int d = g.size;
   int k = g.lane;
-  if constexpr (kPairBatch > 1) {
+  if constexpr (kPairBatch > 1 && kEntryPrefetch) {
+    // The next batch's indices are loaded before this batch's gathers: the list streams from
+    // memory (DRAM latency), the gathers mostly hit the cache, and they then overlap.
+    if (k + (kPairBatch - 1) * d < m) {
+      int jn[kPairBatch];
+      SEAMLESS_PHYS_UNROLL
+      for (int u = 0; u < kPairBatch; ++u) jn[u] = list[(k + u * d) * col];
+      for (;;) {
+        int j[kPairBatch];
+        SEAMLESS_PHYS_UNROLL
+        for (int u = 0; u < kPairBatch; ++u) j[u] = jn[u];
+        const int kn = k + kPairBatch * d;
+        const bool more = kn + (kPairBatch - 1) * d < m;
+        if (more) {
+          SEAMLESS_PHYS_UNROLL
+          for (int u = 0; u < kPairBatch; ++u) jn[u] = list[(kn + u * d) * col];
+        }
+        D v[kPairBatch];
+        SEAMLESS_PHYS_UNROLL
+        for (int u = 0; u < kPairBatch; ++u) v[u] = gather(j[u]);
+        SEAMLESS_PHYS_UNROLL
+        for (int u = 0; u < kPairBatch; ++u) use(k + u * d, j[u], v[u]);
+        k = kn;
+        if (!more) break;
+      }
+    }
+  } else if constexpr (kPairBatch > 1) {
     for (; k + (kPairBatch - 1) * d < m; k += kPairBatch * d) {
       int j[kPairBatch];
       D v[kPairBatch];
@@ -414,6 +451,96 @@ SEAMLESS_HD inline int scan_candidates(const SimViews& S, vec3 p, float R2, std:
   }
   return c;
 }
+
+// Candidates loaded per batch by find_neighbors' one-lane CUDA walk.
+#ifndef SEAMLESS_FIND_BATCH
+#define SEAMLESS_FIND_BATCH 4
+#endif
+constexpr int kFindBatch = SEAMLESS_FIND_BATCH;
+// find_neighbors' occupancy request (MinBlocks; 0: none).
+#ifndef SEAMLESS_FIND_MIN_BLOCKS
+#define SEAMLESS_FIND_MIN_BLOCKS 0
+#endif
+constexpr MinBlocks<SEAMLESS_FIND_MIN_BLOCKS> kFindOccupancy{};
+constexpr int kSlabRows = 2 * GridSpec::reach + 1;
+
+// Entry f of the runs [a[r], a[r] + l[r]), r = 0 .. kSlabRows - 1, taken one after another
+// (f below their total): selects, no branches and no indexing by a run-time value (the arrays
+// stay in registers).
+SEAMLESS_HD inline int run_entry(const int* a, const int* l, int f) {
+  int j = a[0] + f, r = f - l[0];
+  SEAMLESS_PHYS_UNROLL
+  for (int k = 1; k < kSlabRows; ++k) {
+    j = r >= 0 ? a[k] + r : j;  // the last run that starts at or before f (a non-empty one)
+    r -= l[k];
+  }
+  return j;
+}
+
+// The runs of for_each_run_in_radius, in the same order, a slab of rows (fixed z) at a time:
+// fn(a, l) with the runs [a[r], a[r] + l[r]) of the slab's rows r = 0 .. kSlabRows - 1 (l[r] = 0
+// for a row out of reach), the slab's cell_start loads all issued before fn walks any candidate.
+// For CUDA with one thread per particle, whose find_neighbors otherwise waits on each row's two
+// loads before its ~5 candidates. Where a row's x range wraps around the grid (two runs), the
+// slab's runs are handed one at a time instead (in a[0], l[0]), in the same order.
+template <class F>
+SEAMLESS_HD inline void for_each_slab_in_radius(const GridSpec& g, const int* start, vec3 p, float R, F&& fn) {
+  constexpr int kReach = GridSpec::reach;
+  const int3 c = g.cell_of(p);
+  const float R2 = R * R, pad = 1e-3f * g.cell;
+  const std::uint32_t m = (1u << g.bits) - 1u;
+  float ey2[kSlabRows];
+  SEAMLESS_PHYS_UNROLL
+  for (int d = 0; d < kSlabRows; ++d) {
+    const float ey = slab_gap(p.y, c.y + d - kReach, g.cell, pad);
+    ey2[d] = ey * ey;
+  }
+  // Row dy of the slab: whether it is in reach, and its cells [row | x0, row | x1] (wrapping
+  // when x0 > x1), as for_each_run_in_radius computes them.
+  struct Row {
+    bool in;
+    std::uint32_t row, x0, x1;
+  };
+  const auto row_of = [&](int dy, float eyy, float ez2, std::uint32_t slab) {
+    const float d2 = eyy + ez2;
+    const std::uint32_t row = ((static_cast<std::uint32_t>(c.y + dy - kReach) & m) << g.bits) | slab;
+    const float rx = sqrtf(fmaxf(R2 - d2, 0.f)) + pad;  // (R2 - d2 where the row is in reach)
+    const int lo = floor_int((p.x - rx) * g.inv_cell), hi = floor_int((p.x + rx) * g.inv_cell);
+    const std::uint32_t x0 = static_cast<std::uint32_t>(lo > c.x - kReach ? lo : c.x - kReach) & m;
+    const std::uint32_t x1 = static_cast<std::uint32_t>(hi < c.x + kReach ? hi : c.x + kReach) & m;
+    return Row{d2 < R2, row, x0, x1};
+  };
+  for (int dz = 0; dz < kSlabRows; ++dz) {
+    const float ez = slab_gap(p.z, c.z + dz - kReach, g.cell, pad), ez2 = ez * ez;
+    if (ez2 >= R2) continue;  // every row of the slab is out of reach (d2 >= ez2)
+    const std::uint32_t slab = (static_cast<std::uint32_t>(c.z + dz - kReach) & m) << (2 * g.bits);
+    int a[kSlabRows], l[kSlabRows];
+    bool wrap = false;
+    SEAMLESS_PHYS_UNROLL
+    for (int dy = 0; dy < kSlabRows; ++dy) {
+      const Row w = row_of(dy, ey2[dy], ez2, slab);
+      const bool in = w.in & (w.x0 <= w.x1);
+      wrap |= w.in & (w.x0 > w.x1);
+      a[dy] = in ? start[w.row | w.x0] : 0;
+      l[dy] = (in ? start[(w.row | w.x1) + 1] : 0) - a[dy];
+    }
+    if (!wrap) {
+      fn(a, l);
+      continue;
+    }
+    // Rare (particles within reach of the grid's wrap in x): run after run, in order.
+    for (int k = 0; k < 2 * kSlabRows; ++k) {
+      const float ey = slab_gap(p.y, c.y + (k >> 1) - kReach, g.cell, pad);  // ey2[k >> 1], not indexed
+      const Row w = row_of(k >> 1, ey * ey, ez2, slab);
+      if (!w.in || ((k & 1) && w.x0 <= w.x1)) continue;
+      const bool split = w.x0 > w.x1;
+      const std::uint32_t b = (k & 1) ? w.row : w.row | w.x0, e = split && !(k & 1) ? (w.row | m) + 1 : (w.row | w.x1) + 1;
+      int a1[kSlabRows] = {}, l1[kSlabRows] = {};
+      a1[0] = start[b], l1[0] = start[e] - a1[0];
+      fn(a1, l1);
+    }
+  }
+}
 }  // namespace detail
 
 template <class Exec>
@@ -463,22 +590,29 @@ void find_neighbors(const Exec& ex, const SimViews& S) {
       else
         for (int k = 0; k < stored; ++k) solid += !phase::is(S.spk[list[k * S.nbr_col]].bits(), phase::kFluid);
     } else if (g.size == 1) {  // (if constexpr ... else if: the CUDA instantiation)
-      // CUDA, one lane: as above, the non-fluid entries counted on the way (the phase is loaded
-      // anyway) and only kept candidates stored.
-      // The candidates of a run 4 at a time, loaded before any is tested (lanes past the run
-      // load its last entry and reject it): 4 loads in flight instead of one chain of
-      // load-test-store per candidate (see for_each_entry).
-      for_each_run_in_radius(S.grid, S.cell_start, p, R, [&](int a, int e) {
+      // CUDA, one lane: a slab of rows at a time, its rows' run bounds loaded together
+      // (for_each_slab_in_radius), its runs' candidates walked as one sequence kFindBatch at a
+      // time, each batch loaded before any of it is tested (entries past the end load the last
+      // one and reject it; see for_each_entry). Only kept candidates are stored; the non-fluid
+      // entries are counted on the way (the phase is loaded anyway).
+      constexpr int kB = detail::kFindBatch;
+      detail::for_each_slab_in_radius(S.grid, S.cell_start, p, R, [&](const int* a, const int* l) {
         int c = cnt, so = solid;
-        for (int b = a; b < e; b += 4) {
-          Packed q[4];
+        int total = 0;
+        SEAMLESS_PHYS_UNROLL
+        for (int r = 0; r < detail::kSlabRows; ++r) total += l[r];
+        for (int f = 0; f < total; f += kB) {
+          int jj[kB];
+          Packed q[kB];
           SEAMLESS_PHYS_UNROLL
-          for (int u = 0; u < 4; ++u) q[u] = S.spk[b + u < e ? b + u : e - 1];  // position and phase
+          for (int u = 0; u < kB; ++u) jj[u] = detail::run_entry(a, l, f + u < total ? f + u : total - 1);
           SEAMLESS_PHYS_UNROLL
-          for (int u = 0; u < 4; ++u) {
-            const int j = b + u;
+          for (int u = 0; u < kB; ++u) q[u] = S.spk[jj[u]];  // position and phase
+          SEAMLESS_PHYS_UNROLL
+          for (int u = 0; u < kB; ++u) {
+            const int j = jj[u];
             const std::uint32_t phj = q[u].bits();
-            bool ok = (j < e) & (j != s) & (length2(p - q[u].xyz()) < R2);
+            bool ok = (f + u < total) & (j != s) & (length2(p - q[u].xyz()) < R2);
             if (!plain) ok = ok && detail::may_interact(S, ph, phj, s, j);
             const bool store = ok & (c < cap);
             so += store & !(sfluid & phase::is(phj, phase::kFluid));
@@ -520,7 +654,7 @@ void find_neighbors(const Exec& ex, const SimViews& S) {
       if (scnt > atomic_load(&S.counters[3])) atomic_max(&S.counters[3], scnt);
     }
     S.nsnbr[s] = scnt < S.c.max_static_neighbors ? scnt : S.c.max_static_neighbors;
-  });
+  }, detail::kFindOccupancy);
 }
 
 // Macklin 2014, section 4.4: contacts that already exist at the start positions are resolved on
@@ -631,7 +765,7 @@ void prepare_constraints(const Exec& ex, const SimViews& S) {
     S.spl[s] = Packed::of(S.sp[s], lambda);  // what solve_contacts_fluid gathers of a neighbour
     S.density[s] = d.rho;
     S.h_rho[s] = S.c.h / d.rho;  // once here instead of once per neighbour pair in velocity_effects
-  });
+  }, detail::kPairOccupancy);
 }
 
 namespace detail {
@@ -714,7 +848,7 @@ void solve_contacts_fluid(const Exec& ex, const SimViews& S) {
     if (fluid) acc += part.f * (1.f / S.c.rest_density);
     if (coupled) acc += part.f * (S.c.solid_density_scale / S.c.rest_density);
     S.tmp[s] = p + acc;
-  });
+  }, detail::kPairOccupancy);
 }
 
 // Static friction of a rigid body as a whole (Macklin 2014, section 6.1, applied to the body):
@@ -1059,7 +1193,7 @@ void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
       S.cnormal[s] = t.n;
       S.cnv[s] = Packed::of(t.n, S.vort_len[s]);  // what fluid_forces gathers of a neighbour
       S.vtmp[s] = t.dv_visc;
-    });
+    }, detail::kPairOccupancy);
   }
   const bool aero = S.has_cloth_constraints && (S.c.drag > 0.f || S.c.lift > 0.f);
   ex.for_each_grouped(S.n, kPairLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
@@ -1073,7 +1207,7 @@ void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
     if (fluid) v += S.vtmp[s] * S.c.viscosity + forces * S.c.dt;
     if (aero && phase::is(ph, phase::kCloth)) v += detail::cloth_aero(S, s);
     S.vtmp[s] = v;
-  });
+  }, detail::kPairOccupancy);
 }
 
 template <class Exec>
