@@ -125,6 +125,32 @@ struct Gather2 {
   bool fluid;
 };
 
+// The pair math of the fluid passes with one reciprocal square root on CUDA: SphKernel's
+// spiky gradient and the cohesion factor take |r| by an IEEE square root and divide by it, and
+// the symmetrising factor is a division; on CUDA each compiles to a multi-instruction sequence
+// with a slow-path branch, and at 1M particles the pair passes issue an instruction on ~60-70 %
+// of cycles (Nsight, H200: prepare_constraints, solve_contacts_fluid). rsqrtf and __fdividef are
+// the hardware approximations (2 ulp, CUDA programming guide, table of intrinsic functions),
+// far below the CPU/CUDA tolerance of PhysicsParity (FMA contraction and sum order differ
+// already). The CPU keeps the IEEE forms: its results are unchanged.
+SEAMLESS_HD inline vec3 pair_grad(const SphKernel& W, vec3 r) {
+#if defined(__CUDA_ARCH__)
+  const float l2 = length2(r);
+  if (l2 >= W.h2 || l2 <= 1e-24f) return {0.f, 0.f, 0.f};  // l >= h or l <= 1e-12, as spiky_grad
+  const float il = rsqrtf(l2), t = W.h - l2 * il;
+  return r * (W.spiky_c * t * t * il);
+#else
+  return W.spiky_grad(r);
+#endif
+}
+SEAMLESS_HD inline float fast_div(float a, float b) {
+#if defined(__CUDA_ARCH__)
+  return __fdividef(a, b);
+#else
+  return a / b;
+#endif
+}
+
 // spk = (sp, phase bits): the packed copy that the next neighbour loops gather (Packed).
 template <class Exec>
 void pack_positions(const Exec& ex, const SimViews& S) {
@@ -451,96 +477,6 @@ SEAMLESS_HD inline int scan_candidates(const SimViews& S, vec3 p, float R2, std:
   }
   return c;
 }
-
-// Candidates loaded per batch by find_neighbors' one-lane CUDA walk.
-#ifndef SEAMLESS_FIND_BATCH
-#define SEAMLESS_FIND_BATCH 4
-#endif
-constexpr int kFindBatch = SEAMLESS_FIND_BATCH;
-// find_neighbors' occupancy request (MinBlocks; 0: none).
-#ifndef SEAMLESS_FIND_MIN_BLOCKS
-#define SEAMLESS_FIND_MIN_BLOCKS 0
-#endif
-constexpr MinBlocks<SEAMLESS_FIND_MIN_BLOCKS> kFindOccupancy{};
-constexpr int kSlabRows = 2 * GridSpec::reach + 1;
-
-// Entry f of the runs [a[r], a[r] + l[r]), r = 0 .. kSlabRows - 1, taken one after another
-// (f below their total): selects, no branches and no indexing by a run-time value (the arrays
-// stay in registers).
-SEAMLESS_HD inline int run_entry(const int* a, const int* l, int f) {
-  int j = a[0] + f, r = f - l[0];
-  SEAMLESS_PHYS_UNROLL
-  for (int k = 1; k < kSlabRows; ++k) {
-    j = r >= 0 ? a[k] + r : j;  // the last run that starts at or before f (a non-empty one)
-    r -= l[k];
-  }
-  return j;
-}
-
-// The runs of for_each_run_in_radius, in the same order, a slab of rows (fixed z) at a time:
-// fn(a, l) with the runs [a[r], a[r] + l[r]) of the slab's rows r = 0 .. kSlabRows - 1 (l[r] = 0
-// for a row out of reach), the slab's cell_start loads all issued before fn walks any candidate.
-// For CUDA with one thread per particle, whose find_neighbors otherwise waits on each row's two
-// loads before its ~5 candidates. Where a row's x range wraps around the grid (two runs), the
-// slab's runs are handed one at a time instead (in a[0], l[0]), in the same order.
-template <class F>
-SEAMLESS_HD inline void for_each_slab_in_radius(const GridSpec& g, const int* start, vec3 p, float R, F&& fn) {
-  constexpr int kReach = GridSpec::reach;
-  const int3 c = g.cell_of(p);
-  const float R2 = R * R, pad = 1e-3f * g.cell;
-  const std::uint32_t m = (1u << g.bits) - 1u;
-  float ey2[kSlabRows];
-  SEAMLESS_PHYS_UNROLL
-  for (int d = 0; d < kSlabRows; ++d) {
-    const float ey = slab_gap(p.y, c.y + d - kReach, g.cell, pad);
-    ey2[d] = ey * ey;
-  }
-  // Row dy of the slab: whether it is in reach, and its cells [row | x0, row | x1] (wrapping
-  // when x0 > x1), as for_each_run_in_radius computes them.
-  struct Row {
-    bool in;
-    std::uint32_t row, x0, x1;
-  };
-  const auto row_of = [&](int dy, float eyy, float ez2, std::uint32_t slab) {
-    const float d2 = eyy + ez2;
-    const std::uint32_t row = ((static_cast<std::uint32_t>(c.y + dy - kReach) & m) << g.bits) | slab;
-    const float rx = sqrtf(fmaxf(R2 - d2, 0.f)) + pad;  // (R2 - d2 where the row is in reach)
-    const int lo = floor_int((p.x - rx) * g.inv_cell), hi = floor_int((p.x + rx) * g.inv_cell);
-    const std::uint32_t x0 = static_cast<std::uint32_t>(lo > c.x - kReach ? lo : c.x - kReach) & m;
-    const std::uint32_t x1 = static_cast<std::uint32_t>(hi < c.x + kReach ? hi : c.x + kReach) & m;
-    return Row{d2 < R2, row, x0, x1};
-  };
-  for (int dz = 0; dz < kSlabRows; ++dz) {
-    const float ez = slab_gap(p.z, c.z + dz - kReach, g.cell, pad), ez2 = ez * ez;
-    if (ez2 >= R2) continue;  // every row of the slab is out of reach (d2 >= ez2)
-    const std::uint32_t slab = (static_cast<std::uint32_t>(c.z + dz - kReach) & m) << (2 * g.bits);
-    int a[kSlabRows], l[kSlabRows];
-    bool wrap = false;
-    SEAMLESS_PHYS_UNROLL
-    for (int dy = 0; dy < kSlabRows; ++dy) {
-      const Row w = row_of(dy, ey2[dy], ez2, slab);
-      const bool in = w.in & (w.x0 <= w.x1);
-      wrap |= w.in & (w.x0 > w.x1);
-      a[dy] = in ? start[w.row | w.x0] : 0;
-      l[dy] = (in ? start[(w.row | w.x1) + 1] : 0) - a[dy];
-    }
-    if (!wrap) {
-      fn(a, l);
-      continue;
-    }
-    // Rare (particles within reach of the grid's wrap in x): run after run, in order.
-    for (int k = 0; k < 2 * kSlabRows; ++k) {
-      const float ey = slab_gap(p.y, c.y + (k >> 1) - kReach, g.cell, pad);  // ey2[k >> 1], not indexed
-      const Row w = row_of(k >> 1, ey * ey, ez2, slab);
-      if (!w.in || ((k & 1) && w.x0 <= w.x1)) continue;
-      const bool split = w.x0 > w.x1;
-      const std::uint32_t b = (k & 1) ? w.row : w.row | w.x0, e = split && !(k & 1) ? (w.row | m) + 1 : (w.row | w.x1) + 1;
-      int a1[kSlabRows] = {}, l1[kSlabRows] = {};
-      a1[0] = start[b], l1[0] = start[e] - a1[0];
-      fn(a1, l1);
-    }
-  }
-}
 }  // namespace detail
 
 template <class Exec>
@@ -590,29 +526,22 @@ void find_neighbors(const Exec& ex, const SimViews& S) {
       else
         for (int k = 0; k < stored; ++k) solid += !phase::is(S.spk[list[k * S.nbr_col]].bits(), phase::kFluid);
     } else if (g.size == 1) {  // (if constexpr ... else if: the CUDA instantiation)
-      // CUDA, one lane: a slab of rows at a time, its rows' run bounds loaded together
-      // (for_each_slab_in_radius), its runs' candidates walked as one sequence kFindBatch at a
-      // time, each batch loaded before any of it is tested (entries past the end load the last
-      // one and reject it; see for_each_entry). Only kept candidates are stored; the non-fluid
-      // entries are counted on the way (the phase is loaded anyway).
-      constexpr int kB = detail::kFindBatch;
-      detail::for_each_slab_in_radius(S.grid, S.cell_start, p, R, [&](const int* a, const int* l) {
+      // CUDA, one lane: as above, the non-fluid entries counted on the way (the phase is loaded
+      // anyway) and only kept candidates stored.
+      // The candidates of a run 4 at a time, loaded before any is tested (lanes past the run
+      // load its last entry and reject it): 4 loads in flight instead of one chain of
+      // load-test-store per candidate (see for_each_entry).
+      for_each_run_in_radius(S.grid, S.cell_start, p, R, [&](int a, int e) {
         int c = cnt, so = solid;
-        int total = 0;
-        SEAMLESS_PHYS_UNROLL
-        for (int r = 0; r < detail::kSlabRows; ++r) total += l[r];
-        for (int f = 0; f < total; f += kB) {
-          int jj[kB];
-          Packed q[kB];
+        for (int b = a; b < e; b += 4) {
+          Packed q[4];
           SEAMLESS_PHYS_UNROLL
-          for (int u = 0; u < kB; ++u) jj[u] = detail::run_entry(a, l, f + u < total ? f + u : total - 1);
+          for (int u = 0; u < 4; ++u) q[u] = S.spk[b + u < e ? b + u : e - 1];  // position and phase
           SEAMLESS_PHYS_UNROLL
-          for (int u = 0; u < kB; ++u) q[u] = S.spk[jj[u]];  // position and phase
-          SEAMLESS_PHYS_UNROLL
-          for (int u = 0; u < kB; ++u) {
-            const int j = jj[u];
+          for (int u = 0; u < 4; ++u) {
+            const int j = b + u;
             const std::uint32_t phj = q[u].bits();
-            bool ok = (f + u < total) & (j != s) & (length2(p - q[u].xyz()) < R2);
+            bool ok = (j < e) & (j != s) & (length2(p - q[u].xyz()) < R2);
             if (!plain) ok = ok && detail::may_interact(S, ph, phj, s, j);
             const bool store = ok & (c < cap);
             so += store & !(sfluid & phase::is(phj, phase::kFluid));
@@ -654,7 +583,7 @@ void find_neighbors(const Exec& ex, const SimViews& S) {
       if (scnt > atomic_load(&S.counters[3])) atomic_max(&S.counters[3], scnt);
     }
     S.nsnbr[s] = scnt < S.c.max_static_neighbors ? scnt : S.c.max_static_neighbors;
-  }, detail::kFindOccupancy);
+  });
 }
 
 // Macklin 2014, section 4.4: contacts that already exist at the start positions are resolved on
@@ -719,7 +648,7 @@ SEAMLESS_HD inline DensitySum density_part(const SimViews& S, int s, Lanes g) {
   for_each_entry<kPairBatch1>(list, col, S.nnbr[s], g, gather, [&](int k, int, const Packed& q) {
     vec3 r = p - q.xyz();
     float wgt = W.poly6(length2(r));
-    const vec3 gw = W.spiky_grad(r);
+    const vec3 gw = pair_grad(W, r);
     if constexpr (Cache) cache[k * col] = Packed::of(gw, wgt);
     vec3 grad = gw * inv_rho0;
     // A solid neighbour's terms are scaled by sw and add nothing to sum2 (selects, not branches:
@@ -798,7 +727,7 @@ SEAMLESS_HD inline vec3 pbf_part(const SimViews& S, int s, Lanes g) {
     } else {
       const Packed pl = n.a;
       const vec3 r = p - pl.xyz();
-      grad = S.c.W.spiky_grad(r), lj = pl.w;
+      grad = pair_grad(S.c.W, r), lj = pl.w;
       wgt = S.c.scorr_k > 0.f ? S.c.W.poly6(length2(r)) : 0.f;
     }
     float sc = 0.f;
@@ -1071,6 +1000,17 @@ SEAMLESS_HD inline ForceSum operator+(const ForceSum& a, const ForceSum& b) { re
 SEAMLESS_HD inline float cohesion_factor(const SphKernel& W, float coh_c, float l) {
   return l > 1e-9f ? coh_c * W.akinci(l) / l : 0.f;
 }
+// cohesion_factor of |r| (r = p_i - p_j), with one reciprocal square root on CUDA (pair_grad).
+SEAMLESS_HD inline float pair_cohesion(const SphKernel& W, float coh_c, vec3 r) {
+#if defined(__CUDA_ARCH__)
+  const float l2 = length2(r);
+  if (!(l2 > 1e-18f)) return 0.f;  // l <= 1e-9, as cohesion_factor
+  const float il = rsqrtf(l2);
+  return coh_c * W.akinci(l2 * il) * il;
+#else
+  return cohesion_factor(W, coh_c, sqrtf(length2(r)));
+#endif
+}
 
 // With Cached, each pair's spiky gradient and cohesion factor come from pair_w (vorticity_part,
 // at the same positions) instead of a square root, a division and both kernels.
@@ -1100,10 +1040,10 @@ SEAMLESS_HD inline vec3 fluid_forces(const SimViews& S, int s, Lanes g) {
       const Packed gw = S.pair_w[row + k * col];
       grad = gw.xyz(), cf = gw.w;
     } else {
-      grad = S.c.W.spiky_grad(r), cf = cohesion_factor(S.c.W, coh_c, sqrtf(length2(r)));
+      grad = pair_grad(S.c.W, r), cf = pair_cohesion(S.c.W, coh_c, r);
     }
     const vec3 eta = grad * (nv.w * inv_rho0);
-    float K = two_rho0 / (rho_i + q.w);
+    float K = fast_div(two_rho0, rho_i + q.w);
     vec3 coh = r * cf;
     vec3 curv = (ni - nv.xyz()) * st;
     const vec3 acc = (coh + curv) * K, zero{0.f, 0.f, 0.f};
@@ -1162,9 +1102,9 @@ SEAMLESS_HD inline VortSum vorticity_part(const SimViews& S, int s, Lanes g) {
     const bool use = nb.fluid;  // solid neighbours add nothing
     const Packed q = nb.a, vh = nb.b;
     vec3 r = p - q.xyz(), vj = vh.xyz();
-    vec3 grad = W.spiky_grad(r);
+    vec3 grad = pair_grad(W, r);
     if constexpr (Cache) {
-      S.pair_w[row + k * col] = Packed::of(grad, cohesion_factor(W, coh_c, sqrtf(length2(r))));
+      S.pair_w[row + k * col] = Packed::of(grad, pair_cohesion(W, coh_c, r));
     }
     const vec3 w = cross(vj - vi, -grad) * inv_rho0, n = grad * vh.w;
     const vec3 visc = (vj - vi) * (W.poly6(length2(r)) * inv_rho0), zero{0.f, 0.f, 0.f};
