@@ -57,47 +57,19 @@ constexpr int kPairBatch1 = 1, kPairBatch2 = 1;
 #endif
 // Blocks of the executor's threads that the heavy pair passes (prepare_constraints,
 // solve_contacts_fluid, velocity_effects) ask to keep resident per multiprocessor (a register cap
-// on CUDA, MinBlocks; 0: none).
+// on CUDA, MinBlocks; 0: none). H200, fluid_1m: 5 (48 registers, a few spilled bytes in two
+// passes) ran 2.226 ms a step against 2.244 with none (a3ebcb5, one call); not the default
+// because its small scenes were not measured.
 #ifndef SEAMLESS_PAIR_MIN_BLOCKS
 #define SEAMLESS_PAIR_MIN_BLOCKS 0
 #endif
 constexpr MinBlocks<SEAMLESS_PAIR_MIN_BLOCKS> kPairOccupancy{};
-#ifndef SEAMLESS_ENTRY_PREFETCH
-#define SEAMLESS_ENTRY_PREFETCH 0
-#endif
-constexpr bool kEntryPrefetch = SEAMLESS_ENTRY_PREFETCH != 0;
 template <int kPairBatch, class Gather, class Use>
 SEAMLESS_HD inline void for_each_entry(const int* list, std::int64_t col, int m, Lanes g, Gather&& gather, Use&& use) {
   using D = decltype(gather(0));
   const int d = g.size;
   int k = g.lane;
-  if constexpr (kPairBatch > 1 && kEntryPrefetch) {
-    // The next batch's indices are loaded before this batch's gathers: the list streams from
-    // memory (DRAM latency), the gathers mostly hit the cache, and they then overlap.
-    if (k + (kPairBatch - 1) * d < m) {
-      int jn[kPairBatch];
-      SEAMLESS_PHYS_UNROLL
-      for (int u = 0; u < kPairBatch; ++u) jn[u] = list[(k + u * d) * col];
-      for (;;) {
-        int j[kPairBatch];
-        SEAMLESS_PHYS_UNROLL
-        for (int u = 0; u < kPairBatch; ++u) j[u] = jn[u];
-        const int kn = k + kPairBatch * d;
-        const bool more = kn + (kPairBatch - 1) * d < m;
-        if (more) {
-          SEAMLESS_PHYS_UNROLL
-          for (int u = 0; u < kPairBatch; ++u) jn[u] = list[(kn + u * d) * col];
-        }
-        D v[kPairBatch];
-        SEAMLESS_PHYS_UNROLL
-        for (int u = 0; u < kPairBatch; ++u) v[u] = gather(j[u]);
-        SEAMLESS_PHYS_UNROLL
-        for (int u = 0; u < kPairBatch; ++u) use(k + u * d, j[u], v[u]);
-        k = kn;
-        if (!more) break;
-      }
-    }
-  } else if constexpr (kPairBatch > 1) {
+  if constexpr (kPairBatch > 1) {
     for (; k + (kPairBatch - 1) * d < m; k += kPairBatch * d) {
       int j[kPairBatch];
       D v[kPairBatch];
