@@ -96,6 +96,15 @@ constexpr int kPairBatch1 = SEAMLESS_BATCH1, kPairBatch2 = SEAMLESS_BATCH2;
 #else
 constexpr int kPairBatch1 = 1, kPairBatch2 = 1;
 #endif
+// Blocks of the executor's threads that the heavy pair passes (prepare_constraints,
+// solve_contacts_fluid, velocity_effects) ask to keep resident per multiprocessor (a register cap
+// on CUDA, MinBlocks; 0: none). H200, fluid_1m: 5 (48 registers, a few spilled bytes in two
+// passes) ran 2.226 ms a step against 2.244 with none (a3ebcb5, one call); not the default
+// because its small scenes were not measured.
+#ifndef SEAMLESS_PAIR_MIN_BLOCKS
+#define SEAMLESS_PAIR_MIN_BLOCKS 0
+#endif
+constexpr MinBlocks<SEAMLESS_PAIR_MIN_BLOCKS> kPairOccupancy{};
 template <int kPairBatch, class Gather, class Use>
 SEAMLESS_HD inline void for_each_entry(const int* list, std::int64_t col, int m, Lanes g, Gather&& gather, Use&& use) {
   using D = decltype(gather(0));
@@ -128,6 +137,36 @@ struct Gather2 {
   Packed a, b;
   bool fluid;
 };
+
+// The pair math of the fluid passes with one reciprocal square root on CUDA: SphKernel's
+// spiky gradient and the cohesion factor take |r| by an IEEE square root and divide by it, and
+// the symmetrising factor is a division; on CUDA each compiles to a multi-instruction sequence
+// with a slow-path branch, and at 1M particles the pair passes issue an instruction on ~60-70 %
+// of cycles (Nsight, H200: prepare_constraints, solve_contacts_fluid). rsqrtf and __fdividef are
+// the hardware approximations (2 ulp, CUDA programming guide, table of intrinsic functions),
+// far below the CPU/CUDA tolerance of PhysicsParity (FMA contraction and sum order differ
+// already). The CPU keeps the IEEE forms: its results are unchanged.
+// V is vec3 on CUDA and vec3 or the CPU's SIMD lanes on the CPU (F their float), which keeps the
+// IEEE forms.
+template <class V>
+SEAMLESS_HD inline V pair_grad(const SphKernel& W, V r) {
+#if defined(__CUDA_ARCH__)
+  const float l2 = length2(r);
+  if (l2 >= W.h2 || l2 <= 1e-24f) return {0.f, 0.f, 0.f};  // l >= h or l <= 1e-12, as spiky_grad
+  const float il = rsqrtf(l2), t = W.h - l2 * il;
+  return r * (W.spiky_c * t * t * il);
+#else
+  return W.spiky_grad(r);
+#endif
+}
+template <class F>
+SEAMLESS_HD inline F fast_div(float a, F b) {
+#if defined(__CUDA_ARCH__)
+  return __fdividef(a, b);
+#else
+  return a / b;
+#endif
+}
 
 // spk = (sp, phase bits): the packed copy that the next neighbour loops gather (Packed).
 template <class Exec>
@@ -635,7 +674,7 @@ template <class F, class V>
 SEAMLESS_HD inline DensityPair<F, V> density_pair(const SphKernel& W, float inv_rho0, V r) {
   DensityPair<F, V> d;
   d.wgt = W.poly6(length2(r));
-  d.gw = W.spiky_grad(r);
+  d.gw = pair_grad(W, r);
   d.grad = d.gw * inv_rho0;
   return d;
 }
@@ -710,7 +749,7 @@ void prepare_constraints(const Exec& ex, const SimViews& S) {
 #if !defined(__CUDACC__)
   if (!cpu_tiles(ex, S, detail::density_tile, [=](int s) { one(s, Lanes{}); }))
 #endif
-    ex.for_each_grouped(S.n, kPairLanes, one);
+    ex.for_each_grouped(S.n, kPairLanes, one, detail::kPairOccupancy);
 }
 
 namespace detail {
@@ -755,7 +794,7 @@ SEAMLESS_HD inline vec3 pbf_part(const SimViews& S, int s, Lanes g) {
     } else {
       const Packed pl = n.a;
       const vec3 r = p - pl.xyz();
-      grad = S.c.W.spiky_grad(r), lj = pl.w;
+      grad = pair_grad(S.c.W, r), lj = pl.w;
       wgt = S.c.scorr_k > 0.f ? S.c.W.poly6(length2(r)) : 0.f;
     }
     f += n.fluid ? pbf_pair(S.c, grad, wgt, li, lj) : grad * (li * sw);  // a solid neighbour: li * sw alone
@@ -809,7 +848,7 @@ void solve_contacts_fluid(const Exec& ex, const SimViews& S) {
 #if !defined(__CUDACC__)
   if (!cpu_tiles(ex, S, detail::solve_tile, [=](int s) { one(s, Lanes{}); }))
 #endif
-    ex.for_each_grouped(S.n, kPairLanes, one);
+    ex.for_each_grouped(S.n, kPairLanes, one, detail::kPairOccupancy);
 }
 
 // Static friction of a rigid body as a whole (Macklin 2014, section 6.1, applied to the body):
@@ -1041,7 +1080,7 @@ template <class F, class V>
 SEAMLESS_HD inline void force_pair(float inv_rho0, float two_rho0, float st, V r, V grad, F cf, V ni, V nj, F wj, F rho_i,
                                    F rho_j, V& eta, V& acc) {
   eta = grad * (wj * inv_rho0);
-  F K = two_rho0 / (rho_i + rho_j);
+  F K = fast_div(two_rho0, rho_i + rho_j);  // __fdividef on CUDA
   V coh = r * cf;
   V curv = (ni - nj) * st;
   acc = (coh + curv) * K;
@@ -1058,6 +1097,18 @@ SEAMLESS_HD inline vec3 finish_forces(const SimViews& S, int s, ForceSum t) {
 // The velocity of fluid particle s after viscosity (its XSPH sum in vtmp) and its forces.
 SEAMLESS_HD inline vec3 fluid_velocity(const SimViews& S, int s, vec3 forces) {
   return S.sv[s] + (S.vtmp[s] * S.c.viscosity + forces * S.c.dt);
+}
+// cohesion_factor of |r| (r = p_i - p_j), with one reciprocal square root on CUDA (pair_grad).
+template <class V>
+SEAMLESS_HD inline auto pair_cohesion(const SphKernel& W, float coh_c, V r) {
+#if defined(__CUDA_ARCH__)
+  const float l2 = length2(r);
+  if (!(l2 > 1e-18f)) return 0.f;  // l <= 1e-9, as cohesion_factor
+  const float il = rsqrtf(l2);
+  return coh_c * W.akinci(l2 * il) * il;
+#else
+  return cohesion_factor(W, coh_c, length(r));
+#endif
 }
 
 // With Cached, each pair's spiky gradient and cohesion factor come from pair_w (vorticity_part,
@@ -1088,7 +1139,7 @@ SEAMLESS_HD inline vec3 fluid_forces(const SimViews& S, int s, Lanes g) {
       const Packed gw = S.pair_w[row + k * col];
       grad = gw.xyz(), cf = gw.w;
     } else {
-      grad = S.c.W.spiky_grad(r), cf = cohesion_factor(S.c.W, coh_c, sqrtf(length2(r)));
+      grad = pair_grad(S.c.W, r), cf = pair_cohesion(S.c.W, coh_c, r);
     }
     vec3 eta, acc;
     force_pair(inv_rho0, two_rho0, st, r, grad, cf, ni, nv.xyz(), nv.w, rho_i, q.w, eta, acc);
@@ -1134,8 +1185,8 @@ struct VortPair {
 template <bool With, class F, class V>
 SEAMLESS_HD inline VortPair<F, V> vorticity_pair(const SphKernel& W, float inv_rho0, float coh_c, V r, V vi, V vj, F hj) {
   VortPair<F, V> d;
-  d.grad = W.spiky_grad(r);
-  if constexpr (With) d.cf = cohesion_factor(W, coh_c, length(r));
+  d.grad = pair_grad(W, r);
+  if constexpr (With) d.cf = pair_cohesion(W, coh_c, r);
   d.w = cross(vj - vi, -d.grad) * inv_rho0;
   d.n = d.grad * hj;
   d.dv = (vj - vi) * (W.poly6(length2(r)) * inv_rho0);
@@ -1193,7 +1244,7 @@ void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
 #if !defined(__CUDACC__)
     if (!cpu_tiles(ex, S, detail::vorticity_tile, [=](int s) { vort(s, Lanes{}); }))
 #endif
-      ex.for_each_grouped(S.n, kPairLanes, vort);
+      ex.for_each_grouped(S.n, kPairLanes, vort, detail::kPairOccupancy);
   }
   const bool aero = S.has_cloth_constraints && (S.c.drag > 0.f || S.c.lift > 0.f);
   auto one = [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
@@ -1211,7 +1262,7 @@ void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
 #if !defined(__CUDACC__)
   if (!has_fluid || !cpu_tiles(ex, S, detail::forces_tile, [=](int s) { one(s, Lanes{}); }))
 #endif
-    ex.for_each_grouped(S.n, kPairLanes, one);
+    ex.for_each_grouped(S.n, kPairLanes, one, detail::kPairOccupancy);
 }
 
 template <class Exec>

@@ -24,6 +24,10 @@
 //                                        lanes.size lanes (a power of two <= max_lanes, chosen
 //                                        by the executor: 1 on the CPU, 1 or >= 8 on CUDA) that split i's work and
 //                                        combine it with lanes.sum / lanes.rank (Lanes below)
+//   ex.for_each_grouped(n, max_lanes, fn, MinBlocks<B>{})
+//                                        the same, with at least B blocks of the executor's
+//                                        threads resident per multiprocessor (CUDA: a launch
+//                                        bound, which caps the kernel's registers; CPU: ignored)
 //   ex.lanes(n, max_lanes)               the group size for_each_grouped(n, max_lanes, ...) uses
 //   ex.for_each_phases(phases, begin, end, fn)
 //                                        fn(p, i) for i in [begin[p], end[p]), phase after phase:
@@ -122,6 +126,10 @@ struct Staged {
   std::int64_t count = 0;
 };
 
+// for_each_grouped's optional occupancy request (see the list above); B = 0: none.
+template <int B>
+struct MinBlocks {};
+
 struct CpuExec {
   static constexpr Device device = Device::CPU;
   // sort_by_key allocates its own buffers on the CPU (see CudaExec::temp).
@@ -135,6 +143,9 @@ struct CpuExec {
   // One thread per element on the CPU: the groups are single lanes.
   int lanes(std::int64_t, int) const { return 1; }
   template <class F> void for_each_grouped(std::int64_t n, int max_lanes, F fn) const;
+  template <int B, class F> void for_each_grouped(std::int64_t n, int max_lanes, F fn, MinBlocks<B>) const {
+    for_each_grouped(n, max_lanes, fn);
+  }
   template <class F>
   void for_each_phases(int phases, const std::int64_t* begin, const std::int64_t* end, F fn) const;
   // The CPU's caches do the staging: fn gets every array's ptr.
@@ -167,6 +178,7 @@ struct CudaExec {
   // caller's per-element work splits usefully), at least 1. Defined in core/exec_cuda.cu.
   int lanes(std::int64_t n, int max_lanes) const;
   template <class F> void for_each_grouped(std::int64_t n, int max_lanes, F fn) const;
+  template <int B, class F> void for_each_grouped(std::int64_t n, int max_lanes, F fn, MinBlocks<B>) const;
   template <class F>
   void for_each_phases(int phases, const std::int64_t* begin, const std::int64_t* end, F fn) const;
   // Where for_each_phases runs the sweep in one block, the arrays that fit (in argument order)

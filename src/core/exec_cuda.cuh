@@ -200,7 +200,7 @@ namespace cuda_detail {
 // Groups of 2^log2_lanes consecutive threads, one per element; blocks of 256 threads hold whole
 // groups, and groups never straddle a warp, so a group's shuffles stay within its warp.
 template <class F>
-__global__ void for_each_grouped_kernel(std::int64_t n, int log2_lanes, F fn) {
+__device__ __forceinline__ void grouped_element(std::int64_t n, int log2_lanes, F& fn) {
   const std::int64_t t = static_cast<std::int64_t>(blockIdx.x) * blockDim.x + threadIdx.x;
   const std::int64_t i = t >> log2_lanes;
   if (i >= n) return;  // the whole group leaves: its lanes share i
@@ -210,6 +210,17 @@ __global__ void for_each_grouped_kernel(std::int64_t n, int log2_lanes, F fn) {
   g.first = static_cast<int>(threadIdx.x & 31u) & ~(g.size - 1);
   g.mask = g.size == 32 ? 0xFFFFFFFFu : ((1u << g.size) - 1u) << g.first;
   fn(i, g);
+}
+
+template <class F>
+__global__ void for_each_grouped_kernel(std::int64_t n, int log2_lanes, F fn) {
+  grouped_element(n, log2_lanes, fn);
+}
+
+// The same with kMinBlocks blocks of kThreads resident per multiprocessor (registers capped to fit).
+template <int kThreads, int kMinBlocks, class F>
+__global__ void __launch_bounds__(kThreads, kMinBlocks) for_each_grouped_bounded_kernel(std::int64_t n, int log2_lanes, F fn) {
+  grouped_element(n, log2_lanes, fn);
 }
 
 // Up to kMax phases of for_each_phases in one block: __syncthreads() between phases makes each
@@ -310,6 +321,22 @@ void CudaExec::for_each_grouped(std::int64_t n, int max_lanes, F fn) const {
   auto blocks = static_cast<unsigned>(((n << log2_lanes) + kThreads - 1) / kThreads);
   cuda_detail::for_each_grouped_kernel<<<blocks, kThreads, 0, static_cast<cudaStream_t>(stream)>>>(n, log2_lanes, fn);
   SEAMLESS_CUDA_CHECK_LAUNCH("for_each_grouped");
+}
+
+template <int B, class F>
+void CudaExec::for_each_grouped(std::int64_t n, int max_lanes, F fn, MinBlocks<B>) const {
+  if constexpr (B <= 0) {
+    for_each_grouped(n, max_lanes, fn);
+  } else {
+    if (n <= 0) return;
+    int log2_lanes = 0;
+    while ((1 << log2_lanes) < lanes(n, max_lanes)) ++log2_lanes;
+    constexpr int kThreads = 256;  // as for_each_grouped
+    auto blocks = static_cast<unsigned>(((n << log2_lanes) + kThreads - 1) / kThreads);
+    cuda_detail::for_each_grouped_bounded_kernel<kThreads, B>
+        <<<blocks, kThreads, 0, static_cast<cudaStream_t>(stream)>>>(n, log2_lanes, fn);
+    SEAMLESS_CUDA_CHECK_LAUNCH("for_each_grouped");
+  }
 }
 
 template <class F>
