@@ -98,11 +98,11 @@ constexpr int kPairBatch1 = 1, kPairBatch2 = 1;
 #endif
 // Blocks of the executor's threads that the heavy pair passes (prepare_constraints,
 // solve_contacts_fluid, velocity_effects) ask to keep resident per multiprocessor (a register cap
-// on CUDA, MinBlocks; 0: none). H200, fluid_1m: 5 (48 registers, a few spilled bytes in two
-// passes) ran 2.226 ms a step against 2.244 with none (a3ebcb5, one call); not the default
-// because its small scenes were not measured.
+// on CUDA, MinBlocks; 0: none). 5 (48 registers, a few spilled bytes in two passes) against none,
+// H200, one call at 08936fc, medians of 3: fluid_1m 2.226 against 2.256 ms a step, fluid_10k
+// 0.148 against 0.156, the other scenes within 0.4 %.
 #ifndef SEAMLESS_PAIR_MIN_BLOCKS
-#define SEAMLESS_PAIR_MIN_BLOCKS 0
+#define SEAMLESS_PAIR_MIN_BLOCKS 5
 #endif
 constexpr MinBlocks<SEAMLESS_PAIR_MIN_BLOCKS> kPairOccupancy{};
 template <int kPairBatch, class Gather, class Use>
