@@ -1440,7 +1440,7 @@ bool solve_tile(const SimViews& S, int s0) {
     vf lj;
     gather_packed(S.spl, j, q, lj);
     const v3 r = p - q;
-    const v3 grad = W.spiky_grad(r);
+    const v3 grad = pair_grad(W, r);
     const vf wgt = S.c.scorr_k > 0.f ? W.poly6(length2(r)) : vf(0.f);
     tile_add<kMasked>(f, pbf_pair(S.c, grad, wgt, li, lj), in);
   };
@@ -1478,8 +1478,8 @@ bool forces_tile(const SimViews& S, int s0) {
     gather_packed(S.spd, j, q, rho_j);
     gather_packed(S.cnv, j, nj, wj);
     const v3 r = p - q;
-    const v3 grad = W.spiky_grad(r);
-    const vf cf = cohesion_factor(W, coh_c, length(r));
+    const v3 grad = pair_grad(W, r);
+    const vf cf = pair_cohesion(W, coh_c, r);
     v3 e, a;
     force_pair(inv_rho0, two_rho0, st, r, grad, cf, ni, nj, wj, rho_i, rho_j, e, a);
     tile_add<kMasked>(eta, e, in);

@@ -317,29 +317,22 @@ struct StagedPhaseAt {
 
 template <class F>
 void CudaExec::for_each_grouped(std::int64_t n, int max_lanes, F fn) const {
+  for_each_grouped(n, max_lanes, fn, MinBlocks<0>{});
+}
+
+template <int B, class F>
+void CudaExec::for_each_grouped(std::int64_t n, int max_lanes, F fn, MinBlocks<B>) const {
   if (n <= 0) return;
   int log2_lanes = 0;
   while ((1 << log2_lanes) < lanes(n, max_lanes)) ++log2_lanes;
   constexpr int kThreads = 256;
   auto blocks = static_cast<unsigned>(((n << log2_lanes) + kThreads - 1) / kThreads);
-  cuda_detail::for_each_grouped_kernel<<<blocks, kThreads, 0, static_cast<cudaStream_t>(stream)>>>(n, log2_lanes, fn);
+  const auto st = static_cast<cudaStream_t>(stream);
+  if constexpr (B <= 0)
+    cuda_detail::for_each_grouped_kernel<<<blocks, kThreads, 0, st>>>(n, log2_lanes, fn);
+  else
+    cuda_detail::for_each_grouped_bounded_kernel<kThreads, B><<<blocks, kThreads, 0, st>>>(n, log2_lanes, fn);
   SEAMLESS_CUDA_CHECK_LAUNCH("for_each_grouped");
-}
-
-template <int B, class F>
-void CudaExec::for_each_grouped(std::int64_t n, int max_lanes, F fn, MinBlocks<B>) const {
-  if constexpr (B <= 0) {
-    for_each_grouped(n, max_lanes, fn);
-  } else {
-    if (n <= 0) return;
-    int log2_lanes = 0;
-    while ((1 << log2_lanes) < lanes(n, max_lanes)) ++log2_lanes;
-    constexpr int kThreads = 256;  // as for_each_grouped
-    auto blocks = static_cast<unsigned>(((n << log2_lanes) + kThreads - 1) / kThreads);
-    cuda_detail::for_each_grouped_bounded_kernel<kThreads, B>
-        <<<blocks, kThreads, 0, static_cast<cudaStream_t>(stream)>>>(n, log2_lanes, fn);
-    SEAMLESS_CUDA_CHECK_LAUNCH("for_each_grouped");
-  }
 }
 
 template <class F>
