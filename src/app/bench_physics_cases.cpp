@@ -8,7 +8,7 @@ namespace seamless::app {
 
 std::vector<BenchCase> make_physics_bench(const BenchOptions& o) {
   std::vector<BenchCase> cases;
-  for (PhysicsBenchCase& c : physics_bench_cases(o.device, o.scale)) {
+  for (PhysicsBenchCase& c : physics_bench_cases(o.device, o.scale, o.filter)) {
     auto solver = c.solver;
     cases.push_back({c.name, c.step, c.detail, [solver] {
                        auto s = solver->stats();

@@ -24,6 +24,8 @@ struct PhysicsBenchCase {
 // scale: "paper" (Table 5.1: fluid 10,000; cloth 40x40; rigid 4 x 4x4x4), "large" (fluid
 // 1,000,000; cloth 512x512; 4,096 cubes of 4x4x4) or "all". On CUDA each scene comes twice: with
 // the step replayed as a CUDA graph (solver.cuda_graph, the default) and as "<name>_nograph".
-std::vector<PhysicsBenchCase> physics_bench_cases(Device device, const std::string& scale = "all");
+// Only the cases whose name contains filter are built ("" builds all).
+std::vector<PhysicsBenchCase> physics_bench_cases(Device device, const std::string& scale = "all",
+                                                  const std::string& filter = "");
 
 }  // namespace seamless
