@@ -109,21 +109,23 @@ template <int kPairBatch, class Gather, class Use>
 SEAMLESS_HD inline void for_each_entry(const int* list, std::int64_t col, int m, Lanes g, Gather&& gather, Use&& use) {
   using D = decltype(gather(0));
   const int d = g.size;
+  const std::int64_t step = d * col;  // from one of the lane's entries to the next
   int k = g.lane;
+  const int* at = list + k * col;  // entry k (a pointer: (k + u d) col took 64-bit multiplies per entry)
   if constexpr (kPairBatch > 1) {
-    for (; k + (kPairBatch - 1) * d < m; k += kPairBatch * d) {
+    for (; k + (kPairBatch - 1) * d < m; k += kPairBatch * d, at += kPairBatch * step) {
       int j[kPairBatch];
       D v[kPairBatch];
       SEAMLESS_PHYS_UNROLL
-      for (int u = 0; u < kPairBatch; ++u) j[u] = list[(k + u * d) * col];
+      for (int u = 0; u < kPairBatch; ++u) j[u] = at[u * step];
       SEAMLESS_PHYS_UNROLL
       for (int u = 0; u < kPairBatch; ++u) v[u] = gather(j[u]);
       SEAMLESS_PHYS_UNROLL
       for (int u = 0; u < kPairBatch; ++u) use(k + u * d, j[u], v[u]);
     }
   }
-  for (; k < m; k += d) {
-    const int j = list[k * col];
+  for (; k < m; k += d, at += step) {
+    const int j = *at;
     use(k, j, gather(j));
   }
 }
@@ -458,29 +460,14 @@ SEAMLESS_HD inline void append_run(int a, int e, Lanes g, int* list, std::int64_
   }
 }
 
-// Stores candidate j at slot cnt of a list of cap entries (and a spare slot) where `store`
-// (accepted and cnt < cap), for a lane that walks its runs alone. On the CPU without a branch:
-// about half the candidates fail the distance test at random, which a branch mispredicts; every
-// candidate is written to slot min(cnt, cap), where the next one overwrites it unless it was kept
-// (the slot past the last kept entry, like the spare one, is never read). On CUDA only kept
-// candidates are stored (a predicated store): a store for every candidate costs memory traffic
-// that the diverging threads of a warp cannot coalesce (find_neighbors at 1M particles, one lane
-// each, H200: 0.57 ms storing kept entries only, 0.80 ms with every candidate stored; d76cd62).
-SEAMLESS_HD inline void store_candidate(int* list, std::int64_t col, int cap, int cnt, int j, bool store) {
-#if defined(__CUDA_ARCH__)
-  if (store) list[cnt * col] = j;
-#else
-  (void)store;
-  list[(cnt < cap ? cnt : cap) * col] = j;
-#endif
-}
-
 // The CPU's candidate loop over the entries [a, e) of a run, none of them s (find_neighbors):
 // every candidate is written to its slot (list row-major, col = 1 on the CPU), where the next
-// one overwrites it unless it was kept (store_candidate's branch-free store). Clamp: whether the
-// slot must be clamped to the spare one at cap (only where the run can reach the cap). General:
-// the rigid/cloth pair test (may_interact). Everything in locals, so that the stores to list
-// cannot make the compiler reload s, cap or the count. Returns the count.
+// one overwrites it unless it was kept: about half the candidates fail the distance test at
+// random, which a branch mispredicts (the slot past the last kept entry, like the spare one at
+// cap, is never read). Clamp: whether the slot must be clamped to the spare one (only where the
+// run can reach the cap). General: the rigid/cloth pair test (may_interact). Everything in
+// locals, so that the stores to list cannot make the compiler reload s, cap or the count.
+// Returns the count.
 template <bool General, bool Clamp>
 SEAMLESS_HD inline int scan_candidates(const SimViews& S, vec3 p, float R2, std::uint32_t ph, int s, int a, int e, int* list,
                                        int cap, int c) {
@@ -494,9 +481,46 @@ SEAMLESS_HD inline int scan_candidates(const SimViews& S, vec3 p, float R2, std:
   }
   return c;
 }
-}  // namespace detail
 
-namespace detail {
+// CUDA's candidate loop for a lane that walks its runs alone (find_neighbors): the candidates
+// [a, e) of s, 4 at a time, all 4 loaded before any is tested (lanes past the run load its last
+// entry and reject it): 4 loads in flight instead of one chain of load-test-store per candidate
+// (see for_each_entry). Only kept candidates are stored: a store for every candidate (the CPU's
+// branch-free way) costs memory traffic that the diverging threads of a warp cannot coalesce
+// (H200: 0.57 ms storing kept entries only, 0.80 ms with every candidate stored; d76cd62). They
+// are stored through a pointer that moves one column per stored candidate: indexing the
+// column-major list by count x column took 64-bit multiplies and a branch per candidate
+// (Nsight, 1M fluid particles, H200: the store line was 17 % of the pass's instructions).
+// General: the rigid/cloth pair test (may_interact), compiled only into the walk of rigid and
+// cloth particles (a runtime test per candidate left its loads if-converted into the fluid
+// walk, 7 % of the instructions). cnt counts every accepted candidate, solid those stored
+// without a bit of solid_mask.
+template <bool General>
+SEAMLESS_HD inline void scan_run_lane(const SimViews& S, vec3 p, float R2, std::uint32_t ph, int s,
+                                      std::uint32_t solid_mask, int a, int e, int* list, int cap, int& cnt, int& solid) {
+  const int col = static_cast<int>(S.nbr_col);  // particle count on CUDA (< 2^31)
+  int c = cnt, so = solid;
+  int* out = list + static_cast<std::int64_t>(c < cap ? c : cap) * col;
+  for (int b = a; b < e; b += 4) {
+    Packed q[4];
+    SEAMLESS_PHYS_UNROLL
+    for (int u = 0; u < 4; ++u) q[u] = S.spk[b + u < e ? b + u : e - 1];  // position and phase
+    SEAMLESS_PHYS_UNROLL
+    for (int u = 0; u < 4; ++u) {
+      const int j = b + u;
+      const std::uint32_t phj = q[u].bits();
+      bool ok = (j < e) & (j != s) & (length2(p - q[u].xyz()) < R2);
+      if constexpr (General) ok = ok && may_interact(S, ph, phj, s, j);
+      const bool store = ok & (c < cap);
+      so += store & ((phj & solid_mask) == 0u);
+      if (store) *out = j;
+      out += store ? col : 0;
+      c += ok;
+    }
+  }
+  cnt = c, solid = so;
+}
+
 // s's list lengths (cnt candidates kept, solid of them not fluid, scnt static ones) and the
 // overflow counters.
 SEAMLESS_HD inline void finish_neighbors(const SimViews& S, int s, int cnt, int solid, int scnt) {
@@ -564,31 +588,17 @@ void find_neighbors(const Exec& ex, const SimViews& S) {
       else
         for (int k = 0; k < stored; ++k) solid += !phase::is(S.spk[list[k * S.nbr_col]].bits(), phase::kFluid);
     } else if (g.size == 1) {  // (if constexpr ... else if: the CUDA instantiation)
-      // CUDA, one lane: as above, the non-fluid entries counted on the way (the phase is loaded
-      // anyway) and only kept candidates stored.
-      // The candidates of a run 4 at a time, loaded before any is tested (lanes past the run
-      // load its last entry and reject it): 4 loads in flight instead of one chain of
-      // load-test-store per candidate (see for_each_entry).
-      for_each_run_in_radius(S.grid, S.cell_start, p, R, [&](int a, int e) {
-        int c = cnt, so = solid;
-        for (int b = a; b < e; b += 4) {
-          Packed q[4];
-          SEAMLESS_PHYS_UNROLL
-          for (int u = 0; u < 4; ++u) q[u] = S.spk[b + u < e ? b + u : e - 1];  // position and phase
-          SEAMLESS_PHYS_UNROLL
-          for (int u = 0; u < 4; ++u) {
-            const int j = b + u;
-            const std::uint32_t phj = q[u].bits();
-            bool ok = (j < e) & (j != s) & (length2(p - q[u].xyz()) < R2);
-            if (!plain) ok = ok && detail::may_interact(S, ph, phj, s, j);
-            const bool store = ok & (c < cap);
-            so += store & !(sfluid & phase::is(phj, phase::kFluid));
-            detail::store_candidate(list, S.nbr_col, cap, c, j, store);
-            c += ok;
-          }
-        }
-        cnt = c, solid = so;
-      });
+      // CUDA, one lane: as above (the rigid/cloth test compiled only into the walk of rigid and
+      // cloth particles), the non-fluid entries counted on the way (the phase is loaded anyway)
+      // and only kept candidates stored.
+      const std::uint32_t solid_mask = sfluid ? phase::kFluid : 0u;  // stored entries without these bits count
+      auto walk = [&](auto general) {
+        for_each_run_in_radius(S.grid, S.cell_start, p, R, [&](int a, int e) {
+          detail::scan_run_lane<decltype(general)::value>(S, p, R2, ph, s, solid_mask, a, e, list, cap, cnt, solid);
+        });
+      };
+      if (plain) walk(std::false_type{});
+      else walk(std::true_type{});
     } else {
       for_each_run_in_radius(S.grid, S.cell_start, p, R, [&](int a, int e) {
         detail::append_run(
