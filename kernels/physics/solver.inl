@@ -496,7 +496,8 @@ SEAMLESS_HD inline int scan_candidates(const SimViews& S, vec3 p, float R2, std:
 // CUDA's candidate loop for a lane that walks its runs alone (find_neighbors): the candidates
 // [a, e) of s, 4 at a time, all 4 loaded before any is tested (lanes past the run load its last
 // entry and reject it): 4 loads in flight instead of one chain of load-test-store per candidate
-// (see for_each_entry). Only kept candidates are stored: a store for every candidate (the CPU's
+// (see for_each_entry; 2 or 8 at a time: fluid_1m 3 % and 5 % slower, H200). Only kept
+// candidates are stored: a store for every candidate (the CPU's
 // branch-free way) costs memory traffic that the diverging threads of a warp cannot coalesce
 // (H200: 0.57 ms storing kept entries only, 0.80 ms with every candidate stored; d76cd62). They
 // are stored through a pointer that moves one column per stored candidate: indexing the
