@@ -67,6 +67,7 @@ template <class Exec> void update_velocity(const Exec& ex, const SimViews& S);
 template <class Exec> void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid);
 // x, v back to id order; counters[4] = bits of the largest |v|^2 (reset by predict).
 template <class Exec> void write_back(const Exec& ex, const SimViews& S);
+template <class Exec> void slots_to_ids(const Exec& ex, const SimViews& S, vec3* x_id, std::uint32_t* phase_id);
 
 }  // namespace seamless::kernels
 
@@ -89,5 +90,6 @@ template <class Exec> void write_back(const Exec& ex, const SimViews& S);
   template void update_velocity<E>(const E&, const SimViews&);                                              \
   template void velocity_effects<E>(const E&, const SimViews&, bool);                                       \
   template void write_back<E>(const E&, const SimViews&);                                                   \
+  template void slots_to_ids<E>(const E&, const SimViews&, vec3*, std::uint32_t*);                          \
   template std::size_t sort_cells_temp_bytes<E>(const E&, std::int64_t, int);                              \
   }

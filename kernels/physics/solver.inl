@@ -383,18 +383,21 @@ std::size_t sort_cells_temp_bytes(const Exec& ex, std::int64_t n, int bits) {
   return ex.template sort_by_key_temp_bytes<std::uint32_t, int>(n, bits);
 }
 
+// Gathers the slot state into the sorted order; order[s] becomes the particle id of sorted index
+// s (each thread rewrites only its own entry) and rank its inverse.
 template <class Exec>
 void reorder(const Exec& ex, const SimViews& S) {
   ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
-    int id = S.order[s];
+    const int slot = S.order[s], id = S.slot_id[slot];
+    S.order[s] = id;
     S.rank[id] = static_cast<int>(s);
-    S.sx[s] = S.x[id];
-    S.sp[s] = S.pred[id];
-    S.sp0[s] = S.pred[id];
-    S.sv[s] = S.v[id];
-    S.sw[s] = S.w[id];
-    S.sphase[s] = S.phase[id];
-    S.spk[s] = Packed::of_phase(S.pred[id], S.phase[id]);  // for find_neighbors
+    S.sx[s] = S.x[slot];
+    S.sp[s] = S.pred[slot];
+    S.sp0[s] = S.pred[slot];
+    S.sv[s] = S.v[slot];
+    S.sw[s] = S.w[slot];
+    S.sphase[s] = S.phase[slot];
+    S.spk[s] = Packed::of_phase(S.pred[slot], S.phase[slot]);  // for find_neighbors
   });
 }
 
@@ -1302,12 +1305,15 @@ void velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
     ex.for_each_grouped(S.n, kPairLanes, one, detail::kPairOccupancy);
 }
 
+// The sorted state becomes the slot state (slot s = sorted index s: coalesced, no scatter by id).
 template <class Exec>
 void write_back(const Exec& ex, const SimViews& S) {
   ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
-    int id = S.order[s];
-    S.x[id] = S.sp[s];
-    S.v[id] = S.sv[s];
+    S.x[s] = S.sp[s];
+    S.v[s] = S.sv[s];
+    S.w[s] = S.sw[s];
+    S.phase[s] = S.sphase[s];
+    S.slot_id[s] = S.order[s];
     // Largest |v|^2 for stats() without a reduction: the bits of non-negative floats order like
     // ints. Read first: the shared maximum rarely changes, so most particles only load it.
     const int v2 = float_bits(length2(S.sv[s]));
@@ -1315,6 +1321,17 @@ void write_back(const Exec& ex, const SimViews& S) {
   });
 }
 
+
+// The slot state's positions and phases in id order (for what reads particles by id: the
+// renderer's cloth triangles, downloads).
+template <class Exec>
+void slots_to_ids(const Exec& ex, const SimViews& S, vec3* x_id, std::uint32_t* phase_id) {
+  ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
+    const int id = S.slot_id[s];
+    x_id[id] = S.x[s];
+    phase_id[id] = S.phase[s];
+  });
+}
 
 #if !defined(__CUDACC__)
 // ---- the CPU's SIMD tiles (kernels/physics/simd.hpp) ------------------------------------------

@@ -55,10 +55,16 @@ struct ParticleSolver::Impl {
   SolverParams P;
   Device dev;
   std::int64_t n = 0, cap = 0;
-  // id order
-  Buffer<vec3> x, v, rest, pred;
+  // slot order (the state between steps in the last substep's sorted order; SimViews): slot_id
+  // holds the particle id of each slot
+  Buffer<vec3> x, v, pred;
   Buffer<float> w;
   Buffer<std::uint32_t> phase;
+  Buffer<int> slot_id;
+  // id order: per-particle constants; positions and phases copied out for device_positions()
+  Buffer<vec3> rest, x_id;
+  Buffer<std::uint32_t> phase_id;
+  std::uint64_t state_version = 0, id_copy_version = ~std::uint64_t{0};  // x_id, phase_id of this version
   Buffer<vec4> rsdf, sdf_at;
   Buffer<K::Packed> spk, spl, spd, svh, cnv;  // packed copies for the neighbour loops (sim_views.hpp)
   Buffer<K::Packed> pair_w;              // CPU: kernel values per list entry (SimViews::pair_w)
@@ -152,7 +158,7 @@ struct ParticleSolver::Impl {
                   std::to_string(P.max_particles) + "; raise solver.max_particles");
     if (need <= cap) return;
     std::int64_t nc = std::min<std::int64_t>(P.max_particles, std::max<std::int64_t>({need, 2 * cap, 1024}));
-    grow(x, nc, n, dev), grow(v, nc, n, dev), grow(w, nc, n, dev), grow(phase, nc, n, dev);
+    grow(x, nc, n, dev), grow(v, nc, n, dev), grow(w, nc, n, dev), grow(phase, nc, n, dev), grow(slot_id, nc, n, dev);
     grow(rest, nc, n, dev), grow(rsdf, nc, n, dev);
     for (auto* b : {&pred, &sx, &sp, &sp0, &sv, &tmp, &vtmp, &vort, &cnormal, &scene_n}) b->reserve_discard(nc, dev);
     for (auto* b : {&order, &rank, &ncontacts, &nnbr, &nsnbr, &nsolid}) b->reserve_discard(nc, dev);
@@ -162,6 +168,16 @@ struct ParticleSolver::Impl {
     nbr.reserve_discard(nc * (P.max_neighbours + 1), dev);  // + 1: the spare slot (sim_views.hpp)
     if (dev == Device::CPU) pair_w.reserve_discard(nc * (P.max_neighbours + 1), dev);  // kernels::kCachePairs
     cap = nc;
+  }
+
+  // x_id and phase_id: the slot state's positions and phases in id order, copied when the state
+  // changed since the last copy (on CUDA on the default stream, after the last step).
+  void copy_to_id_order() {
+    if (id_copy_version == state_version) return;
+    x_id.reserve_discard(cap, dev), phase_id.reserve_discard(cap, dev);
+    K::SimViews S = views(P.dt);
+    with_exec(dev, [&](const auto& ex) { K::slots_to_ids(ex, S, x_id.data(), phase_id.data()); });
+    id_copy_version = state_version;
   }
 
   K::SimViews views(float dt) {
@@ -188,7 +204,7 @@ struct ParticleSolver::Impl {
     c.max_neighbors = P.max_neighbours, c.max_static_neighbors = P.max_static_neighbours;
     c.rotation_iterations = P.rotation_iterations;
     S.n = n;
-    S.x = x.data(), S.v = v.data(), S.w = w.data(), S.phase = phase.data(), S.rest = rest.data();
+    S.x = x.data(), S.v = v.data(), S.w = w.data(), S.phase = phase.data(), S.slot_id = slot_id.data(), S.rest = rest.data();
     S.rsdf = rsdf.data(), S.pred = pred.data();
     S.key = key.data(), S.order = order.data(), S.rank = rank.data();
     S.sx = sx.data(), S.sp = sp.data(), S.sp0 = sp0.data(), S.sv = sv.data(), S.tmp = tmp.data(), S.vtmp = vtmp.data();
@@ -267,6 +283,7 @@ struct ParticleSolver::Impl {
   // when solver.cuda_graph is set and the scene did not change since the last step.
   void advance(float dt, int k) {
     if (n == 0) return;
+    ++state_version;
     prepare_grid();
 #if SEAMLESS_HAS_CUDA
     if (dev == Device::CUDA) {
@@ -486,6 +503,10 @@ struct ParticleSolver::Impl {
       flags = K::phase::kCloth | static_cast<std::uint32_t>(cloth_groups++) | (b.self_collide ? K::phase::kSelfCollide : 0u);
     upload_at(x, first, b.x), upload_at(v, first, b.v), upload_at(w, first, b.inv_mass);
     upload_at(phase, first, std::vector<std::uint32_t>(static_cast<std::size_t>(m), flags));
+    std::vector<int> ids(static_cast<std::size_t>(m));
+    for (std::int64_t i = 0; i < m; ++i) ids[static_cast<std::size_t>(i)] = static_cast<int>(first + i);
+    upload_at(slot_id, first, ids);  // new particles: slot = id, after every slot in use
+    ++state_version;
     if (!b.rest.empty()) upload_at(rest, first, b.rest);
     if (!b.rsdf.empty()) upload_at(rsdf, first, b.rsdf);
     n += m;
@@ -666,7 +687,15 @@ ParticleState ParticleSolver::download_state() const {
     return v;
   };
   if (I.n == 0) return s;
-  s.x = cut(I.x.to_host()), s.v = cut(I.v.to_host()), s.inv_mass = cut(I.w.to_host()), s.phase = cut(I.phase.to_host());
+  // The slots' state, put in id order here.
+  const std::vector<int> ids = cut(I.slot_id.to_host());
+  const auto by_id = [&](auto slots) {
+    auto out = slots;
+    for (std::size_t k = 0; k < ids.size(); ++k) out[static_cast<std::size_t>(ids[k])] = slots[k];
+    return out;
+  };
+  s.x = by_id(cut(I.x.to_host())), s.v = by_id(cut(I.v.to_host()));
+  s.inv_mass = by_id(cut(I.w.to_host())), s.phase = by_id(cut(I.phase.to_host()));
   return s;
 }
 
@@ -680,8 +709,14 @@ std::vector<RigidFrame> ParticleSolver::rigid_frames() const {
 }
 
 const std::vector<int3>& ParticleSolver::cloth_triangles() const { return impl_->tris; }
-const vec3* ParticleSolver::device_positions() const { return impl_->x.data(); }
-const std::uint32_t* ParticleSolver::device_phases() const { return impl_->phase.data(); }
+const vec3* ParticleSolver::device_positions() const {
+  impl_->copy_to_id_order();
+  return impl_->x_id.data();
+}
+const std::uint32_t* ParticleSolver::device_phases() const {
+  impl_->copy_to_id_order();
+  return impl_->phase_id.data();
+}
 std::int64_t ParticleSolver::size() const { return impl_->n; }
 const SolverParams& ParticleSolver::params() const { return impl_->P; }
 Device ParticleSolver::device() const { return impl_->dev; }

@@ -84,6 +84,8 @@ class ParticleSolver {
   const std::vector<int3>& cloth_triangles() const;
   // Positions and phases of the size() particles in id order on device(), read-only, valid until
   // the next step or spawn (for CUDA-OpenGL interop: the renderer copies them device to device).
+  // The solver keeps its state in sorted order; the first call after a step copies it into id
+  // order (one kernel, on the default stream).
   const vec3* device_positions() const;
   const std::uint32_t* device_phases() const;
   std::int64_t size() const;
