@@ -73,7 +73,7 @@ SEAMLESS_HD inline bool both_fluid(std::uint32_t a, std::uint32_t b) {
 template <class Exec>
 inline constexpr bool kCachePairs = Exec::device == Device::CPU;
 
-// Calls use(k, j, gather(j)) with j = list[k * col] for a lane's entries k = g.lane,
+// Calls use(k, gather(j)) with j = list[k * col] for a lane's entries k = g.lane,
 // g.lane + g.size, ... below m, in k order (sums keep the order of a plain loop). gather(j)
 // loads what the pair needs of neighbour j; use does the math. On CUDA the entries come in
 // batches of kPairBatch: their indices, then all their gathers, then the math. At 1M particles
@@ -121,12 +121,12 @@ SEAMLESS_HD inline void for_each_entry(const int* list, std::int64_t col, int m,
       SEAMLESS_PHYS_UNROLL
       for (int u = 0; u < kPairBatch; ++u) v[u] = gather(j[u]);
       SEAMLESS_PHYS_UNROLL
-      for (int u = 0; u < kPairBatch; ++u) use(k + u * d, j[u], v[u]);
+      for (int u = 0; u < kPairBatch; ++u) use(k + u * d, v[u]);
     }
   }
   for (; k < m; k += d, at += step) {
     const int j = *at;
-    use(k, j, gather(j));
+    use(k, gather(j));
   }
 }
 
@@ -719,7 +719,7 @@ SEAMLESS_HD inline DensitySum density_part(const SimViews& S, int s, Lanes g) {
   Packed* const cache = S.pair_w + s * S.nbr_row;
   const std::int64_t col = S.nbr_col;
   const auto gather = [&](int j) { return S.spk[j]; };  // position and phase in one load
-  for_each_entry<kPairBatch1>(list, col, S.nnbr[s], g, gather, [&](int k, int, const Packed& q) {
+  for_each_entry<kPairBatch1>(list, col, S.nnbr[s], g, gather, [&](int k, const Packed& q) {
     const DensityPair<float, vec3> dp = density_pair<float>(W, inv_rho0, p - q.xyz());
     if constexpr (Cache) cache[k * col] = Packed::of(dp.gw, dp.wgt);
     // A solid neighbour's terms are scaled by sw and add nothing to sum2 (selects, not branches:
@@ -784,18 +784,14 @@ struct SolveSum {
 };
 SEAMLESS_HD inline SolveSum operator+(const SolveSum& a, const SolveSum& b) { return {a.acc + b.acc, a.f + b.f}; }
 
-// One fluid pair's term of the PBF sum: grad (lambda_i + lambda_j + s_corr), s_corr from the
-// pair's poly6 wgt (eq. 13, n = 4); F is float or the CPU's SIMD lanes (V their vec3).
+// One fluid pair's term of the PBF sum is grad times this factor, lambda_i + lambda_j + s_corr,
+// s_corr from the pair's poly6 wgt (eq. 13, n = 4); F is float or the CPU's SIMD lanes.
 // Without a branch: with s_corr off (scorr_k = 0), sc is -0 and li + lj + sc is li + lj to the bit.
 template <class F>
 SEAMLESS_HD inline F pbf_factor(const SimConstants& c, F wgt, F li, F lj) {
   const F q = wgt * c.scorr_inv_wdq;
   const F sc = -c.scorr_k * q * q * q * q;
   return li + lj + sc;
-}
-template <class F, class V>
-SEAMLESS_HD inline V pbf_pair(const SimConstants& c, V grad, F wgt, F li, F lj) {
-  return grad * pbf_factor(c, wgt, li, lj);
 }
 
 // The PBF position update of fluid particle s (eq. 12) with the artificial pressure s_corr
@@ -815,7 +811,7 @@ SEAMLESS_HD inline vec3 pbf_part(const SimViews& S, int s, Lanes g) {
     const bool fluid = !mixed || phase::is(S.sphase[j], phase::kFluid);
     return Gather1{Cached ? Packed{0.f, 0.f, 0.f, S.lambda[j]} : S.spl[j], fluid};
   };
-  for_each_entry<kPairBatch1>(S.nbrs(s), S.nbr_col, S.nnbr[s], g, gather, [&](int k, int, const Gather1& n) {
+  for_each_entry<kPairBatch1>(S.nbrs(s), S.nbr_col, S.nnbr[s], g, gather, [&](int k, const Gather1& n) {
     vec3 grad;
     float wgt, lj;
     if constexpr (Cached) {
@@ -1163,7 +1159,7 @@ SEAMLESS_HD inline vec3 fluid_forces(const SimViews& S, int s, Lanes g) {
     const bool fluid = !mixed || phase::is(S.sphase[j], phase::kFluid);
     return Gather2{S.spd[j], fluid ? S.cnv[j] : Packed{0.f, 0.f, 0.f, 0.f}, fluid};
   };
-  for_each_entry<kPairBatch2>(list, col, S.nnbr[s], g, gather, [&](int k, int, const Gather2& nb) {
+  for_each_entry<kPairBatch2>(list, col, S.nnbr[s], g, gather, [&](int k, const Gather2& nb) {
     const bool use = nb.fluid;  // solid neighbours add nothing
     const Packed q = nb.a, nv = nb.b;
     const vec3 r = p - q.xyz();
@@ -1245,7 +1241,7 @@ SEAMLESS_HD inline VortSum vorticity_part(const SimViews& S, int s, Lanes g) {
   const auto gather = [&](int j) {
     return Gather2{S.spd[j], S.svh[j], !mixed || phase::is(S.sphase[j], phase::kFluid)};
   };
-  for_each_entry<kPairBatch2>(list, col, S.nnbr[s], g, gather, [&](int k, int, const Gather2& nb) {
+  for_each_entry<kPairBatch2>(list, col, S.nnbr[s], g, gather, [&](int k, const Gather2& nb) {
     const Packed q = nb.a, vh = nb.b;
     const VortPair<float, vec3> d = vorticity_pair<Cache>(W, inv_rho0, coh_c, p - q.xyz(), vi, vh.xyz(), vh.w);
     if constexpr (Cache) S.pair_w[row + k * col] = Packed::of(d.grad, d.cf);
@@ -1495,8 +1491,8 @@ bool solve_tile(const SimViews& S, int s0) {
     gather_packed(S.spl, j, q, lj);
     const v3 r = p - q;
     const v3 grad = pair_grad(W, r);
-    const vf wgt = S.c.scorr_k > 0.f ? W.poly6(length2(r)) : vf(0.f);
-    tile_add<kMasked>(f, pbf_pair(S.c, grad, wgt, li, lj), in);
+    const vf wgt = W.poly6(length2(r));  // (s_corr off: unused, see pbf_factor)
+    tile_add<kMasked>(f, grad * pbf_factor(S.c, wgt, li, lj), in);
   };
   for (int k = 0; k < t.kmin; ++k) step(k, std::false_type{});
   for (int k = t.kmin; k < t.kmax; ++k) step(k, std::true_type{});
