@@ -45,6 +45,7 @@ struct SimConstants {
   float max_speed = 4.f;
   float omega = 1.f;                       // SOR factor of averaged constraints (Macklin 2014, eq. 11)
   float static_friction = 0.5f, kinetic_friction = 0.3f, restitution = 0.f;
+  float fluid_friction = 0.f;              // fluid against the scene and solids (0: fluids slip)
   // Position Based Fluids (Macklin & Mueller 2013), in number-density units.
   float h = 0.08f;                  // smoothing radius
   SphKernel W = SphKernel::make(0.08f);  // kernels of radius h (host: SphKernel::make(h))

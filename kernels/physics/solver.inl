@@ -312,6 +312,7 @@ SEAMLESS_HD inline vec3 contact_part(const SimViews& S, int s, const vec3* P, co
   const vec3 p = P[s], dx = p - X[s];
   const float ni = static_cast<float>(S.ncontacts[s]);
   const float mus = friction ? S.c.static_friction : 0.f, muk = friction ? S.c.kinetic_friction : 0.f;
+  const float fmu = friction ? S.c.fluid_friction : 0.f;
   vec3 acc{0.f, 0.f, 0.f};
   for (int k = g.lane, m = contact_list_len(S, s); k < m; k += g.size) {
     int j = S.nbrs(s)[k * S.nbr_col];
@@ -319,15 +320,16 @@ SEAMLESS_HD inline vec3 contact_part(const SimViews& S, int s, const vec3* P, co
     if (fl && phase::is(phj, phase::kFluid)) continue;
     PairGeom pg = pair_geometry(S, s, j, P);
     if (!pg.hit) continue;
-    bool any_fluid = fl || phase::is(phj, phase::kFluid);  // fluids slip
+    // Fluid against a solid: solver.fluid_friction for both coefficients (0: fluids slip).
+    bool any_fluid = fl || phase::is(phj, phase::kFluid);
     vec3 rel = dx - (P[j] - X[j]);
     float scale = S.c.omega / fmaxf(ni, static_cast<float>(S.ncontacts[j]));
-    acc += contact_delta(pg.n, pg.depth, rel, wi, S.sw[j], any_fluid ? 0.f : mus, any_fluid ? 0.f : muk) * scale;
+    acc += contact_delta(pg.n, pg.depth, rel, wi, S.sw[j], any_fluid ? fmu : mus, any_fluid ? fmu : muk) * scale;
   }
   const int ms = S.nsnbr[s];
   if (ms == 0) return acc;
   const float self = scene_contact_weight(S, s);
-  const float smu_s = fl ? 0.f : mus, smu_k = fl ? 0.f : muk;
+  const float smu_s = fl ? fmu : mus, smu_k = fl ? fmu : muk;
   for (int k = g.lane; k < ms; k += g.size) {
     vec3 r = p - S.stat[S.snbrs(s)[k * S.snbr_col]];
     float l2 = length2(r);
@@ -346,7 +348,8 @@ SEAMLESS_HD inline void add_sdf_contact(const SimViews& S, int s, const vec3* P,
   const vec4 q = S.sdf_at[s];  // scene_sdf(S.sdf, p), stored by count_contacts
   if (!(q.w < S.c.radius)) return;
   const bool fl = phase::is(S.sphase[s], phase::kFluid);
-  const float mu_s = friction && !fl ? S.c.static_friction : 0.f, mu_k = friction && !fl ? S.c.kinetic_friction : 0.f;
+  const float mu_s = !friction ? 0.f : fl ? S.c.fluid_friction : S.c.static_friction;
+  const float mu_k = !friction ? 0.f : fl ? S.c.fluid_friction : S.c.kinetic_friction;
   acc += contact_delta(xyz(q), S.c.radius - q.w, P[s] - X[s], S.sw[s], 0.f, mu_s, mu_k) * scene_contact_weight(S, s);
 }
 

@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -10,7 +11,9 @@
 #include "app/commands.hpp"
 #include "app/pipeline.hpp"
 #include "app/render_stage.hpp"
+#include "app/placement.hpp"
 #include "app/run_context.hpp"
+#include "app/run_summary.hpp"
 #include "config/config.hpp"
 #include "core/error.hpp"
 #include "physics/particle_solver.hpp"
@@ -26,25 +29,17 @@ int dry_run(const CommonOptions& o) {
   return 0;
 }
 
-// The floor as an infinite plane: parts of the floor the camera never saw (under and in front of
-// the desk, say) have no scene particles, and objects would fall through them. The plane sits at
-// the height below which 2% of the scene particles lie, if at least 5% of them are within 5 cm of
-// it (a floor is there); nullopt otherwise.
-std::optional<kernels::SceneSdf> floor_plane(const std::vector<vec3>& points, vec3 gravity) {
-  if (points.size() < 100 || length(gravity) == 0.f) return std::nullopt;
-  vec3 up = -normalize(gravity);
-  std::vector<float> h;
-  for (vec3 p : points) h.push_back(dot(p, up));
-  std::vector<float> sorted = h;
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 50, sorted.end());
-  float floor_h = sorted[sorted.size() / 50];
-  auto near = std::count_if(h.begin(), h.end(), [&](float v) { return std::fabs(v - floor_h) < 0.05f; });
-  if (near < static_cast<std::ptrdiff_t>(points.size() / 20)) return std::nullopt;
+// The floor as an infinite plane at the scanned floor's height: parts of the floor the camera
+// never saw (under and in front of the desk, say) have no scene particles, and objects would fall
+// through them. Only where a floor was seen (find_horizontal_surfaces): a plane invented under a
+// scan without one would stand in the air where the room is empty.
+std::optional<kernels::SceneSdf> floor_plane(const HorizontalSurface* floor, vec3 up) {
+  if (!floor) return std::nullopt;
   kernels::SceneSdf sdf{};
   sdf.count = 1;
   sdf.prims[0].kind = kernels::kSdfHalfSpace;
   sdf.prims[0].a = up;
-  sdf.prims[0].b = {floor_h, 0.f, 0.f};
+  sdf.prims[0].b = {floor->height, 0.f, 0.f};
   sdf.prims[0].R = mat3::identity();
   return sdf;
 }
@@ -66,17 +61,47 @@ SdfGrid scene_sdf_grid(Volume& volume, const Mesh& mesh, const Experiment& e) {
   return g;
 }
 
+void log_escaped(const EscapedParticles& x, std::size_t dynamic) {
+  if (x.total() == 0) return spdlog::info("physics: none of the {} dynamic particles left the scene", dynamic);
+  spdlog::warn("physics: {} of {} dynamic particles left the scene ({} below the floor, {} outside the scanned "
+               "region, {} still falling): holes in the scan (see docs/PLACEMENT.md, 'Physics on real scans')",
+               x.total(), dynamic, x.below_floor, x.outside, x.falling);
+}
+
+// The input's ground truth for ATE, when it has one (TUM folders: groundtruth.txt).
+std::string groundtruth_path(const InputParams& in) {
+  if (in.source != "tum") return "";
+  const std::string gt = in.path + "/groundtruth.txt";
+  return std::filesystem::exists(gt) ? gt : "";
+}
+
+std::vector<vec3> camera_positions(const Trajectory& tr) {
+  std::vector<vec3> out;
+  for (const TumPose& p : tr) out.push_back(p.se3().t);
+  return out;
+}
+
 int run(const CommonOptions& o) {
   if (o.dry_run) return dry_run(o);
   RunContext ctx(o);
-  const Experiment& e = ctx.experiment();
+  Experiment& e = ctx.experiment();
+  check_placements(e.spawn);  // before the scan: a malformed place costs no scan
+  if (e.render.camera == "recorded" && e.input.source == "kinect" && e.mode != "live")
+    throw Error("render.camera: recorded replays the input after the scan, which a live Kinect cannot; use "
+                "mode: live (each frame drawn from its own pose) or record first (`seamless record`)");
   auto renderer = RunRenderer::make(ctx);
+  RunSummary summary;
+  summary.command = "run", summary.config = o.config, summary.device = device_name(ctx.device());
+  if (ctx.device() == Device::CUDA) summary.device += std::string(" (") + cuda_device_description() + ")";
   if (e.mode == "live") {
     live(ctx, renderer.get());
     spdlog::info("outputs in {}", ctx.out_dir());
     return 0;
   }
   ScanResult scan_result = scan(ctx, true);
+  const Trajectory& traj = scan_result.tracking.trajectory;
+  summary.intrinsics = scan_result.intrinsics;
+  add_tracking(summary, scan_result.tracking, scan_result.unreadable, groundtruth_path(e.input));
   std::optional<SdfGrid> grid;
   if (e.solver.scene_collision == "sdf") grid = scene_sdf_grid(*scan_result.volume, scan_result.mesh, e);
   SceneParticleParams sp;
@@ -92,15 +117,48 @@ int run(const CommonOptions& o) {
   scene_state.inv_mass.assign(points.size(), 0.f);
   scene_state.phase.assign(points.size(), 0u);
   write_particles_ply(ctx.out_path("scene_particles.ply"), scene_state);
+
+  // The scene's horizontal surfaces with gravity (world -y after the tracker's gravity alignment).
+  PlacementScene ps;
+  ps.up = -normalize(e.solver.gravity);
+  ps.mesh = &scan_result.mesh;
+  ps.surfaces = find_horizontal_surfaces(scan_result.mesh, ps.up, camera_positions(traj));
+  ps.scene_points = &points;
+  ps.volume = scan_result.volume.get();
+  ps.trajectory = &traj;
+  ps.K = scan_result.intrinsics;
+  spdlog::info("scan: {}", describe_surfaces(ps.surfaces));
+  summary.placements = resolve_placements(e.spawn, e.solver, ps);
+  if (!summary.placements.empty() && e.output.write_config)
+    write_effective_config(e, ctx.out_path("config.yaml"));  // with the resolved positions
+  summary.spawns = e.spawn;
+
   if (renderer) {
-    const Trajectory& tr = scan_result.tracking.trajectory;
-    renderer->set_scene(scan_result.mesh, tr.empty() ? SE3::identity() : tr.front().se3());
+    renderer->set_scene(scan_result.mesh, traj.empty() ? SE3::identity() : traj.front().se3());
+    if (e.render.camera == "fixed" && !traj.empty())
+      renderer->set_kinect_frame(scan_result.first_frame, traj.front().se3());
   }
-  std::optional<kernels::SceneSdf> floor;
-  if (e.floor_plane) floor = floor_plane(points, e.solver.gravity);
+  const HorizontalSurface* floor_surface = e.floor_plane ? find_floor(ps.surfaces) : nullptr;
+  std::optional<kernels::SceneSdf> floor = floor_plane(floor_surface, ps.up);
   if (floor) spdlog::info("floor plane at height {:.3f} m along -gravity", floor->prims[0].b.x);
+  else if (e.floor_plane) spdlog::info("no floor plane: the scan shows no floor");
+  SceneBounds bounds;
+  bounds.up = ps.up;
+  if (floor_surface) bounds.floor = floor_surface->height;
+  if (!scan_result.mesh.positions.empty()) {
+    bounds.lo = bounds.hi = scan_result.mesh.positions[0];
+    for (vec3 p : scan_result.mesh.positions) bounds.lo = vmin(bounds.lo, p), bounds.hi = vmax(bounds.hi, p);
+  }
   if (grid) points.clear();  // collide with the TSDF instead of scene particles
-  simulate(ctx, points, floor ? &*floor : nullptr, renderer.get(), grid ? &*grid : nullptr);
+  Replay replay{&traj, e.render.replay_start};
+  const bool replaying = e.render.camera == "recorded" && renderer;
+  SimulationResult sim = simulate(ctx, points, floor ? &*floor : nullptr, renderer.get(), grid ? &*grid : nullptr,
+                                  replaying ? &replay : nullptr);
+  summary.physics = sim.stats;
+  summary.escaped = count_escaped(sim.state, bounds, e.solver.particle_diameter);
+  log_escaped(*summary.escaped, sim.state.x.size());
+  add_stage_medians(summary, ctx.timer());
+  write_summary(ctx.out_path("summary.json"), summary);
   spdlog::info("outputs in {}", ctx.out_dir());
   return 0;
 }

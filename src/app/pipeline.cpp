@@ -4,9 +4,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <optional>
 
+#include "core/error.hpp"
 #include "core/progress.hpp"
 #include "io/frame_source.hpp"
+#include "app/placement.hpp"
 #include "app/render_stage.hpp"
 #include "physics/builders.hpp"
 #include "physics/particle_solver.hpp"
@@ -23,6 +27,14 @@ TrackSequenceParams tracking_params(const Experiment& e) {
   p.max_frames = e.frames;
   p.write_files = e.output.write_trajectory;
   return p;
+}
+
+RgbdFrame host_copy(const RgbdFrame& f) {
+  RgbdFrame c;
+  c.index = f.index, c.timestamp = f.timestamp, c.intrinsics = f.intrinsics;
+  c.accelerometer = f.accelerometer, c.ground_truth = f.ground_truth;
+  c.rgb = f.rgb.clone(Device::CPU), c.depth = f.depth.clone(Device::CPU);
+  return c;
 }
 
 void log_volume(const VolumeStats& s) {
@@ -43,8 +55,13 @@ ScanResult scan(RunContext& ctx, bool with_volume) {
   std::int64_t total = e.frames > 0 ? e.frames : source->size().value_or(0);
   Progress progress("scan", total);
   std::int64_t n = 0;
-  auto on_frame = [&](const RgbdFrame&, const FrameRecord& rec) { progress.update(++n, to_string(rec.result.status)); };
+  r.intrinsics = source->intrinsics();
+  auto on_frame = [&](const RgbdFrame& f, const FrameRecord& rec) {
+    if (n == 0) r.first_frame = host_copy(f);
+    progress.update(++n, to_string(rec.result.status));
+  };
   r.tracking = track_sequence(*source, tracking_params(e), ctx.device(), ctx.out_dir(), r.volume.get(), on_frame);
+  r.unreadable = source->skipped_frames();
   progress.finish();
   for (const FrameRecord& f : r.tracking.frames) {
     ctx.timer().add(f.frame, "preprocess", f.preprocess_ms);
@@ -76,12 +93,14 @@ class SpawnQueue {
   SpawnQueue(const std::vector<SpawnParams>& spawns, const SolverParams& p) : pending_(spawns.begin(), spawns.end()) {
     check_spawn_capacity(spawns, p);  // the whole list fits, or an Error naming the entry
   }
-  // Before the step that starts at `time` (seconds).
-  void due(ParticleSolver& solver, double time) {
+  // Before the step that starts at `time` (seconds). `ready`, if given, may hold an entry back
+  // (live mode: its placement needs a surface not scanned yet); it is tried again next time.
+  void due(ParticleSolver& solver, double time, const std::function<bool(SpawnParams&)>& ready = {}) {
     for (auto it = pending_.begin(); it != pending_.end();)
-      if (it->time <= time + 1e-9) solver.spawn(*it), it = pending_.erase(it);
+      if (it->time <= time + 1e-9 && (!ready || ready(*it))) solver.spawn(*it), it = pending_.erase(it);
       else ++it;
   }
+  std::size_t pending() const { return pending_.size(); }
   void next_now(ParticleSolver& solver) {
     if (pending_.empty()) return spdlog::info("spawn: every configured object is spawned already");
     auto it = std::min_element(pending_.begin(), pending_.end(),
@@ -95,18 +114,83 @@ class SpawnQueue {
   std::vector<SpawnParams> pending_;
 };
 
-// simulate()'s loop: render_every solver steps per displayed frame.
+// The input frames of a replay in output order, each with its tracked pose and its time since the
+// replay began: forward from replay.start; when the simulation must last longer than that and the
+// recording is short enough to keep in memory, backward and forward again.
+class ReplayFrames {
+ public:
+  static constexpr std::int64_t kMaxKept = 64;  // frames kept for playing back and forth (~2 MB each)
+
+  ReplayFrames(const Experiment& e, Device d, const Replay& r)
+      : source_(make_source(e.input, d)), traj_(*r.trajectory), start_(r.start) {
+    const auto n = static_cast<std::int64_t>(traj_.size());
+    if (start_ >= n)
+      throw Error("render.replay_start is " + std::to_string(start_) + " but the scan tracked " + std::to_string(n) +
+                  " frames");
+    keep_ = n - start_ <= kMaxKept;
+    for (std::int64_t k = 0; k < start_; ++k)
+      if (!source_->next(frame_)) throw Error("the input ended before render.replay_start on the replay");
+  }
+  std::int64_t frames() const { return static_cast<std::int64_t>(traj_.size()) - start_; }
+
+  // The next output frame; false when the replay is over (min_duration seconds reached at the end
+  // of a pass, or the recording ended and is not kept).
+  bool next(double min_duration, const RgbdFrame*& frame, SE3& pose, double& time) {
+    if (!forward_done_) {
+      const std::int64_t k = start_ + static_cast<std::int64_t>(kept_.size()) + streamed_;
+      if (k < static_cast<std::int64_t>(traj_.size()) && source_->next(frame_)) {
+        advance_clock(frame_.timestamp);
+        pose = traj_[k].se3(), time = time_;
+        if (keep_) kept_.push_back({host_copy(frame_), pose});
+        else ++streamed_;
+        frame = keep_ ? &kept_.back().first : &frame_;
+        return true;
+      }
+      forward_done_ = true;
+      pos_ = static_cast<std::int64_t>(kept_.size()) - 1;
+    }
+    if (time_ >= min_duration || kept_.size() < 2) return false;
+    // Back and forth: turn at either end.
+    if (pos_ + dir_ < 0 || pos_ + dir_ >= static_cast<std::int64_t>(kept_.size())) dir_ = -dir_;
+    pos_ += dir_;
+    const auto& [f, p] = kept_[pos_];
+    advance_clock(f.timestamp);
+    frame = &f, pose = p, time = time_;
+    return true;
+  }
+
+ private:
+  // Time runs forward by the recording's frame interval whichever way the frames are played.
+  void advance_clock(double timestamp) {
+    if (have_last_) time_ += std::fabs(timestamp - last_stamp_);
+    last_stamp_ = timestamp, have_last_ = true;
+  }
+
+  std::unique_ptr<FrameSource> source_;
+  const Trajectory& traj_;
+  std::int64_t start_ = 0, streamed_ = 0, pos_ = 0, dir_ = 1;
+  bool keep_ = false, forward_done_ = false, have_last_ = false;
+  RgbdFrame frame_;
+  std::vector<std::pair<RgbdFrame, SE3>> kept_;
+  double time_ = 0.0, last_stamp_ = 0.0;
+};
+
+// simulate()'s loop: render_every solver steps per displayed frame, or with a replay the steps up
+// to the next replayed frame's time.
 class SimulationLoop : public FrameLoop {
  public:
-  SimulationLoop(RunContext& ctx, ParticleSolver& solver, RunRenderer* renderer)
+  SimulationLoop(RunContext& ctx, ParticleSolver& solver, RunRenderer* renderer, const Replay* replay)
       : ctx_(ctx), e_(ctx.experiment()), solver_(solver), renderer_(renderer), queue_(e_.spawn, e_.solver),
         steps_(static_cast<std::int64_t>(std::ceil(e_.duration / e_.solver.dt))),
         render_every_(std::max<std::int64_t>(1, std::llround(1.0 / (e_.render.fps * e_.solver.dt)))),
-        progress_("simulate", steps_) {}
+        replay_(replay ? std::make_unique<ReplayFrames>(e_, ctx.device(), *replay) : nullptr),
+        progress_(replay_ ? "replay" : "simulate", replay_ ? replay_->frames() : steps_) {}
 
   std::int64_t steps() const { return steps_; }
   std::int64_t done_steps() const { return k_; }
+  bool complete() const { return replay_ ? replay_done_ : k_ >= steps_; }
   bool advance() override {
+    if (replay_) return advance_replay();
     for (std::int64_t i = 0; i < render_every_ && k_ < steps_; ++i) step();
     return k_ < steps_;
   }
@@ -115,6 +199,20 @@ class SimulationLoop : public FrameLoop {
   void finish() { progress_.finish(); }
 
  private:
+  bool advance_replay() {
+    const RgbdFrame* frame = nullptr;
+    SE3 pose;
+    double t = 0.0;
+    if (replay_done_ || !replay_->next(e_.duration, frame, pose, t)) return !(replay_done_ = true);
+    while (time_ + 0.5 * e_.solver.dt <= t) step();
+    if (renderer_) {
+      renderer_->set_kinect_frame(*frame, pose);
+      renderer_->draw(solver_);
+    }
+    progress_.update(++replayed_);
+    return true;
+  }
+
   void step() {
     {
       StageScope s(ctx_.timer(), "physics");
@@ -123,11 +221,12 @@ class SimulationLoop : public FrameLoop {
       time_ += e_.solver.dt;
     }
     ctx_.timer().end_frame(k_);
-    if (renderer_ && k_ % render_every_ == 0) renderer_->draw(solver_);
+    if (renderer_ && !replay_ && k_ % render_every_ == 0) renderer_->draw(solver_);
     const int every = e_.output.particles_every;
     if (every > 0 && (k_ + 1) % every == 0)
       write_particles_ply(ctx_.out_path("particles_" + std::to_string(k_ + 1) + ".ply"), solver_.download_state());
-    progress_.update(++k_);
+    ++k_;
+    if (!replay_) progress_.update(k_);
   }
 
   RunContext& ctx_;
@@ -136,34 +235,42 @@ class SimulationLoop : public FrameLoop {
   RunRenderer* renderer_;
   SpawnQueue queue_;
   const std::int64_t steps_, render_every_;
+  std::unique_ptr<ReplayFrames> replay_;
   Progress progress_;
-  std::int64_t k_ = 0;
+  std::int64_t k_ = 0, replayed_ = 0;
+  bool replay_done_ = false;
   double time_ = 0.0;  // accumulated like the solver's clock, so spawns fall on the same steps
 };
 
 }  // namespace
 
-void simulate(RunContext& ctx, const std::vector<vec3>& scene_particles, const kernels::SceneSdf* sdf,
-              RunRenderer* renderer, const SdfGrid* grid) {
+SimulationResult simulate(RunContext& ctx, const std::vector<vec3>& scene_particles, const kernels::SceneSdf* sdf,
+                          RunRenderer* renderer, const SdfGrid* grid, const Replay* replay) {
   const Experiment& e = ctx.experiment();
   ParticleSolver solver(e.solver, ctx.device());
   if (!scene_particles.empty()) solver.add_static_particles(scene_particles);
   if (sdf) solver.set_scene_sdf(*sdf);
   if (grid) solver.set_scene_sdf_grid(grid->values, grid->dims, grid->origin, grid->voxel);
-  SimulationLoop loop(ctx, solver, renderer);  // checks the particle budget up front
-  spdlog::info("simulating {:.2f} s in {} steps of {} s on {} scene particles{}{}", e.duration, loop.steps(),
-               e.solver.dt, scene_particles.size(), sdf ? ", analytic SDF primitives" : "",
-               grid ? ", the TSDF sampled on a grid" : "");
+  SimulationLoop loop(ctx, solver, renderer, replay);  // checks the particle budget up front
+  if (replay)
+    spdlog::info("replaying input frames {}..{} from their tracked poses, simulating in the recording's time "
+                 "(at least {:.2f} s) in steps of {} s on {} scene particles{}{}",
+                 replay->start, replay->trajectory->size() - 1, e.duration, e.solver.dt, scene_particles.size(),
+                 sdf ? ", analytic SDF primitives" : "", grid ? ", the TSDF sampled on a grid" : "");
+  else
+    spdlog::info("simulating {:.2f} s in {} steps of {} s on {} scene particles{}{}", e.duration, loop.steps(),
+                 e.solver.dt, scene_particles.size(), sdf ? ", analytic SDF primitives" : "",
+                 grid ? ", the TSDF sampled on a grid" : "");
   if (renderer) renderer->run(loop);
   else
     while (loop.advance()) {
     }
   loop.finish();
-  if (loop.done_steps() < loop.steps())
-    spdlog::warn("stopped after {} of {} steps (window closed): the outputs hold the state reached", loop.done_steps(),
-                 loop.steps());
+  if (!loop.complete())
+    spdlog::warn("stopped after {} steps (window closed): the outputs hold the state reached", loop.done_steps());
   if (renderer) renderer->finish();
-  write_particles_ply(ctx.out_path("particles.ply"), solver.download_state());
+  SimulationResult result{solver.download_state(), solver.stats()};
+  write_particles_ply(ctx.out_path("particles.ply"), result.state);
   write_run_objects(ctx.out_path("objects.txt"), collect_run_objects(solver, e.spawn));  // for `seamless render`
   SolverStats st = solver.stats();
   spdlog::info("physics: {} particles ({} fluid, {} cloth, {} rigid in {} bodies), {} substeps/step, median {:.3f} ms "
@@ -172,6 +279,7 @@ void simulate(RunContext& ctx, const std::vector<vec3>& scene_particles, const k
                ctx.timer().median_ms("physics"), st.neighbour_overflow, st.static_neighbour_overflow);
   if (st.neighbour_overflow || st.static_neighbour_overflow)
     spdlog::warn("some particles had more neighbours than solver.max_neighbours / max_static_neighbours: raise them");
+  return result;
 }
 
 namespace {
@@ -196,13 +304,20 @@ class LiveLoop : public FrameLoop {
     const FrameRecord rec = session_.process(frame_);
     const auto k = static_cast<std::int64_t>(records_.size());
     if (traj_) traj_->write(frame_.timestamp, rec.result.world_T_camera);
+    poses_.push_back(TumPose::from_se3(frame_.timestamp, rec.result.world_T_camera));
     const bool reextract = rec.fused && (fused_++ % e_.reextract_every) == 0;
     if (reextract) extract_scene();
     if (fused_ > 0) {
       StageScope s(ctx_.timer(), "physics");
-      queue_.due(solver_, time_);
-      solver_.step();
-      time_ += e_.solver.dt;
+      if (!t0_) t0_ = frame_.timestamp;
+      // camera recorded: the simulation keeps the recording's time (several steps a frame);
+      // otherwise one step a frame, as the dissertation's live loop.
+      const double target = e_.render.camera == "recorded" ? frame_.timestamp - *t0_ : time_ + 0.5 * e_.solver.dt;
+      while (time_ + 0.5 * e_.solver.dt <= target) {
+        queue_.due(solver_, time_, [&](SpawnParams& sp) { return place_live(sp, rec.result.world_T_camera); });
+        solver_.step();
+        time_ += e_.solver.dt;
+      }
     }
     if (renderer_) {
       renderer_->set_kinect_frame(frame_, rec.result.world_T_camera);
@@ -225,6 +340,9 @@ class LiveLoop : public FrameLoop {
 
   void finish() {
     progress_.finish();
+    if (queue_.pending())
+      spdlog::warn("live: {} spawn entries were never spawned (their time or their placement's surface never "
+                   "came)", queue_.pending());
     if (renderer_) renderer_->finish();
     if (e_.output.write_stats) write_tracking_stats(ctx_.out_path("tracking_stats.csv"), records_);
     write_particles_ply(ctx_.out_path("particles.ply"), solver_.download_state());
@@ -240,10 +358,36 @@ class LiveLoop : public FrameLoop {
   void extract_scene() {
     StageScope s(ctx_.timer(), "extract");
     SceneParticles scene = volume_->extract_scene_particles(sp_);
-    std::vector<vec3> points = scene.positions.to_host();
-    points.resize(static_cast<std::size_t>(scene.count));
+    points_ = scene.positions.to_host();
+    points_.resize(static_cast<std::size_t>(scene.count));
     solver_.clear_static_particles();
-    solver_.add_static_particles(points);
+    solver_.add_static_particles(points_);
+  }
+
+  // A due entry with `place`: resolved against the surface scanned so far. Not yet possible (no
+  // such surface, or it would start inside the scan): held back until the next re-extraction.
+  bool place_live(SpawnParams& sp, const SE3& pose) {
+    if (!sp.place.active()) return true;
+    if (tried_at_ == fused_) return false;  // nothing new since the last try
+    tried_at_ = fused_;
+    const Mesh mesh = volume_->extract_mesh();
+    PlacementScene ps;
+    ps.up = -normalize(e_.solver.gravity);
+    ps.mesh = &mesh;
+    ps.surfaces = find_horizontal_surfaces(mesh, ps.up, {pose.t});
+    ps.scene_points = &points_;
+    ps.volume = volume_.get();
+    ps.trajectory = &poses_;
+    ps.K = source_->intrinsics();
+    std::vector<SpawnParams> one{sp};
+    try {
+      resolve_placements(one, e_.solver, ps);
+    } catch (const Error& err) {
+      spdlog::debug("live: placement not possible yet: {}", err.what());
+      return false;
+    }
+    sp.position = one[0].position;
+    return true;
   }
 
   RunContext& ctx_;
@@ -260,8 +404,11 @@ class LiveLoop : public FrameLoop {
   SceneParticleParams sp_;
   std::vector<FrameRecord> records_;
   RgbdFrame frame_;
-  std::int64_t fused_ = 0;
+  std::int64_t fused_ = 0, tried_at_ = -1;
   double time_ = 0.0;
+  std::optional<double> t0_;  // timestamp of the first fused frame
+  std::vector<vec3> points_;  // the scene particles of the last extraction
+  Trajectory poses_;          // tracked so far (pixel placements)
   bool finished_ = false;
 };
 

@@ -3,6 +3,8 @@
 #include <memory>
 
 #include "app/run_context.hpp"
+#include "io/frame_source.hpp"
+#include "physics/particle_solver.hpp"
 #include "recon/tracker_sequence.hpp"
 #include "recon/volume.hpp"
 #include "kernels/physics/scene_sdf.hpp"
@@ -13,6 +15,9 @@ struct ScanResult {
   std::unique_ptr<Volume> volume;  // null when tracking only
   TrackSequenceResult tracking;
   Mesh mesh;                       // marching cubes of the volume (empty when tracking only)
+  Intrinsics intrinsics{};         // of the frames (undistorted)
+  RgbdFrame first_frame;           // host copy of the first frame (the Kinect view's fixed camera)
+  std::int64_t unreadable = 0;     // frames the source skipped as unreadable
 };
 
 class RunRenderer;
@@ -36,8 +41,23 @@ struct SdfGrid {
   float voxel = 0.f;
 };
 
-// With a renderer, draws a frame every 1 / (render.fps * solver.dt) steps.
-void simulate(RunContext& ctx, const std::vector<vec3>& scene_particles, const kernels::SceneSdf* sdf,
-              RunRenderer* renderer = nullptr, const SdfGrid* grid = nullptr);
+// The recording replayed under the simulation (render.camera: recorded): output frame k is input
+// frame replay_start + k with its tracked pose, the solver advanced to that frame's time.
+struct Replay {
+  const Trajectory* trajectory = nullptr;  // one pose per input frame (the scan's)
+  std::int64_t start = 0;
+};
+
+struct SimulationResult {
+  ParticleState state;  // the last state, id order
+  SolverStats stats;
+};
+
+// With a renderer, draws a frame every 1 / (render.fps * solver.dt) steps; with a replay, one
+// frame per replayed input frame (then the simulation lasts as long as the replay, at least
+// experiment.duration: a recording shorter than that plays forward and back).
+SimulationResult simulate(RunContext& ctx, const std::vector<vec3>& scene_particles, const kernels::SceneSdf* sdf,
+                          RunRenderer* renderer = nullptr, const SdfGrid* grid = nullptr,
+                          const Replay* replay = nullptr);
 
 }  // namespace seamless::app

@@ -353,14 +353,21 @@ class GlRunRenderer : public RunRenderer {
   void set_scene(const Mesh& mesh, const SE3& scan_camera) override {
     if (p_.view != "mesh") return;
     renderer_.set_scene_mesh(mesh);
+    if (have_recorded_camera_) return;  // the recorded frames set it
     SceneCamera c = mesh_view_camera(mesh, scan_camera);
     camera_ = RenderCamera::look_at(c.eye, c.target, {0.f, 1.f, 0.f}, p_.fov_y, p_.width, p_.height, p_.znear, p_.zfar);
   }
 
   void set_kinect_frame(const RgbdFrame& frame, const SE3& world_T_camera) override {
-    if (p_.view != "kinect") return;
-    renderer_.set_kinect_view(frame.rgb, frame.depth, frame.intrinsics, world_T_camera);
-    camera_ = renderer_.kinect_camera();
+    if (p_.view == "kinect") {
+      renderer_.set_kinect_view(frame.rgb, frame.depth, frame.intrinsics, world_T_camera);
+      camera_ = renderer_.kinect_camera();
+    } else if (p_.camera == "recorded") {  // the mesh seen through the recorded camera
+      camera_.K = scale_intrinsics(frame.intrinsics, p_.width, p_.height);
+      camera_.world_T_camera = world_T_camera;
+      camera_.znear = p_.znear, camera_.zfar = p_.zfar;
+      have_recorded_camera_ = true;
+    }
   }
 
   void draw(const ParticleSolver& solver) override {
@@ -389,6 +396,7 @@ class GlRunRenderer : public RunRenderer {
   Renderer renderer_;
   HeadlessOutput out_;
   RenderCamera camera_{};
+  bool have_recorded_camera_ = false;
   RunDrawState draw_state_;
 #if SEAMLESS_HAS_CUDA
   std::unique_ptr<CudaGlParticles> interop_;

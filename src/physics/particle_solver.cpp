@@ -191,6 +191,7 @@ struct ParticleSolver::Impl {
     c.search_radius = std::max(c.h, 1.5f * d);
     c.max_speed = P.max_speed, c.omega = P.relaxation;
     c.static_friction = P.static_friction, c.kinetic_friction = P.kinetic_friction, c.restitution = P.restitution;
+    c.fluid_friction = P.fluid_friction;
     c.rest_density = rho0, c.relaxation = eps;
     c.scorr_k = P.tensile_k;
     float wdq = K::poly6(P.tensile_dq * P.tensile_dq * c.h * c.h, c.h);

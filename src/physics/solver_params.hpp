@@ -21,6 +21,7 @@ struct SolverParams {
   float static_friction = 0.5f;
   float kinetic_friction = 0.3f;
   float restitution = 0.f;
+  float fluid_friction = 0.f;           // fluid on the scene and on solids; 0: fluids slip (Macklin 2014)
   float rest_density = 1000.f;          // kg/m^3 (water)
   float viscosity = 0.01f;              // XSPH coefficient c (Macklin & Mueller 2013, eq. 17)
   float vorticity = 0.0001f;            // vorticity confinement epsilon (ibid., eq. 16)
@@ -62,6 +63,10 @@ struct SolverParams {
     v("static_friction", static_friction, "static friction coefficient", Range{0.0, 10.0});
     v("kinetic_friction", kinetic_friction, "kinetic friction coefficient", Range{0.0, 10.0});
     v("restitution", restitution, "coefficient of restitution", Range{0.0, 1.0});
+    v("fluid_friction", fluid_friction,
+      "friction coefficient of fluid on the scene and on solids (static and kinetic); 0: fluids slip. Real "
+      "water wets what it runs over: without it a film spreads without end over an unbounded floor",
+      Range{0.0, 10.0});
     v("rest_density", rest_density, "fluid rest density, kg/m^3", Range{1.0, 1e5});
     v("viscosity", viscosity, "XSPH viscosity coefficient", Range{0.0, 1.0});
     v("vorticity", vorticity, "vorticity confinement strength", Range{0.0, 10.0});
@@ -98,11 +103,34 @@ struct SolverParams {
   }
 };
 
+// Where a spawn entry goes relative to the scanned scene, resolved once the scene exists (after the
+// scan, or in live mode once the surface is there): on a horizontal surface found with gravity, or
+// on the surface seen at a pixel of a recorded frame. `on: none` and no pixel: `position` is used
+// as given (world metres). docs/PLACEMENT.md.
+struct PlaceParams {
+  std::string on = "none";            // support: the index-th largest horizontal surface that is not the floor
+  int index = 0;                      // 0 = largest
+  float above = 0.15f;                // metres above the surface (to the entry's centre)
+  std::vector<int> pixel;             // [u, v]: the surface seen at this pixel of frame `frame`
+  int frame = 0;                      // input frame whose camera the pixel belongs to
+
+  bool active() const { return on != "none" || !pixel.empty(); }
+  template <class V> void visit(V& v) {
+    v("on", on, "place on a scanned horizontal surface: support (largest that is not the floor), floor, or none",
+      Choices{"none", "support", "floor"});
+    v("index", index, "which surface: 0 = largest, 1 = second largest, ...", Range{0, 1000});
+    v("above", above, "height of the entry's centre above the surface, metres", Range{-10.0, 10.0});
+    v("pixel", pixel, "[u, v]: place on the surface seen at this pixel of input frame `frame`", Range{0, 1e5});
+    v("frame", frame, "input frame (0 = first) of the pixel pick", Range{0, 1e9});
+  }
+};
+
 // One thing to drop into the scene at time `time`. Which fields matter depends on `kind`.
 struct SpawnParams {
   std::string kind = "fluid_block";
   float time = 0.f;                   // seconds of simulated time
   vec3 position{0.f, 1.f, 0.f};       // world, metres (centre; emitter: nozzle)
+  PlaceParams place;                  // relative to the scan instead (resolved into position)
   vec3 size{0.2f, 0.2f, 0.2f};        // metres (fluid_block, rigid box/sphere bounding box)
   vec3 velocity{0.f, 0.f, 0.f};       // m/s (initial velocity; emitter: jet velocity)
   float rate = 500.f;                 // emitter: particles per second
@@ -124,6 +152,7 @@ struct SpawnParams {
     v("kind", kind, "what to spawn", Choices{"fluid_block", "emitter", "cloth", "rigid"});
     v("time", time, "when to spawn, seconds of simulated time", Range{0.0, 1e6});
     v("position", position, "centre (emitter: nozzle position), world metres");
+    v("place", place, "place relative to the scanned scene instead of `position` (resolved after the scan)");
     v("size", size, "extent, metres (fluid_block, rigid)");
     v("velocity", velocity, "initial velocity, m/s (emitter: jet velocity)");
     v("rate", rate, "emitter particles per second", Range{0.0, 1e8});

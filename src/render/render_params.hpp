@@ -13,6 +13,11 @@ struct RenderParams {
   int width = 1280;
   int height = 720;
   std::string view = "mesh";          // mesh: coloured scene mesh; kinect: live RGB with depth occlusion
+  // fixed: the mesh view from behind and above the first camera, the Kinect view from the first
+  // frame; recorded: output frame k is recorded frame k seen from its tracked pose, the simulation
+  // advancing by the recording's frame interval (scan_then_simulate replays the recording after the scan).
+  std::string camera = "fixed";
+  int replay_start = 0;               // recorded, scan_then_simulate: first input frame of the replay
   std::string fluid = "ssfr";         // screen-space fluid rendering (van der Laan 2009) or raw particles
   bool write_frames = false;
   bool video = false;
@@ -62,6 +67,12 @@ struct RenderParams {
     v("width", width, "framebuffer width, pixels", Range{16, 16384});
     v("height", height, "framebuffer height, pixels", Range{16, 16384});
     v("view", view, "scene as reconstructed mesh or as the Kinect's view", Choices{"mesh", "kinect"});
+    v("camera", camera,
+      "fixed: one viewpoint (mesh: behind the first camera; kinect: the first frame); recorded: replay the "
+      "recording, output frame k = input frame k from its tracked pose, simulation in the recording's time",
+      Choices{"fixed", "recorded"});
+    v("replay_start", replay_start, "camera recorded, scan_then_simulate: input frame the replay starts at",
+      Range{0, 1e9});
     v("fluid", fluid, "fluid drawing", Choices{"ssfr", "particles"});
     v("write_frames", write_frames, "write each rendered frame as PNG into the output folder");
     v("video", video, "encode the frames into a video (needs ffmpeg)");

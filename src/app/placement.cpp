@@ -1,0 +1,156 @@
+#include "app/placement.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <cstdio>
+#include <unordered_map>
+
+#include "core/error.hpp"
+#include "physics/builders.hpp"
+
+namespace seamless::app {
+namespace {
+
+std::string entry_name(int i, const SpawnParams& s) {
+  return "spawn[" + std::to_string(i) + "] (" + s.kind + ")";
+}
+
+std::string fmt_vec(vec3 v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "(%.3f, %.3f, %.3f)", v.x, v.y, v.z);
+  return buf;
+}
+
+// The surface point of a pixel pick: a ray from frame `frame`'s tracked camera through the pixel,
+// into the model (the volume's raycast, as a person points at a spot in a picture).
+vec3 pixel_point(int i, const SpawnParams& s, const PlacementScene& scene) {
+  const PlaceParams& pl = s.place;
+  const std::string who = entry_name(i, s) + ".place";
+  if (!scene.volume || !scene.trajectory) throw Error(who + ": a pixel pick needs the scan's volume and trajectory");
+  if (pl.frame >= static_cast<int>(scene.trajectory->size()))
+    throw Error(who + ".frame is " + std::to_string(pl.frame) + " but the scan has " +
+                std::to_string(scene.trajectory->size()) + " frames");
+  const int u = pl.pixel[0], v = pl.pixel[1];
+  if (u >= scene.K.width || v >= scene.K.height)
+    throw Error(who + ".pixel (" + std::to_string(u) + ", " + std::to_string(v) + ") is outside the " +
+                std::to_string(scene.K.width) + "x" + std::to_string(scene.K.height) + " image");
+  const SE3 pose = (*scene.trajectory)[pl.frame].se3();
+  RaycastMaps maps = scene.volume->raycast(scene.K, pose);
+  const std::vector<float> depth = maps.depth.to_host();
+  const std::vector<vec3> vertex = maps.vertex.to_host();
+  const std::size_t at = static_cast<std::size_t>(v) * scene.K.width + u;
+  if (!(depth[at] > 0.f)) {
+    std::size_t hits = 0;
+    for (float d : depth) hits += d > 0.f;
+    throw Error(who + ": pixel (" + std::to_string(u) + ", " + std::to_string(v) + ") of frame " +
+                std::to_string(pl.frame) + " sees no scanned surface (" +
+                std::to_string(100 * hits / depth.size()) + "% of that view does; pick a pixel on the scan)");
+  }
+  return vertex[at];
+}
+
+const HorizontalSurface& surface_pick(int i, const SpawnParams& s, const PlacementScene& scene) {
+  const PlaceParams& pl = s.place;
+  const std::string who = entry_name(i, s) + ".place";
+  if (pl.on == "floor") {
+    if (const HorizontalSurface* f = find_floor(scene.surfaces)) return *f;
+    throw Error(who + ": on floor, but no floor was seen in the scan; " + describe_surfaces(scene.surfaces));
+  }
+  const std::vector<const HorizontalSurface*> support = support_surfaces(scene.surfaces);
+  if (pl.index < static_cast<int>(support.size())) return *support[pl.index];
+  throw Error(who + ": on support, index " + std::to_string(pl.index) + ", but the scan has " +
+              std::to_string(support.size()) + " horizontal surface(s) larger than 0.04 m^2 besides the floor; " +
+              describe_surfaces(scene.surfaces));
+}
+
+// How many of the entry's particles would start closer than half a diameter to a scene particle
+// (inside the scanned geometry), against how many it has.
+std::pair<std::size_t, std::size_t> overlap(const SpawnParams& s, const SolverParams& p,
+                                            const std::vector<vec3>& scene) {
+  ParticleBatch b;
+  if (s.kind == "fluid_block") b = make_fluid_block(s, p);
+  else if (s.kind == "cloth") b = make_cloth(s, p);
+  else if (s.kind == "rigid") b = make_rigid(s, p);
+  else b = make_emitter_layer(s, p);
+  const float cell = p.particle_diameter, r = 0.5f * p.particle_diameter;
+  auto key = [cell](vec3 x) {
+    const auto c = [cell](float v) { return static_cast<std::int64_t>(std::floor(v / cell)) & 0x1fffff; };
+    return (c(x.x) << 42) | (c(x.y) << 21) | c(x.z);
+  };
+  std::unordered_map<std::int64_t, std::vector<vec3>> grid;
+  for (vec3 x : scene) grid[key(x)].push_back(x);
+  std::size_t inside = 0;
+  for (vec3 x : b.x) {
+    bool hit = false;
+    for (int dx = -1; dx <= 1 && !hit; ++dx)
+      for (int dy = -1; dy <= 1 && !hit; ++dy)
+        for (int dz = -1; dz <= 1 && !hit; ++dz) {
+          auto it = grid.find(key(x + vec3{dx * cell, dy * cell, dz * cell}));
+          if (it == grid.end()) continue;
+          for (vec3 q : it->second)
+            if (length(q - x) < r) { hit = true; break; }
+        }
+    inside += hit;
+  }
+  return {inside, b.x.size()};
+}
+
+}  // namespace
+
+void check_placements(const std::vector<SpawnParams>& spawns) {
+  for (int i = 0; i < static_cast<int>(spawns.size()); ++i) {
+    const PlaceParams& pl = spawns[i].place;
+    const std::string who = entry_name(i, spawns[i]) + ".place";
+    if (!pl.pixel.empty() && pl.pixel.size() != 2)
+      throw Error(who + ".pixel: expected [u, v] (two numbers), got " + std::to_string(pl.pixel.size()));
+    if (!pl.pixel.empty() && pl.on != "none")
+      throw Error(who + ": give either `on` (" + pl.on + ") or `pixel`, not both");
+  }
+}
+
+std::string describe_surfaces(const std::vector<HorizontalSurface>& surfaces) {
+  if (surfaces.empty()) return "the scan has no horizontal surface larger than 0.04 m^2";
+  std::string out = "largest horizontal surfaces: ";
+  for (std::size_t i = 0; i < surfaces.size() && i < 5; ++i) out += (i ? "; " : "") + describe(surfaces[i]);
+  return out;
+}
+
+std::vector<ResolvedPlacement> resolve_placements(std::vector<SpawnParams>& spawns, const SolverParams& solver,
+                                                  const PlacementScene& scene) {
+  check_placements(spawns);
+  std::vector<ResolvedPlacement> out;
+  for (int i = 0; i < static_cast<int>(spawns.size()); ++i) {
+    SpawnParams& s = spawns[i];
+    if (!s.place.active()) continue;
+    ResolvedPlacement r;
+    r.spawn = i;
+    if (!s.place.pixel.empty()) {
+      r.surface_point = pixel_point(i, s, scene);
+      r.how = "pixel (" + std::to_string(s.place.pixel[0]) + ", " + std::to_string(s.place.pixel[1]) + ") of frame " +
+              std::to_string(s.place.frame);
+    } else {
+      const HorizontalSurface& f = surface_pick(i, s, scene);
+      r.surface_point = f.centre;
+      r.how = "on " + s.place.on + (s.place.on == "support" ? " " + std::to_string(s.place.index) : "") + ": " +
+              describe(f);
+    }
+    r.position = r.surface_point + normalize(scene.up) * s.place.above;
+    s.position = r.position;
+    if (scene.scene_points && !scene.scene_points->empty()) {
+      const auto [inside, total] = overlap(s, solver, *scene.scene_points);
+      // A few particles of a sheet or block may graze the scan's noisy surface (each one is pushed
+      // out by its contact); a tenth inside means the entry starts in a wall or under the surface.
+      if (inside * 10 > total)
+        throw Error(entry_name(i, s) + ".place (" + r.how + ", " + std::to_string(s.place.above) +
+                    " m above) puts " + std::to_string(inside) + " of its " + std::to_string(total) +
+                    " particles inside the scanned geometry at " + fmt_vec(r.position) + ": raise `above`");
+    }
+    spdlog::info("place: {} at {} ({}, {:.2f} m above {})", entry_name(i, s), fmt_vec(r.position), r.how,
+                 s.place.above, fmt_vec(r.surface_point));
+    out.push_back(r);
+  }
+  return out;
+}
+
+}  // namespace seamless::app

@@ -1,0 +1,52 @@
+// What a run says about itself: which dynamic particles escaped the scanned scene, and summary.json
+// (docs/OUTPUTS.md), which scripts read instead of log lines.
+#pragma once
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/placement.hpp"
+#include "core/camera.hpp"
+#include "physics/particle_solver.hpp"
+#include "recon/tracker_sequence.hpp"
+
+namespace seamless::app {
+
+// Dynamic particles that left the scene at the end of a run. A particle counts once, in the
+// first class it falls in: below the floor (more than two diameters under it), outside the
+// scanned region (more than two diameters outside the scan's bounds), or still falling (moving
+// down faster than fall_speed: a particle at rest on a surface moves at most at settling speeds).
+struct EscapedParticles {
+  std::int64_t below_floor = 0, outside = 0, falling = 0;
+  std::int64_t total() const { return below_floor + outside + falling; }
+};
+struct SceneBounds {
+  vec3 lo{0, 0, 0}, hi{0, 0, 0};  // world bounds of the scanned mesh
+  std::optional<float> floor;     // floor height along up, when the floor was seen
+  vec3 up{0, 1, 0};
+};
+constexpr float kFallSpeed = 0.5f;  // m/s: free fall reaches it in 0.05 s (12 mm of drop)
+EscapedParticles count_escaped(const ParticleState& s, const SceneBounds& b, float diameter);
+
+struct RunSummary {
+  std::string command, config, device;
+  std::optional<Intrinsics> intrinsics;
+  std::int64_t frames_read = 0, frames_lost = 0, frames_fused = 0, frames_unreadable = 0;
+  std::optional<double> ate_rmse_m;    // against the input's ground truth, when it has one
+  std::int64_t ate_pairs = 0;
+  std::vector<ResolvedPlacement> placements;
+  std::vector<SpawnParams> spawns;     // as resolved
+  std::optional<SolverStats> physics;
+  std::optional<EscapedParticles> escaped;
+  std::vector<std::pair<std::string, double>> stage_median_ms;
+};
+
+// Frames, loss and ATE (when `groundtruth` is not empty) of a tracked sequence.
+void add_tracking(RunSummary& s, const TrackSequenceResult& r, std::int64_t unreadable,
+                  const std::string& groundtruth);
+// The medians of every stage in the run's timer.
+void add_stage_medians(RunSummary& s, const StageTimer& t);
+// Writes summary.json (to a temporary name, then renamed: a reader never sees half a file).
+void write_summary(const std::string& path, const RunSummary& s);
+
+}  // namespace seamless::app
