@@ -128,6 +128,32 @@ TEST(PhysicsFluid, DamBreakFollowsMartinMoyce) {
 // Scene 1 mixes tiles that take the vector path (fluid with fluid-only lists) with tiles that
 // decline (fluid next to static walls, a rigid cube that falls into the fluid, the cube); scene
 // 2 (a fluid block in an SDF box, no static particles) also takes find_neighbors' tiles.
+// solver.fluid_friction: a fluid particle sliding over a floor at v0 = 1 m/s. Position-based
+// friction (Macklin 2014, section 6.1) takes up to mu times the contact depth off the tangential
+// motion each substep; resting on the floor that depth is g dt^2 per substep, so the particle
+// decelerates at mu g (Coulomb) and stops after v0^2 / (2 mu g) = 0.102 m for mu = 0.5. The
+// discrete stop errs by at most one substep's travel (v0 dt / substeps = 5 mm) plus the last
+// static capture, hence 1.5 cm. Without it (0, the default) the particle keeps its speed.
+double slide_distance(float mu, float seconds) {
+  SolverParams p;
+  p.fluid_friction = mu;
+  ParticleSolver s(p, Device::CPU);
+  s.set_scene_sdf(test::half_space({0.f, 1.f, 0.f}, 0.f));
+  ParticleBatch b;
+  b.kind = ParticleBatch::kFluid;
+  b.x = {{0.f, 0.5f * p.particle_diameter, 0.f}};
+  b.v = {{1.f, 0.f, 0.f}};
+  b.inv_mass = {1.f};
+  s.add_batch(b);
+  for (int i = 0; i < static_cast<int>(std::lround(seconds / p.dt)); ++i) s.step();
+  return s.download_state().x[0].x;
+}
+
+TEST(PhysicsFluid, FrictionOnTheSceneStopsASlideAtCoulombsDistance) {
+  EXPECT_NEAR(slide_distance(0.5f, 0.5f), 1.0 / (2 * 0.5 * 9.81), 0.015);
+  EXPECT_NEAR(slide_distance(0.f, 0.5f), 0.5, 0.01);  // slips: 1 m/s for 0.5 s
+}
+
 TEST(FluidSimd, TilesGiveTheScalarLoopsStatesBitForBit) {
   if (!kernels::simd::cpu_simd()) GTEST_SKIP() << "this CPU has no AVX2: the SIMD tiles do not run";
   auto run = [](bool simd, bool walls) {

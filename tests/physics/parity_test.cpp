@@ -19,9 +19,10 @@ struct SimRun {
 
 // Fluid in a box of scene particles, a rigid cube and a cloth falling onto it; a second cube is
 // spawned at 0.05 s, so that the scene changes during the run (a CUDA graph is captured again).
-SimRun run(Device dev, bool graph = true, int steps = 10) {
+SimRun run(Device dev, bool graph = true, int steps = 10, float fluid_friction = 0.f) {
   SolverParams p;
   p.cuda_graph = graph;
+  p.fluid_friction = fluid_friction;
   ParticleSolver s(p, dev);
   const float d = p.particle_diameter;
   s.add_static_particles(test::static_box({-0.3f, 0.f, -0.3f}, {0.3f, 0.4f, 0.3f}, d));
@@ -51,6 +52,17 @@ TEST(PhysicsParity, CpuAndCudaAgree) {
   float worst = 0.f;
   for (std::size_t i = 0; i < a.x.size(); ++i) worst = std::max(worst, length(a.x[i] - b.x[i]));
   std::printf("parity: largest CPU/CUDA position difference %.3g m\n", worst);
+  EXPECT_LT(worst, 1e-4f);
+}
+
+// The same with solver.fluid_friction (the fluid's friction on the walls, the cube and the cloth).
+TEST(PhysicsParity, CpuAndCudaAgreeWithFluidFriction) {
+  if (!cuda_available()) GTEST_SKIP() << "no CUDA device";
+  ParticleState a = run(Device::CPU, true, 10, 0.5f).state, b = run(Device::CUDA, true, 10, 0.5f).state;
+  ASSERT_EQ(a.x.size(), b.x.size());
+  float worst = 0.f;
+  for (std::size_t i = 0; i < a.x.size(); ++i) worst = std::max(worst, length(a.x[i] - b.x[i]));
+  std::printf("parity (fluid friction 0.5): largest CPU/CUDA position difference %.3g m\n", worst);
   EXPECT_LT(worst, 1e-4f);
 }
 
