@@ -144,7 +144,8 @@ int run(const CommonOptions& o) {
   else if (e.floor_plane) spdlog::info("no floor plane: the scan shows no floor");
   SceneBounds bounds;
   bounds.up = ps.up;
-  if (floor_surface) bounds.floor = floor_surface->height;
+  if (floor_surface) bounds.floor = summary.floor_height = floor_surface->height;
+  summary.surfaces = ps.surfaces;
   if (!scan_result.mesh.positions.empty()) {
     bounds.lo = bounds.hi = scan_result.mesh.positions[0];
     for (vec3 p : scan_result.mesh.positions) bounds.lo = vmin(bounds.lo, p), bounds.hi = vmax(bounds.hi, p);

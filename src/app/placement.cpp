@@ -64,6 +64,24 @@ const HorizontalSurface& surface_pick(int i, const SpawnParams& s, const Placeme
               describe_surfaces(scene.surfaces));
 }
 
+// The surface's centre moved by place.offset along world x and z, onto the surface: the nearest of
+// its cells (within a cell's diagonal), at that cell's height.
+vec3 offset_point(int i, const SpawnParams& s, const HorizontalSurface& f, vec3 up) {
+  const vec3 target = f.centre + vec3{s.place.offset[0], 0.f, s.place.offset[1]};
+  float best = 1e30f;
+  vec3 at = f.centre;
+  for (vec3 c : f.cells) {
+    const vec3 d = c - target;
+    const float across = dot(d, d) - dot(d, up) * dot(d, up);
+    if (across < best) best = across, at = c;
+  }
+  if (std::sqrt(best) > f.cell * std::sqrt(2.f))
+    throw Error(entry_name(i, s) + ".place.offset [" + std::to_string(s.place.offset[0]) + ", " +
+                std::to_string(s.place.offset[1]) + "] leaves the surface (" + describe(f) + ") by " +
+                std::to_string(std::sqrt(best)) + " m: the point " + fmt_vec(target) + " is not on it");
+  return at;
+}
+
 // How many of the entry's particles would start closer than half a diameter to a scene particle
 // (inside the scanned geometry), against how many it has.
 std::pair<std::size_t, std::size_t> overlap(const SpawnParams& s, const SolverParams& p,
@@ -106,6 +124,10 @@ void check_placements(const std::vector<SpawnParams>& spawns) {
       throw Error(who + ".pixel: expected [u, v] (two numbers), got " + std::to_string(pl.pixel.size()));
     if (!pl.pixel.empty() && pl.on != "none")
       throw Error(who + ": give either `on` (" + pl.on + ") or `pixel`, not both");
+    if (!pl.offset.empty() && pl.offset.size() != 2)
+      throw Error(who + ".offset: expected [x, z] (two numbers), got " + std::to_string(pl.offset.size()));
+    if (!pl.offset.empty() && pl.on == "none")
+      throw Error(who + ".offset moves an `on:` placement across its surface; it needs `on: support` or `on: floor`");
   }
 }
 
@@ -131,7 +153,7 @@ std::vector<ResolvedPlacement> resolve_placements(std::vector<SpawnParams>& spaw
               std::to_string(s.place.frame);
     } else {
       const HorizontalSurface& f = surface_pick(i, s, scene);
-      r.surface_point = f.centre;
+      r.surface_point = s.place.offset.empty() ? f.centre : offset_point(i, s, f, scene.up);
       r.how = "on " + s.place.on + (s.place.on == "support" ? " " + std::to_string(s.place.index) : "") + ": " +
               describe(f);
     }

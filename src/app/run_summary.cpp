@@ -91,6 +91,15 @@ void write_summary(const std::string& path, const RunSummary& s) {
   j << "  \"frames\": {\"read\": " << s.frames_read << ", \"lost\": " << s.frames_lost
     << ", \"fused\": " << s.frames_fused << ", \"unreadable\": " << s.frames_unreadable << "},\n";
   if (s.ate_rmse_m) j << "  \"ate\": {\"rmse_m\": " << num(*s.ate_rmse_m) << ", \"pairs\": " << s.ate_pairs << "},\n";
+  if (s.floor_height) j << "  \"floor_height\": " << num(*s.floor_height) << ",\n";
+  j << "  \"surfaces\": [";
+  for (std::size_t i = 0; i < s.surfaces.size() && i < 10; ++i) {
+    const HorizontalSurface& h = s.surfaces[i];
+    j << (i ? ", " : "") << "{\"area_m2\": " << num(h.area) << ", \"height\": " << num(h.height)
+      << ", \"centre\": " << vec(h.centre) << ", \"open_radius\": " << num(h.open_radius)
+      << ", \"floor\": " << (h.floor ? "true" : "false") << "}";
+  }
+  j << "],\n";
   j << "  \"spawns\": [";
   for (std::size_t i = 0; i < s.spawns.size(); ++i) {
     const SpawnParams& sp = s.spawns[i];

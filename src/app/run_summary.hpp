@@ -38,6 +38,8 @@ struct RunSummary {
   std::vector<SpawnParams> spawns;     // as resolved
   std::optional<SolverStats> physics;
   std::optional<EscapedParticles> escaped;
+  std::optional<float> floor_height;   // of the floor found in the scan (along up), when one was seen
+  std::vector<HorizontalSurface> surfaces;  // the scan's horizontal surfaces, largest first
   std::vector<std::pair<std::string, double>> stage_median_ms;
 };
 

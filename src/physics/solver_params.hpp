@@ -111,6 +111,7 @@ struct PlaceParams {
   std::string on = "none";            // support: the index-th largest horizontal surface that is not the floor
   int index = 0;                      // 0 = largest
   float above = 0.15f;                // metres above the surface (to the entry's centre)
+  std::vector<float> offset;          // [x, z]: metres from the surface's centre along world x and z
   std::vector<int> pixel;             // [u, v]: the surface seen at this pixel of frame `frame`
   int frame = 0;                      // input frame whose camera the pixel belongs to
 
@@ -120,6 +121,8 @@ struct PlaceParams {
       Choices{"none", "support", "floor"});
     v("index", index, "which surface: 0 = largest, 1 = second largest, ...", Range{0, 1000});
     v("above", above, "height of the entry's centre above the surface, metres", Range{-10.0, 10.0});
+    v("offset", offset, "[x, z]: metres from the surface's centre along world x (right of the first camera) and z "
+      "(ahead of it); the point must lie on the surface", Range{-100.0, 100.0});
     v("pixel", pixel, "[u, v]: place on the surface seen at this pixel of input frame `frame`", Range{0, 1e5});
     v("frame", frame, "input frame (0 = first) of the pixel pick", Range{0, 1e9});
   }

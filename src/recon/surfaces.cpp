@@ -96,13 +96,14 @@ std::vector<HorizontalSurface> find_horizontal_surfaces(const Mesh& mesh, vec3 u
   std::vector<HorizontalSurface> s(n);
   std::vector<vec3> centroid(n, vec3{0, 0, 0});
   std::vector<double> area_h(n, 0.0);
-  for (HorizontalSurface& x : s) x.lo = {1e9f, 1e9f, 1e9f}, x.hi = {-1e9f, -1e9f, -1e9f};
+  for (HorizontalSurface& x : s) x.lo = {1e9f, 1e9f, 1e9f}, x.hi = {-1e9f, -1e9f, -1e9f}, x.cell = p.cell;
   for (const auto& [key, c] : cells) {
     HorizontalSurface& x = s[c.component];
     x.area += static_cast<float>(c.area);
     area_h[c.component] += c.area_h;
     centroid[c.component] += c.area_p;
     x.lo = vmin(x.lo, c.lo), x.hi = vmax(x.hi, c.hi);
+    x.cells.push_back(c.area_p * static_cast<float>(1.0 / c.area));
   }
   for (int i = 0; i < n; ++i) {
     s[i].height = static_cast<float>(area_h[i] / s[i].area);

@@ -17,6 +17,8 @@ struct HorizontalSurface {
   float open_radius = 0.f;  // metres of free surface around the centre (at most SurfaceParams::open_radius)
   vec3 lo{0, 0, 0}, hi{0, 0, 0};  // world bounds of its pieces
   bool floor = false;
+  std::vector<vec3> cells;  // the mean point of each of its grid cells (where it can be stood on)
+  float cell = 0.f;         // their size across the surface, metres
 };
 
 struct SurfaceParams {

@@ -5,10 +5,10 @@ config's own tracker, simulated for 3 s on the CPU without pictures. Checks, fro
 
 - summary.json: every spawn was placed on the same support surface (the desk, about 0.9 m below the
   first camera), no dynamic particle escaped, and the counts add up;
-- particles.ply against scene_particles.ply: every dynamic particle rests on something (a scene
-  particle, the floor plane or another dynamic particle within two diameters below it, inside a
-  column one diameter wide), none is below the desk's top by more than two diameters (none fell
-  through it), the fluid and the cloth are at rest (median speed below 0.3 m/s) and the cube
+- particles.ply against scene_particles.ply: every fluid and cube particle rests on something (a
+  scene particle, the floor plane or another dynamic particle within two diameters below it, inside
+  a column one diameter wide); each particle is on the desk or (water that ran over its edge) on the
+  floor, none in between or below; the cube and the cloth stay on the desk; the fluid and the cloth are at rest (median speed below 0.3 m/s) and the cube
   (the body that creeps first if friction fails) moves slower than 0.2 m/s.
 
 Usage: real_placement_test.py SEAMLESS ROOT DATA OUT; exit 77 (skip) without the data folder outside CI.
@@ -56,9 +56,10 @@ def main():
     diameter = 0.02  # configs/real/tum_desk.yaml solver.particle_diameter
     assert s["frames"]["read"] == 60 and s["frames"]["lost"] == 0, s["frames"]
     assert len(s["spawns"]) == 3 and all("placed" in sp for sp in s["spawns"]), s["spawns"]
-    surface = [sp["surface_point"] for sp in s["spawns"]]
-    assert all(np.allclose(p, surface[0]) for p in surface), "all three entries go to the same support surface"
-    desk_h = surface[0][1]  # world up is +y (gravity along -y)
+    # All three on the same support surface (its height within the 3 cm height bins of one surface).
+    heights = [sp["surface_point"][1] for sp in s["spawns"]]
+    assert max(heights) - min(heights) < 0.06, f"not on one surface: heights {heights}"
+    desk_h = min(heights)  # world up is +y (gravity along -y)
     # The desk of freiburg1_rpy lies 0.8-1.0 m below the hand-held camera (its first pose is the origin).
     assert -1.0 < desk_h < -0.8, f"support surface at height {desk_h}: not the desk"
     p = s["particles"]
@@ -69,15 +70,24 @@ def main():
     scene = read_ply(os.path.join(out, "scene_particles.ply"))["x"]
     x, v, ph = dyn["x"], dyn["v"], dyn["ph"]
     assert len(x) == p["dynamic"]
-    # Nothing fell through the desk: the lowest particle centre of a body resting on the desk top is
-    # one radius above it; two diameters allow for the scan's noise at ~1.5 m (a centimetre or two).
-    low = x[:, 1].min()
-    assert low > desk_h - 2 * diameter, f"a particle at height {low:.3f}, below the desk top {desk_h:.3f}"
-    # Every fluid and cube particle rests on something within two diameters below it (nothing floats
-    # or hangs in a hole). Cloth is held by its own edges where it drapes over something, so the
-    # sheet is checked by its speed instead.
+    # Everything is on the desk or, where water ran over its edge, on the floor: a particle centre
+    # resting on the floor is one radius above it, and two diameters allow for the scan's noise at
+    # ~1.5 m (a centimetre or two). The desk's scanned top is not flat to better than a few
+    # centimetres over its metre (noise, tilt of the gravity estimate), so "on the desk" is anything
+    # less than 10 cm below the height where the entries were placed; the rest-on-something check
+    # below pins each particle to the surface under it.
+    floor = s["floor_height"]
+    on_desk = x[:, 1] > desk_h - 0.1
+    on_floor = np.abs(x[:, 1] - floor) < 2 * diameter
+    assert (on_desk | on_floor).all(), f"particles neither on the desk nor on the floor: {x[~(on_desk | on_floor)][:5]}"
+    assert (ph[on_floor] & RIGID).sum() == 0 and (ph[on_floor] & CLOTH).sum() == 0, "the cube or the cloth fell off"
+    # Every fluid and cube particle rests on something within two diameters below it: a scene
+    # particle, the floor plane or another particle (nothing floats or hangs in a hole). Cloth is
+    # held by its own edges where it drapes over something, so the sheet is checked by its speed.
     support = np.concatenate([scene, x])
     for i in np.nonzero((ph & (FLUID | RIGID)) != 0)[0]:
+        if on_floor[i]:
+            continue
         d = x[i] - support
         below = (d[:, 1] > 0.1 * diameter) & (d[:, 1] <= 2 * diameter) & (np.hypot(d[:, 0], d[:, 2]) <= diameter)
         assert below.any(), f"particle {i} at {x[i]} has nothing within two diameters below it"
