@@ -5,8 +5,11 @@
 // A gap is filled only where two opposite neighbours (left/right, up/down or a diagonal pair) both
 // have depth and agree to `max_rel_diff` of their depth: then the pixel lies between two samples
 // of one surface and their mean is the linear interpolation at its centre. Next to a depth
-// discontinuity the pairs disagree and the pixel stays empty; wider holes stay empty.
+// discontinuity the pairs disagree and the pixel stays empty, as does a pixel of a wider hole that
+// no line through it crosses with measurements on both sides.
 #pragma once
+#include <cmath>
+
 #include "core/math.hpp"
 #include "core/view.hpp"
 

@@ -6,7 +6,9 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/exec.hpp"
 #include "core/log.hpp"
+#include "kernels/io/fill_gaps.hpp"
 
 namespace seamless {
 namespace {
@@ -129,6 +131,31 @@ void DepthScaleCheck::check(const Image<std::uint16_t>& raw, const std::string& 
       break;
   }
   done_ = true;
+}
+
+void fill_depth_gaps_host(const Image<float>& in, Image<float>& out) {
+  with_exec(Device::CPU, [&](const auto& ex) {
+    kernels::fill_depth_gaps(ex, in.cview(), out.view(), kernels::kFillGapsMaxRelDiff);
+  });
+}
+
+double fillable_gap_fraction(const Image<float>& depth) {
+  if (depth.buffer().size() == 0) return 0.0;
+  Image<float> filled(depth.width(), depth.height(), Device::CPU);
+  fill_depth_gaps_host(depth, filled);
+  std::int64_t n = 0;
+  const float *a = depth.buffer().data(), *b = filled.buffer().data();
+  for (std::int64_t i = 0; i < depth.buffer().size(); ++i) n += a[i] <= 0.f && b[i] > 0.f;
+  return static_cast<double>(n) / static_cast<double>(depth.buffer().size());
+}
+
+void hint_depth_gaps(const Image<float>& depth, const std::string& file) {
+  const double f = fillable_gap_fraction(depth);
+  if (f > kGapHint)
+    spdlog::warn("depth image '{}': {:.0f}% of the pixels are one-pixel gaps between two agreeing depths (depth "
+                 "registered to colour by forward projection); normals and fusion fail there, ICP may lose track: "
+                 "set input.fill_gaps: true",
+                 file, 100 * f);
 }
 
 float median_depth(const Image<float>& depth) {

@@ -68,6 +68,17 @@ class DepthScaleCheck {
   int frames_ = 0;
 };
 
+// One-pixel gaps of forward-registered depth (kernels/io/fill_gaps.hpp), on the host: input decoding.
+// in and out are host images of one size, out not in.
+void fill_depth_gaps_host(const Image<float>& in, Image<float>& out);
+// The fraction of all pixels that fill_depth_gaps_host would fill. Above kGapHint a source says once
+// that input.fill_gaps would help (normals and fusion fail at such pixels: the real frames_box_50
+// sample has 27% of its pixels in such gaps, and ICP loses every frame without filling them).
+double fillable_gap_fraction(const Image<float>& depth);
+inline constexpr double kGapHint = 0.05;
+// One warning naming `file` when depth has more than kGapHint of fillable gaps (a source's first frame).
+void hint_depth_gaps(const Image<float>& depth, const std::string& file);
+
 // Median of the valid depths (metres; every 7th pixel); 0 when none.
 float median_depth(const Image<float>& depth);
 // Throws an Error naming `file`, the median and input.depth_scale when the median depth lies outside

@@ -19,8 +19,6 @@
 #include "io/intrinsics_presets.hpp"
 #include "io/jpeg_io.hpp"
 #include "io/png_io.hpp"
-#include "core/exec.hpp"
-#include "kernels/io/fill_gaps.hpp"
 
 namespace seamless {
 namespace fs = std::filesystem;
@@ -238,10 +236,8 @@ void FrameFolderSource::load_frame(std::size_t i, RgbdFrame& frame) {
   float* d = depth.buffer().data();
   // 0 and 65535 both mean "no reading" (7-Scenes writes 65535).
   for (std::int64_t k = 0; k < raw.buffer().size(); ++k) d[k] = r[k] == 65535 ? 0.f : r[k] * inv;
-  if (params_.fill_gaps)  // on the host: this is input decoding
-    with_exec(Device::CPU, [&](const auto& ex) {
-      kernels::fill_depth_gaps(ex, gap_scratch_.cview(), frame.depth.view(), kernels::kFillGapsMaxRelDiff);
-    });
+  if (params_.fill_gaps) fill_depth_gaps_host(gap_scratch_, frame.depth);
+  if (!params_.fill_gaps && delivered_ == 0) hint_depth_gaps(frame.depth, depth_path);
   check_median_depth(frame.depth, scale_, depth_path);
   scale_check_->check(raw, depth_path);
   frame.rgb.buffer().copy_from(rgb.buffer());

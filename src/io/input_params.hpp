@@ -127,7 +127,7 @@ struct InputParams {
       "off for sensors of another geometry");
     v("fps", fps, "frame folders (source: frames): frame rate, timestamp = frame number / fps", Range{0.001, 1e6});
     v("fill_gaps", fill_gaps,
-      "tum, frames: fill one-pixel gaps of the depth (left by registering depth to colour by forward projection) "
+      "tum and frames: fill one-pixel gaps of the depth (left by registering depth to colour by forward projection) "
       "from two opposite neighbours that agree within 3% (kernels/io/fill_gaps.hpp)");
     v("intrinsics", intrinsics, "camera intrinsics");
     v("max_frames", max_frames, "stop after this many frames; 0 = all", Range{0, 1e12});

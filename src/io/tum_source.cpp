@@ -225,10 +225,15 @@ void TumSource::load_frame(const TumPair& pair, RgbdFrame& frame) {
   const bool undistort = K.dist[0] == 0.f && K_.dist[0] != 0.f;
   reserve_frame_images(frame, raw.width(), raw.height(), pinned_);
   if (undistort && scratch_.width() != raw.width()) scratch_ = Image<float>(raw.width(), raw.height(), Device::CPU);
+  if (params_.fill_gaps && gap_scratch_.width() != raw.width())
+    gap_scratch_ = Image<float>(raw.width(), raw.height(), Device::CPU);
   Image<float>& depth = undistort ? scratch_ : frame.depth;
+  Image<float>& decoded = params_.fill_gaps ? gap_scratch_ : depth;
   const double scale = effective_depth_scale(params_);
   const float inv = static_cast<float>(1.0 / scale);
-  for (std::int64_t i = 0; i < depth.buffer().size(); ++i) depth.buffer().data()[i] = raw.buffer().data()[i] * inv;
+  for (std::int64_t i = 0; i < depth.buffer().size(); ++i) decoded.buffer().data()[i] = raw.buffer().data()[i] * inv;
+  if (params_.fill_gaps) fill_depth_gaps_host(gap_scratch_, depth);
+  if (!params_.fill_gaps && delivered_ == 0) hint_depth_gaps(depth, depth_path);
   check_median_depth(depth, scale, depth_path);
   scale_check_->check(raw, depth_path);
   if (undistort) {  // on the host: this is input decoding

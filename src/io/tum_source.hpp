@@ -63,6 +63,7 @@ class TumSource : public FrameSource {
   Image<vec2> undistort_map_;                   // where each undistorted pixel comes from
   Image<uchar3> rgb_scratch_;                   // undistortion's source
   Image<float> scratch_;                        // depth before undistortion
+  Image<float> gap_scratch_;                    // input.fill_gaps: depth before its gaps are filled
   std::unique_ptr<DepthScaleCheck> scale_check_;  // depth_scale against the first frames' quantisation
   bool pinned_ = false;
   std::size_t next_ = 0;
