@@ -77,7 +77,10 @@ Image<uchar3> read_jpeg_rgb(const std::string& path) {
   jpeg_read_header(d.get(), TRUE);
   d->out_color_space = JCS_RGB;  // libjpeg converts YCbCr and greyscale; CMYK is an error above
   jpeg_start_decompress(d.get());
-  if (d->output_components != 3) longjmp(s->jb, 1);  // cannot happen with JCS_RGB; guards the memcpy below
+  if (const int channels = d->output_components; channels != 3) {  // not with JCS_RGB; guards the rows below
+    jpeg_destroy_decompress(d.get());
+    throw Error("JPEG file '" + path + "' decodes to " + std::to_string(channels) + " channels, not RGB");
+  }
   *img = Image<uchar3>(static_cast<int>(d->output_width), static_cast<int>(d->output_height), Device::CPU);
   auto* base = reinterpret_cast<JSAMPLE*>(img->buffer().data());
   while (d->output_scanline < d->output_height) {
