@@ -17,8 +17,9 @@ struct IntrinsicsParams {
   template <class V> void visit(V& v) {
     // TUM values from vision.in.tum.de/data/datasets/rgbd-dataset/file_formats; kinect_v1 is the
     // generic 525/319.5/239.5 set the TUM page gives for the default OpenNI calibration.
-    // auto: a TUM folder's calibration.txt (written by `seamless record`), else the freiburg preset
-    // its name contains, else kinect_v1 (also for the synthetic room and a live Kinect).
+    // auto: a folder's calibration.txt (written by `seamless record`), else its 3x3 K file
+    // (camera-intrinsics.txt or intrinsics.K.txt, frame folders), else the freiburg preset its name
+    // contains, else kinect_v1 (also for the synthetic room and a live Kinect).
     v("preset", preset, "intrinsics preset (fx fy cx cy below are used only for custom)",
       Choices{"auto", "freiburg1", "freiburg2", "freiburg3", "kinect_v1", "custom"});
     v("fx", fx, "focal length x, pixels (custom only)", Range{1.0, 1e5});
@@ -96,8 +97,11 @@ struct KinectParams {
 
 struct InputParams {
   std::string source = "synthetic";
-  std::string path;                 // TUM folder for source: tum
-  double depth_scale = 5000.0;      // TUM: 5000 units per metre
+  std::string path;                 // TUM folder (source: tum) or frame folder (source: frames)
+  double depth_scale = 0.0;         // units per metre; 0: the layout's own (TUM 5000, frames 1000)
+  bool check_depth_scale = true;    // compare depth_scale with the depth's Kinect quantisation
+  double fps = 30.0;                // frame folders: timestamp = frame number / fps
+  bool fill_gaps = false;           // close one-pixel gaps of forward-registered depth
   IntrinsicsParams intrinsics;
   std::int64_t max_frames = 0;      // 0 = all
   std::int64_t first_frame = 0;
@@ -111,9 +115,20 @@ struct InputParams {
   KinectParams kinect;
 
   template <class V> void visit(V& v) {
-    v("source", source, "frame source", Choices{"synthetic", "tum", "kinect"});
-    v("path", path, "dataset folder (source: tum), e.g. rgbd_dataset_freiburg1_desk");
-    v("depth_scale", depth_scale, "depth units per metre in the depth PNGs", Range{1.0, 1e6});
+    v("source", source, "frame source", Choices{"synthetic", "tum", "frames", "kinect"});
+    v("path", path,
+      "dataset folder: a TUM folder (source: tum), e.g. rgbd_dataset_freiburg1_desk, or a frame folder of "
+      "frame-NNNNNN.color/depth/pose files (source: frames)");
+    v("depth_scale", depth_scale,
+      "depth units per metre in the depth PNGs; 0: the layout's convention (tum 5000, frames 1000 = millimetres)",
+      Range{0.0, 1e6});
+    v("check_depth_scale", check_depth_scale,
+      "stop on a depth_scale that contradicts the depth images' Kinect v1 quantisation steps (docs/INPUT.md); "
+      "off for sensors of another geometry");
+    v("fps", fps, "frame folders (source: frames): frame rate, timestamp = frame number / fps", Range{0.001, 1e6});
+    v("fill_gaps", fill_gaps,
+      "tum and frames: fill one-pixel gaps of the depth (left by registering depth to colour by forward projection) "
+      "from two opposite neighbours that agree within 3% (kernels/io/fill_gaps.hpp)");
     v("intrinsics", intrinsics, "camera intrinsics");
     v("max_frames", max_frames, "stop after this many frames; 0 = all", Range{0, 1e12});
     v("first_frame", first_frame, "skip frames before this index", Range{0, 1e12});
@@ -134,5 +149,12 @@ struct InputParams {
     v("kinect", kinect, "live Kinect v1 settings (source: kinect)");
   }
 };
+
+// input.depth_scale as used: an explicit value, else (0) the convention of the source's layout:
+// TUM folders store 5000 units per metre, frame folders (7-Scenes, 3DMatch) millimetres.
+inline double effective_depth_scale(const InputParams& p) {
+  if (p.depth_scale > 0.0) return p.depth_scale;
+  return p.source == "frames" ? 1000.0 : 5000.0;
+}
 
 }  // namespace seamless

@@ -1,6 +1,7 @@
 #include "core/buffer.hpp"
 #include "core/device.hpp"
 #include "core/error.hpp"
+#include "io/frame_folder_source.hpp"
 #include "io/frame_source.hpp"
 #include "io/input_params.hpp"
 #include "io/synthetic_source.hpp"
@@ -15,6 +16,7 @@ namespace seamless {
 std::unique_ptr<FrameSource> make_source(const InputParams& params, Device device) {
   const bool pinned = device == Device::CUDA;
   if (params.source == "tum") return std::make_unique<TumSource>(params, pinned);
+  if (params.source == "frames") return std::make_unique<FrameFolderSource>(params, pinned);
   if (params.source == "synthetic") return std::make_unique<SyntheticSource>(params, device);
   if (params.source == "kinect") {
 #if SEAMLESS_HAS_FREENECT
@@ -23,7 +25,7 @@ std::unique_ptr<FrameSource> make_source(const InputParams& params, Device devic
     throw Error("input.source is kinect but this build has no libfreenect: apt-get install libfreenect-dev, reconfigure");
 #endif
   }
-  throw Error("unknown input.source '" + params.source + "': use synthetic, tum or kinect");
+  throw Error("unknown input.source '" + params.source + "': use synthetic, tum, frames or kinect");
 }
 
 namespace {

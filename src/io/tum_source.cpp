@@ -11,7 +11,9 @@
 #include "core/error.hpp"
 #include "core/exec.hpp"
 #include "core/log.hpp"
+#include "io/depth_scale.hpp"
 #include "io/intrinsics_presets.hpp"
+#include "io/jpeg_io.hpp"
 #include "io/png_io.hpp"
 #include "kernels/io/undistort.hpp"
 
@@ -71,17 +73,6 @@ std::vector<std::pair<double, vec3>> read_accelerometer(const std::string& path)
     out.push_back({t, vec3{static_cast<float>(-ax), static_cast<float>(-ay), static_cast<float>(az)}});
   }
   return out;
-}
-
-// Median of the valid depths (every 7th pixel is plenty): a wrong depth_scale shows here first.
-float median_depth(const Image<float>& depth) {
-  std::vector<float> v;
-  const float* d = depth.buffer().data();
-  for (std::int64_t i = 0; i < depth.buffer().size(); i += 7)
-    if (d[i] > 0.f) v.push_back(d[i]);
-  if (v.empty()) return 0.f;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
 }
 
 }  // namespace
@@ -177,7 +168,8 @@ TumSource::TumSource(const InputParams& params, bool pinned) : params_(params), 
   if (folder_.empty()) throw Error("input.path is empty: set it to a TUM RGB-D folder (source: tum)");
   if (!fs::is_directory(folder_))
     throw Error("input.path '" + folder_ + "' is not a folder: download one with datasets/download_tum.sh");
-  K_ = resolve_intrinsics(params.intrinsics, folder_);
+  std::string origin;
+  K_ = resolve_intrinsics(params.intrinsics, folder_, &origin);
   fs::path dir(folder_);
   pairs_ = tum_folder_pairs(folder_, params);
   if (pairs_.empty())
@@ -191,7 +183,11 @@ TumSource::TumSource(const InputParams& params, bool pinned) : params_(params), 
     throw Error("input.first_frame " + std::to_string(params.first_frame) + " is past the end of '" + folder_ + "'");
   if (fs::exists(dir / "groundtruth.txt")) groundtruth_ = read_tum_trajectory((dir / "groundtruth.txt").string());
   if (fs::exists(dir / "accelerometer.txt")) accel_ = read_accelerometer((dir / "accelerometer.txt").string());
+  scale_check_ = std::make_unique<DepthScaleCheck>(effective_depth_scale(params), params.check_depth_scale);
+  log_intrinsics("TUM folder '" + folder_ + "'", K_, origin);
 }
+
+TumSource::~TumSource() = default;
 
 Intrinsics TumSource::intrinsics() const {
   Intrinsics K = K_;
@@ -216,7 +212,7 @@ void TumSource::load_frame(const TumPair& pair, RgbdFrame& frame) {
   fs::path dir(folder_);
   std::string depth_path = (dir / pair.depth.file).string(), rgb_path = (dir / pair.rgb.file).string();
   Image<std::uint16_t> raw = read_png_u16(depth_path);
-  Image<uchar3> rgb = read_png_rgb(rgb_path);
+  Image<uchar3> rgb = read_colour_image(rgb_path);  // PNG or JPEG, by content
   if (raw.width() != K_.width || raw.height() != K_.height)
     throw Error("depth image '" + depth_path + "' is " + std::to_string(raw.width()) + "x" + std::to_string(raw.height()) +
                 " but input.intrinsics says " + std::to_string(K_.width) + "x" + std::to_string(K_.height));
@@ -229,15 +225,17 @@ void TumSource::load_frame(const TumPair& pair, RgbdFrame& frame) {
   const bool undistort = K.dist[0] == 0.f && K_.dist[0] != 0.f;
   reserve_frame_images(frame, raw.width(), raw.height(), pinned_);
   if (undistort && scratch_.width() != raw.width()) scratch_ = Image<float>(raw.width(), raw.height(), Device::CPU);
+  if (params_.fill_gaps && gap_scratch_.width() != raw.width())
+    gap_scratch_ = Image<float>(raw.width(), raw.height(), Device::CPU);
   Image<float>& depth = undistort ? scratch_ : frame.depth;
-  const float inv = static_cast<float>(1.0 / params_.depth_scale);
-  for (std::int64_t i = 0; i < depth.buffer().size(); ++i) depth.buffer().data()[i] = raw.buffer().data()[i] * inv;
-  float med = median_depth(depth);
-  if (med > 0.f && (med < 0.2f || med > 10.f))
-    throw Error("depth image '" + depth_path + "': median depth " + std::to_string(med) + " m with input.depth_scale " +
-                std::to_string(params_.depth_scale) + " is implausible for a Kinect (0.2-10 m); TUM uses 5000, " +
-                "millimetre depth needs 1000 (a scale of about " +
-                std::to_string(params_.depth_scale * med / 2.0) + " would put the median at 2 m)");
+  Image<float>& decoded = params_.fill_gaps ? gap_scratch_ : depth;
+  const double scale = effective_depth_scale(params_);
+  const float inv = static_cast<float>(1.0 / scale);
+  for (std::int64_t i = 0; i < depth.buffer().size(); ++i) decoded.buffer().data()[i] = raw.buffer().data()[i] * inv;
+  if (params_.fill_gaps) fill_depth_gaps_host(gap_scratch_, depth);
+  if (!params_.fill_gaps && delivered_ == 0) hint_depth_gaps(depth, depth_path);
+  check_median_depth(depth, scale, depth_path);
+  scale_check_->check(raw, depth_path);
   if (undistort) {  // on the host: this is input decoding
     with_exec(Device::CPU, [&](const auto& ex) {
       if (undistort_map_.width() != depth.width()) {

@@ -1,6 +1,7 @@
 // A TUM RGB-D benchmark folder (Sturm et al., IROS 2012): rgb.txt, depth.txt, optional
 // associations.txt / associate.txt, groundtruth.txt and accelerometer.txt, rgb/ and depth/ PNGs.
 #pragma once
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -10,6 +11,8 @@
 #include "io/trajectory.hpp"
 
 namespace seamless {
+
+class DepthScaleCheck;
 
 // One line of a TUM list file (rgb.txt, depth.txt): `timestamp filename`.
 struct TumListEntry {
@@ -35,6 +38,7 @@ class TumSource : public FrameSource {
  public:
   // pinned: frames in page-locked host memory (for a GPU pipeline; make_source decides).
   explicit TumSource(const InputParams& params, bool pinned = false);
+  ~TumSource() override;
   bool next(RgbdFrame& frame) override;
   std::optional<std::int64_t> size() const override { return static_cast<std::int64_t>(pairs_.size()); }
   std::string name() const override { return "tum:" + folder_; }
@@ -59,6 +63,8 @@ class TumSource : public FrameSource {
   Image<vec2> undistort_map_;                   // where each undistorted pixel comes from
   Image<uchar3> rgb_scratch_;                   // undistortion's source
   Image<float> scratch_;                        // depth before undistortion
+  Image<float> gap_scratch_;                    // input.fill_gaps: depth before its gaps are filled
+  std::unique_ptr<DepthScaleCheck> scale_check_;  // depth_scale against the first frames' quantisation
   bool pinned_ = false;
   std::size_t next_ = 0;
   std::int64_t delivered_ = 0;

@@ -324,11 +324,26 @@ TrackSequenceResult track_sequence(FrameSource& source, const TrackSequenceParam
   TrackSequenceResult out;
   RgbdFrame frame;
   std::vector<double> track_ms, frame_ms;
+  // The source's own poses, for evaluation: groundtruth.txt in this run's world frame (the first
+  // frame's ground truth maps onto its pose, the map the ground_truth tracker uses), at the same
+  // timestamps as trajectory.txt, so `seamless eval trajectory.txt groundtruth.txt` pairs them all.
+  std::unique_ptr<TrajectoryWriter> gt_writer;
+  SE3 world_T_gt = SE3::identity();
   while ((params.max_frames <= 0 || static_cast<std::int64_t>(out.frames.size()) < params.max_frames) &&
          source.next(frame)) {
     FrameRecord rec = session.process(frame);
     out.trajectory.push_back(TumPose::from_se3(frame.timestamp, rec.result.world_T_camera));
     if (writer) writer->write(out.trajectory.back());
+    if (out.frames.empty() && frame.ground_truth)
+      world_T_gt = rec.result.world_T_camera * frame.ground_truth->inverse();
+    if (frame.ground_truth) {
+      out.ground_truth.push_back(TumPose::from_se3(frame.timestamp, world_T_gt * *frame.ground_truth));
+      if (params.write_files && !gt_writer)
+        gt_writer = std::make_unique<TrajectoryWriter>(
+            out_dir + "/groundtruth.txt", "ground truth of " + source.name() + " (world_T_camera), in the world frame of "
+                                          "trajectory.txt: the first frame's ground truth is its pose there");
+      if (gt_writer) gt_writer->write(out.ground_truth.back());
+    }
     if (out.frames.size() > 0) track_ms.push_back(rec.track_ms);
     frame_ms.push_back(rec.frame_ms);
     if (!rec.result.ok())

@@ -99,6 +99,7 @@ class TrackingSession {
 
 struct TrackSequenceResult {
   Trajectory trajectory;             // one pose per frame (a lost frame: the last good pose)
+  Trajectory ground_truth;           // the source's poses of the frames that have one, in the same world frame
   std::vector<FrameRecord> frames;
   std::int64_t lost_frames = 0;
   GravityEstimate gravity;
@@ -107,7 +108,9 @@ struct TrackSequenceResult {
 };
 
 // Tracks every frame of `source` (up to params.max_frames), writes out_dir/trajectory.txt and
-// out_dir/tracking_stats.csv when params.write_files, and returns both in memory. on_frame, if
+// out_dir/tracking_stats.csv when params.write_files, and returns both in memory; frames with ground
+// truth (TUM groundtruth.txt, frame-folder pose files, the synthetic room) also give
+// out_dir/groundtruth.txt, their poses re-expressed in the run's world frame. on_frame, if
 // given, sees each frame after it was processed (progress, rendering).
 TrackSequenceResult track_sequence(FrameSource& source, const TrackSequenceParams& params, Device device,
                                    const std::string& out_dir, Volume* volume = nullptr,
