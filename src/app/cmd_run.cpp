@@ -68,11 +68,13 @@ void log_escaped(const EscapedParticles& x, std::size_t dynamic) {
                x.total(), dynamic, x.below_floor, x.outside, x.falling);
 }
 
-// The input's ground truth for ATE, when it has one (TUM folders: groundtruth.txt).
-std::string groundtruth_path(const InputParams& in) {
-  if (in.source != "tum") return "";
+// The input's ground truth for ATE, when it has one: the scan writes it beside trajectory.txt in
+// the same frame (any source with poses), else a TUM folder's own groundtruth.txt.
+std::string groundtruth_path(const RunContext& ctx) {
+  if (std::filesystem::exists(ctx.out_path("groundtruth.txt"))) return ctx.out_path("groundtruth.txt");
+  const InputParams& in = ctx.experiment().input;
   const std::string gt = in.path + "/groundtruth.txt";
-  return std::filesystem::exists(gt) ? gt : "";
+  return in.source == "tum" && std::filesystem::exists(gt) ? gt : "";
 }
 
 std::vector<vec3> camera_positions(const Trajectory& tr) {
@@ -101,7 +103,7 @@ int run(const CommonOptions& o) {
   ScanResult scan_result = scan(ctx, true);
   const Trajectory& traj = scan_result.tracking.trajectory;
   summary.intrinsics = scan_result.intrinsics;
-  add_tracking(summary, scan_result.tracking, scan_result.unreadable, groundtruth_path(e.input));
+  add_tracking(summary, scan_result.tracking, scan_result.unreadable, groundtruth_path(ctx));
   std::optional<SdfGrid> grid;
   if (e.solver.scene_collision == "sdf") grid = scene_sdf_grid(*scan_result.volume, scan_result.mesh, e);
   SceneParticleParams sp;
