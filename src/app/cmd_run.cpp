@@ -74,7 +74,7 @@ int run(const CommonOptions& o) {
   if (e.mode == "live") {
     live(ctx, renderer.get());
     spdlog::info("outputs in {}", ctx.out_dir());
-    return 0;
+    return ctx.exit_code();
   }
   ScanResult scan_result = scan(ctx, true);
   std::optional<SdfGrid> grid;
@@ -102,7 +102,7 @@ int run(const CommonOptions& o) {
   if (grid) points.clear();  // collide with the TSDF instead of scene particles
   simulate(ctx, points, floor ? &*floor : nullptr, renderer.get(), grid ? &*grid : nullptr);
   spdlog::info("outputs in {}", ctx.out_dir());
-  return 0;
+  return ctx.exit_code();
 }
 
 }  // namespace

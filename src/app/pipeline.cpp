@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/interrupt.hpp"
 #include "core/progress.hpp"
 #include "io/frame_source.hpp"
 #include "app/render_stage.hpp"
@@ -43,18 +44,19 @@ ScanResult scan(RunContext& ctx, bool with_volume) {
   std::int64_t total = e.frames > 0 ? e.frames : source->size().value_or(0);
   Progress progress("scan", total);
   std::int64_t n = 0;
-  auto on_frame = [&](const RgbdFrame&, const FrameRecord& rec) { progress.update(++n, to_string(rec.result.status)); };
-  r.tracking = track_sequence(*source, tracking_params(e), ctx.device(), ctx.out_dir(), r.volume.get(), on_frame);
-  progress.finish();
-  for (const FrameRecord& f : r.tracking.frames) {
-    ctx.timer().add(f.frame, "preprocess", f.preprocess_ms);
+  auto on_frame = [&](const RgbdFrame&, const FrameRecord& f) {
+    ctx.timer().add(f.frame, "preprocess", f.preprocess_ms);  // as it goes: a run that fails keeps them
     ctx.timer().add(f.frame, "track", f.track_ms);
     ctx.timer().add(f.frame, "fuse", f.fuse_ms);
     ctx.timer().add(f.frame, "frame", f.frame_ms);
-  }
+    progress.update(++n, to_string(f.result.status));
+  };
+  r.tracking = track_sequence(*source, tracking_params(e), ctx.device(), ctx.out_dir(), r.volume.get(), on_frame);
+  progress.finish();
   spdlog::info("{} frames from {} ({} unreadable, skipped); {} lost by tracking; median track {:.3f} ms, frame {:.3f} ms",
                r.tracking.frames.size(), source->name(), source->skipped_frames(), r.tracking.lost_frames,
                r.tracking.median_track_ms, r.tracking.median_frame_ms);
+  ctx.report_tracking(static_cast<std::int64_t>(r.tracking.frames.size()), r.tracking.lost_frames);
   if (r.volume) {
     log_volume(r.volume->stats());
     r.mesh = r.volume->extract_mesh();
@@ -107,8 +109,8 @@ class SimulationLoop : public FrameLoop {
   std::int64_t steps() const { return steps_; }
   std::int64_t done_steps() const { return k_; }
   bool advance() override {
-    for (std::int64_t i = 0; i < render_every_ && k_ < steps_; ++i) step();
-    return k_ < steps_;
+    for (std::int64_t i = 0; i < render_every_ && k_ < steps_ && !interrupted(); ++i) step();
+    return k_ < steps_ && !interrupted();
   }
   void spawn_next() override { queue_.next_now(solver_); }
   const ParticleSolver& solver() const override { return solver_; }
@@ -160,8 +162,8 @@ void simulate(RunContext& ctx, const std::vector<vec3>& scene_particles, const k
     }
   loop.finish();
   if (loop.done_steps() < loop.steps())
-    spdlog::warn("stopped after {} of {} steps (window closed): the outputs hold the state reached", loop.done_steps(),
-                 loop.steps());
+    spdlog::warn("stopped after {} of {} steps (window closed or interrupted): the outputs hold the state reached",
+                 loop.done_steps(), loop.steps());
   if (renderer) renderer->finish();
   write_particles_ply(ctx.out_path("particles.ply"), solver.download_state());
   write_run_objects(ctx.out_path("objects.txt"), collect_run_objects(solver, e.spawn));  // for `seamless render`
@@ -191,7 +193,8 @@ class LiveLoop : public FrameLoop {
   }
 
   bool advance() override {
-    if (finished_ || (total_ > 0 && static_cast<std::int64_t>(records_.size()) >= total_) || !source_->next(frame_))
+    if (finished_ || (total_ > 0 && static_cast<std::int64_t>(records_.size()) >= total_) || interrupted() ||
+        !source_->next(frame_))
       return !(finished_ = true);
     const FrameRecord rec = session_.process(frame_);
     const auto k = static_cast<std::int64_t>(records_.size());
@@ -223,10 +226,23 @@ class LiveLoop : public FrameLoop {
   void spawn_next() override { queue_.next_now(solver_); }
   const ParticleSolver& solver() const override { return solver_; }
 
+  // A frame failed: the statistics of the frames before it are written (the trajectory is as it goes).
+  void finish_failed() {
+    const auto n = static_cast<long long>(records_.size());
+    spdlog::error("the run stopped at frame {}: tracking_stats.csv holds the {} frames before it", n, n);
+    if (!e_.output.write_stats) return;
+    try {
+      write_tracking_stats(ctx_.out_path("tracking_stats.csv"), records_);
+    } catch (const std::exception& e) {
+      spdlog::error("{}", e.what());
+    }
+  }
+
   void finish() {
     progress_.finish();
     if (renderer_) renderer_->finish();
     if (e_.output.write_stats) write_tracking_stats(ctx_.out_path("tracking_stats.csv"), records_);
+    ctx_.report_tracking(static_cast<std::int64_t>(records_.size()), session_.lost_frames());
     write_particles_ply(ctx_.out_path("particles.ply"), solver_.download_state());
     write_run_objects(ctx_.out_path("objects.txt"), collect_run_objects(solver_, e_.spawn));  // for `seamless render`
     spdlog::info("live: {} frames ({} lost), median track {:.3f} ms, physics {:.3f} ms, extraction {:.3f} ms",
@@ -270,10 +286,15 @@ class LiveLoop : public FrameLoop {
 void live(RunContext& ctx, RunRenderer* renderer) {
   require_tracker(ctx.experiment().tracker.kind);
   LiveLoop loop(ctx, renderer);
-  if (renderer) renderer->run(loop);
-  else
-    while (loop.advance()) {
-    }
+  try {
+    if (renderer) renderer->run(loop);
+    else
+      while (loop.advance()) {
+      }
+  } catch (...) {
+    loop.finish_failed();
+    throw;
+  }
   loop.finish();
 }
 
