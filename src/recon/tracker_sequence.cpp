@@ -364,8 +364,11 @@ TrackSequenceResult track_sequence(FrameSource& source, const TrackSequenceParam
       } catch (const std::exception& e) {
         spdlog::error("{}", e.what());
       }
-      spdlog::error("the run stopped at frame {}: trajectory.txt and tracking_stats.csv hold the {} frames before it{}",
-                    n, n, n > 0 ? " (0-" + std::to_string(n - 1) + ")" : "");
+      if (n > 0)
+        spdlog::error("the run stopped at frame {}: trajectory.txt and tracking_stats.csv hold frames 0-{} before it",
+                      n, n - 1);
+      else
+        spdlog::error("the run stopped at frame 0, before any frame was tracked");
     } else {
       spdlog::error("the run stopped at frame {}, after {} frames", n, n);
     }
