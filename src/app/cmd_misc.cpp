@@ -7,6 +7,7 @@
 #include "app/run_context.hpp"
 #include "config/config.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "eval/trajectory_eval.hpp"
 #include "io/frame_source.hpp"
 #include "io/record.hpp"
@@ -72,6 +73,7 @@ struct RecordArgs {
   std::string config, source, out, device = "auto", path;
   std::vector<std::string> sets;
   std::int64_t frames = 0;
+  bool force = false;
 };
 
 int run_record(const RecordArgs& a) {
@@ -80,6 +82,8 @@ int run_record(const RecordArgs& a) {
   if (!a.path.empty()) sets.push_back("input.path=" + a.path);
   Experiment e = a.config.empty() ? parse_experiment("{}", sets, "<defaults>") : load_experiment(a.config, sets);
   auto source = make_source(e.input, resolve_device(a.device));
+  prepare_output_folder(a.out, a.force, {"rgb.txt", "depth.txt", "associations.txt"});
+  install_interrupt_handlers();  // record() stops after the frame being written
   RecordOptions o;
   o.max_frames = a.frames;
   std::int64_t n = record(*source, a.out, o);
@@ -97,7 +101,10 @@ void add_record_command(CLI::App& app, std::function<int()>& action) {
       ->check(CLI::IsMember({"synthetic", "tum", "kinect"}));
   cmd->add_option("--path", a->path, "TUM folder when --source tum");
   cmd->add_option("--out", a->out, "folder to write")->required();
-  cmd->add_option("--frames", a->frames, "stop after this many frames (0: until the source ends; Ctrl-C stops a Kinect)");
+  cmd->add_option("--frames", a->frames,
+                  "stop after this many frames (0: until the source ends; Ctrl-C stops after the frame being written, "
+                  "leaving a folder that loads)");
+  cmd->add_flag("--force", a->force, "write into a folder that holds an earlier recording after clearing it");
   cmd->add_option("--set", a->sets, "override a config key, e.g. --set input.synthetic.frames=30");
   cmd->add_option("--device", a->device, "where the synthetic room renders: cpu, cuda or auto");
   cmd->callback([&action, a] { action = [a] { return run_record(*a); }; });

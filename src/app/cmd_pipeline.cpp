@@ -1,8 +1,11 @@
 // reconstruct, track, simulate: the pipeline's parts run on their own (render: cmd_render.cpp).
+#include <spdlog/spdlog.h>
+
 #include "app/commands.hpp"
 #include "app/pipeline.hpp"
 #include "app/run_context.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "kernels/io/synthetic_room.hpp"
 #include "recon/refine/refine.hpp"
 
@@ -17,7 +20,7 @@ void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
     action = [rec] {
       RunContext ctx(*rec);
       scan(ctx, true);
-      return 0;
+      return ctx.exit_code();
     };
   });
   auto trk = std::make_shared<CommonOptions>();
@@ -29,12 +32,13 @@ void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
       const Experiment& e = ctx.experiment();
       require_refine(e.refine);  // before tracking: a missing Ceres is not found out 150 frames later
       ScanResult r = scan(ctx, false);
-      if (e.refine.enabled) {
+      if (e.refine.enabled && interrupted()) spdlog::warn("refine: skipped (interrupted)");
+      if (e.refine.enabled && !interrupted()) {
         std::vector<bool> tracked;
         for (const FrameRecord& f : r.tracking.frames) tracked.push_back(f.result.ok());
         refine_run(e.input, r.tracking.trajectory, tracked, e.refine, e.preprocess, ctx.device(), ctx.out_dir());
       }
-      return 0;
+      return ctx.exit_code();
     };
   });
   auto sim = std::make_shared<CommonOptions>();
@@ -45,13 +49,13 @@ void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
     action = [sim] {
       RunContext ctx(*sim);
       if (ctx.experiment().input.source != "synthetic")
-        throw Error("seamless simulate runs on the synthetic room's analytic scene (input.source: synthetic); to "
+        throw ConfigError("seamless simulate runs on the synthetic room's analytic scene (input.source: synthetic); to "
                     "simulate on a scanned scene use `seamless run` with mode: scan_then_simulate");
       kernels::SceneSdf sdf{};
       sdf.synthetic_room = 1;
       ctx.experiment().solver.gravity = kernels::room::gravity();  // the room's world is z up
       simulate(ctx, {}, &sdf);
-      return 0;
+      return ctx.exit_code();
     };
   });
 }

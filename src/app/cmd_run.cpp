@@ -89,7 +89,7 @@ int run(const CommonOptions& o) {
   Experiment& e = ctx.experiment();
   check_placements(e.spawn);  // before the scan: a malformed place costs no scan
   if (e.render.camera == "recorded" && e.input.source == "kinect" && e.mode != "live")
-    throw Error("render.camera: recorded replays the input after the scan, which a live Kinect cannot; use "
+    throw ConfigError("render.camera: recorded replays the input after the scan, which a live Kinect cannot; use "
                 "mode: live (each frame drawn from its own pose) or record first (`seamless record`)");
   auto renderer = RunRenderer::make(ctx);
   RunSummary summary;
@@ -98,7 +98,7 @@ int run(const CommonOptions& o) {
   if (e.mode == "live") {
     live(ctx, renderer.get());
     spdlog::info("outputs in {}", ctx.out_dir());
-    return 0;
+    return ctx.exit_code();
   }
   ScanResult scan_result = scan(ctx, true);
   const Trajectory& traj = scan_result.tracking.trajectory;
@@ -163,7 +163,7 @@ int run(const CommonOptions& o) {
   add_stage_medians(summary, ctx.timer());
   write_summary(ctx.out_path("summary.json"), summary);
   spdlog::info("outputs in {}", ctx.out_dir());
-  return 0;
+  return ctx.exit_code();
 }
 
 }  // namespace

@@ -1,11 +1,12 @@
-// The `seamless` command. Exit codes: 0 done, 1 error (message names the problem), 2 bad usage,
-// 3 the asked-for part of the pipeline is not built yet.
+// The `seamless` command. Exit codes: app/exit_codes.hpp (README, "Exit codes and interrupted runs").
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
 #include "app/bench.hpp"
 #include "app/commands.hpp"
+#include "app/exit_codes.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "core/log.hpp"
 #include "seamless/build_config.hpp"
 
@@ -14,6 +15,7 @@ int main(int argc, char** argv) {
   CLI::App app{"seamless: scan a room with a depth camera, then let virtual rigid bodies, cloth and fluid live in it"};
   app.require_subcommand(1);
   app.set_version_flag("--version", SEAMLESS_VERSION);
+  app.footer(app::kExitCodesHelp);
   bool quiet = false, verbose = false;
   app.add_flag("-q,--quiet", quiet, "warnings and errors only");
   app.add_flag("-v,--verbose", verbose, "debug output");
@@ -31,16 +33,35 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    return app.exit(e) == 0 ? app::kExitOk : app::kExitUsage;  // --help and --version exit 0
   }
   init_logging(quiet ? Verbosity::Quiet : verbose ? Verbosity::Verbose : Verbosity::Normal);
+  int code = app::kExitUsage;
   try {
-    return action ? action() : 2;
+    if (action) code = action();
+  } catch (const ConfigError& e) {
+    spdlog::error("{}", e.what());
+    code = app::kExitConfig;
+  } catch (const InputError& e) {
+    spdlog::error("{}", e.what());
+    code = app::kExitInput;
+  } catch (const UsageError& e) {
+    spdlog::error("{}", e.what());
+    code = app::kExitUsage;
   } catch (const Error& e) {
     spdlog::error("{}", e.what());
-    return 1;
+    code = app::kExitError;
   } catch (const std::exception& e) {
     spdlog::error("internal error: {}", e.what());
-    return 1;
+    code = app::kExitError;
   }
+  // A failure keeps its own code; a run that was stopped early otherwise says so, whatever it
+  // would have returned for the frames it did.
+  const bool failed = code != app::kExitOk && code != app::kExitLostFrames;
+  if (interrupted() && !failed) {
+    code = app::kExitSignalBase + interrupt_signal();
+    spdlog::warn("stopped by a signal: the outputs hold what was computed (exit code {})", code);
+  }
+  spdlog::default_logger()->flush();
+  return code;
 }

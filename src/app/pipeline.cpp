@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "core/progress.hpp"
 #include "io/frame_source.hpp"
 #include "app/placement.hpp"
@@ -56,22 +57,21 @@ ScanResult scan(RunContext& ctx, bool with_volume) {
   Progress progress("scan", total);
   std::int64_t n = 0;
   r.intrinsics = source->intrinsics();
-  auto on_frame = [&](const RgbdFrame& f, const FrameRecord& rec) {
-    if (n == 0) r.first_frame = host_copy(f);
-    progress.update(++n, to_string(rec.result.status));
+  auto on_frame = [&](const RgbdFrame& frame, const FrameRecord& f) {
+    ctx.timer().add(f.frame, "preprocess", f.preprocess_ms);  // as it goes: a run that fails keeps them
+    ctx.timer().add(f.frame, "track", f.track_ms);
+    ctx.timer().add(f.frame, "fuse", f.fuse_ms);
+    ctx.timer().add(f.frame, "frame", f.frame_ms);
+    if (n == 0) r.first_frame = host_copy(frame);
+    progress.update(++n, to_string(f.result.status));
   };
   r.tracking = track_sequence(*source, tracking_params(e), ctx.device(), ctx.out_dir(), r.volume.get(), on_frame);
   r.unreadable = source->skipped_frames();
   progress.finish();
-  for (const FrameRecord& f : r.tracking.frames) {
-    ctx.timer().add(f.frame, "preprocess", f.preprocess_ms);
-    ctx.timer().add(f.frame, "track", f.track_ms);
-    ctx.timer().add(f.frame, "fuse", f.fuse_ms);
-    ctx.timer().add(f.frame, "frame", f.frame_ms);
-  }
   spdlog::info("{} frames from {} ({} unreadable, skipped); {} lost by tracking; median track {:.3f} ms, frame {:.3f} ms",
                r.tracking.frames.size(), source->name(), source->skipped_frames(), r.tracking.lost_frames,
                r.tracking.median_track_ms, r.tracking.median_frame_ms);
+  ctx.report_tracking(static_cast<std::int64_t>(r.tracking.frames.size()), r.tracking.lost_frames);
   if (r.volume) {
     log_volume(r.volume->stats());
     r.mesh = r.volume->extract_mesh();
@@ -125,7 +125,7 @@ class ReplayFrames {
       : source_(make_source(e.input, d)), traj_(*r.trajectory), start_(r.start) {
     const auto n = static_cast<std::int64_t>(traj_.size());
     if (start_ >= n)
-      throw Error("render.replay_start is " + std::to_string(start_) + " but the scan tracked " + std::to_string(n) +
+      throw ConfigError("render.replay_start is " + std::to_string(start_) + " but the scan tracked " + std::to_string(n) +
                   " frames");
     keep_ = n - start_ <= kMaxKept;
     for (std::int64_t k = 0; k < start_; ++k)
@@ -191,8 +191,8 @@ class SimulationLoop : public FrameLoop {
   bool complete() const { return replay_ ? replay_done_ : k_ >= steps_; }
   bool advance() override {
     if (replay_) return advance_replay();
-    for (std::int64_t i = 0; i < render_every_ && k_ < steps_; ++i) step();
-    return k_ < steps_;
+    for (std::int64_t i = 0; i < render_every_ && k_ < steps_ && !interrupted(); ++i) step();
+    return k_ < steps_ && !interrupted();
   }
   void spawn_next() override { queue_.next_now(solver_); }
   const ParticleSolver& solver() const override { return solver_; }
@@ -203,7 +203,7 @@ class SimulationLoop : public FrameLoop {
     const RgbdFrame* frame = nullptr;
     SE3 pose;
     double t = 0.0;
-    if (replay_done_ || !replay_->next(e_.duration, frame, pose, t)) return !(replay_done_ = true);
+    if (replay_done_ || interrupted() || !replay_->next(e_.duration, frame, pose, t)) return !(replay_done_ = true);
     while (time_ + 0.5 * e_.solver.dt <= t) step();
     if (renderer_) {
       renderer_->set_kinect_frame(*frame, pose);
@@ -267,7 +267,8 @@ SimulationResult simulate(RunContext& ctx, const std::vector<vec3>& scene_partic
     }
   loop.finish();
   if (!loop.complete())
-    spdlog::warn("stopped after {} steps (window closed): the outputs hold the state reached", loop.done_steps());
+    spdlog::warn("stopped after {} steps (window closed or interrupted): the outputs hold the state reached",
+                 loop.done_steps());
   if (renderer) renderer->finish();
   SimulationResult result{solver.download_state(), solver.stats()};
   write_particles_ply(ctx.out_path("particles.ply"), result.state);
@@ -299,7 +300,8 @@ class LiveLoop : public FrameLoop {
   }
 
   bool advance() override {
-    if (finished_ || (total_ > 0 && static_cast<std::int64_t>(records_.size()) >= total_) || !source_->next(frame_))
+    if (finished_ || (total_ > 0 && static_cast<std::int64_t>(records_.size()) >= total_) || interrupted() ||
+        !source_->next(frame_))
       return !(finished_ = true);
     const FrameRecord rec = session_.process(frame_);
     const auto k = static_cast<std::int64_t>(records_.size());
@@ -338,6 +340,18 @@ class LiveLoop : public FrameLoop {
   void spawn_next() override { queue_.next_now(solver_); }
   const ParticleSolver& solver() const override { return solver_; }
 
+  // A frame failed: the statistics of the frames before it are written (the trajectory is as it goes).
+  void finish_failed() {
+    const auto n = static_cast<long long>(records_.size());
+    spdlog::error("the run stopped at frame {}: tracking_stats.csv holds the {} frames before it", n, n);
+    if (!e_.output.write_stats) return;
+    try {
+      write_tracking_stats(ctx_.out_path("tracking_stats.csv"), records_);
+    } catch (const std::exception& e) {
+      spdlog::error("{}", e.what());
+    }
+  }
+
   void finish() {
     progress_.finish();
     if (queue_.pending())
@@ -345,6 +359,7 @@ class LiveLoop : public FrameLoop {
                    "came)", queue_.pending());
     if (renderer_) renderer_->finish();
     if (e_.output.write_stats) write_tracking_stats(ctx_.out_path("tracking_stats.csv"), records_);
+    ctx_.report_tracking(static_cast<std::int64_t>(records_.size()), session_.lost_frames());
     write_particles_ply(ctx_.out_path("particles.ply"), solver_.download_state());
     write_run_objects(ctx_.out_path("objects.txt"), collect_run_objects(solver_, e_.spawn));  // for `seamless render`
     spdlog::info("live: {} frames ({} lost), median track {:.3f} ms, physics {:.3f} ms, extraction {:.3f} ms",
@@ -417,10 +432,15 @@ class LiveLoop : public FrameLoop {
 void live(RunContext& ctx, RunRenderer* renderer) {
   require_tracker(ctx.experiment().tracker.kind);
   LiveLoop loop(ctx, renderer);
-  if (renderer) renderer->run(loop);
-  else
-    while (loop.advance()) {
-    }
+  try {
+    if (renderer) renderer->run(loop);
+    else
+      while (loop.advance()) {
+      }
+  } catch (...) {
+    loop.finish_failed();
+    throw;
+  }
   loop.finish();
 }
 

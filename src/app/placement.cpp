@@ -29,11 +29,11 @@ vec3 pixel_point(int i, const SpawnParams& s, const PlacementScene& scene) {
   const std::string who = entry_name(i, s) + ".place";
   if (!scene.volume || !scene.trajectory) throw Error(who + ": a pixel pick needs the scan's volume and trajectory");
   if (pl.frame >= static_cast<int>(scene.trajectory->size()))
-    throw Error(who + ".frame is " + std::to_string(pl.frame) + " but the scan has " +
+    throw ConfigError(who + ".frame is " + std::to_string(pl.frame) + " but the scan has " +
                 std::to_string(scene.trajectory->size()) + " frames");
   const int u = pl.pixel[0], v = pl.pixel[1];
   if (u >= scene.K.width || v >= scene.K.height)
-    throw Error(who + ".pixel (" + std::to_string(u) + ", " + std::to_string(v) + ") is outside the " +
+    throw ConfigError(who + ".pixel (" + std::to_string(u) + ", " + std::to_string(v) + ") is outside the " +
                 std::to_string(scene.K.width) + "x" + std::to_string(scene.K.height) + " image");
   const SE3 pose = (*scene.trajectory)[pl.frame].se3();
   RaycastMaps maps = scene.volume->raycast(scene.K, pose);
@@ -121,13 +121,13 @@ void check_placements(const std::vector<SpawnParams>& spawns) {
     const PlaceParams& pl = spawns[i].place;
     const std::string who = entry_name(i, spawns[i]) + ".place";
     if (!pl.pixel.empty() && pl.pixel.size() != 2)
-      throw Error(who + ".pixel: expected [u, v] (two numbers), got " + std::to_string(pl.pixel.size()));
+      throw ConfigError(who + ".pixel: expected [u, v] (two numbers), got " + std::to_string(pl.pixel.size()));
     if (!pl.pixel.empty() && pl.on != "none")
-      throw Error(who + ": give either `on` (" + pl.on + ") or `pixel`, not both");
+      throw ConfigError(who + ": give either `on` (" + pl.on + ") or `pixel`, not both");
     if (!pl.offset.empty() && pl.offset.size() != 2)
-      throw Error(who + ".offset: expected [x, z] (two numbers), got " + std::to_string(pl.offset.size()));
+      throw ConfigError(who + ".offset: expected [x, z] (two numbers), got " + std::to_string(pl.offset.size()));
     if (!pl.offset.empty() && pl.on == "none")
-      throw Error(who + ".offset moves an `on:` placement across its surface; it needs `on: support` or `on: floor`");
+      throw ConfigError(who + ".offset moves an `on:` placement across its surface; it needs `on: support` or `on: floor`");
   }
 }
 

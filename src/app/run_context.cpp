@@ -8,6 +8,7 @@
 
 #include "config/config.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "core/log.hpp"
 
 namespace seamless::app {
@@ -20,6 +21,7 @@ void add_common_options(CLI::App& cmd, CommonOptions& o, bool config_required) {
   cmd.add_option("--set", o.sets, "override a config key: --set volume.voxel_size=0.01 (repeatable)")
       ->allow_extra_args(false);
   cmd.add_option("--out", o.out, "output folder (default: <output.dir>/<config name>-<date-time>)");
+  cmd.add_flag("--force", o.force, "write into an output folder that holds an earlier run after clearing it");
   cmd.add_option("--device", o.device, "cpu, cuda or auto (overrides the config's device)")
       ->check(CLI::IsMember({"cpu", "cuda", "auto"}));
 }
@@ -37,23 +39,56 @@ std::string timestamp() {
   std::strftime(buf, sizeof buf, "%Y%m%d-%H%M%S", std::localtime(&t));
   return buf;
 }
+
 }  // namespace
+
+void prepare_output_folder(const std::string& out, bool force, const std::vector<std::string>& marks) {
+  std::error_code ec;
+  if (fs::exists(out, ec) && !fs::is_directory(out, ec))
+    throw UsageError("the output folder " + out + " is a file; give --out a folder");
+  if (!fs::is_directory(out, ec)) return;
+  std::string found;
+  for (const std::string& m : marks)
+    if (fs::exists(fs::path(out) / m)) found += (found.empty() ? "" : ", ") + m;
+  if (found.empty()) return;
+  if (!force)
+    throw UsageError("the output folder " + out + " holds an earlier run (" + found + "); choose another --out, or add "
+                     "--force to clear it first");
+  std::vector<fs::path> entries;
+  for (const auto& entry : fs::directory_iterator(out)) entries.push_back(entry.path());
+  for (const fs::path& p : entries) fs::remove_all(p, ec);
+  if (!fs::is_empty(out, ec)) throw Error("--force: could not clear the output folder " + out);
+  spdlog::info("--force: cleared {} entries of the earlier run in {}", entries.size(), out);
+}
 
 RunContext::RunContext(const CommonOptions& o) : window_frames_(o.window_frames) {
   exp_ = load_experiment(o.config, overrides(o));
   device_ = resolve_device(exp_.device);
 
   out_ = o.out.empty() ? exp_.output.dir + "/" + fs::path(o.config).stem().string() + "-" + timestamp() : o.out;
+  prepare_output_folder(out_, o.force, {"config.yaml", "log.txt"});  // what every run writes first
   std::error_code ec;
   fs::create_directories(out_, ec);
   if (ec) throw Error("cannot create the output folder " + out_ + ": " + ec.message());
   log_to_file(out_path("log.txt"));
   if (exp_.output.write_config) write_effective_config(exp_, out_path("config.yaml"));
   timer_ = std::make_unique<StageTimer>(device_);
+  install_interrupt_handlers();
 
   std::string gpu = device_ == Device::CUDA ? " (" + cuda_device_description() + ")" : "";
   spdlog::info("experiment '{}' from {}, device {}{}, output {}", exp_.name, o.config, device_name(device_), gpu,
                out_);
+}
+
+void RunContext::report_tracking(std::int64_t frames, std::int64_t lost) {
+  if (frames <= 0) return;
+  const double fraction = static_cast<double>(lost) / static_cast<double>(frames);
+  if (fraction <= exp_.output.max_lost_fraction) return;
+  exit_code_ = kExitLostFrames;
+  spdlog::error("tracking lost {} of {} frames ({:.0f}%), more than output.max_lost_fraction = {}: the trajectory and "
+                "the model are not to be trusted (exit code {}). tracking_stats.csv says why each frame was lost; "
+                "check input.depth_scale (TUM: 5000, millimetres: 1000), input.intrinsics and the tracker section",
+                lost, frames, 100 * fraction, exp_.output.max_lost_fraction, kExitLostFrames);
 }
 
 RunContext::~RunContext() {

@@ -4,10 +4,12 @@
 #pragma once
 #include <CLI/CLI.hpp>
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "app/exit_codes.hpp"
 #include "config/experiment.hpp"
 #include "core/device.hpp"
 #include "core/timing.hpp"
@@ -20,19 +22,22 @@ struct CommonOptions {
   std::string out;                // --out; default <output.dir>/<config stem>-<time>
   std::string device;             // --device; overrides the config's device
   bool dry_run = false;
+  bool force = false;             // --force: clear an output folder that holds an earlier run
   int window_frames = 0;          // run --window-frames: close the window after this many frames
 };
 
 // The config overrides of the options, in order: every --set, then --device as device=...
 std::vector<std::string> overrides(const CommonOptions& o);
 
-// Adds config, --set, --out, --device (and --dry-run when asked) to a subcommand.
+// Adds config, --set, --out, --force, --device to a subcommand.
 void add_common_options(CLI::App& cmd, CommonOptions& o, bool config_required = true);
 
 class RunContext {
  public:
-  // Loads and validates the config (throws seamless::Error naming file:line and key), resolves the
-  // device, creates the output folder, starts the log file and writes the effective config.
+  // Loads and validates the config (throws seamless::ConfigError naming file:line and key), resolves
+  // the device, creates the output folder (refusing one that holds another run unless --force, which
+  // clears it), starts the log file, writes the effective config and installs the Ctrl-C / SIGTERM
+  // handlers (core/interrupt.hpp) that the frame loops check.
   explicit RunContext(const CommonOptions& o);
   ~RunContext();
 
@@ -45,16 +50,26 @@ class RunContext {
   // render.mode window: close the window after this many frames (0: when the user closes it).
   int window_frames() const { return window_frames_; }
 
+  // Tracking's outcome: when more than output.max_lost_fraction of `frames` were lost, logs an
+  // error naming the likely causes and exit_code() becomes kExitLostFrames.
+  void report_tracking(std::int64_t frames, std::int64_t lost);
+  // What the subcommand returns when it got to the end: kExitOk or kExitLostFrames.
+  int exit_code() const { return exit_code_; }
+
  private:
   Experiment exp_;
   Device device_;
   std::string out_;
   int window_frames_ = 0;
+  int exit_code_ = kExitOk;
   std::unique_ptr<StageTimer> timer_;
 };
 
-// Exit code of a subcommand whose part of the pipeline is not built yet (see README).
-constexpr int kNotBuilt = 3;
+// An output folder holds one run's files only: when `out` holds any of `marks` (files an earlier
+// run wrote), throws seamless::UsageError naming them, or with `force` removes everything in it.
+void prepare_output_folder(const std::string& out, bool force, const std::vector<std::string>& marks);
+
+// Logs that the subcommand's part of the pipeline is not built yet; returns kNotBuilt (see README).
 int not_built(const std::string& command, const std::string& what);
 
 }  // namespace seamless::app

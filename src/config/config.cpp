@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "config/params_yaml.hpp"
+#include "core/output_file.hpp"
 
 namespace seamless {
 namespace fs = std::filesystem;
@@ -15,7 +16,7 @@ YAML::Node parse_yaml(const std::string& text, const std::string& source) {
   try {
     return YAML::Load(text);
   } catch (const YAML::ParserException& e) {
-    throw Error(source + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
+    throw ConfigError(source + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
                 ": YAML syntax error: " + e.msg);
   }
 }
@@ -26,14 +27,22 @@ Experiment parse_experiment(const std::string& yaml_text, const std::vector<std:
                             const std::string& source_name) {
   YAML::Node root = parse_yaml(yaml_text, source_name);
   std::vector<config::Override> applied;
-  for (const auto& o : overrides) applied.push_back(config::apply_override(root, o));
+  std::vector<std::string> unusable;  // --set options that cannot be applied: reported with the rest
+  for (const auto& o : overrides) {
+    try {
+      applied.push_back(config::apply_override(root, o));
+    } catch (const Error& e) {
+      unusable.push_back(e.what());
+    }
+  }
   config::LoadContext ctx(source_name, std::move(applied), experiment_keys());
+  for (const std::string& problem : unusable) ctx.problem(problem);
   return config::load_params<Experiment>(root, ctx);
 }
 
 Experiment load_experiment(const std::string& path, const std::vector<std::string>& overrides) {
   std::ifstream in(path);
-  if (!in) throw Error("cannot open config file '" + path + "' (check the path; examples are in configs/)");
+  if (!in) throw ConfigError("cannot open config file '" + path + "' (check the path; examples are in configs/)");
   std::stringstream text;
   text << in.rdbuf();
   return parse_experiment(text.str(), overrides, path);
@@ -51,10 +60,11 @@ std::string write_effective_config(const Experiment& e, const std::string& path)
   std::error_code ec;
   if (fs::is_directory(file, ec) || (!path.empty() && path.back() == '/')) file /= "config.yaml";
   if (file.has_parent_path()) fs::create_directories(file.parent_path(), ec);
-  std::ofstream out(file);
+  std::ofstream out(partial_path(file.string()));
   out << to_yaml(e);
   out.close();
   if (!out) throw Error("cannot write the effective config to '" + file.string() + "' (is the output folder writable?)");
+  commit_partial(file.string());
   return file.string();
 }
 

@@ -13,8 +13,9 @@ namespace seamless {
 
 // Reads a YAML experiment file, applies `overrides` ("a.b.c=value", as given to --set, in order)
 // to the YAML tree, then validates and loads every key. Keys not in the file keep their defaults.
-// Throws seamless::Error listing every problem: "file:line:column: key.path: what was expected"
-// (or "(from --set a.b=c): ..." for values that came from an override).
+// Throws seamless::ConfigError listing every problem: "file:line:column: key.path: what was
+// expected" (or "(from --set a.b=c): ..." for values that came from an override); a --set that
+// cannot be applied at all is listed with the file's own problems, never instead of them.
 Experiment load_experiment(const std::string& path, const std::vector<std::string>& overrides = {});
 
 // Same from YAML text; `source_name` stands in for the file name in messages.

@@ -25,6 +25,7 @@ struct OutputParams {
   bool write_timings = true;      // timings.csv, one row per frame and stage
   bool write_stats = true;        // tracking_stats.csv: per-frame residual, inliers, timings
   int particles_every = 25;       // write particles_<step>.ply every this many solver steps; 0 = only the last
+  double max_lost_fraction = 0.2;  // a run whose tracking loses more of its frames exits with code 6
 
   template <class V> void visit(V& v) {
     v("dir", dir, "output folder (created if missing)");
@@ -35,6 +36,10 @@ struct OutputParams {
     v("write_stats", write_stats, "write per-frame tracking statistics as tracking_stats.csv");
     v("particles_every", particles_every, "write particles_<step>.ply every this many solver steps; 0 = only the last",
       Range{0, 1e9});
+    v("max_lost_fraction", max_lost_fraction,
+      "a run whose tracking loses more than this fraction of its frames exits with code 6 (README, exit codes); "
+      "1 = never",
+      Range{0, 1});
   }
 };
 

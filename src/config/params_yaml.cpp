@@ -64,7 +64,7 @@ void set_in(YAML::Node node, const std::vector<std::string>& segs, std::size_t i
   const std::string& seg = segs[i];
   const bool last = i + 1 == segs.size();
   const std::string parent = i == 0 ? "(top level)" : join(segs, ".", i);
-  auto fail = [&](const std::string& what) { throw Error("(from --set " + option + "): " + what); };
+  auto fail = [&](const std::string& what) { throw ConfigError("(from --set " + option + "): " + what); };
   if (node.IsSequence()) {
     std::size_t idx;
     if (!parse_index(seg, idx)) fail("'" + parent + "' is a list; address its entries by index, e.g. " + parent + ".0");
@@ -164,6 +164,8 @@ void LoadContext::error(const YAML::Node& at, const std::string& path, const std
   errors_.push_back({pos, at_where + ": " + path + ": " + what});
 }
 
+void LoadContext::problem(const std::string& message) { errors_.push_back({1L << 40, message}); }
+
 void LoadContext::unknown_key(const YAML::Node& key, const std::string& path, const std::vector<std::string>& known) {
   std::string name = path.substr(path.rfind('.') + 1);  // npos + 1 == 0
   std::string what = "unknown key '" + name + "'";
@@ -187,12 +189,12 @@ void LoadContext::unknown_key(const YAML::Node& key, const std::string& path, co
 void LoadContext::throw_if_errors() const {
   if (errors_.empty()) return;
   const char* hint = "\n(every key: `seamless config --list` or docs/CONFIG.md)";
-  if (errors_.size() == 1) throw Error(errors_[0].message + hint);
+  if (errors_.size() == 1) throw ConfigError(errors_[0].message + hint);
   auto sorted = errors_;
   std::stable_sort(sorted.begin(), sorted.end(), [](const Problem& a, const Problem& b) { return a.order < b.order; });
   std::string msg = std::to_string(errors_.size()) + " problems in the configuration:";
   for (const auto& e : sorted) msg += "\n  " + e.message;
-  throw Error(msg + hint);
+  throw ConfigError(msg + hint);
 }
 
 // ---- SectionReader ----------------------------------------------------------------------------
@@ -225,12 +227,12 @@ Override apply_override(YAML::Node& root, const std::string& assignment) {
   auto eq = assignment.find('=');
   std::string key = trim(assignment.substr(0, eq));
   if (eq == std::string::npos || key.empty())
-    throw Error("--set expects key.path=value (e.g. --set volume.voxel_size=0.01), got '" + assignment + "'");
+    throw ConfigError("--set expects key.path=value (e.g. --set volume.voxel_size=0.01), got '" + assignment + "'");
   std::vector<std::string> segs;
   for (std::size_t b = 0;;) {
     auto dot = key.find('.', b);
     segs.push_back(key.substr(b, dot == std::string::npos ? std::string::npos : dot - b));
-    if (segs.back().empty()) throw Error("(from --set " + assignment + "): empty key segment in '" + key + "'");
+    if (segs.back().empty()) throw ConfigError("(from --set " + assignment + "): empty key segment in '" + key + "'");
     if (dot == std::string::npos) break;
     b = dot + 1;
   }
@@ -240,7 +242,7 @@ Override apply_override(YAML::Node& root, const std::string& assignment) {
     try {
       return YAML::Load(text);
     } catch (const YAML::Exception& e) {
-      throw Error("(from --set " + assignment + "): cannot parse '" + text + "' as a YAML value: " + e.msg);
+      throw ConfigError("(from --set " + assignment + "): cannot parse '" + text + "' as a YAML value: " + e.msg);
     }
   }();
   if (!root.IsDefined() || root.IsNull()) root.reset(YAML::Node(YAML::NodeType::Map));

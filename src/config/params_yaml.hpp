@@ -31,8 +31,10 @@ class LoadContext {
   // Records "where: path: what" with where = file:line:column or (from --set ...).
   void error(const YAML::Node& at, const std::string& path, const std::string& what);
   void unknown_key(const YAML::Node& key, const std::string& path, const std::vector<std::string>& known);
+  // Records a problem whose message says where it is already (a --set that cannot be applied).
+  void problem(const std::string& message);
   bool ok() const { return errors_.empty(); }
-  // Throws seamless::Error listing every problem (one per line) if there was any.
+  // Throws seamless::ConfigError listing every problem (one per line) if there was any.
   void throw_if_errors() const;
 
  private:

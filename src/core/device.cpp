@@ -50,14 +50,14 @@ Device resolve_device(const std::string& name) {
   if (name == "cpu") return Device::CPU;
   if (name == "cuda") {
     if (!cuda_built())
-      throw Error("device 'cuda' was asked for, but this build has no CUDA backend "
+      throw ConfigError("device 'cuda' was asked for, but this build has no CUDA backend "
                   "(reconfigure with -DSEAMLESS_CUDA=ON on a machine with nvcc, or use --device cpu)");
     if (!cuda_available())
-      throw Error("device 'cuda' was asked for, but no CUDA GPU is usable on this machine (use --device cpu)");
+      throw ConfigError("device 'cuda' was asked for, but no CUDA GPU is usable on this machine (use --device cpu)");
     return Device::CUDA;
   }
   if (name == "auto") return cuda_available() ? Device::CUDA : Device::CPU;
-  throw Error("unknown device '" + name + "' (expected cpu, cuda or auto)");
+  throw ConfigError("unknown device '" + name + "' (expected cpu, cuda or auto)");
 }
 
 const char* device_name(Device d) { return d == Device::CPU ? "cpu" : "cuda"; }

@@ -23,6 +23,8 @@ void log_to_file(const std::string& path) {
   file->set_level(spdlog::level::debug);
   file->set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%l] %v");
   spdlog::default_logger()->sinks().push_back(file);
+  // Every line reaches the file at once: a run that is killed or fails keeps its log.
+  spdlog::default_logger()->flush_on(spdlog::level::trace);
 }
 
 }  // namespace seamless

@@ -5,6 +5,7 @@
 
 #include "core/cuda_check.hpp"
 #include "core/error.hpp"
+#include "core/output_file.hpp"
 
 namespace seamless {
 
@@ -77,10 +78,15 @@ void StageTimer::end_frame(std::int64_t frame) {
 }
 
 void StageTimer::write_csv(const std::string& path) const {
-  std::ofstream f(path);
-  if (!f) throw Error("cannot write timings to " + path);
-  f << "frame,stage,ms\n";
-  for (const Row& r : rows_) f << r.frame << ',' << r.stage << ',' << r.ms << '\n';
+  {
+    std::ofstream f(partial_path(path));
+    if (!f) throw Error("cannot write timings to " + path);
+    f << "frame,stage,ms\n";
+    for (const Row& r : rows_) f << r.frame << ',' << r.stage << ',' << r.ms << '\n';
+    f.close();
+    if (!f) throw Error("error writing timings to " + path + " (disk full?)");
+  }
+  commit_partial(path);
 }
 
 DeviceMarks::DeviceMarks(Device d, int count) : device_(d), host_(count), events_(count, nullptr) {

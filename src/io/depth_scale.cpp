@@ -116,7 +116,7 @@ void DepthScaleCheck::check(const Image<std::uint16_t>& raw, const std::string& 
   const DepthQuantisation q = depth_quantisation(raw);
   const DepthScaleVerdict v = judge_depth_scale(q, scale_, file);
   switch (v.kind) {
-    case DepthScaleVerdict::wrong: throw Error(v.message);
+    case DepthScaleVerdict::wrong: throw ConfigError(v.message);
     case DepthScaleVerdict::doubtful: spdlog::warn("{}", v.message); break;
     case DepthScaleVerdict::consistent:
       spdlog::info("input.depth_scale {} agrees with the Kinect v1 quantisation steps of '{}' ({} steps suggest {:.0f})",
@@ -171,7 +171,7 @@ float median_depth(const Image<float>& depth) {
 void check_median_depth(const Image<float>& depth, double scale, const std::string& file) {
   const float med = median_depth(depth);
   if (med > 0.f && (med < 0.2f || med > 10.f))
-    throw Error("depth image '" + file + "': median depth " + std::to_string(med) + " m with input.depth_scale " +
+    throw InputError("depth image '" + file + "': median depth " + std::to_string(med) + " m with input.depth_scale " +
                 std::to_string(scale) + " is implausible for a depth camera (0.2-10 m); TUM uses 5000, " +
                 "millimetre depth (frame folders) 1000 (a scale of about " + std::to_string(scale * med / 2.0) +
                 " would put the median at 2 m)");

@@ -31,7 +31,7 @@ constexpr float kStandardGravity = 9.80665f;
 // naming the file and line of a token that is not a number. "inf", "-inf" and "nan" are numbers.
 std::vector<double> read_numbers(const std::string& path, const char* what) {
   std::ifstream in(path);
-  if (!in) throw Error(std::string("cannot open ") + what + " '" + path + "': " + std::strerror(errno));
+  if (!in) throw InputError(std::string("cannot open ") + what + " '" + path + "': " + std::strerror(errno));
   std::vector<double> v;
   std::string line, token;
   for (int n = 1; std::getline(in, line); ++n) {
@@ -47,7 +47,7 @@ std::vector<double> read_numbers(const std::string& path, const char* what) {
         used = 0;
       }
       if (used != token.size())
-        throw Error(std::string(what) + " '" + path + "' line " + std::to_string(n) + ": '" + token + "' is not a number");
+        throw InputError(std::string(what) + " '" + path + "' line " + std::to_string(n) + ": '" + token + "' is not a number");
       v.push_back(x);
     }
   }
@@ -86,7 +86,7 @@ std::string frame_name(std::int64_t number) {
 
 std::vector<FrameFolderEntry> list_frame_folder(const std::string& folder) {
   if (!fs::is_directory(folder))
-    throw Error("input.path '" + folder + "' is not a folder (source: frames wants a folder of frame-NNNNNN.color.png, "
+    throw InputError("input.path '" + folder + "' is not a folder (source: frames wants a folder of frame-NNNNNN.color.png, "
                 ".depth.png and .pose.txt files)");
   std::map<std::int64_t, FrameFolderEntry> by_number;
   for (const fs::directory_entry& e : fs::directory_iterator(folder)) {
@@ -100,7 +100,7 @@ std::vector<FrameFolderEntry> list_frame_folder(const std::string& folder) {
     f.number = number;
     if (colour) {
       if (!f.colour.empty())
-        throw Error("frame folder '" + folder + "' has two colour images for frame " + std::to_string(number) + ": '" +
+        throw InputError("frame folder '" + folder + "' has two colour images for frame " + std::to_string(number) + ": '" +
                     f.colour + "' and '" + name + "'; keep one");
       f.colour = name;
     } else {
@@ -115,13 +115,13 @@ std::vector<FrameFolderEntry> list_frame_folder(const std::string& folder) {
 std::optional<SE3> read_pose_matrix(const std::string& path) {
   std::vector<double> v = read_numbers(path, "pose file");
   if (v.size() != 16)
-    throw Error("pose file '" + path + "' holds " + std::to_string(v.size()) +
+    throw InputError("pose file '" + path + "' holds " + std::to_string(v.size()) +
                 " numbers; expected a 4x4 camera-to-world matrix, 16 numbers row by row");
   for (double x : v)
     if (!std::isfinite(x)) return std::nullopt;  // the capture marks a lost pose this way
   // Exact comparison: every writer of these files prints the constant row as 0 0 0 1.
   if (v[12] != 0 || v[13] != 0 || v[14] != 0 || v[15] != 1)
-    throw Error("pose file '" + path + "': the bottom row is " + std::to_string(v[12]) + " " + std::to_string(v[13]) +
+    throw InputError("pose file '" + path + "': the bottom row is " + std::to_string(v[12]) + " " + std::to_string(v[13]) +
                 " " + std::to_string(v[14]) + " " + std::to_string(v[15]) +
                 ", not 0 0 0 1 (a transposed matrix, translation in the last row?); expected a 4x4 camera-to-world "
                 "matrix row by row");
@@ -132,7 +132,7 @@ std::optional<SE3> read_pose_matrix(const std::string& path) {
   // shear) separates drift from a matrix that is not a rotation at all (scaled, sheared, a K).
   const double off = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (off > 1e-2 || R.determinant() < 0)
-    throw Error("pose file '" + path + "': the upper-left 3x3 is not a rotation (R^T R differs from I by " +
+    throw InputError("pose file '" + path + "': the upper-left 3x3 is not a rotation (R^T R differs from I by " +
                 std::to_string(off) + ", det " + std::to_string(R.determinant()) +
                 "); expected a rigid camera-to-world matrix");
   Eigen::JacobiSVD<Eigen::Matrix3d> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);
@@ -148,17 +148,17 @@ std::optional<SE3> read_pose_matrix(const std::string& path) {
 vec3 read_gravity_direction(const std::string& path) {
   std::vector<double> v = read_numbers(path, "gravity file");
   if (v.size() != 3)
-    throw Error("gravity file '" + path + "' holds " + std::to_string(v.size()) +
+    throw InputError("gravity file '" + path + "' holds " + std::to_string(v.size()) +
                 " numbers; expected the direction of gravity in the poses' world frame, three numbers");
   const double n = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
   if (!(n > 1e-6) || !std::isfinite(n))
-    throw Error("gravity file '" + path + "' holds a zero or non-finite vector; expected the direction of gravity");
+    throw InputError("gravity file '" + path + "' holds a zero or non-finite vector; expected the direction of gravity");
   return {static_cast<float>(v[0] / n), static_cast<float>(v[1] / n), static_cast<float>(v[2] / n)};
 }
 
 FrameFolderSource::FrameFolderSource(const InputParams& params, bool pinned)
     : params_(params), folder_(params.path), scale_(effective_depth_scale(params)), pinned_(pinned) {
-  if (folder_.empty()) throw Error("input.path is empty: set it to a frame folder (source: frames)");
+  if (folder_.empty()) throw InputError("input.path is empty: set it to a frame folder (source: frames)");
   std::vector<FrameFolderEntry> all = list_frame_folder(folder_);
   for (const FrameFolderEntry& f : all) {
     if (!f.colour.empty() && !f.depth.empty()) {
@@ -170,17 +170,17 @@ FrameFolderSource::FrameFolderSource(const InputParams& params, bool pinned)
         "frame folder '" + folder_ + "': frame " + std::to_string(f.number) + " has " +
         (f.depth.empty() ? "no depth image " + base + ".depth.png" : "no colour image " + base + ".color.png or .jpg") +
         " (its files: " + f.colour + (f.colour.empty() ? "" : " ") + f.depth + (f.depth.empty() ? "" : " ") + f.pose + ")";
-    if (!params.skip_bad_frames) throw Error(problem + "; add it, remove the frame's other files, or set input.skip_bad_frames: true");
+    if (!params.skip_bad_frames) throw InputError(problem + "; add it, remove the frame's other files, or set input.skip_bad_frames: true");
     ++skipped_;
     spdlog::warn("{}: skipped (input.skip_bad_frames)", problem);
   }
   if (frames_.empty())
-    throw Error("frame folder '" + folder_ + "' has no frames (no frame-NNNNNN.color.png/.jpg with a frame-NNNNNN.depth.png)");
+    throw InputError("frame folder '" + folder_ + "' has no frames (no frame-NNNNNN.color.png/.jpg with a frame-NNNNNN.depth.png)");
   const std::size_t first = static_cast<std::size_t>(std::min<std::int64_t>(params.first_frame, frames_.size()));
   frames_.erase(frames_.begin(), frames_.begin() + first);
   if (params.max_frames > 0 && frames_.size() > static_cast<std::size_t>(params.max_frames)) frames_.resize(params.max_frames);
   if (frames_.empty())
-    throw Error("input.first_frame " + std::to_string(params.first_frame) + " is past the end of '" + folder_ + "'");
+    throw InputError("input.first_frame " + std::to_string(params.first_frame) + " is past the end of '" + folder_ + "'");
 
   std::int64_t with_pose = 0, lost_pose = 0;
   for (const FrameFolderEntry& f : frames_) {
@@ -221,10 +221,10 @@ void FrameFolderSource::load_frame(std::size_t i, RgbdFrame& frame) {
   Image<std::uint16_t> raw = read_png_u16(depth_path);
   Image<uchar3> rgb = read_colour_image(colour_path);  // PNG or JPEG, by content
   if (raw.width() != K_.width || raw.height() != K_.height)
-    throw Error("depth image '" + depth_path + "' is " + std::to_string(raw.width()) + "x" + std::to_string(raw.height()) +
+    throw InputError("depth image '" + depth_path + "' is " + std::to_string(raw.width()) + "x" + std::to_string(raw.height()) +
                 " but input.intrinsics says " + std::to_string(K_.width) + "x" + std::to_string(K_.height));
   if (rgb.width() != raw.width() || rgb.height() != raw.height())
-    throw Error("colour image '" + colour_path + "' is " + std::to_string(rgb.width()) + "x" +
+    throw InputError("colour image '" + colour_path + "' is " + std::to_string(rgb.width()) + "x" +
                 std::to_string(rgb.height()) + ", its depth image '" + depth_path + "' " + std::to_string(raw.width()) +
                 "x" + std::to_string(raw.height()) + " (the depth must be registered to the colour camera)");
   reserve_frame_images(frame, raw.width(), raw.height(), pinned_);

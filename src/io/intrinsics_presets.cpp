@@ -36,7 +36,7 @@ Intrinsics intrinsics_preset(const std::string& name) {
   if (name == "freiburg2") return make(520.9f, 521.0f, 325.1f, 249.7f, {0.2312f, -0.7849f, -0.0033f, -0.0001f, 0.9172f});
   if (name == "freiburg3") return make(535.4f, 539.2f, 320.1f, 247.6f);
   if (name == "kinect_v1") return make(525.f, 525.f, 319.5f, 239.5f);
-  throw Error("unknown intrinsics preset '" + name + "': use freiburg1, freiburg2, freiburg3, kinect_v1, custom or auto");
+  throw ConfigError("unknown intrinsics preset '" + name + "': use freiburg1, freiburg2, freiburg3, kinect_v1, custom or auto");
 }
 
 Intrinsics resolve_intrinsics(const IntrinsicsParams& p, const std::string& folder, std::string* origin) {
@@ -92,7 +92,7 @@ std::string find_intrinsics_matrix(const std::string& folder) {
 
 Intrinsics read_intrinsics_matrix(const std::string& path) {
   std::ifstream in(path);
-  if (!in) throw Error("cannot open camera matrix file '" + path + "': " + std::strerror(errno));
+  if (!in) throw InputError("cannot open camera matrix file '" + path + "': " + std::strerror(errno));
   std::vector<double> v;
   std::string line, token;
   for (int n = 1; std::getline(in, line); ++n) {
@@ -109,13 +109,13 @@ Intrinsics read_intrinsics_matrix(const std::string& path) {
         used = 0;
       }
       if (used != token.size())
-        throw Error("camera matrix file '" + path + "' line " + std::to_string(n) + ": '" + token +
+        throw InputError("camera matrix file '" + path + "' line " + std::to_string(n) + ": '" + token +
                     "' is not a number (expected a 3x3 matrix K, nine numbers)");
       v.push_back(x);
     }
   }
   if (v.size() != 9)
-    throw Error("camera matrix file '" + path + "' holds " + std::to_string(v.size()) +
+    throw InputError("camera matrix file '" + path + "' holds " + std::to_string(v.size()) +
                 " numbers; expected a 3x3 matrix K = [fx 0 cx; 0 fy cy; 0 0 1], nine numbers");
   auto bad = [&](const std::string& what) {
     return Error("camera matrix file '" + path + "': " + what + "; expected K = [fx 0 cx; 0 fy cy; 0 0 1]");
@@ -135,7 +135,7 @@ void log_intrinsics(const std::string& what, const Intrinsics& K, const std::str
 
 Intrinsics read_calibration(const std::string& path) {
   std::ifstream in(path);
-  if (!in) throw Error("cannot open calibration file '" + path + "': " + std::strerror(errno));
+  if (!in) throw InputError("cannot open calibration file '" + path + "': " + std::strerror(errno));
   std::string line;
   while (std::getline(in, line)) {
     if (line.empty() || line[0] == '#') continue;
@@ -144,10 +144,10 @@ Intrinsics read_calibration(const std::string& path) {
     if (ss >> K.fx >> K.fy >> K.cx >> K.cy >> K.width >> K.height >> K.dist[0] >> K.dist[1] >> K.dist[2] >> K.dist[3] >>
         K.dist[4])
       return K;
-    throw Error("malformed calibration file '" + path + "': expected 'fx fy cx cy width height d0 d1 d2 d3 d4', got '" +
+    throw InputError("malformed calibration file '" + path + "': expected 'fx fy cx cy width height d0 d1 d2 d3 d4', got '" +
                 line + "'");
   }
-  throw Error("calibration file '" + path + "' has no calibration line");
+  throw InputError("calibration file '" + path + "' has no calibration line");
 }
 
 void write_calibration(const std::string& path, const Intrinsics& K) {

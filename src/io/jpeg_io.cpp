@@ -49,7 +49,7 @@ using File = std::unique_ptr<FILE, int (*)(FILE*)>;
 
 File open_file(const std::string& path, const char* mode, const char* what) {
   FILE* f = std::fopen(path.c_str(), mode);
-  if (!f) throw Error(std::string("cannot ") + what + " image file '" + path + "': " + std::strerror(errno));
+  if (!f) throw InputError(std::string("cannot ") + what + " image file '" + path + "': " + std::strerror(errno));
   return File(f, std::fclose);
 }
 
@@ -70,7 +70,7 @@ Image<uchar3> read_jpeg_rgb(const std::string& path) {
   auto img = std::make_unique<Image<uchar3>>();
   if (setjmp(s->jb)) {
     jpeg_destroy_decompress(d.get());
-    throw Error("JPEG file '" + path + "' is truncated, corrupt or not decodable as RGB (libjpeg: " + s->message + ")");
+    throw InputError("JPEG file '" + path + "' is truncated, corrupt or not decodable as RGB (libjpeg: " + s->message + ")");
   }
   jpeg_create_decompress(d.get());
   jpeg_stdio_src(d.get(), f.get());
@@ -79,7 +79,7 @@ Image<uchar3> read_jpeg_rgb(const std::string& path) {
   jpeg_start_decompress(d.get());
   if (const int channels = d->output_components; channels != 3) {  // not with JCS_RGB; guards the rows below
     jpeg_destroy_decompress(d.get());
-    throw Error("JPEG file '" + path + "' decodes to " + std::to_string(channels) + " channels, not RGB");
+    throw InputError("JPEG file '" + path + "' decodes to " + std::to_string(channels) + " channels, not RGB");
   }
   *img = Image<uchar3>(static_cast<int>(d->output_width), static_cast<int>(d->output_height), Device::CPU);
   auto* base = reinterpret_cast<JSAMPLE*>(img->buffer().data());
@@ -89,7 +89,7 @@ Image<uchar3> read_jpeg_rgb(const std::string& path) {
   }
   jpeg_finish_decompress(d.get());
   jpeg_destroy_decompress(d.get());
-  if (s->truncated) throw Error("JPEG file '" + path + "' is truncated (libjpeg: premature end of data)");
+  if (s->truncated) throw InputError("JPEG file '" + path + "' is truncated (libjpeg: premature end of data)");
   return std::move(*img);
 }
 
@@ -142,7 +142,7 @@ Image<uchar3> read_colour_image(const std::string& path) {
     case ImageFormat::jpeg: return read_jpeg_rgb(path);
     case ImageFormat::unknown: break;
   }
-  throw Error("colour image '" + path + "' is neither PNG nor JPEG (its first bytes are no PNG signature and no "
+  throw InputError("colour image '" + path + "' is neither PNG nor JPEG (its first bytes are no PNG signature and no "
               "JPEG start-of-image marker; empty, truncated or another format?)");
 }
 

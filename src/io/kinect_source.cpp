@@ -31,23 +31,23 @@ vec3 camera_accel(freenect_raw_tilt_state* s) {
 KinectSource::KinectSource(const InputParams& params, bool pinned) : params_(params), pinned_(pinned) {
   K_ = resolve_intrinsics(params.intrinsics);
   if (K_.width != kW || K_.height != kH)
-    throw Error("input.intrinsics width/height must be 640x480 for a Kinect v1 (got " + std::to_string(K_.width) + "x" +
+    throw ConfigError("input.intrinsics width/height must be 640x480 for a Kinect v1 (got " + std::to_string(K_.width) + "x" +
                 std::to_string(K_.height) + ")");
   if (freenect_init(&ctx_, nullptr) < 0)
-    throw Error("libfreenect could not initialise (is libusb working? try running as root or add the udev rules)");
+    throw InputError("libfreenect could not initialise (is libusb working? try running as root or add the udev rules)");
   freenect_set_log_level(ctx_, FREENECT_LOG_WARNING);
   freenect_select_subdevices(ctx_, static_cast<freenect_device_flags>(FREENECT_DEVICE_MOTOR | FREENECT_DEVICE_CAMERA));
   int n = freenect_num_devices(ctx_);
   int index = params.kinect.device_index;
   if (n <= 0 || index >= n) {
     close();
-    throw Error("no Kinect v1 found at input.kinect.device_index " + std::to_string(index) + " (" + std::to_string(n) +
+    throw InputError("no Kinect v1 found at input.kinect.device_index " + std::to_string(index) + " (" + std::to_string(n) +
                 " connected): plug it in (with its power supply), check `lsusb` for 045e:02ae and the udev rules, "
                 "or use input.source: tum / synthetic");
   }
   if (freenect_open_device(ctx_, &dev_, index) < 0) {
     close();
-    throw Error("could not open Kinect " + std::to_string(index) + " (in use by another program, or no permission)");
+    throw InputError("could not open Kinect " + std::to_string(index) + " (in use by another program, or no permission)");
   }
   freenect_set_user(dev_, this);
   freenect_set_depth_callback(dev_, &KinectSource::on_depth);
@@ -61,7 +61,7 @@ KinectSource::KinectSource(const InputParams& params, bool pinned) : params_(par
       freenect_set_depth_mode(dev_, freenect_find_depth_mode(FREENECT_RESOLUTION_MEDIUM, depth_format)) < 0 ||
       freenect_start_video(dev_) < 0 || freenect_start_depth(dev_) < 0) {
     close();
-    throw Error("the Kinect refused the 640x480 RGB + registered depth modes");
+    throw InputError("the Kinect refused the 640x480 RGB + registered depth modes");
   }
   thread_ = std::thread([this] { capture_loop(); });
 }
@@ -143,7 +143,7 @@ void KinectSource::check_replay_is_millimetres(const std::vector<std::uint16_t>&
     raw_invalid += v == 2047;
   }
   if (zeros == 0 && raw_invalid > 0)
-    throw Error(std::string("the fakenect recording in FAKENECT_PATH=") + std::getenv("FAKENECT_PATH") +
+    throw InputError(std::string("the fakenect recording in FAKENECT_PATH=") + std::getenv("FAKENECT_PATH") +
                 " holds raw 11-bit disparity (made by fakenect-record); seamless replays recordings of registered "
                 "millimetres written by write_fakenect_dump() (docs/INPUT.md)");
 }
@@ -154,10 +154,10 @@ bool KinectSource::next(RgbdFrame& frame) {
     std::unique_lock lock(mutex_);
     auto timeout = std::chrono::duration<double>(params_.kinect.timeout_s);
     if (!ready_.wait_for(lock, timeout, [&] { return !queue_.empty() || ended_; }))
-      throw Error("no frame from the Kinect for " + std::to_string(params_.kinect.timeout_s) +
+      throw InputError("no frame from the Kinect for " + std::to_string(params_.kinect.timeout_s) +
                   " s (input.kinect.timeout_s): is it still connected and powered?");
     if (queue_.empty()) {
-      if (delivered_ == 0) throw Error("the Kinect stopped before its first frame: " + end_reason_);
+      if (delivered_ == 0) throw InputError("the Kinect stopped before its first frame: " + end_reason_);
       return false;
     }
     raw = std::move(queue_.front());

@@ -22,10 +22,10 @@ std::unique_ptr<FrameSource> make_source(const InputParams& params, Device devic
 #if SEAMLESS_HAS_FREENECT
     return std::make_unique<KinectSource>(params, pinned);
 #else
-    throw Error("input.source is kinect but this build has no libfreenect: apt-get install libfreenect-dev, reconfigure");
+    throw ConfigError("input.source is kinect but this build has no libfreenect: apt-get install libfreenect-dev, reconfigure");
 #endif
   }
-  throw Error("unknown input.source '" + params.source + "': use synthetic, tum, frames or kinect");
+  throw ConfigError("unknown input.source '" + params.source + "': use synthetic, tum, frames or kinect");
 }
 
 namespace {

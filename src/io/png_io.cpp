@@ -40,7 +40,11 @@ using File = std::unique_ptr<FILE, int (*)(FILE*)>;
 
 File open_file(const std::string& path, const char* mode, const char* what) {
   FILE* f = std::fopen(path.c_str(), mode);
-  if (!f) throw Error(std::string("cannot ") + what + " PNG file '" + path + "': " + std::strerror(errno));
+  if (!f) {
+    std::string msg = std::string("cannot ") + what + " PNG file '" + path + "': " + std::strerror(errno);
+    if (mode[0] == 'r') throw InputError(msg);  // a missing input; a file we cannot create is not one
+    throw Error(msg);
+  }
   return File(f, std::fclose);
 }
 
@@ -73,13 +77,13 @@ void read_png(const std::string& path, Want want, State* s) {
   File f = open_file(path, "rb", "open");
   png_byte sig[8];
   if (std::fread(sig, 1, 8, f.get()) != 8 || png_sig_cmp(sig, 0, 8))
-    throw Error("'" + path + "' is not a PNG file (bad signature; empty or truncated?)");
+    throw InputError("'" + path + "' is not a PNG file (bad signature; empty or truncated?)");
   png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, s, on_error, on_warning);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
-  if (!info) throw Error("libpng could not allocate its read structures for '" + path + "'");
+  if (!info) throw InputError("libpng could not allocate its read structures for '" + path + "'");
   if (setjmp(s->jb)) {
     png_destroy_read_struct(&png, &info, nullptr);
-    throw Error("PNG file '" + path + "' is truncated or corrupt (libpng: " + s->libpng_message + ")");
+    throw InputError("PNG file '" + path + "' is truncated or corrupt (libpng: " + s->libpng_message + ")");
   }
   png_init_io(png, f.get());
   png_set_sig_bytes(png, 8);
@@ -100,14 +104,14 @@ void read_png(const std::string& path, Want want, State* s) {
     png_read_end(png, nullptr);
   }
   png_destroy_read_struct(&png, &info, nullptr);
-  if (!s->format_problem.empty()) throw Error("PNG file '" + path + "' " + s->format_problem);
+  if (!s->format_problem.empty()) throw InputError("PNG file '" + path + "' " + s->format_problem);
 }
 
 template <class T>
 Image<T> to_image(const State& s, const std::string& path) {
   std::size_t n = static_cast<std::size_t>(s.info.width) * s.info.height;
   if (s.pixels.size() != n * sizeof(T))
-    throw Error("PNG file '" + path + "': unexpected decoded size (internal error)");
+    throw InputError("PNG file '" + path + "': unexpected decoded size (internal error)");
   Image<T> im(s.info.width, s.info.height, Device::CPU);
   std::memcpy(im.buffer().data(), s.pixels.data(), s.pixels.size());
   return im;

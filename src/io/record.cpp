@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "io/intrinsics_presets.hpp"
 #include "io/png_io.hpp"
 #include "io/trajectory.hpp"
@@ -19,7 +20,7 @@ namespace {
 std::ofstream open_list(const fs::path& p, const std::string& header) {
   std::ofstream f(p);
   if (!f) throw Error("cannot create '" + p.string() + "': " + std::strerror(errno));
-  f << header;
+  f << header << std::flush;
   return f;
 }
 
@@ -57,19 +58,23 @@ std::int64_t record(FrameSource& source, const std::string& out_dir, const Recor
   write_calibration((dir / "calibration.txt").string(), source.intrinsics());
   RgbdFrame f;
   std::int64_t n = 0;
-  while ((opt.max_frames <= 0 || n < opt.max_frames) && source.next(f)) {
+  // Ctrl-C (or SIGTERM) ends the recording after the frame being written.
+  while ((opt.max_frames <= 0 || n < opt.max_frames) && !interrupted() && source.next(f)) {
     std::string name = stamp(f.timestamp) + ".png";
     write_png_rgb((dir / "rgb" / name).string(), f.rgb);
     write_png_u16((dir / "depth" / name).string(), to_u16(f.depth, opt.depth_scale));
-    rgb_txt << stamp(f.timestamp) << " rgb/" << name << '\n';
-    depth_txt << stamp(f.timestamp) << " depth/" << name << '\n';
-    assoc_txt << stamp(f.timestamp) << " rgb/" << name << ' ' << stamp(f.timestamp) << " depth/" << name << '\n';
+    // The lists name a frame only once both its images are written, and reach the disk with every
+    // frame: a recording that is killed is a folder that loads, up to its last whole frame.
+    rgb_txt << stamp(f.timestamp) << " rgb/" << name << '\n' << std::flush;
+    depth_txt << stamp(f.timestamp) << " depth/" << name << '\n' << std::flush;
+    assoc_txt << stamp(f.timestamp) << " rgb/" << name << ' ' << stamp(f.timestamp) << " depth/" << name << '\n'
+              << std::flush;
     if (f.accelerometer) {
       if (!accel_txt.is_open())
         accel_txt = open_list(dir / "accelerometer.txt", "# accelerometer data\n" + origin + "# timestamp ax ay az\n");
       // Back to the Kinect's own axes (x left, y up), as TUM stores them; see tum_source.cpp.
       vec3 a = *f.accelerometer;
-      accel_txt << stamp(f.timestamp) << ' ' << -a.x << ' ' << -a.y << ' ' << a.z << '\n';
+      accel_txt << stamp(f.timestamp) << ' ' << -a.x << ' ' << -a.y << ' ' << a.z << '\n' << std::flush;
     }
     if (f.ground_truth) {
       if (!gt) gt = std::make_unique<TrajectoryWriter>((dir / "groundtruth.txt").string(), "ground truth trajectory");
@@ -79,6 +84,7 @@ std::int64_t record(FrameSource& source, const std::string& out_dir, const Recor
   }
   for (std::ofstream* s : {&rgb_txt, &depth_txt, &assoc_txt, &accel_txt})
     if (s->is_open() && !s->flush()) throw Error("cannot write the lists of recording '" + out_dir + "'");
+  if (gt) gt->close();
   return n;
 }
 

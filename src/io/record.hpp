@@ -16,7 +16,10 @@ struct RecordOptions {
 // Creates out_dir (and rgb/, depth/) and writes rgb/<t>.png, depth/<t>.png, rgb.txt, depth.txt,
 // associations.txt, calibration.txt (intrinsics), accelerometer.txt when the frames have readings
 // and groundtruth.txt when they have poses. Depths beyond 65535 / depth_scale are written as 0.
-// Returns the number of frames written. Throws seamless::Error when a file cannot be written.
+// The lists are appended and flushed frame by frame, so a recording that is stopped at any point
+// loads up to its last whole frame; Ctrl-C or SIGTERM (core/interrupt.hpp) ends it after the frame
+// being written. Returns the number of frames written. Throws seamless::Error when a file cannot
+// be written.
 std::int64_t record(FrameSource& source, const std::string& out_dir, const RecordOptions& options = {});
 
 }  // namespace seamless

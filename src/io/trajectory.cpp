@@ -9,6 +9,8 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/output_file.hpp"
 
 namespace seamless {
 namespace {
@@ -55,7 +57,7 @@ TumPose TumPose::from_se3(double timestamp, const SE3& T) {
 
 Trajectory read_tum_trajectory(const std::string& path) {
   std::ifstream in(path);
-  if (!in) throw Error("cannot open trajectory file '" + path + "': " + std::strerror(errno));
+  if (!in) throw InputError("cannot open trajectory file '" + path + "': " + std::strerror(errno));
   Trajectory out;
   std::string line;
   for (int n = 1; std::getline(in, line); ++n) {
@@ -64,13 +66,13 @@ Trajectory read_tum_trajectory(const std::string& path) {
     std::istringstream ss(line);
     TumPose p;
     if (!(ss >> p.timestamp >> p.t[0] >> p.t[1] >> p.t[2] >> p.q[0] >> p.q[1] >> p.q[2] >> p.q[3]))
-      throw Error("malformed pose at " + where(path, n) + ": expected 'timestamp tx ty tz qx qy qz qw', got '" + line + "'");
+      throw InputError("malformed pose at " + where(path, n) + ": expected 'timestamp tx ty tz qx qy qz qw', got '" + line + "'");
     double norm = quat(p).norm();
     if (!(norm > 0.9 && norm < 1.1))
-      throw Error("quaternion at " + where(path, n) + " has norm " + std::to_string(norm) + ", expected 1 (order is qx qy qz qw)");
+      throw InputError("quaternion at " + where(path, n) + " has norm " + std::to_string(norm) + ", expected 1 (order is qx qy qz qw)");
     set_quat(p, quat(p).normalized());
     if (!out.empty() && p.timestamp < out.back().timestamp)
-      throw Error("timestamps go backwards at " + where(path, n) + " (" + std::to_string(p.timestamp) + " after " +
+      throw InputError("timestamps go backwards at " + where(path, n) + " (" + std::to_string(p.timestamp) + " after " +
                   std::to_string(out.back().timestamp) + "): sort the file by time");
     out.push_back(p);
   }
@@ -80,6 +82,7 @@ Trajectory read_tum_trajectory(const std::string& path) {
 void write_tum_trajectory(const std::string& path, const Trajectory& trajectory) {
   TrajectoryWriter w(path);
   for (const TumPose& p : trajectory) w.write(p);
+  w.close();
 }
 
 std::optional<TumPose> interpolate_pose(const Trajectory& tr, double t, double max_gap) {
@@ -99,14 +102,26 @@ std::optional<TumPose> interpolate_pose(const Trajectory& tr, double t, double m
 }
 
 TrajectoryWriter::TrajectoryWriter(const std::string& path, const std::string& comment) : path_(path) {
-  f_ = std::fopen(path.c_str(), "w");
+  f_ = std::fopen(partial_path(path).c_str(), "w");
   if (!f_) throw Error("cannot create trajectory file '" + path + "': " + std::strerror(errno));
   if (!comment.empty()) std::fprintf(f_, "# %s\n", comment.c_str());
   std::fprintf(f_, "# timestamp tx ty tz qx qy qz qw\n");
 }
 
 TrajectoryWriter::~TrajectoryWriter() {
-  if (f_) std::fclose(f_);
+  try {
+    close();
+  } catch (const Error& e) {
+    spdlog::error("{}", e.what());
+  }
+}
+
+void TrajectoryWriter::close() {
+  if (!f_) return;
+  const bool ok = std::fclose(f_) == 0;
+  f_ = nullptr;
+  if (!ok) throw Error("cannot write trajectory file '" + path_ + "': " + std::strerror(errno));
+  commit_partial(path_);
 }
 
 void TrajectoryWriter::write(const TumPose& p) {

@@ -34,8 +34,9 @@ void write_tum_trajectory(const std::string& path, const Trajectory& trajectory)
 // max_gap seconds apart (motion-capture dropouts: interpolating across them would invent poses).
 std::optional<TumPose> interpolate_pose(const Trajectory& trajectory, double t, double max_gap = 0.1);
 
-// Appends poses to a TUM trajectory file as they come (flushed per line, so a crashed run keeps
-// what it had). Throws seamless::Error when the file cannot be created or written.
+// Appends poses to a TUM trajectory file as they come, under the name <path>.partial (flushed per
+// line, so a crashed run keeps what it had), renamed to <path> when closed: a file under its own
+// name was closed by its writer. Throws seamless::Error when the file cannot be created or written.
 class TrajectoryWriter {
  public:
   explicit TrajectoryWriter(const std::string& path, const std::string& comment = "");
@@ -44,6 +45,8 @@ class TrajectoryWriter {
   TrajectoryWriter& operator=(const TrajectoryWriter&) = delete;
   void write(const TumPose& pose);
   void write(double timestamp, const SE3& world_T_camera) { write(TumPose::from_se3(timestamp, world_T_camera)); }
+  // Renames the file to its name (the destructor does it too, logging a failure instead).
+  void close();
 
  private:
   std::string path_;

@@ -28,9 +28,17 @@ bool is_comment(const std::string& line) {
   return first == std::string::npos || line[first] == '#';
 }
 
+// A line whose timestamp repeats the one before it (a list concatenated or edited twice) would make
+// one frame two, fused twice with two poses at one time: it is dropped, with a warning naming it.
+bool repeated(double prev, double t, const std::string& path, int n, const std::string& line) {
+  if (t != prev) return false;
+  spdlog::warn("{}: timestamp {:.6f} repeats the line before it; line dropped ('{}')", where(path, n), t, line);
+  return true;
+}
+
 void check_order(double prev, double t, const std::string& path, int n) {
   if (t < prev)
-    throw Error("timestamps out of order at " + where(path, n) + " (" + std::to_string(t) + " after " +
+    throw InputError("timestamps out of order at " + where(path, n) + " (" + std::to_string(t) + " after " +
                 std::to_string(prev) + "): TUM list files must be sorted by time");
 }
 
@@ -38,7 +46,7 @@ void check_order(double prev, double t, const std::string& path, int n) {
 // a file written the other way round (depth first) is recognised by its file names.
 std::vector<TumPair> read_associations(const std::string& path) {
   std::ifstream in(path);
-  if (!in) throw Error("cannot open association file '" + path + "': " + std::strerror(errno));
+  if (!in) throw InputError("cannot open association file '" + path + "': " + std::strerror(errno));
   std::vector<TumPair> out;
   std::string line;
   for (int n = 1; std::getline(in, line); ++n) {
@@ -46,10 +54,11 @@ std::vector<TumPair> read_associations(const std::string& path) {
     std::istringstream ss(line);
     TumPair p;
     if (!(ss >> p.rgb.timestamp >> p.rgb.file >> p.depth.timestamp >> p.depth.file))
-      throw Error("malformed association at " + where(path, n) + ": expected 't_rgb rgb/x.png t_depth depth/y.png', got '" +
+      throw InputError("malformed association at " + where(path, n) + ": expected 't_rgb rgb/x.png t_depth depth/y.png', got '" +
                   line + "'");
     if (p.rgb.file.find("depth") != std::string::npos && p.depth.file.find("rgb") != std::string::npos)
       std::swap(p.rgb, p.depth);
+    if (!out.empty() && repeated(out.back().rgb.timestamp, p.rgb.timestamp, path, n, line)) continue;
     if (!out.empty()) check_order(out.back().rgb.timestamp, p.rgb.timestamp, path, n);
     out.push_back(p);
   }
@@ -58,7 +67,7 @@ std::vector<TumPair> read_associations(const std::string& path) {
 
 std::vector<std::pair<double, vec3>> read_accelerometer(const std::string& path) {
   std::ifstream in(path);
-  if (!in) throw Error("cannot open accelerometer file '" + path + "': " + std::strerror(errno));
+  if (!in) throw InputError("cannot open accelerometer file '" + path + "': " + std::strerror(errno));
   std::vector<std::pair<double, vec3>> out;
   std::string line;
   for (int n = 1; std::getline(in, line); ++n) {
@@ -66,7 +75,7 @@ std::vector<std::pair<double, vec3>> read_accelerometer(const std::string& path)
     std::istringstream ss(line);
     double t, ax, ay, az;
     if (!(ss >> t >> ax >> ay >> az))
-      throw Error("malformed accelerometer sample at " + where(path, n) + ": expected 'timestamp ax ay az'");
+      throw InputError("malformed accelerometer sample at " + where(path, n) + ": expected 'timestamp ax ay az'");
     if (!out.empty()) check_order(out.back().first, t, path, n);
     // The Kinect's accelerometer axes are the camera's turned half a turn about z (x left, y up):
     // checked against the motion-capture ground truth of freiburg1 (tests/io/test_tum.cpp).
@@ -79,7 +88,7 @@ std::vector<std::pair<double, vec3>> read_accelerometer(const std::string& path)
 
 std::vector<TumListEntry> read_tum_list(const std::string& path) {
   std::ifstream in(path);
-  if (!in) throw Error("cannot open TUM list file '" + path + "': " + std::strerror(errno));
+  if (!in) throw InputError("cannot open TUM list file '" + path + "': " + std::strerror(errno));
   std::vector<TumListEntry> out;
   std::string line;
   for (int n = 1; std::getline(in, line); ++n) {
@@ -87,7 +96,8 @@ std::vector<TumListEntry> read_tum_list(const std::string& path) {
     std::istringstream ss(line);
     TumListEntry e;
     if (!(ss >> e.timestamp >> e.file))
-      throw Error("malformed line at " + where(path, n) + ": expected 'timestamp filename', got '" + line + "'");
+      throw InputError("malformed line at " + where(path, n) + ": expected 'timestamp filename', got '" + line + "'");
+    if (!out.empty() && repeated(out.back().timestamp, e.timestamp, path, n, line)) continue;
     if (!out.empty()) check_order(out.back().timestamp, e.timestamp, path, n);
     out.push_back(e);
   }
@@ -144,7 +154,7 @@ std::vector<TumPair> tum_folder_pairs(const std::string& folder, const InputPara
   const std::string file = association_file(dir);
   if (params.association == "file") {
     if (file.empty())
-      throw Error("input.association is 'file' but '" + folder + "' has neither associations.txt nor associate.txt: " +
+      throw InputError("input.association is 'file' but '" + folder + "' has neither associations.txt nor associate.txt: " +
                   "set input.association: auto to pair rgb.txt and depth.txt by time");
     return read_associations(file);
   }
@@ -165,22 +175,22 @@ std::vector<TumPair> tum_folder_pairs(const std::string& folder, const InputPara
 }
 
 TumSource::TumSource(const InputParams& params, bool pinned) : params_(params), folder_(params.path), pinned_(pinned) {
-  if (folder_.empty()) throw Error("input.path is empty: set it to a TUM RGB-D folder (source: tum)");
+  if (folder_.empty()) throw InputError("input.path is empty: set it to a TUM RGB-D folder (source: tum)");
   if (!fs::is_directory(folder_))
-    throw Error("input.path '" + folder_ + "' is not a folder: download one with datasets/download_tum.sh");
+    throw InputError("input.path '" + folder_ + "' is not a folder: download one with datasets/download_tum.sh");
   std::string origin;
   K_ = resolve_intrinsics(params.intrinsics, folder_, &origin);
   fs::path dir(folder_);
   pairs_ = tum_folder_pairs(folder_, params);
   if (pairs_.empty())
-    throw Error("TUM folder '" + folder_ + "' has no rgb/depth pairs (input.association " + params.association +
+    throw InputError("TUM folder '" + folder_ + "' has no rgb/depth pairs (input.association " + params.association +
                 ": no rgb/depth timestamps within input.association_max_dt " + std::to_string(params.association_max_dt) +
                 " s, or empty lists); check rgb.txt and depth.txt, or input.association_offset");
   std::size_t first = static_cast<std::size_t>(std::min<std::int64_t>(params.first_frame, pairs_.size()));
   pairs_.erase(pairs_.begin(), pairs_.begin() + first);
   if (params.max_frames > 0 && pairs_.size() > static_cast<std::size_t>(params.max_frames)) pairs_.resize(params.max_frames);
   if (pairs_.empty())
-    throw Error("input.first_frame " + std::to_string(params.first_frame) + " is past the end of '" + folder_ + "'");
+    throw InputError("input.first_frame " + std::to_string(params.first_frame) + " is past the end of '" + folder_ + "'");
   if (fs::exists(dir / "groundtruth.txt")) groundtruth_ = read_tum_trajectory((dir / "groundtruth.txt").string());
   if (fs::exists(dir / "accelerometer.txt")) accel_ = read_accelerometer((dir / "accelerometer.txt").string());
   scale_check_ = std::make_unique<DepthScaleCheck>(effective_depth_scale(params), params.check_depth_scale);
@@ -214,10 +224,10 @@ void TumSource::load_frame(const TumPair& pair, RgbdFrame& frame) {
   Image<std::uint16_t> raw = read_png_u16(depth_path);
   Image<uchar3> rgb = read_colour_image(rgb_path);  // PNG or JPEG, by content
   if (raw.width() != K_.width || raw.height() != K_.height)
-    throw Error("depth image '" + depth_path + "' is " + std::to_string(raw.width()) + "x" + std::to_string(raw.height()) +
+    throw InputError("depth image '" + depth_path + "' is " + std::to_string(raw.width()) + "x" + std::to_string(raw.height()) +
                 " but input.intrinsics says " + std::to_string(K_.width) + "x" + std::to_string(K_.height));
   if (rgb.width() != raw.width() || rgb.height() != raw.height())
-    throw Error("colour image '" + rgb_path + "' is " + std::to_string(rgb.width()) + "x" + std::to_string(rgb.height()) +
+    throw InputError("colour image '" + rgb_path + "' is " + std::to_string(rgb.width()) + "x" + std::to_string(rgb.height()) +
                 ", its depth image '" + depth_path + "' " + std::to_string(raw.width()) + "x" + std::to_string(raw.height()));
   // Decoded straight into the frame's (reused, possibly page-locked) images; undistortion reads
   // from scratch images instead.

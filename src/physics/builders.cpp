@@ -73,7 +73,7 @@ std::vector<vec4> voxel_sdf(const std::vector<int3>& cells, float d) {
 
 ParticleBatch rigid_from_cells(const std::vector<int3>& cells, const SpawnParams& s, const SolverParams& p) {
   if (cells.empty())
-    throw Error("spawn rigid: shape '" + s.shape + "' of size (" + std::to_string(s.size.x) + ", " +
+    throw ConfigError("spawn rigid: shape '" + s.shape + "' of size (" + std::to_string(s.size.x) + ", " +
                 std::to_string(s.size.y) + ", " + std::to_string(s.size.z) +
                 ") holds no particle of diameter " + std::to_string(p.particle_diameter) + "; make it larger");
   const float d = p.particle_diameter;
@@ -223,7 +223,7 @@ ParticleBatch make_rigid(const SpawnParams& s, const SolverParams& p) {
         for (int x = -k; x <= k; ++x)
           if (static_cast<float>(x * x + y * y + z * z) * d * d <= R * R + 1e-6f * d * d) cells.push_back({x, y, z});
   } else {
-    if (s.mesh.empty()) throw Error("spawn rigid: shape 'mesh' needs the key 'mesh' (an OBJ file path)");
+    if (s.mesh.empty()) throw ConfigError("spawn rigid: shape 'mesh' needs the key 'mesh' (an OBJ file path)");
     for (vec3 q : voxelize_obj(s.mesh, d, s.size)) cells.push_back(floor_to_int(q / d + vec3{0.5f, 0.5f, 0.5f}));
   }
   return rigid_from_cells(cells, s, p);
@@ -245,7 +245,7 @@ void check_spawn_capacity(const std::vector<SpawnParams>& spawns, const SolverPa
     std::int64_t n = spawn_particle_count(spawns[i], p);
     if (n > 0) total += n;
     if (total > p.max_particles)
-      throw Error("spawn[" + std::to_string(i) + "] (" + spawns[i].kind + ") brings the particle count to " +
+      throw ConfigError("spawn[" + std::to_string(i) + "] (" + spawns[i].kind + ") brings the particle count to " +
                   std::to_string(total) + ", over solver.max_particles = " + std::to_string(p.max_particles) +
                   "; raise solver.max_particles or make the spawn entries smaller");
   }
@@ -260,7 +260,7 @@ struct ObjMesh {
 
 ObjMesh read_obj(const std::string& path) {
   std::ifstream in(path);
-  if (!in) throw Error("cannot open mesh file '" + path + "' (spawn rigid, shape: mesh); check the path");
+  if (!in) throw InputError("cannot open mesh file '" + path + "' (spawn rigid, shape: mesh); check the path");
   ObjMesh m;
   std::string line;
   while (std::getline(in, line)) {
@@ -281,7 +281,7 @@ ObjMesh read_obj(const std::string& path) {
       for (std::size_t k = 2; k < idx.size(); ++k) m.f.push_back({idx[0], idx[k - 1], idx[k]});
     }
   }
-  if (m.v.empty() || m.f.empty()) throw Error("mesh file '" + path + "' has no triangles (expected OBJ 'v' and 'f' lines)");
+  if (m.v.empty() || m.f.empty()) throw InputError("mesh file '" + path + "' has no triangles (expected OBJ 'v' and 'f' lines)");
   return m;
 }
 

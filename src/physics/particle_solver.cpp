@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <exception>
 #include <fstream>
@@ -9,6 +10,7 @@
 
 #include "core/buffer.hpp"
 #include "core/error.hpp"
+#include "core/output_file.hpp"
 #include "core/exec.hpp"
 #include "core/log.hpp"
 #include "kernels/physics/solver.hpp"
@@ -18,6 +20,10 @@ namespace seamless {
 namespace K = kernels;
 
 namespace {
+
+// A spawn further than this outside the scanned scene's bounding box is reported: objects are
+// spawned above the scene, within a metre or so of what the camera saw.
+constexpr float kScanMargin = 1.f;
 
 template <class T>
 void grow(Buffer<T>& b, std::int64_t cap, std::int64_t keep, Device d) {
@@ -546,6 +552,10 @@ struct ParticleSolver::Impl {
         e.distance -= P.particle_diameter;
         e.budget -= static_cast<double>(layer.size());
         if (n + layer.size() > P.max_particles) {
+          if (emitter_dropped == 0)
+            spdlog::warn("emitter at ({:.2f}, {:.2f}, {:.2f}): solver.max_particles = {} reached at t = {:.3f} s; its "
+                         "further layers are dropped (the total is in the physics summary)",
+                         e.s.position.x, e.s.position.y, e.s.position.z, P.max_particles, time);
           emitter_dropped += layer.size();
           continue;
         }
@@ -559,6 +569,55 @@ struct ParticleSolver::Impl {
     }
   }
 
+  // A spawn whose particles start inside the scene's solid (in a wall, or outside the synthetic
+  // room: the room's SDF is solid there) is pushed to the nearest surface by the first collision;
+  // one far outside the scanned scene falls with nothing to land on. Either is said once, with the
+  // number of particles, instead of happening silently.
+  void report_placement(const SpawnParams& s, const std::vector<vec3>& x) {
+    if (x.empty()) return;
+    kernels::SceneSdf host_sdf = sdf;
+    host_sdf.grid = nullptr;  // the sampled TSDF lives on the device; the primitives and the room suffice
+    std::int64_t solid = 0, far = 0;
+    const bool scanned = !static_host.empty();
+    vec3 lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
+    for (vec3 p : static_host) lo = vmin(lo, p), hi = vmax(hi, p);
+    const float m = kScanMargin;
+    for (vec3 p : x) {
+      if (host_sdf.active() && kernels::scene_sdf(host_sdf, p).d < 0.f) ++solid;
+      if (scanned && (p.x < lo.x - m || p.y < lo.y - m || p.z < lo.z - m || p.x > hi.x + m || p.y > hi.y + m ||
+                      p.z > hi.z + m))
+        ++far;
+    }
+    const std::string what = s.kind + " at (" + format_vec(s.position) + ")";
+    if (solid > 0)
+      spdlog::warn("spawn {}: {} of {} particles start inside the scene's solid (in a wall or object, or outside the "
+                   "room); the first collision moves them to the nearest surface. Check the spawn position (world "
+                   "frame: README, Usage)",
+                   what, solid, x.size());
+    if (far > 0)
+      spdlog::warn("spawn {}: {} of {} particles start more than {} m outside the scanned scene (x {:.2f}..{:.2f}, y "
+                   "{:.2f}..{:.2f}, z {:.2f}..{:.2f}): there is nothing there for them to land on",
+                   what, far, x.size(), kScanMargin, lo.x, hi.x, lo.y, hi.y, lo.z, hi.z);
+  }
+
+  // An emitter puts out one layer each time its jet has moved one diameter: at most
+  // layer * |velocity| / diameter particles a second, whatever its rate asks for.
+  void report_emitter_rate(const SpawnParams& s) {
+    const double layer = static_cast<double>(make_emitter_layer(s, P).size());
+    const double most = layer * length(s.velocity) / P.particle_diameter;
+    if (s.rate <= most * (1.0 + 1e-6)) return;
+    spdlog::warn("spawn emitter at ({}): rate {} particles/s is more than its jet carries ({} particles a layer, a "
+                 "layer per {} m travelled at {:.3g} m/s: {:.0f} particles/s); it emits {:.0f}/s. Raise velocity or "
+                 "nozzle_radius for more",
+                 format_vec(s.position), s.rate, layer, P.particle_diameter, length(s.velocity), most, most);
+  }
+
+  static std::string format_vec(vec3 v) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "%.2f, %.2f, %.2f", v.x, v.y, v.z);
+    return buf;
+  }
+
   void spawn_due() {
     std::vector<SpawnParams> later;
     for (const SpawnParams& s : pending)
@@ -568,14 +627,20 @@ struct ParticleSolver::Impl {
   }
 
   std::int64_t spawn(const SpawnParams& s) {
-    if (s.kind == "fluid_block") return add_batch(make_fluid_block(s, P));
-    if (s.kind == "cloth") return add_batch(make_cloth(s, P));
-    if (s.kind == "rigid") return add_batch(make_rigid(s, P));
+    auto placed = [&](ParticleBatch b) {
+      report_placement(s, b.x);
+      return add_batch(b);
+    };
+    if (s.kind == "fluid_block") return placed(make_fluid_block(s, P));
+    if (s.kind == "cloth") return placed(make_cloth(s, P));
+    if (s.kind == "rigid") return placed(make_rigid(s, P));
     if (s.kind == "emitter") {
+      report_placement(s, make_emitter_layer(s, P).x);
+      report_emitter_rate(s);
       emitters.push_back({s, time, P.particle_diameter, 0.0});
       return n;
     }
-    throw Error("spawn: unknown kind '" + s.kind + "' (expected fluid_block, emitter, cloth or rigid)");
+    throw ConfigError("spawn: unknown kind '" + s.kind + "' (expected fluid_block, emitter, cloth or rigid)");
   }
 
   void rebuild_static() {
@@ -673,6 +738,10 @@ SolverStats ParticleSolver::stats() const {
   s.neighbour_overflow = c[0], s.static_neighbour_overflow = c[1];
   s.max_neighbours_seen = c[2], s.max_static_neighbours_seen = c[3];
   if (I.n > 0) s.max_speed = std::sqrt(bits_float(c[4]));
+  if (s.emitter_dropped > 0)
+    spdlog::warn("particle solver: emitters could not create {} particles (solver.max_particles = {} reached); raise "
+                 "solver.max_particles",
+                 s.emitter_dropped, I.P.max_particles);
   if (s.neighbour_overflow > 0 || s.static_neighbour_overflow > 0)
     spdlog::warn("particle solver: {} neighbour lists and {} scene lists exceeded the cap ({} / {}); raise "
               "solver.max_neighbours / solver.max_static_neighbours",
@@ -742,7 +811,7 @@ std::vector<float> ParticleSolver::fluid_density_ratio() const {
 }
 
 void write_particles_ply(const std::string& path, const ParticleState& s) {
-  std::ofstream out(path, std::ios::binary);
+  std::ofstream out(partial_path(path), std::ios::binary);
   if (!out) throw Error("cannot write particle file '" + path + "'; check that the folder exists and is writable");
   out << "ply\nformat binary_little_endian 1.0\nelement vertex " << s.x.size()
       << "\nproperty float x\nproperty float y\nproperty float z\nproperty float vx\nproperty float vy\n"
@@ -754,6 +823,9 @@ void write_particles_ply(const std::string& path, const ParticleState& s) {
     std::memcpy(&buf[i * 28 + 24], &s.phase[i], 4);
   }
   out.write(buf.data(), static_cast<std::streamsize>(buf.size()));
+  out.close();
+  if (!out) throw Error("writing particle file '" + path + "' failed (disk full?)");
+  commit_partial(path);
 }
 
 }  // namespace seamless

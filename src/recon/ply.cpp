@@ -6,11 +6,12 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/output_file.hpp"
 
 namespace seamless {
 
 void write_ply(const std::string& path, const Mesh& mesh) {
-  std::ofstream f(path, std::ios::binary);
+  std::ofstream f(partial_path(path), std::ios::binary);
   if (!f) throw Error("cannot write mesh to '" + path + "' (does the folder exist and is it writable?)");
   const bool normals = mesh.normals.size() == mesh.positions.size();
   const bool colors = mesh.colors.size() == mesh.positions.size();
@@ -32,7 +33,9 @@ void write_ply(const std::string& path, const Mesh& mesh) {
     put(&t, 12);
   }
   f.write(buf.data(), static_cast<std::streamsize>(buf.size()));
+  f.close();
   if (!f) throw Error("writing mesh to '" + path + "' failed (disk full?)");
+  commit_partial(path);
 }
 
 namespace {
@@ -44,16 +47,16 @@ std::size_t type_size(const std::string& t, const std::string& path) {
   if (t == "uchar" || t == "uint8" || t == "char" || t == "int8") return 1;
   if (t == "double" || t == "float64") return 8;
   if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
-  throw Error("PLY '" + path + "': unsupported property type '" + t + "'");
+  throw InputError("PLY '" + path + "': unsupported property type '" + t + "'");
 }
 }  // namespace
 
 Mesh read_ply(const std::string& path) {
   std::ifstream f(path, std::ios::binary);
-  if (!f) throw Error("cannot open mesh '" + path + "'");
+  if (!f) throw InputError("cannot open mesh '" + path + "'");
   std::string line;
   std::getline(f, line);
-  if (line != "ply") throw Error("'" + path + "' is not a PLY file (first line is not 'ply')");
+  if (line != "ply") throw InputError("'" + path + "' is not a PLY file (first line is not 'ply')");
   std::size_t nv = 0, nf = 0;
   std::vector<Prop> vprops;
   std::string element, face_count = "uchar", face_index = "int";
@@ -65,20 +68,20 @@ Mesh read_ply(const std::string& path) {
       std::string fmt;
       ls >> fmt;
       if (fmt != "binary_little_endian")
-        throw Error("PLY '" + path + "': format " + fmt + " is not supported (only binary_little_endian)");
+        throw InputError("PLY '" + path + "': format " + fmt + " is not supported (only binary_little_endian)");
     } else if (word == "element") {
       std::size_t n = 0;
       ls >> element >> n;
       (element == "vertex" ? nv : nf) = n;
       if (element != "vertex" && element != "face")
-        throw Error("PLY '" + path + "': element '" + element + "' is not supported");
+        throw InputError("PLY '" + path + "': element '" + element + "' is not supported");
     } else if (word == "property") {
       std::string t, name;
       ls >> t;
       if (t == "list") {
         ls >> face_count >> face_index;
         if (type_size(face_count, path) != 1 || type_size(face_index, path) != 4)
-          throw Error("PLY '" + path + "': face lists must be 'list uchar int'");
+          throw InputError("PLY '" + path + "': face lists must be 'list uchar int'");
       } else if (element == "vertex") {
         ls >> name;
         vprops.push_back({t, name});
@@ -95,7 +98,7 @@ Mesh read_ply(const std::string& path) {
   for (const Prop& p : vprops) stride += type_size(p.type, path);
   std::vector<char> rec(stride);
   for (std::size_t i = 0; i < nv; ++i) {
-    if (!f.read(rec.data(), static_cast<std::streamsize>(stride))) throw Error("PLY '" + path + "': truncated vertex data");
+    if (!f.read(rec.data(), static_cast<std::streamsize>(stride))) throw InputError("PLY '" + path + "': truncated vertex data");
     std::size_t off = 0;
     for (const Prop& p : vprops) {
       float v = 0.f;
@@ -118,8 +121,8 @@ Mesh read_ply(const std::string& path) {
   for (std::size_t i = 0; i < nf; ++i) {
     std::uint8_t count = 0;
     f.read(reinterpret_cast<char*>(&count), 1);
-    if (count != 3) throw Error("PLY '" + path + "': face " + std::to_string(i) + " is not a triangle");
-    if (!f.read(reinterpret_cast<char*>(&m.triangles[i]), 12)) throw Error("PLY '" + path + "': truncated face data");
+    if (count != 3) throw InputError("PLY '" + path + "': face " + std::to_string(i) + " is not a triangle");
+    if (!f.read(reinterpret_cast<char*>(&m.triangles[i]), 12)) throw InputError("PLY '" + path + "': truncated face data");
   }
   return m;
 }

@@ -136,7 +136,7 @@ SE3 orthonormalize(SE3 T) {
 
 Tracker::Tracker(const TrackerParams& params, Device device) : params_(params), device_(device) {
   if (params_.kind != "icp" && params_.kind != "rgbd")
-    throw Error("tracker.kind '" + params_.kind + "' is not an ICP tracker (the Tracker class runs icp and rgbd)");
+    throw ConfigError("tracker.kind '" + params_.kind + "' is not an ICP tracker (the Tracker class runs icp and rgbd)");
 }
 
 bool Tracker::use_photometric(const FramePyramid& frame, const ReferenceMaps& ref) const {
@@ -160,7 +160,7 @@ void Tracker::set_pose(const SE3& ref_T_cur) const {
 
 kernels::IcpSums* Tracker::sums_slot(int level) const {
   if (level >= kernels::kIcpMaxLevels)
-    throw Error("the tracker handles at most " + std::to_string(kernels::kIcpMaxLevels) + " pyramid levels, not " +
+    throw ConfigError("the tracker handles at most " + std::to_string(kernels::kIcpMaxLevels) + " pyramid levels, not " +
                 std::to_string(level + 1) + " (preprocess.levels)");
   return &state()->sums[level];
 }

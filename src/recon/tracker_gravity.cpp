@@ -83,7 +83,7 @@ GravityEstimate estimate_gravity(const TrackerParams& p, const std::optional<vec
   const std::string& how = p.gravity;
   if (how == "none") return g;
   if (how == "fixed") {
-    if (length2(p.fixed_gravity) == 0) throw Error("tracker.fixed_gravity is the zero vector; give a direction");
+    if (length2(p.fixed_gravity) == 0) throw ConfigError("tracker.fixed_gravity is the zero vector; give a direction");
     return {normalize(p.fixed_gravity), "fixed", true, 0};
   }
   if ((how == "accelerometer" || how == "auto") && accelerometer && length2(*accelerometer) > 0) {

@@ -8,7 +8,9 @@
 
 #include "core/error.hpp"
 #include "core/exec.hpp"
+#include "core/interrupt.hpp"
 #include "core/log.hpp"
+#include "core/output_file.hpp"
 #include "core/timing.hpp"
 #include "kernels/recon/rgbd.hpp"
 #include "seamless/build_config.hpp"
@@ -67,12 +69,12 @@ void require_tracker(const std::string& kind) { (void)tracker_info(kind); }
 const TrackerInfo& tracker_info(const std::string& kind) {
   for (const TrackerInfo& t : tracker_registry()) {
     if (t.kind != kind) continue;
-    if (!t.available) throw Error("tracker.kind '" + kind + "' is not available in this build: " + t.missing);
+    if (!t.available) throw ConfigError("tracker.kind '" + kind + "' is not available in this build: " + t.missing);
     return t;
   }
   std::string known;
   for (const TrackerInfo& t : tracker_registry()) known += (known.empty() ? "" : ", ") + t.kind;
-  throw Error("tracker.kind '" + kind + "' is unknown; known trackers: " + known);
+  throw ConfigError("tracker.kind '" + kind + "' is unknown; known trackers: " + known);
 }
 
 // ---- TrackingSession ----------------------------------------------------------------------------
@@ -118,7 +120,7 @@ bool TrackingSession::uses_volume() const { return volume_ != nullptr; }
 
 void TrackingSession::upload(const RgbdFrame& frame) {
   if (frame.depth.width() != K_.width || frame.depth.height() != K_.height)
-    throw Error("frame " + std::to_string(frame.index) + " is " + std::to_string(frame.depth.width()) + "x" +
+    throw InputError("frame " + std::to_string(frame.index) + " is " + std::to_string(frame.depth.width()) + "x" +
                 std::to_string(frame.depth.height()) + " but the source's intrinsics say " +
                 std::to_string(K_.width) + "x" + std::to_string(K_.height));
   // Persistent device images: one host-to-device copy a frame, no allocation. The copies are
@@ -295,7 +297,7 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
 }
 
 void write_tracking_stats(const std::string& path, const std::vector<FrameRecord>& frames) {
-  std::FILE* f = std::fopen(path.c_str(), "w");
+  std::FILE* f = std::fopen(partial_path(path).c_str(), "w");
   if (!f) throw Error("cannot write tracking statistics '" + path + "': check that the folder exists and is writable");
   std::fprintf(f,
                "frame,timestamp,status,fused,inlier_ratio,inliers,residual_rms,condition,iterations,"
@@ -308,7 +310,18 @@ void write_tracking_stats(const std::string& path, const std::vector<FrameRecord
                  t.rotation_jump_deg, r.preprocess_ms, r.track_ms, r.fuse_ms, r.frame_ms);
   }
   if (std::fclose(f) != 0) throw Error("error writing tracking statistics '" + path + "' (disk full?)");
+  commit_partial(path);
 }
+
+namespace {
+// The warning for a frame that tracking lost.
+void log_lost(const FrameRecord& rec) {
+  if (rec.result.ok()) return;
+  spdlog::warn("frame {}: tracking lost ({}, inliers {:.2f}, condition {:.3g}, jump {:.3f} m / {:.1f} deg); not fused",
+               rec.frame, to_string(rec.result.status), rec.result.inlier_ratio, rec.result.condition,
+               rec.result.translation_jump, rec.result.rotation_jump_deg);
+}
+}  // namespace
 
 TrackSequenceResult track_sequence(FrameSource& source, const TrackSequenceParams& params, Device device,
                                    const std::string& out_dir, Volume* volume,
@@ -329,34 +342,62 @@ TrackSequenceResult track_sequence(FrameSource& source, const TrackSequenceParam
   // timestamps as trajectory.txt, so `seamless eval trajectory.txt groundtruth.txt` pairs them all.
   std::unique_ptr<TrajectoryWriter> gt_writer;
   SE3 world_T_gt = SE3::identity();
-  while ((params.max_frames <= 0 || static_cast<std::int64_t>(out.frames.size()) < params.max_frames) &&
-         source.next(frame)) {
-    FrameRecord rec = session.process(frame);
-    out.trajectory.push_back(TumPose::from_se3(frame.timestamp, rec.result.world_T_camera));
-    if (writer) writer->write(out.trajectory.back());
-    if (out.frames.empty() && frame.ground_truth)
-      world_T_gt = rec.result.world_T_camera * frame.ground_truth->inverse();
-    if (frame.ground_truth) {
-      out.ground_truth.push_back(TumPose::from_se3(frame.timestamp, world_T_gt * *frame.ground_truth));
-      if (params.write_files && !gt_writer)
-        gt_writer = std::make_unique<TrajectoryWriter>(
-            out_dir + "/groundtruth.txt", "ground truth of " + source.name() + " (world_T_camera), in the world frame of "
-                                          "trajectory.txt: the first frame's ground truth is its pose there");
-      if (gt_writer) gt_writer->write(out.ground_truth.back());
+  // Frames still wanted: up to max_frames, and none after Ctrl-C / SIGTERM (the frame being
+  // processed when the signal came is finished first).
+  auto wanted = [&] {
+    return (params.max_frames <= 0 || static_cast<std::int64_t>(out.frames.size()) < params.max_frames) &&
+           !interrupted();
+  };
+  try {
+    while (wanted() && source.next(frame)) {
+      FrameRecord rec = session.process(frame);
+      out.trajectory.push_back(TumPose::from_se3(frame.timestamp, rec.result.world_T_camera));
+      if (writer) writer->write(out.trajectory.back());
+      if (out.frames.empty() && frame.ground_truth)
+        world_T_gt = rec.result.world_T_camera * frame.ground_truth->inverse();
+      if (frame.ground_truth) {
+        out.ground_truth.push_back(TumPose::from_se3(frame.timestamp, world_T_gt * *frame.ground_truth));
+        if (params.write_files && !gt_writer)
+          gt_writer = std::make_unique<TrajectoryWriter>(
+              out_dir + "/groundtruth.txt", "ground truth of " + source.name() +
+                                                " (world_T_camera), in the world frame of trajectory.txt: the first "
+                                                "frame's ground truth is its pose there");
+        if (gt_writer) gt_writer->write(out.ground_truth.back());
+      }
+      if (out.frames.size() > 0) track_ms.push_back(rec.track_ms);
+      frame_ms.push_back(rec.frame_ms);
+      log_lost(rec);
+      if (on_frame) on_frame(frame, rec);
+      out.frames.push_back(rec);
     }
-    if (out.frames.size() > 0) track_ms.push_back(rec.track_ms);
-    frame_ms.push_back(rec.frame_ms);
-    if (!rec.result.ok())
-      spdlog::warn("frame {}: tracking lost ({}, inliers {:.2f}, condition {:.3g}, jump {:.3f} m / {:.1f} deg); not fused",
-                rec.frame, to_string(rec.result.status), rec.result.inlier_ratio, rec.result.condition,
-                rec.result.translation_jump, rec.result.rotation_jump_deg);
-    if (on_frame) on_frame(frame, rec);
-    out.frames.push_back(rec);
+  } catch (...) {
+    // A frame that cannot be read or processed ends the run; the frames before it are kept.
+    const auto n = static_cast<long long>(out.frames.size());
+    if (params.write_files) {
+      try {
+        writer.reset();  // trajectory.txt under its own name
+        gt_writer.reset();
+        write_tracking_stats(out_dir + "/tracking_stats.csv", out.frames);
+      } catch (const std::exception& e) {
+        spdlog::error("{}", e.what());
+      }
+      if (n > 0)
+        spdlog::error("the run stopped at frame {}: trajectory.txt and tracking_stats.csv hold frames 0-{} before it",
+                      n, n - 1);
+      else
+        spdlog::error("the run stopped at frame 0, before any frame was tracked");
+    } else {
+      spdlog::error("the run stopped at frame {}, after {} frames", n, n);
+    }
+    throw;
   }
+  if (interrupted()) spdlog::warn("tracking stopped after {} frames (interrupted)", out.frames.size());
   out.lost_frames = session.lost_frames();
   out.gravity = session.gravity();
   out.median_track_ms = median(track_ms);
   out.median_frame_ms = median(frame_ms);
+  if (writer) writer->close();
+  if (gt_writer) gt_writer->close();
   if (params.write_files) write_tracking_stats(out_dir + "/tracking_stats.csv", out.frames);
   spdlog::info("tracked {} frames with {} ({}), {} lost; median {:.2f} ms tracking, {:.2f} ms a frame",
             out.frames.size(), params.tracker.kind, params.tracker.mode, out.lost_frames, out.median_track_ms,

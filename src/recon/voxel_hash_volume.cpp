@@ -19,7 +19,9 @@ using kernels::kBlockVoxels;
 
 namespace {
 constexpr int kMaxProbe = 128;   // linear probing at <= 50% fill rarely probes past 20 slots
-constexpr int kMaxRetries = 4;   // allocation passes after growing, per frame
+// Allocation passes after growing, per frame. Each growth at least doubles the pool or the table,
+// so this bound is never the one that stops growth: the pool's 2^30 blocks (grow_pool) come first.
+constexpr int kMaxGrowths = 40;
 
 std::int64_t next_pow2(std::int64_t n) {
   std::int64_t p = 1;
@@ -38,10 +40,10 @@ void staged(StageTimer* timer, const char* stage, F&& fn) {
 
 VoxelHashVolume::VoxelHashVolume(const VolumeParams& p, Device d) : params_(p), device_(d) {
   if (p.truncation < 2.f * p.voxel_size)
-    throw Error("volume.truncation (" + std::to_string(p.truncation) + " m) must be at least two voxels (2 * " +
+    throw ConfigError("volume.truncation (" + std::to_string(p.truncation) + " m) must be at least two voxels (2 * " +
                 "volume.voxel_size = " + std::to_string(2.f * p.voxel_size) +
                 " m): the truncation band must reach the voxels on both sides of the surface");
-  if (p.capacity > (1ll << 30)) throw Error("volume.capacity must be below 2^30 blocks");
+  if (p.capacity > (1ll << 30)) throw ConfigError("volume.capacity must be below 2^30 blocks");
   geom_ = {{0.f, 0.f, 0.f}, p.voxel_size, p.truncation};
   const std::int64_t slots = next_pow2(std::max<std::int64_t>(p.hash_buckets, 1024));
   keys_ = Buffer<kernels::HashKey>(slots, d);
@@ -110,6 +112,7 @@ void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTime
     depth_tiles_.reserve_discard(grid.count(), device_);
     tiles = {grid, depth_tiles_.data()};
   }
+  const std::int64_t pool_before = free_list_.size(), slots_before = keys_.size();
   for (int attempt = 0;; ++attempt) {
     with_exec(device_, [&](const auto& ex) {
       kernels::reset_frame_counters(ex, counters_.data());
@@ -123,11 +126,26 @@ void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTime
     });
     last_ = read_counters();
     failed_ = last_.probe_failures + last_.pool_failures;
-    if (failed_ == 0 || attempt == kMaxRetries || !params_.grow_when_full) break;
+    if (failed_ == 0 || !params_.grow_when_full) break;
+    // Grow as often as this frame needs: a frame that is only partly fused is a hole in the model
+    // that tracking then fails against (issue 20: a pool of 64 blocks doubled 4 times, then
+    // dropped the rest of the frame and every later frame was lost).
+    if (attempt == kMaxGrowths)
+      throw Error("voxel hashing: " + std::to_string(failed_) + " block insertions still fail in frame " +
+                  std::to_string(frames_) + " after growing " + std::to_string(kMaxGrowths) +
+                  " times; raise volume.voxel_size or lower volume.max_depth");
     handle_failures(last_);
     ++retries_;
   }
-  if (failed_ > 0)
+  if (free_list_.size() != pool_before)
+    spdlog::warn("voxel hashing: block pool full in frame {}; grew it from {} to {} blocks (set volume.capacity: {} to "
+                 "avoid this pause)",
+                 frames_, pool_before, free_list_.size(), free_list_.size());
+  if (keys_.size() != slots_before)
+    spdlog::warn("voxel hashing: hash table too crowded in frame {}; rehashed it from {} into {} slots (set "
+                 "volume.hash_buckets: {} to avoid this pause)",
+                 frames_, slots_before, keys_.size(), keys_.size());
+  if (failed_ > 0)  // volume.grow_when_full is off
     spdlog::warn(
         "voxel hashing: {} block insertion attempts failed in frame {} ({} found no hash slot within {} probes, "
         "{} found the pool of {} blocks full); that part of the frame is not fused. Set volume.capacity >= {} and "
@@ -137,17 +155,16 @@ void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTime
 }
 
 void VoxelHashVolume::handle_failures(const HashCounters& c) {
+  // Logged once per frame by allocate_and_list, with the sizes reached.
   if (c.probe_failures > 0) {
-    spdlog::warn("voxel hashing: hash table of {} slots too crowded ({} insertions failed); rehashing into {} slots "
-                 "(set volume.hash_buckets: {} to avoid this pause)",
-                 keys_.size(), c.probe_failures, 2 * keys_.size(), 2 * keys_.size());
+    spdlog::debug("voxel hashing: hash table of {} slots too crowded ({} insertions failed); rehashing into {} slots",
+                  keys_.size(), c.probe_failures, 2 * keys_.size());
     rehash(2 * keys_.size());
   }
   if (c.pool_failures > 0) {
     std::int64_t cap = free_list_.size();
-    spdlog::warn("voxel hashing: block pool full ({} blocks, {} insertion attempts failed); growing it to {} blocks (set "
-                 "volume.capacity: {} to avoid this pause)",
-                 cap, c.pool_failures, 2 * cap, 2 * cap);
+    spdlog::debug("voxel hashing: block pool full ({} blocks, {} insertion attempts failed); growing it to {} blocks",
+                  cap, c.pool_failures, 2 * cap);
     grow_pool(2 * cap);
   }
 }
@@ -203,7 +220,9 @@ void VoxelHashVolume::rehash(std::int64_t new_slots) {
 
 void VoxelHashVolume::grow_pool(std::int64_t blocks) {
   const std::int64_t old = free_list_.size();
-  if (blocks > (1ll << 30)) throw Error("voxel hashing: the block pool cannot grow beyond 2^30 blocks");
+  if (blocks > (1ll << 30))
+    throw Error("voxel hashing: the block pool cannot grow beyond 2^30 blocks; raise volume.voxel_size or lower "
+                "volume.max_depth");
   Buffer<kernels::Voxel> voxels(blocks * kBlockVoxels, device_);
   voxels.zero();
   voxels.copy_from(voxels_);

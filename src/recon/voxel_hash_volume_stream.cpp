@@ -41,7 +41,7 @@ void VoxelHashVolume::maybe_stream(const Intrinsics& K, const vec3& camera_posit
   const float reach = (params_.max_depth + params_.truncation) * corner_factor(K) + block_diagonal;
   const float need = reach + params_.stream_step;
   if (params_.stream_radius < need)
-    throw Error("volume.stream_radius (" + std::to_string(params_.stream_radius) +
+    throw ConfigError("volume.stream_radius (" + std::to_string(params_.stream_radius) +
                 " m) is too small: a frame of this camera touches blocks up to " + std::to_string(reach) +
                 " m away (max_depth + truncation at the image corner, plus a block), and the camera moves up to "
                 "volume.stream_step = " + std::to_string(params_.stream_step) +

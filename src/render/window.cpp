@@ -11,6 +11,7 @@
 #include <cstdio>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "render/renderer.hpp"
 
 namespace seamless {
@@ -170,7 +171,7 @@ void run_window(const RenderParams& params, const std::string& title, const Wind
     if (cb.on_start) cb.on_start(r);
     auto last = std::chrono::steady_clock::now();
     int frame = 0;
-    while (!glfwWindowShouldClose(w)) {
+    while (!glfwWindowShouldClose(w) && !interrupted()) {  // Ctrl-C closes the window as Esc does
       const auto now = std::chrono::steady_clock::now();
       const double dt = std::chrono::duration<double>(now - last).count();
       last = now;

@@ -77,7 +77,7 @@ class Cli(unittest.TestCase):
             with open(bad, "w") as f:
                 f.write("name: x\nvolume:\n  voxel_sise: 0.01\n")
             r = seamless("run", bad, "--dry-run", check=False)
-            self.assertEqual(r.returncode, 1)
+            self.assertEqual(r.returncode, 4)  # a config error (README, "Exit codes and interrupted runs")
             self.assertIn("bad.yaml:3:", r.stderr)
             self.assertIn("volume.voxel_sise", r.stderr)
             self.assertIn("did you mean 'voxel_size'", r.stderr)

@@ -95,5 +95,25 @@ TEST(ConfigOverride, MalformedOptions) {
   EXPECT_THAT(error_of(kBase, {"solver.gravity=[0,1"}), HasSubstr("cannot parse"));
 }
 
+// Issue 20: an option that cannot be applied at all (malformed, or a path through a value) was
+// thrown on its own and hid every problem of the file; now they are all listed together, and the
+// error is a ConfigError (exit code 4).
+TEST(ConfigOverride, UnusableOptionIsListedWithTheFilesProblems) {
+  const char* bad_file = "name: x\nvolume:\n  voxel_sise: 0.01\n  layout: dens\ntracker:\n  kindd: icp\n";
+  std::string msg;
+  try {
+    parse_experiment(bad_file, {"name.first=x", "volume.voxel_size", "solver.dt=fast"}, "bad.yaml");
+  } catch (const ConfigError& e) {
+    msg = e.what();
+  }
+  EXPECT_THAT(msg, HasSubstr("6 problems in the configuration"));
+  EXPECT_THAT(msg, HasSubstr("bad.yaml:3:3: volume.voxel_sise: unknown key"));
+  EXPECT_THAT(msg, HasSubstr("bad.yaml:4:11: volume.layout"));
+  EXPECT_THAT(msg, HasSubstr("bad.yaml:6:3: tracker.kindd: unknown key"));
+  EXPECT_THAT(msg, HasSubstr("(from --set name.first=x): 'name' is a value"));
+  EXPECT_THAT(msg, HasSubstr("--set expects key.path=value (e.g. --set volume.voxel_size=0.01), got 'volume.voxel_size'"));
+  EXPECT_THAT(msg, HasSubstr("(from --set solver.dt=fast): solver.dt: expected a number"));
+}
+
 }  // namespace
 }  // namespace seamless

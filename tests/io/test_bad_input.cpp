@@ -2,8 +2,12 @@
 // counted frame.
 #include <gtest/gtest.h>
 
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
+
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "core/error.hpp"
 #include "io/input_params.hpp"
@@ -170,4 +174,51 @@ TEST(BadInput, MalformedListLine) {
   std::string msg = read_all(tum(dir));
   EXPECT_MENTIONS(msg, "associations.txt");
   EXPECT_MENTIONS(msg, "line 4");
+}
+
+// Issue 20: a line repeated in a TUM list (same timestamp twice) made one frame two, fused twice
+// with two poses at one time. It is dropped, with a warning naming the file and line.
+TEST(BadInput, RepeatedListLinesAreDroppedWithAWarning) {
+  TmpDir dir("bad_repeat");
+  make_folder(dir);
+  for (const char* list : {"rgb.txt", "depth.txt", "associations.txt"}) {
+    auto ls = lines(dir / list);
+    std::size_t first = 0;
+    while (ls[first][0] == '#') ++first;
+    ls.insert(ls.begin() + first + 1, ls[first + 1]);  // the second frame's line twice
+    write_lines(dir / list, ls);
+  }
+  std::ostringstream log;
+  auto logger = std::make_shared<spdlog::logger>("test", std::make_shared<spdlog::sinks::ostream_sink_mt>(log));
+  auto previous = spdlog::default_logger();
+  spdlog::set_default_logger(logger);
+  const auto depth = read_tum_list(dir / "depth.txt");
+  spdlog::set_default_logger(previous);
+  ASSERT_EQ(depth.size(), 3u);  // the folder's 3 frames, each once
+  EXPECT_LT(depth[0].timestamp, depth[1].timestamp);
+  EXPECT_LT(depth[1].timestamp, depth[2].timestamp);
+  // depth.txt: 3 comment lines, frame 0 on line 4, frame 1 on lines 5 and 6.
+  EXPECT_MENTIONS(log.str(), "depth.txt' line 6");
+  EXPECT_MENTIONS(log.str(), "repeats the line before it; line dropped");
+  for (const char* association : {"auto", "file"}) {
+    InputParams p = tum(dir);
+    p.association = association;
+    std::int64_t n = 0;
+    EXPECT_EQ(read_all(p, &n), "") << association;
+    EXPECT_EQ(n, 3) << association;
+  }
+}
+
+// Issue 20: the readers' errors are InputErrors, so that `seamless` exits with its input-error code.
+TEST(BadInput, ReadersThrowInputErrors) {
+  TmpDir dir("bad_kind");
+  make_folder(dir);
+  fs::resize_file(second_depth_file(dir), 20);
+  TumSource src(tum(dir));
+  RgbdFrame f;
+  EXPECT_TRUE(src.next(f));
+  EXPECT_THROW(src.next(f), InputError);
+  InputParams missing = tum(dir);
+  missing.path = dir / "nowhere";
+  EXPECT_THROW(TumSource{missing}, InputError);
 }

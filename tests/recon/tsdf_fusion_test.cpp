@@ -235,6 +235,27 @@ TEST(TsdfFusion, FullPoolGrowsAndRetriesOrReports) {
   EXPECT_GT(c.failed_insertions, 0);  // counted and reported, not silent
 }
 
+// Issue 20: growth used to stop after 4 doublings a frame, dropping the rest of the frame. A pool
+// of 2 blocks and 1024 hash slots must grow as often as the first frame needs (here 2 -> 1024
+// blocks and more: 9 doublings or more) and hold exactly the blocks a roomy volume allocates.
+TEST(TsdfFusion, GrowthKeepsUpWithAFrameThatNeedsManyDoublings) {
+  Intrinsics K = test::camera(160, 120, 140.f);
+  Scene s;
+  VoxelHashVolume ref(test::small_volume_params(), Device::CPU);
+  fuse(ref, s, K, {SE3::identity()});
+  ASSERT_GT(ref.stats().allocated_blocks, 2 << 8);  // needs more than 8 doublings of 2 blocks
+
+  VolumeParams tiny = test::small_volume_params();
+  tiny.capacity = 2;
+  tiny.hash_buckets = 1024;
+  VoxelHashVolume grown(tiny, Device::CPU);
+  fuse(grown, s, K, {SE3::identity()});
+  VolumeStats g = grown.stats();
+  EXPECT_EQ(g.failed_insertions, 0);
+  EXPECT_GE(g.retries, 9);
+  EXPECT_EQ(grown.allocated_block_coords(), ref.allocated_block_coords());
+}
+
 TEST(TsdfFusion, RejectsTruncationBelowTwoVoxels) {
   VolumeParams p = test::small_volume_params();
   p.truncation = 0.015f;

@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "core/exec.hpp"
 #include "core/log.hpp"
+#include "core/output_file.hpp"
 #include "io/input_params.hpp"
 #include "kernels/recon/rgbd.hpp"
 #include "recon/preprocess.hpp"
@@ -60,7 +61,7 @@ bool refine_available() { return SEAMLESS_HAS_CERES != 0; }
 
 void require_refine(const RefineParams& params) {
   if (params.enabled && !refine_available())
-    throw Error("refine.enabled is true but this build has no Ceres: install libceres-dev (scripts/packages.txt) "
+    throw ConfigError("refine.enabled is true but this build has no Ceres: install libceres-dev (scripts/packages.txt) "
                 "and reconfigure, or set refine.enabled=false");
 }
 
@@ -144,7 +145,7 @@ std::vector<KeyframeData> load_keyframes(FrameSource& source, const Trajectory& 
     ++n;
   }
   if (n != total)
-    throw Error("refine: the source '" + source.name() + "' gave " + std::to_string(n) +
+    throw InputError("refine: the source '" + source.name() + "' gave " + std::to_string(n) +
                 " frames but the trajectory has " + std::to_string(total) +
                 " poses; refine the trajectory of exactly these frames (same input, same frames setting)");
   return out;
@@ -175,7 +176,7 @@ TrackerParams pair_tracker_params(const RefineParams& p) {
 int finest_level(const RefineParams& p, int levels) {
   for (int l = 0; l < std::min<int>(levels, static_cast<int>(p.iterations.size())); ++l)
     if (p.iterations[l] > 0) return l;
-  throw Error("refine.iterations has no level with iterations > 0: the pairwise alignment would do nothing");
+  throw ConfigError("refine.iterations has no level with iterations > 0: the pairwise alignment would do nothing");
 }
 
 struct PairResult {
@@ -354,7 +355,7 @@ RefineResult refine_trajectory(FrameSource& source, const Trajectory& odometry, 
     return no_op(odometry, r, "fewer than two keyframes (" + std::to_string(odometry.size()) +
                                   " frames, refine.keyframe_every " + std::to_string(params.keyframe_every) + ")");
   if (!refine_available())
-    throw Error("refine: this build has no Ceres; install libceres-dev (scripts/packages.txt) and reconfigure");
+    throw ConfigError("refine: this build has no Ceres; install libceres-dev (scripts/packages.txt) and reconfigure");
   std::vector<KeyframeData> kf =
       load_keyframes(source, odometry, r.keyframes, preprocess, params.pair_tracker == "rgbd", device);
   const double t_load = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -393,7 +394,7 @@ RefineResult refine_trajectory(FrameSource& source, const Trajectory& odometry, 
 }
 
 void write_refine_stats(const std::string& path, const RefineStats& s) {
-  std::FILE* f = std::fopen(path.c_str(), "w");
+  std::FILE* f = std::fopen(partial_path(path).c_str(), "w");
   if (!f) throw Error("cannot write refinement statistics '" + path + "': check that the folder exists and is writable");
   std::fprintf(f, "key,value\nframes,%lld\nkeyframes,%lld\ncandidate_pairs,%lld\npair_edges,%lld\n"
                "rejected_pairs,%lld\nodometry_edges,%lld\niterations,%d\ninitial_cost,%.9g\nfinal_cost,%.9g\n"
@@ -404,6 +405,7 @@ void write_refine_stats(const std::string& path, const RefineStats& s) {
                s.initial_cost, s.final_cost, s.converged ? 1 : 0, s.max_correction_m, s.max_correction_deg, s.seconds,
                s.message.c_str());
   if (std::fclose(f) != 0) throw Error("error writing refinement statistics '" + path + "' (disk full?)");
+  commit_partial(path);
 }
 
 RefineResult refine_run(const InputParams& input, const Trajectory& odometry, const std::vector<bool>& tracked,

@@ -1,0 +1,23 @@
+// The exit codes of the `seamless` command (README, "Exit codes and interrupted runs"; --help).
+// Scripts and sweeps tell a finished run from a failed one by these, never by parsing messages.
+#pragma once
+
+namespace seamless::app {
+
+constexpr int kExitOk = 0;
+constexpr int kExitError = 1;       // any other failure (cannot write an output, a GPU error, ...)
+constexpr int kExitUsage = 2;       // bad command line, or an output folder that holds another run
+constexpr int kNotBuilt = 3;        // the asked-for part of the pipeline is not built
+constexpr int kExitConfig = 4;      // the experiment (file or --set) is invalid or asks for what is not there
+constexpr int kExitInput = 5;       // input data missing, unreadable or malformed
+constexpr int kExitLostFrames = 6;  // the run finished, but tracking lost more than output.max_lost_fraction
+// Interrupted by a signal: 128 + the signal number (130 Ctrl-C, 143 SIGTERM), the outputs written.
+constexpr int kExitSignalBase = 128;
+
+// The codes as --help shows them.
+constexpr const char* kExitCodesHelp =
+    "Exit codes: 0 success; 1 error; 2 bad usage (or --out holds another run: add --force); 3 part not built;\n"
+    "4 config error; 5 input error (missing or corrupt data); 6 tracking lost more than output.max_lost_fraction\n"
+    "of the frames (outputs written); 130 / 143 stopped by Ctrl-C / SIGTERM after writing the outputs.";
+
+}  // namespace seamless::app
