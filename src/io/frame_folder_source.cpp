@@ -18,6 +18,7 @@
 #include "io/depth_scale.hpp"
 #include "io/intrinsics_presets.hpp"
 #include "io/jpeg_io.hpp"
+#include "io/number_file.hpp"
 #include "io/png_io.hpp"
 
 namespace seamless {
@@ -26,33 +27,6 @@ namespace {
 
 // Standard gravity: the specific force an accelerometer at rest reads, m/s^2.
 constexpr float kStandardGravity = 9.80665f;
-
-// The numbers of a small text file (whitespace or commas between them, '#' comments), or an Error
-// naming the file and line of a token that is not a number. "inf", "-inf" and "nan" are numbers.
-std::vector<double> read_numbers(const std::string& path, const char* what) {
-  std::ifstream in(path);
-  if (!in) throw InputError(std::string("cannot open ") + what + " '" + path + "': " + std::strerror(errno));
-  std::vector<double> v;
-  std::string line, token;
-  for (int n = 1; std::getline(in, line); ++n) {
-    line = line.substr(0, line.find('#'));
-    std::replace(line.begin(), line.end(), ',', ' ');
-    std::istringstream ss(line);
-    while (ss >> token) {
-      std::size_t used = 0;
-      double x = 0;
-      try {
-        x = std::stod(token, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used != token.size())
-        throw InputError(std::string(what) + " '" + path + "' line " + std::to_string(n) + ": '" + token + "' is not a number");
-      v.push_back(x);
-    }
-  }
-  return v;
-}
 
 // `name` in the folder, else in its parent (7-Scenes and 3DMatch keep one file per scene, above its
 // sequence folders); "" when neither has it.

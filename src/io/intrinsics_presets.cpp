@@ -10,6 +10,7 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "io/number_file.hpp"
 #include "io/input_params.hpp"
 
 namespace seamless {
@@ -91,29 +92,8 @@ std::string find_intrinsics_matrix(const std::string& folder) {
 }
 
 Intrinsics read_intrinsics_matrix(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError("cannot open camera matrix file '" + path + "': " + std::strerror(errno));
-  std::vector<double> v;
-  std::string line, token;
-  for (int n = 1; std::getline(in, line); ++n) {
-    line = line.substr(0, line.find('#'));
-    for (char& c : line)
-      if (c == ',' || c == ';' || c == '[' || c == ']') c = ' ';
-    std::istringstream ss(line);
-    while (ss >> token) {
-      std::size_t used = 0;
-      double x = 0;
-      try {
-        x = std::stod(token, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used != token.size())
-        throw InputError("camera matrix file '" + path + "' line " + std::to_string(n) + ": '" + token +
-                    "' is not a number (expected a 3x3 matrix K, nine numbers)");
-      v.push_back(x);
-    }
-  }
+  const std::vector<double> v =
+      read_numbers(path, "camera matrix file", "(expected a 3x3 matrix K, nine numbers)");
   if (v.size() != 9)
     throw InputError("camera matrix file '" + path + "' holds " + std::to_string(v.size()) +
                 " numbers; expected a 3x3 matrix K = [fx 0 cx; 0 fy cy; 0 0 1], nine numbers");

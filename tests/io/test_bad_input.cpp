@@ -70,7 +70,6 @@ std::string read_all(const InputParams& p, std::int64_t* frames = nullptr, std::
   }
 }
 
-#define EXPECT_MENTIONS(msg, needle) EXPECT_NE((msg).find(needle), std::string::npos) << (msg)
 
 }  // namespace
 

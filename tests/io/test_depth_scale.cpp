@@ -11,17 +11,13 @@
 #include "io/input_params.hpp"
 #include "io/png_io.hpp"
 #include "io/tum_source.hpp"
+#include "tmp_dir.hpp"
 #include "kernels/io/render_room.hpp"
 
 using namespace seamless;
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string data_dir(const std::string& name) { return std::string(SEAMLESS_TEST_DATA) + "/" + name; }
-#define REQUIRE_DATA(dir) \
-  if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << "test data folder " << dir << " is absent"
-#define EXPECT_MENTIONS(msg, needle) EXPECT_NE((msg).find(needle), std::string::npos) << (msg)
 
 const char* kTum = "tum_fr1_rpy_000-149";
 // The first depth image of the TUM folder (depth.txt's first entry).

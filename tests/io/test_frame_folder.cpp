@@ -21,12 +21,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string data_dir(const std::string& name) { return std::string(SEAMLESS_TEST_DATA) + "/" + name; }
-
-#define REQUIRE_DATA(dir) \
-  if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << "test data folder " << dir << " is absent"
-#define EXPECT_MENTIONS(msg, needle) EXPECT_NE((msg).find(needle), std::string::npos) << (msg)
-
 InputParams frames_params(const std::string& dir) {
   InputParams p;
   p.source = "frames";

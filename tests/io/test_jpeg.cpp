@@ -21,11 +21,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string data_dir(const std::string& name) { return std::string(SEAMLESS_TEST_DATA) + "/" + name; }
-#define REQUIRE_DATA(dir) \
-  if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << "test data folder " << dir << " is absent"
-#define EXPECT_MENTIONS(msg, needle) EXPECT_NE((msg).find(needle), std::string::npos) << (msg)
-
 // ITU-R BT.601 luma, the Y that JPEG (JFIF) codes at full resolution.
 double luma(uchar3 c) { return 0.299 * c.x + 0.587 * c.y + 0.114 * c.z; }
 

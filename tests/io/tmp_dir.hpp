@@ -1,4 +1,5 @@
-// A temporary folder for one test, removed afterwards.
+// Shared by the io tests: a temporary folder for one test (removed afterwards), the real data
+// folders of ../shared/data, and a check that an error message names something.
 #pragma once
 #include <unistd.h>
 
@@ -19,3 +20,9 @@ struct TmpDir {
   std::string operator/(const std::string& name) const { return (path / name).string(); }
   std::string str() const { return path.string(); }
 };
+
+// A folder of the real test data (../shared/data); REQUIRE_DATA skips a test where it is absent.
+inline std::string data_dir(const std::string& name) { return std::string(SEAMLESS_TEST_DATA) + "/" + name; }
+#define REQUIRE_DATA(dir) \
+  if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << "test data folder " << dir << " is absent"
+#define EXPECT_MENTIONS(msg, needle) EXPECT_NE((msg).find(needle), std::string::npos) << (msg)
