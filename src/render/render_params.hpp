@@ -34,6 +34,12 @@ struct RenderParams {
   vec3 light_dir{0.3f, -1.f, 0.4f};      // direction the light travels, world coordinates
   float ambient = 0.3f;                  // fraction of light that is not directional
   bool light_scene = false;              // the scan's colours already hold the room's lighting
+  // Shadows of the virtual objects on the real scene and on each other (docs/RENDERING.md, pass
+  // shadow): a shadow map along light_dir over the dynamic objects' bounds.
+  bool shadows = true;
+  float shadow_strength = 0.5f;          // share of a real surface's light that light_dir brings (darkening)
+  int shadow_map_size = 2048;            // texels per side
+  float light_angle = 4.f;               // the light's angular diameter, degrees: penumbra growth
   vec3 rigid_color{0.85f, 0.3f, 0.2f};
   vec3 cloth_color{0.9f, 0.75f, 0.3f};
   // Screen-space fluid rendering (van der Laan, Green, Sainz 2009).
@@ -90,6 +96,12 @@ struct RenderParams {
     v("light_dir", light_dir, "direction the light travels, world coordinates");
     v("ambient", ambient, "ambient fraction of the lighting", Range{0.0, 1.0});
     v("light_scene", light_scene, "also light the scene mesh (its colours already contain lighting)");
+    v("shadows", shadows, "virtual objects cast shadows (on the scene and on each other) from light_dir");
+    v("shadow_strength", shadow_strength,
+      "darkening of the real scene in full shadow: the share of its light that comes from light_dir", Range{0.0, 1.0});
+    v("shadow_map_size", shadow_map_size, "shadow map texels per side (over the dynamic objects)", Range{64, 16384});
+    v("light_angle", light_angle, "angular diameter of the light, degrees (soft shadows widen with it)",
+      Range{0.0, 60.0});
     v("rigid_color", rigid_color, "colour of rigid bodies, RGB 0..1");
     v("cloth_color", cloth_color, "colour of cloth, RGB 0..1");
     v("fluid_radius_scale", fluid_radius_scale, "fluid sphere size in the SSFR passes, particle radii",

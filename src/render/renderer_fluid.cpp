@@ -93,6 +93,7 @@ void Renderer::Impl::render_cube_map() {
   glDepthFunc(GL_LESS);
   glDisable(GL_CULL_FACE);
   const vec3 centre = (scene_lo + scene_hi) * 0.5f;
+  shadow_live = false;  // the cube map holds the scan alone, lit as recorded
   for (int f = 0; f < 6; ++f) {
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, cube, 0);
     glClearColor(p.background.x, p.background.y, p.background.z, 1.f);

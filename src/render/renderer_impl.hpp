@@ -132,6 +132,17 @@ struct Renderer::Impl {
   std::int64_t part_capacity = 0;
   std::int64_t fluid_count = -1;  // fluid particles of the last upload; -1: unknown (device data)
 
+  // Shadows of the virtual objects (renderer_shadow.cpp): built when the context has compute
+  // shaders and glClearTexImage (GL 4.4 or ARB_clear_texture).
+  bool has_shadow = false;
+  Program shadow_bounds_prog, shadow_splat_prog, shadow_resolve_prog, shadow_mesh_prog, shadow_cloth_prog;
+  Texture light_bounds;                   // 6 x 1 R32I: casters' bounds in the light frame (shadow.glsl)
+  Texture shadow_depth, shadow_bits, shadow_map;  // rasterised casters, particle splat, the merged map
+  Framebuffer shadow_fbo;
+  int shadow_size = 0;
+  mat3 light_R = mat3::identity();        // world -> light frame
+  bool shadow_live = false;               // this frame's receivers read a map
+
   std::vector<StageImage> stages;
   std::vector<RenderTiming> timings;
   PassTimer timer;
@@ -172,6 +183,12 @@ struct Renderer::Impl {
   void fluid_depth_splat(std::int64_t n, float sphere_r, const RenderCamera& cam);
   void fluid_thickness_splat(std::int64_t n, float sphere_r, const RenderCamera& low);
   void capture_stages();
+  // renderer_shadow.cpp
+  void build_shadow_programs();
+  void make_shadow_targets();
+  void shadow_pass(const DrawList& list, std::int64_t n);
+  void shadow_uniforms(const Program& prog) const;  // the receivers' (shadow.glsl)
+  void bind_cloth(const Program& prog);
   void set_camera_uniforms(const Program& prog, const RenderCamera& cam) const;
   vec3 light_eye(const RenderCamera& cam) const;
 };
