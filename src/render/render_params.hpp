@@ -53,9 +53,11 @@ struct RenderParams {
   float filter_size = 3.f;            // filter half-width in particle radii (world), projected per pixel
   int filter_max_px = 24;             // ... but at most this many pixels
   float filter_depth_sigma = 1.f;     // range sigma of the bilateral filter, in particle radii
-  vec3 absorption{6.f, 1.8f, 0.8f};   // Beer-Lambert coefficients per colour channel, 1/m (water-like)
-  float refraction = 0.06f;           // screen-space refraction offset per metre of thickness
+  vec3 absorption{25.f, 8.f, 3.5f};   // Beer-Lambert coefficients per colour channel, 1/m (tinted water)
+  float ior = 1.33f;                  // refractive index (water): Snell's law bends the view into the fluid
   float fresnel_f0 = 0.02f;           // reflectance at normal incidence (water: ((1-1.33)/(1+1.33))^2)
+  float fluid_roughness = 0.05f;      // GGX alpha of the fluid surface: size of the light's highlight
+  float light_intensity = 0.6f;      // radiance light_dir alone gives a white diffuse surface facing it (0..1 = black..white)
   int cube_size = 256;                // cube map face size for reflections in the mesh view
   // Cost of the fluid passes (docs/RENDERING.md, section Speed).
   // compute: sphere depth and thickness as compute splats (GL 4.3; atomics into integer images)
@@ -113,8 +115,12 @@ struct RenderParams {
     v("filter_max_px", filter_max_px, "depth filter half-width limit, pixels", Range{1, 128});
     v("filter_depth_sigma", filter_depth_sigma, "bilateral range sigma, particle radii", Range{0.01, 100.0});
     v("absorption", absorption, "fluid absorption per channel (Beer-Lambert), 1/m");
-    v("refraction", refraction, "refraction offset, screen fraction per metre of thickness", Range{0.0, 10.0});
+    v("ior", ior, "fluid refractive index (Snell's law at the surface)", Range{1.0, 3.0});
     v("fresnel_f0", fresnel_f0, "fluid reflectance at normal incidence", Range{0.0, 1.0});
+    v("fluid_roughness", fluid_roughness, "fluid surface roughness (GGX alpha): spread of the light's highlight",
+      Range{0.01, 1.0});
+    v("light_intensity", light_intensity,
+      "light_dir's radiance on a white diffuse surface facing it (1 = white): strength of highlights", Range{0.0, 100.0});
     v("cube_size", cube_size, "reflection cube map face size, pixels", Range{16, 4096});
     v("fluid_splat", fluid_splat, "fluid passes: compute shaders (GL 4.3: splats, screen passes) or raster sprites",
       Choices{"compute", "raster"});

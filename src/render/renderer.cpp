@@ -16,6 +16,19 @@ std::vector<float> mat3_cols(const mat3& R) {  // column-major for glUniformMatr
   return {R.m[0][0], R.m[1][0], R.m[2][0], R.m[0][1], R.m[1][1], R.m[2][1], R.m[0][2], R.m[1][2], R.m[2][2]};
 }
 
+// The mean of an sRGB image in linear radiance (what the fluid reflects in the Kinect view).
+vec3 mean_linear_color(const std::vector<uchar3>& c) {
+  float lut[256];
+  for (int i = 0; i < 256; ++i) {
+    const float x = i / 255.f;
+    lut[i] = x <= 0.04045f ? x / 12.92f : std::pow((x + 0.055f) / 1.055f, 2.4f);
+  }
+  double r = 0, g = 0, b = 0;
+  for (const uchar3& q : c) r += lut[q.x], g += lut[q.y], b += lut[q.z];
+  const double n = std::max<double>(1.0, static_cast<double>(c.size()));
+  return {static_cast<float>(r / n), static_cast<float>(g / n), static_cast<float>(b / n)};
+}
+
 }  // namespace
 
 void Renderer::Impl::build_programs() {
@@ -33,7 +46,7 @@ void Renderer::Impl::build_programs() {
   kinect_prog = Program("kinect view",
                         {vs({"fullscreen.vert"}), fs({"camera.glsl", "color.glsl", "shadow.glsl", "kinect_bg.frag"})});
   auto screen = [&](const char* name, const char* body, const char* main) {
-    return Program(name, {vs({"fullscreen.vert"}), fs({"camera.glsl", body, main})});
+    return Program(name, {vs({"fullscreen.vert"}), fs({"camera.glsl", "color.glsl", body, main})});
   };
   filter_prog = screen("fluid filter", "ssfr_filter.glsl", "ssfr_filter.frag");
   normal_prog = screen("fluid normals", "ssfr_normal.glsl", "ssfr_normal.frag");
@@ -435,6 +448,7 @@ void Renderer::set_kinect_view(const Image<uchar3>& rgb, const Image<float>& dep
   glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, K.width, K.height, GL_RED, GL_FLOAT, d.data());
   m.kin_K = K;
   m.kin_pose = world_T_camera;
+  m.kin_mean = mean_linear_color(c);
   m.has_kinect = true;
 }
 

@@ -56,6 +56,11 @@ Image<uchar3> upsample_nearest(Image<uchar3> im, int w, int h) {
   return Image<uchar3>::from_host(out, w, h, Device::CPU);
 }
 
+vec3 srgb_to_linear(vec3 c) {
+  auto f = [](float x) { return x <= 0.04045f ? x / 12.92f : std::pow((x + 0.055f) / 1.055f, 2.4f); };
+  return {f(c.x), f(c.y), f(c.z)};
+}
+
 }  // namespace
 
 Image<uchar3> float_to_grey(const std::vector<float>& v, int w, int h) {
@@ -247,17 +252,24 @@ void Renderer::Impl::composite_pass(const RenderCamera& cam) {
   bind_tex(2, GL_TEXTURE_2D, normals);
   bind_tex(3, GL_TEXTURE_2D, thick[0]);
   bind_tex(4, GL_TEXTURE_CUBE_MAP, cube);
-  const char* samplers[] = {"u_scene_color", "u_fluid_depth", "u_normal", "u_thickness", "u_cube"};
-  for (int i = 0; i < 5; ++i) glUniform1i(cp.loc(samplers[i]), i);
+  bind_tex(5, GL_TEXTURE_2D, scene_depth);
+  const char* samplers[] = {"u_scene_color", "u_fluid_depth", "u_normal", "u_thickness", "u_cube", "u_scene_depth"};
+  for (int i = 0; i < 6; ++i) glUniform1i(cp.loc(samplers[i]), i);
   const bool use_cube = has_cube && p.view == "mesh";
   glUniform1i(cp.loc("u_use_cube"), use_cube);
+  // Without a cube map, the Kinect image's mean colour (or the mesh view's background) is what
+  // the surface reflects.
+  const vec3 env = p.view == "kinect" && has_kinect ? kin_mean : srgb_to_linear(p.background);
+  glUniform3f(cp.loc("u_env"), env.x, env.y, env.z);
   const std::vector<float> R = {cam.world_T_camera.R.m[0][0], cam.world_T_camera.R.m[1][0], cam.world_T_camera.R.m[2][0],
                                 cam.world_T_camera.R.m[0][1], cam.world_T_camera.R.m[1][1], cam.world_T_camera.R.m[2][1],
                                 cam.world_T_camera.R.m[0][2], cam.world_T_camera.R.m[1][2], cam.world_T_camera.R.m[2][2]};
   glUniformMatrix3fv(cp.loc("u_world_R_eye"), 1, GL_FALSE, R.data());
   glUniform3f(cp.loc("u_absorption"), p.absorption.x, p.absorption.y, p.absorption.z);
-  glUniform1f(cp.loc("u_refraction"), p.refraction);
+  glUniform1f(cp.loc("u_ior"), p.ior);
   glUniform1f(cp.loc("u_f0"), p.fresnel_f0);
+  glUniform1f(cp.loc("u_roughness"), p.fluid_roughness);
+  glUniform1f(cp.loc("u_light_intensity"), p.light_intensity);
   if (compute) {
     const GLuint out[] = {final_color, reflect_color, refract_color};
     for (GLuint i = 0; i < 3; ++i) glBindImageTexture(i, out[i], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);

@@ -114,6 +114,7 @@ struct Renderer::Impl {
   bool has_cube = false;
   Texture kin_rgb, kin_depth;
   Intrinsics kin_K;
+  vec3 kin_mean{0.5f, 0.5f, 0.5f};  // the image's mean colour, linear
   SE3 kin_pose = SE3::identity();
   bool has_kinect = false;
 
