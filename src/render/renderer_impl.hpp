@@ -138,7 +138,11 @@ struct Renderer::Impl {
   bool has_shadow = false;
   Program shadow_bounds_prog, shadow_splat_prog, shadow_resolve_prog, shadow_mesh_prog, shadow_cloth_prog;
   Texture light_bounds;                   // 6 x 1 R32I: casters' bounds in the light frame (shadow.glsl)
-  Texture shadow_depth, shadow_bits, shadow_map;  // rasterised casters, particle splat, the merged map
+  Texture shadow_depth, shadow_map;       // rasterised casters' depth, the opaque map
+  Texture shadow_bits, shadow_thick;      // fluid splat: front depth bits, fixed-point path in fluid
+  Texture shadow_fluid;                   // RG32F: fluid front depth and path, in the splat's grid
+  bool fluid_shadow_live = false;         // this frame's fluid transmits into the map
+  float list_sphere_r = 0.f;              // this frame's fluid sphere radius (its splat level)
   Framebuffer shadow_fbo;
   int shadow_size = 0;
   mat3 light_R = mat3::identity();        // world -> light frame

@@ -21,7 +21,11 @@
 namespace seamless {
 namespace {
 
-constexpr int kShadowMapUnit = 6, kLightBoundsUnit = 7;  // texture units the receivers read
+constexpr int kShadowMapUnit = 6, kLightBoundsUnit = 7, kFluidShadowUnit = 8;  // texture units the receivers read
+// Fixed-point path in fluid along the light (as the camera's thickness splat, renderer_splat.cpp):
+// 2^20 units per metre, at most half a unit of rounding per sphere on a ray (0.5 um), and 4096 m
+// of path before the uint32 wraps, far beyond any light path through the fluid.
+constexpr float kFixedPerMetre = 1048576.f;
 constexpr GLuint kBoundsGroup = 256;                     // local_size_x of shadow_bounds.comp
 constexpr GLuint kBoundsGroupsMax = 256;                 // grid-stride: few atomics on 6 texels
 constexpr GLuint kSplatGroup = 64;                       // splat.glsl
@@ -76,13 +80,18 @@ void Renderer::Impl::make_shadow_targets() {
   shadow_depth = make_texture_2d(GL_DEPTH_COMPONENT32F, s, s);
   shadow_fbo = make_framebuffer({}, shadow_depth, "shadow casters");
   shadow_bits = make_texture_2d(GL_R32UI, s, s);
+  shadow_thick = make_texture_2d(GL_R32UI, s, s);
   shadow_map = make_texture_2d(GL_R32F, s, s);
-  // Outside the map there is no caster: the border reads as infinitely far along the light.
-  glBindTexture(GL_TEXTURE_2D, shadow_map);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
-  const float far[4] = {1e30f, 1e30f, 1e30f, 1e30f};
-  glTexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, far);
+  shadow_fluid = make_texture_2d(GL_RG32F, s, s);
+  // Outside the maps there is no caster: the border reads as infinitely far along the light (and
+  // no path in fluid).
+  const float far[4] = {1e30f, 0.f, 0.f, 0.f};
+  for (GLuint t : {shadow_map.get(), shadow_fluid.get()}) {
+    glBindTexture(GL_TEXTURE_2D, t);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+    glTexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, far);
+  }
   glBindTexture(GL_TEXTURE_2D, 0);
 }
 
@@ -93,9 +102,15 @@ void Renderer::Impl::shadow_uniforms(const Program& prog) const {
   glBindTexture(GL_TEXTURE_2D, shadow_map);
   glActiveTexture(GL_TEXTURE0 + kLightBoundsUnit);
   glBindTexture(GL_TEXTURE_2D, light_bounds);
+  glActiveTexture(GL_TEXTURE0 + kFluidShadowUnit);
+  glBindTexture(GL_TEXTURE_2D, shadow_fluid);
   glActiveTexture(GL_TEXTURE0);
   glUniform1i(prog.loc("u_shadow_map"), kShadowMapUnit);
   glUniform1i(prog.loc("u_light_bounds"), kLightBoundsUnit);
+  glUniform1i(prog.loc("u_fluid_shadow"), kFluidShadowUnit);
+  glUniform1i(prog.loc("u_fluid_shadow_on"), fluid_shadow_live);
+  glUniform1f(prog.loc("u_fluid_radius"), list_sphere_r);
+  glUniform3f(prog.loc("u_shadow_absorption"), p.absorption.x, p.absorption.y, p.absorption.z);
   glUniformMatrix3fv(prog.loc("u_light_R"), 1, GL_FALSE, cols(light_R).data());
   glUniform1f(prog.loc("u_shadow_size"), static_cast<float>(shadow_size));
   glUniform1f(prog.loc("u_light_tan"), std::tan(0.5f * p.light_angle * kernels::kPi / 180.f));
@@ -116,7 +131,7 @@ void light_uniforms(const Program& prog, const mat3& R, GLuint bounds, int size)
 }  // namespace
 
 void Renderer::Impl::shadow_pass(const DrawList& list, std::int64_t n) {
-  shadow_live = false;
+  shadow_live = fluid_shadow_live = false;
   if (!p.shadows || !has_shadow) return;
   make_shadow_targets();
   light_R = light_frame(p.light_dir);
@@ -126,7 +141,11 @@ void Renderer::Impl::shadow_pass(const DrawList& list, std::int64_t n) {
   for (const ClothDraw& c : list.cloths) cloth = cloth || (p.show_cloth && n > 0 && !c.triangles.empty());
   const bool fluid = p.show_fluid && n > 0 && fluid_count != 0;
   if (!rigids && !cloth && !fluid) return;
-  const float sphere_r = list.particle_radius * (p.fluid == "ssfr" ? p.fluid_radius_scale : 1.f);
+  // The fluid's spheres as the camera sees them: the SSFR passes' enlarged spheres, a body of
+  // water that transmits (fluid_transmittance, shadow.glsl); or the debug view's opaque balls.
+  const bool ssfr = p.fluid == "ssfr";
+  const float sphere_r = list.particle_radius * (ssfr ? p.fluid_radius_scale : 1.f);
+  list_sphere_r = sphere_r;
 
   // 1. Bounds: the rigid bodies' boxes (8 corners each) on the host, then the particles.
   float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
@@ -192,35 +211,44 @@ void Renderer::Impl::shadow_pass(const DrawList& list, std::int64_t n) {
     glBindVertexArray(0);
   }
 
-  // 3. Fluid spheres, splatted (the image is cleared to "none" first).
+  // 3. Fluid spheres, splatted (the images are cleared to "none" first).
   if (fluid) {
-    const GLuint none = 0xffffffffu;
+    const GLuint none = 0xffffffffu, zero = 0u;
     glClearTexImage(shadow_bits, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &none);
+    glClearTexImage(shadow_thick, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     const Program& sp = shadow_splat_prog;
     light_uniforms(sp, light_R, light_bounds, shadow_size);
     glUniform1f(sp.loc("u_radius"), sphere_r);
+    const float s = p.fluid_radius_scale;  // path in fluid: chords over the spheres' volume fraction
+    glUniform1f(sp.loc("u_thickness_scale"), ssfr ? 6.f / (kernels::kPi * s * s * s) : 1.f);
+    glUniform1f(sp.loc("u_fixed_per_metre"), kFixedPerMetre);
     glUniform1ui(sp.loc("u_count"), static_cast<GLuint>(n));
     glUniform1ui(sp.loc("u_phase_mask"), kernels::phase::kFluid);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, part_pos);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, part_phase);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
     glBindImageTexture(0, shadow_bits, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+    glBindImageTexture(1, shadow_thick, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
     const std::int64_t groups = (n + kSplatGroup - 1) / kSplatGroup;
     const auto gx = static_cast<GLuint>(std::min<std::int64_t>(groups, 65535));
     glDispatchCompute(gx, static_cast<GLuint>((groups + gx - 1) / gx), 1);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
   }
 
-  // 4. One map.
+  // 4. The opaque map and the fluid's.
   const Program& rp = shadow_resolve_prog;
   light_uniforms(rp, light_R, light_bounds, shadow_size);
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_2D, shadow_depth);
   glUniform1i(rp.loc("u_mesh_depth"), 0);
   glUniform1i(rp.loc("u_has_splat"), fluid);
+  glUniform1i(rp.loc("u_splat_opaque"), !ssfr);
   glUniform1f(rp.loc("u_splat_radius"), sphere_r);
+  glUniform1f(rp.loc("u_metres_per_unit"), 1.f / kFixedPerMetre);
   glBindImageTexture(0, shadow_bits, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
-  glBindImageTexture(1, shadow_map, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+  glBindImageTexture(1, shadow_thick, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
+  glBindImageTexture(2, shadow_map, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+  glBindImageTexture(3, shadow_fluid, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RG32F);
   const auto tiles = static_cast<GLuint>((shadow_size + static_cast<int>(kScreenGroup) - 1) / static_cast<int>(kScreenGroup));
   glDispatchCompute(tiles, tiles, 1);
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
@@ -228,6 +256,7 @@ void Renderer::Impl::shadow_pass(const DrawList& list, std::int64_t n) {
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   glViewport(0, 0, w, h);
   shadow_live = true;
+  fluid_shadow_live = fluid && ssfr;
 }
 
 }  // namespace seamless

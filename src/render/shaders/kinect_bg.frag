@@ -16,7 +16,7 @@ void main() {
   float z = texture(u_depth, uv).r;
   if (z > 0.0) {
     vec3 world = (u_world_T_camera * vec4(z * pixel_ray(px), 1.0)).xyz;
-    rgb = shadowed_srgb(rgb, shadow_at(world, vec3(0.0), gl_FragCoord.xy));
+    rgb = shadowed_srgb(rgb, shadow_light(world, vec3(0.0), gl_FragCoord.xy));
   }
   o_color = vec4(rgb, 1.0);
   gl_FragDepth = z > 0.0 ? window_depth(clamp(z, u_near_far.x, u_near_far.y)) : 1.0;

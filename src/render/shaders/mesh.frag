@@ -16,12 +16,12 @@ void main() {
   // Two-sided surfaces (cloth) are one mesh: the normal is turned towards the side being seen,
   // so the back face is lit like the front instead of drawing a second, offset copy.
   if (u_two_sided && !gl_FrontFacing) n = -n, nw = -nw;
-  float shadow = shadow_at(v_world, nw, gl_FragCoord.xy);
+  vec3 light = shadow_light(v_world, nw, gl_FragCoord.xy);
   if (u_lit) {
-    // The light's share is its diffuse term; a shadow takes away that share only.
-    float diffuse = max(dot(n, u_light), 0.0) * (1.0 - shadow);
+    // The light's share is its diffuse term; a shadow takes away (part of) that share only.
+    vec3 diffuse = max(dot(n, u_light), 0.0) * light;
     o_color = vec4(v_color * (u_ambient + (1.0 - u_ambient) * diffuse), 1.0);
   } else {
-    o_color = vec4(shadowed_srgb(v_color, shadow), 1.0);  // the scan's colours hold its light
+    o_color = vec4(shadowed_srgb(v_color, light), 1.0);  // the scan's colours hold its light
   }
 }

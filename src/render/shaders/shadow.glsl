@@ -71,7 +71,11 @@ vec4 light_clip(vec3 world) {
 }
 #else
 uniform bool u_shadow_on;           // a map was made this frame (render.shadows and casters drawn)
-uniform sampler2D u_shadow_map;     // metres below z0 of the nearest caster; 1e30 = none
+uniform sampler2D u_shadow_map;     // metres below z0 of the nearest opaque caster; 1e30 = none
+uniform bool u_fluid_shadow_on;     // the fluid is in u_fluid_shadow this frame
+uniform sampler2D u_fluid_shadow;   // in the fluid splat's texel grid: front depth (1e30 = none), path in fluid
+uniform float u_fluid_radius;       // the fluid spheres' radius (their splat level)
+uniform vec3 u_shadow_absorption;   // the fluid's Beer-Lambert coefficients, 1/m (render.absorption)
 uniform float u_light_tan;          // tan of half the light's angular diameter (render.light_angle)
 uniform float u_shadow_strength;    // render.shadow_strength
 
@@ -86,30 +90,73 @@ vec2 vogel(int i, int n, float phi) {
   return r * vec2(cos(a), sin(a));
 }
 
-// The four texels of the bilinear footprint at uv and their bilinear weights (textureGather's
-// order: (i0, j1), (i1, j1), (i1, j0), (i0, j0)).
-void shadow_gather(vec2 uv, out vec4 d, out vec4 w) {
-  vec2 t = uv * u_shadow_size - 0.5;
+// Texel coordinate t (texel centres at integers) -> the gather position of its bilinear
+// footprint and the four texels' weights (textureGather's order: (i0, j1), (i1, j1), (i1, j0),
+// (i0, j0)).
+vec2 gather_at(vec2 t, out vec4 w) {
   vec2 f = fract(t);
-  d = textureGather(u_shadow_map, (floor(t) + 1.0) / u_shadow_size);
   w = vec4((1.0 - f.x) * f.y, f.x * f.y, f.x * (1.0 - f.y), (1.0 - f.x) * (1.0 - f.y));
+  return (floor(t) + 1.0) / u_shadow_size;
 }
 
-// Fraction (0..1) of the light hidden from the world point by casters: percentage-closer soft
-// shadows (Fernando 2005). A directional light of angular radius a gives a penumbra of radius
-// tan(a) (d_receiver - d_blocker): sharp where an object touches the surface (the contact shadow),
-// softer further away. Steps: the mean depth of the blockers found within the largest possible
-// penumbra, then percentage-closer filtering (Reeves et al. 1987) over the penumbra it predicts.
-// n: the receiver's unit world normal, or (0, 0, 0) where it is unknown (the Kinect image).
-// pixel: the frame pixel, seeds the taps' rotation.
-float shadow_at(vec3 world, vec3 n, vec2 pixel) {
-  if (!u_shadow_on) return 0.0;
+// Fraction (0..1) of the light an opaque caster hides from the point at light coordinates c:
+// percentage-closer soft shadows (Fernando 2005). A directional light of angular radius a gives a
+// penumbra of radius tan(a) (d_receiver - d_blocker): sharp where an object touches the surface
+// (the contact shadow), softer further away. Steps: the mean depth of the blockers found within
+// the largest possible penumbra, then percentage-closer filtering (Reeves et al. 1987) over the
+// penumbra it predicts. slope: the receiver's depth change per metre across the light.
+float opaque_shadow(LightMap m, vec3 c, vec2 slope, float bias, float phi) {
+  // Blocker search: a caster at depth 0 hides part of the light from up to tan(a) c.z away.
+  float search = u_light_tan * c.z + 2.0 * m.texel;  // metres
+  float sum = 0.0, count = 0.0;
+  for (int i = 0; i < 16; ++i) {
+    vec2 o = vogel(i, 16, phi) * search;
+    vec4 w;
+    vec4 d = textureGather(u_shadow_map, gather_at((c.xy + o / m.extent) * u_shadow_size - 0.5, w));
+    vec4 blocked = step(d, vec4(c.z - bias + dot(slope, o)));
+    sum += dot(blocked, d);
+    count += dot(blocked, vec4(1.0));
+  }
+  if (count == 0.0) return 0.0;
+  // Penumbra from the mean blocker depth; at least one texel, which hides the map's staircase.
+  float radius = u_light_tan * max(c.z - sum / count, 0.0) + m.texel;
+  float shadow = 0.0;
+  for (int i = 0; i < 32; ++i) {
+    vec2 o = vogel(i, 32, phi) * radius;
+    vec4 w;
+    vec4 d = textureGather(u_shadow_map, gather_at((c.xy + o / m.extent) * u_shadow_size - 0.5, w));
+    shadow += dot(w, step(d, vec4(c.z - bias + dot(slope, o))));
+  }
+  return shadow / 32.0;
+}
+
+// What of the light passes the fluid between the light and the point, per channel: water is
+// transparent, so its shadow is the light it absorbs on the way (Beer-Lambert over the light's
+// path in fluid: the summed chords of its spheres, as the camera's thickness), a tinted shadow,
+// not a black one. Bilinear in the splat's grid (texels of about a quarter sphere radius: soft
+// enough for the fluid's rounded outline). The light refraction gathers into caustics and the
+// few per cent the surface reflects are left out.
+vec3 fluid_transmittance(LightMap m, vec3 c, float bias) {
+  float size_k = float(int(u_shadow_size) >> splat_level(m, u_fluid_radius));
+  vec4 w;
+  vec2 at = gather_at(c.xy * size_k - 0.5, w);
+  vec4 d = textureGather(u_fluid_shadow, at, 0), path = textureGather(u_fluid_shadow, at, 1);
+  vec3 t = vec3(0.0);
+  for (int i = 0; i < 4; ++i) t += w[i] * (d[i] < c.z - bias ? exp(-u_shadow_absorption * path[i]) : vec3(1.0));
+  return t;
+}
+
+// The share of the light that reaches the world point past the virtual objects, per channel (1:
+// all of it). n: the receiver's unit world normal, or (0, 0, 0) where it is unknown (the Kinect
+// image). pixel: the frame pixel, seeds the filter taps' rotation.
+vec3 shadow_light(vec3 world, vec3 n, vec2 pixel) {
+  if (!u_shadow_on) return vec3(1.0);
   LightMap m = light_map();
-  if (!m.valid) return 0.0;
+  if (!m.valid) return vec3(1.0);
   vec3 nl = u_light_R * n;
   bool has_normal = dot(n, n) > 0.0;
   // A surface turned away from the light gets none of it: nothing to take away.
-  if (has_normal && nl.z >= 0.0) return 0.0;
+  if (has_normal && nl.z >= 0.0) return vec3(1.0);
   // Depth bias. Receivers are either the real scene, which is never in the map, or virtual
   // surfaces, which are: the map holds their own depth at the texel centres. For those the
   // reference depth follows the receiver's plane across the filter (receiver-plane depth bias,
@@ -123,37 +170,17 @@ float shadow_at(vec3 world, vec3 n, vec2 pixel) {
   }
   float bias = 1.5 * m.texel * (1.0 + length(slope)) + 1e-3;
   vec3 c = light_coords(m, world);
-  if (c.z <= 0.0 || any(lessThan(c.xy, vec2(0.0))) || any(greaterThan(c.xy, vec2(1.0)))) return 0.0;
-  float phi = 6.2831853 * shadow_ign(pixel);
-  // Blocker search: a caster at depth 0 hides part of the light from up to tan(a) c.z away.
-  float search = u_light_tan * c.z + 2.0 * m.texel;  // metres
-  float sum = 0.0, count = 0.0;
-  for (int i = 0; i < 16; ++i) {
-    vec2 o = vogel(i, 16, phi) * search;
-    vec4 d, w;
-    shadow_gather(c.xy + o / m.extent, d, w);
-    vec4 blocked = step(d, vec4(c.z - bias + dot(slope, o)));
-    sum += dot(blocked, d);
-    count += dot(blocked, vec4(1.0));
-  }
-  if (count == 0.0) return 0.0;
-  // Penumbra from the mean blocker depth; at least one texel, which hides the map's staircase.
-  float radius = u_light_tan * max(c.z - sum / count, 0.0) + m.texel;
-  float shadow = 0.0;
-  for (int i = 0; i < 32; ++i) {
-    vec2 o = vogel(i, 32, phi) * radius;
-    vec4 d, w;
-    shadow_gather(c.xy + o / m.extent, d, w);
-    shadow += dot(w, step(d, vec4(c.z - bias + dot(slope, o))));
-  }
-  return shadow / 32.0;
+  if (c.z <= 0.0 || any(lessThan(c.xy, vec2(0.0))) || any(greaterThan(c.xy, vec2(1.0)))) return vec3(1.0);
+  vec3 light = vec3(1.0 - opaque_shadow(m, c, slope, bias, 6.2831853 * shadow_ign(pixel)));
+  if (u_fluid_shadow_on) light *= fluid_transmittance(m, c, bias);
+  return light;
 }
 
 // What the shadow leaves of a colour whose light is all accounted for (the camera image, the
 // unlit scan): u_shadow_strength is the share of the light at the surface that came from this
 // light, the rest (the room's other light) stays; applied to linear radiance.
-vec3 shadowed_srgb(vec3 srgb, float s) {
-  if (s <= 0.0) return srgb;
-  return linear_to_srgb(srgb_to_linear(srgb) * (1.0 - u_shadow_strength * s));
+vec3 shadowed_srgb(vec3 srgb, vec3 light) {
+  if (all(greaterThanEqual(light, vec3(1.0)))) return srgb;
+  return linear_to_srgb(srgb_to_linear(srgb) * (1.0 - u_shadow_strength * (1.0 - light)));
 }
 #endif

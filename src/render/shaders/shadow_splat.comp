@@ -1,10 +1,14 @@
 // Shadow pass 3: particle spheres (the fluid) into the map, as a compute splat like the fluid's
-// depth (ssfr_depth_splat.comp) but orthographic along the light: each particle takes the texels
-// of its disc at the coarser level splat_level() (shadow.glsl) and keeps the nearest front
-// depth per texel by an atomic minimum on the float's bits (depths below z0 are positive, and
-// positive floats order like their bits). Needs camera.glsl, sphere_hit.glsl (u_radius: the
-// sphere radius) and splat.glsl (particle buffers) before it.
-layout(r32ui, binding = 0) uniform uimage2D u_shadow_bits;  // 0xffffffff = no particle
+// depth and thickness (ssfr_depth_splat.comp, ssfr_thickness_splat.comp) but orthographic along
+// the light: each particle takes the texels of its disc at the coarser level splat_level()
+// (shadow.glsl), keeps the nearest front depth per texel by an atomic minimum on the float's bits
+// (depths below z0 are positive, and positive floats order like their bits) and adds its chord
+// to the texel's path in fluid (fixed point, as the camera's thickness splat). Needs
+// camera.glsl, sphere_hit.glsl (u_radius: the sphere radius) and splat.glsl (particle buffers).
+layout(r32ui, binding = 0) uniform uimage2D u_shadow_bits;   // 0xffffffff = no particle
+layout(r32ui, binding = 1) uniform uimage2D u_shadow_thick;  // path in fluid, fixed point; 0 = none
+uniform float u_thickness_scale;  // inverse volume fraction of the enlarged spheres (ssfr_thickness.frag)
+uniform float u_fixed_per_metre;
 
 void main() {
   uint i = particle_index();
@@ -24,8 +28,10 @@ void main() {
       vec2 d = (vec2(x, y) + 0.5 - a) * t;
       float h2 = u_radius * u_radius - dot(d, d);
       if (h2 <= 0.0) continue;
-      uint bits = floatBitsToUint(max(q.z - sqrt(h2) - m.z0, 0.0));
+      float h = sqrt(h2);
       ivec2 p = ivec2(x, y);
+      imageAtomicAdd(u_shadow_thick, p, uint(2.0 * h * u_thickness_scale * u_fixed_per_metre + 0.5));
+      uint bits = floatBitsToUint(max(q.z - h - m.z0, 0.0));
       if (imageLoad(u_shadow_bits, p).r <= bits) continue;  // see ssfr_depth_splat.comp
       imageAtomicMin(u_shadow_bits, p, bits);
     }
