@@ -274,7 +274,7 @@ TEST(RenderLooks, CubeShadowOnTheRealDesk) {
       }
     }
   std::printf("umbra %d px (contact %d), lit %d px, lit cube faces %d px\n", umbra, contact, lit, lit_faces);
-  EXPECT_GT(umbra, 1000);
+  EXPECT_GT(umbra, 500);
   EXPECT_GT(contact, 30);
   EXPECT_GT(lit, 200000);
   EXPECT_GT(lit_faces, 500);

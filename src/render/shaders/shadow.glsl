@@ -53,11 +53,12 @@ vec3 light_coords(LightMap m, vec3 world) {
 }
 
 // Particles are splatted into a coarser level of the map (every 2^k-th texel) with k such that a
-// sphere's radius spans at least kSplatTexelsPerRadius texels there: a splat then touches at most
-// (2 * 4 + 1)^2 texels, not (2 r / texel)^2 (a 2 cm sphere in a map of 0.25 mm texels: 25 000),
-// and the union of spheres packed one particle diameter apart (radius 1.5 r, the fluid passes'
-// size) still covers every texel centre between them.
-const float kSplatTexelsPerRadius = 4.0;
+// sphere's radius spans 2 to 4 texels there: a splat then touches at most (2 * 4 + 1)^2 texels,
+// not (2 r / texel)^2 (a 2 cm sphere in a map of 0.25 mm texels: 25 000), with two atomics each
+// (depth, path). Spheres packed one particle diameter apart (radius 1.5 r, the fluid passes' size)
+// leave no gap a texel centre could fall into (the farthest point from 4 lattice neighbours is
+// sqrt(2) r from each), and the fluid's shadow is soft anyway (bilinear over these texels).
+const float kSplatTexelsPerRadius = 2.0;
 int splat_level(LightMap m, float radius) {
   return clamp(int(ceil(log2(radius / (kSplatTexelsPerRadius * m.texel)))), 0, 14);
 }
