@@ -10,6 +10,12 @@
 #include "render/renderer_impl.hpp"
 
 namespace seamless {
+
+vec3 srgb_to_linear(vec3 c) {  // IEC 61966-2-1, as color.glsl
+  auto f = [](float x) { return x <= 0.04045f ? x / 12.92f : std::pow((x + 0.055f) / 1.055f, 2.4f); };
+  return {f(c.x), f(c.y), f(c.z)};
+}
+
 namespace {
 
 std::vector<float> mat3_cols(const mat3& R) {  // column-major for glUniformMatrix3fv
@@ -19,10 +25,7 @@ std::vector<float> mat3_cols(const mat3& R) {  // column-major for glUniformMatr
 // The mean of an sRGB image in linear radiance (what the fluid reflects in the Kinect view).
 vec3 mean_linear_color(const std::vector<uchar3>& c) {
   float lut[256];
-  for (int i = 0; i < 256; ++i) {
-    const float x = i / 255.f;
-    lut[i] = x <= 0.04045f ? x / 12.92f : std::pow((x + 0.055f) / 1.055f, 2.4f);
-  }
+  for (int i = 0; i < 256; ++i) lut[i] = srgb_to_linear(vec3{i / 255.f, 0.f, 0.f}).x;
   double r = 0, g = 0, b = 0;
   for (const uchar3& q : c) r += lut[q.x], g += lut[q.y], b += lut[q.z];
   const double n = std::max<double>(1.0, static_cast<double>(c.size()));

@@ -56,11 +56,6 @@ Image<uchar3> upsample_nearest(Image<uchar3> im, int w, int h) {
   return Image<uchar3>::from_host(out, w, h, Device::CPU);
 }
 
-vec3 srgb_to_linear(vec3 c) {
-  auto f = [](float x) { return x <= 0.04045f ? x / 12.92f : std::pow((x + 0.055f) / 1.055f, 2.4f); };
-  return {f(c.x), f(c.y), f(c.z)};
-}
-
 }  // namespace
 
 Image<uchar3> float_to_grey(const std::vector<float>& v, int w, int h) {

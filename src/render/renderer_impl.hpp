@@ -44,6 +44,9 @@ using Framebuffer = GlName<gl_delete_framebuffer>;
 using Renderbuffer = GlName<gl_delete_renderbuffer>;
 using VertexArray = GlName<gl_delete_vertex_array>;
 
+// sRGB-encoded 0..1 -> linear radiance (the host side of color.glsl).
+vec3 srgb_to_linear(vec3 c);
+
 Texture make_texture_2d(GLenum internal, int w, int h, GLenum filter = GL_NEAREST);
 GLuint new_name(void (*gen)(GLsizei, GLuint*));
 // Framebuffer with the given colour textures (attachments 0..n-1) and optional depth texture.
