@@ -39,7 +39,7 @@ struct RenderParams {
   bool shadows = true;
   float shadow_strength = 0.5f;          // share of a real surface's light that light_dir brings (darkening)
   int shadow_map_size = 2048;            // texels per side
-  float light_angle = 4.f;               // the light's angular diameter, degrees: penumbra growth
+  float light_angle = 10.f;              // the light's angular diameter, degrees: penumbra growth
   vec3 rigid_color{0.85f, 0.3f, 0.2f};
   vec3 cloth_color{0.9f, 0.75f, 0.3f};
   // Screen-space fluid rendering (van der Laan, Green, Sainz 2009).

@@ -223,7 +223,7 @@ TEST(RenderLooks, CubeShadowOnTheRealDesk) {
   std::printf("desk plane: n (%.3f %.3f %.3f), %.3f m from the camera, rms %.2f mm, %.0f %% inliers\n", s.n.x, s.n.y,
               s.n.z, -s.d, 1e3f * s.rms, 100.f * s.inliers);
   ASSERT_LT(s.rms, 0.004f) << "the desk plane fit is off (Kinect noise at 1 m: about 2 mm)";
-  const float half = 0.04f;
+  const float half = 0.05f;
   const ShadowFrames fr = render_cube(s, kinect_params(s), cube_on_desk(s, 520.f, 405.f, half, 0.5f));
   const vec3 L = normalize(fr.p.light_dir);
   float z0 = 1e30f;

@@ -39,9 +39,9 @@ RenderParams down_light() {
   return p;
 }
 
-// A cube floating 0.3 m above the floor. Its shadow straight down is the square |x|, |z| < 0.1;
+// A cube floating 0.15 m above the floor. Its shadow straight down is the square |x|, |z| < 0.12;
 // the renderer may blur it by tan(light_angle / 2) times the depth below the cube's top (at
-// most 0.5 m) plus three texels (minimum filter, bilinear footprint, the rasterised edge; a
+// most 0.39 m) plus three texels (minimum filter, bilinear footprint, the rasterised edge; a
 // texel is at most the cube's diagonal over the map's inner size). Inside the square shrunk by
 // that margin the floor's linear colour is (1 - shadow_strength) of the unshadowed one, within
 // one 8-bit level; outside the square grown by it, the same colour as without shadows.
@@ -53,8 +53,9 @@ TEST(RenderShadow, MeshViewFloorUnderACube) {
   r.set_scene_mesh(floor_scan(floor_colour));
   DrawList list;
   RigidDraw cube;
-  cube.world_T_body.t = {0.f, 0.4f, 0.f};
-  cube.half_extents = {0.1f, 0.1f, 0.1f};
+  const float half = 0.12f;
+  cube.world_T_body.t = {0.f, 0.15f + half, 0.f};
+  cube.half_extents = {half, half, half};
   list.rigids = {cube};
   const RenderCamera cam = above();
   const Pixels bg(r.render(DrawList{}, cam));
@@ -62,8 +63,8 @@ TEST(RenderShadow, MeshViewFloorUnderACube) {
   const Pixels off(r.render(list, cam));
   r.params().shadows = true;
   const Pixels on(r.render(list, cam));
-  const float margin = std::tan(0.5f * p.light_angle * kernels::kPi / 180.f) * 0.5f +
-                       3.f * 2.f * std::sqrt(3.f) * 0.1f / (p.shadow_map_size - 4);
+  const float margin = std::tan(0.5f * p.light_angle * kernels::kPi / 180.f) * (0.15f + 2 * half) +
+                       3.f * 2.f * std::sqrt(3.f) * half / (p.shadow_map_size - 4);
   const float k = p.shadow_strength;
   int umbra = 0, lit = 0;
   for (int v = 0; v < on.h; ++v)
@@ -73,14 +74,14 @@ TEST(RenderShadow, MeshViewFloorUnderACube) {
       const vec3 q = floor_point(cam, u, v);
       const float m = std::max(std::abs(q.x), std::abs(q.z));
       const uchar3 c = on.at(u, v);
-      if (m < 0.1f - margin) {
+      if (m < half - margin) {
         ++umbra;
         for (int i = 0; i < 3; ++i) {
           const std::uint8_t got = (&c.x)[i], was = (&floor_colour.x)[i];
           const float level = linear(got) - linear(static_cast<std::uint8_t>(got - 1));
           EXPECT_NEAR(linear(got), (1.f - k) * linear(was), level) << u << "," << v << " channel " << i;
         }
-      } else if (m > 0.1f + margin) {
+      } else if (m > half + margin) {
         ++lit;
         EXPECT_TRUE(same(c, floor_colour)) << "shadow outside the footprint at " << u << "," << v;
       }
