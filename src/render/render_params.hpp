@@ -57,7 +57,7 @@ struct RenderParams {
   float ior = 1.33f;                  // refractive index (water): Snell's law bends the view into the fluid
   float fresnel_f0 = 0.02f;           // reflectance at normal incidence (water: ((1-1.33)/(1+1.33))^2)
   float fluid_roughness = 0.05f;      // GGX alpha of the fluid surface: size of the light's highlight
-  float light_intensity = 0.6f;      // radiance light_dir alone gives a white diffuse surface facing it (0..1 = black..white)
+  float light_intensity = 0.6f;       // radiance light_dir alone gives a white diffuse surface facing it (0..1 = black..white)
   int cube_size = 256;                // cube map face size for reflections in the mesh view
   // Cost of the fluid passes (docs/RENDERING.md, section Speed).
   // compute: sphere depth and thickness as compute splats (GL 4.3; atomics into integer images)
