@@ -34,6 +34,12 @@ struct RenderParams {
   vec3 light_dir{0.3f, -1.f, 0.4f};      // direction the light travels, world coordinates
   float ambient = 0.3f;                  // fraction of light that is not directional
   bool light_scene = false;              // the scan's colours already hold the room's lighting
+  // Shadows of the virtual objects on the real scene and on each other (docs/RENDERING.md, pass
+  // shadow): a shadow map along light_dir over the dynamic objects' bounds.
+  bool shadows = true;
+  float shadow_strength = 0.5f;          // share of a real surface's light that light_dir brings (darkening)
+  int shadow_map_size = 2048;            // texels per side
+  float light_angle = 10.f;              // the light's angular diameter, degrees: penumbra growth
   vec3 rigid_color{0.85f, 0.3f, 0.2f};
   vec3 cloth_color{0.9f, 0.75f, 0.3f};
   // Screen-space fluid rendering (van der Laan, Green, Sainz 2009).
@@ -47,9 +53,11 @@ struct RenderParams {
   float filter_size = 3.f;            // filter half-width in particle radii (world), projected per pixel
   int filter_max_px = 24;             // ... but at most this many pixels
   float filter_depth_sigma = 1.f;     // range sigma of the bilateral filter, in particle radii
-  vec3 absorption{6.f, 1.8f, 0.8f};   // Beer-Lambert coefficients per colour channel, 1/m (water-like)
-  float refraction = 0.06f;           // screen-space refraction offset per metre of thickness
+  vec3 absorption{25.f, 8.f, 3.5f};   // Beer-Lambert coefficients per colour channel, 1/m (tinted water)
+  float ior = 1.33f;                  // refractive index (water): Snell's law bends the view into the fluid
   float fresnel_f0 = 0.02f;           // reflectance at normal incidence (water: ((1-1.33)/(1+1.33))^2)
+  float fluid_roughness = 0.05f;      // GGX alpha of the fluid surface: size of the light's highlight
+  float light_intensity = 0.6f;       // radiance light_dir alone gives a white diffuse surface facing it (0..1 = black..white)
   int cube_size = 256;                // cube map face size for reflections in the mesh view
   // Cost of the fluid passes (docs/RENDERING.md, section Speed).
   // compute: sphere depth and thickness as compute splats (GL 4.3; atomics into integer images)
@@ -90,6 +98,12 @@ struct RenderParams {
     v("light_dir", light_dir, "direction the light travels, world coordinates");
     v("ambient", ambient, "ambient fraction of the lighting", Range{0.0, 1.0});
     v("light_scene", light_scene, "also light the scene mesh (its colours already contain lighting)");
+    v("shadows", shadows, "virtual objects cast shadows (on the scene and on each other) from light_dir");
+    v("shadow_strength", shadow_strength,
+      "darkening of the real scene in full shadow: the share of its light that comes from light_dir", Range{0.0, 1.0});
+    v("shadow_map_size", shadow_map_size, "shadow map texels per side (over the dynamic objects)", Range{64, 16384});
+    v("light_angle", light_angle, "angular diameter of the light, degrees (soft shadows widen with it)",
+      Range{0.0, 60.0});
     v("rigid_color", rigid_color, "colour of rigid bodies, RGB 0..1");
     v("cloth_color", cloth_color, "colour of cloth, RGB 0..1");
     v("fluid_radius_scale", fluid_radius_scale, "fluid sphere size in the SSFR passes, particle radii",
@@ -101,8 +115,12 @@ struct RenderParams {
     v("filter_max_px", filter_max_px, "depth filter half-width limit, pixels", Range{1, 128});
     v("filter_depth_sigma", filter_depth_sigma, "bilateral range sigma, particle radii", Range{0.01, 100.0});
     v("absorption", absorption, "fluid absorption per channel (Beer-Lambert), 1/m");
-    v("refraction", refraction, "refraction offset, screen fraction per metre of thickness", Range{0.0, 10.0});
+    v("ior", ior, "fluid refractive index (Snell's law at the surface)", Range{1.0, 3.0});
     v("fresnel_f0", fresnel_f0, "fluid reflectance at normal incidence", Range{0.0, 1.0});
+    v("fluid_roughness", fluid_roughness, "fluid surface roughness (GGX alpha): spread of the light's highlight",
+      Range{0.01, 1.0});
+    v("light_intensity", light_intensity,
+      "light_dir's radiance on a white diffuse surface facing it (1 = white): strength of highlights", Range{0.0, 100.0});
     v("cube_size", cube_size, "reflection cube map face size, pixels", Range{16, 4096});
     v("fluid_splat", fluid_splat, "fluid passes: compute shaders (GL 4.3: splats, screen passes) or raster sprites",
       Choices{"compute", "raster"});

@@ -10,10 +10,26 @@
 #include "render/renderer_impl.hpp"
 
 namespace seamless {
+
+vec3 srgb_to_linear(vec3 c) {  // IEC 61966-2-1, as color.glsl
+  auto f = [](float x) { return x <= 0.04045f ? x / 12.92f : std::pow((x + 0.055f) / 1.055f, 2.4f); };
+  return {f(c.x), f(c.y), f(c.z)};
+}
+
 namespace {
 
 std::vector<float> mat3_cols(const mat3& R) {  // column-major for glUniformMatrix3fv
   return {R.m[0][0], R.m[1][0], R.m[2][0], R.m[0][1], R.m[1][1], R.m[2][1], R.m[0][2], R.m[1][2], R.m[2][2]};
+}
+
+// The mean of an sRGB image in linear radiance (what the fluid reflects in the Kinect view).
+vec3 mean_linear_color(const std::vector<uchar3>& c) {
+  float lut[256];
+  for (int i = 0; i < 256; ++i) lut[i] = srgb_to_linear(vec3{i / 255.f, 0.f, 0.f}).x;
+  double r = 0, g = 0, b = 0;
+  for (const uchar3& q : c) r += lut[q.x], g += lut[q.y], b += lut[q.z];
+  const double n = std::max<double>(1.0, static_cast<double>(c.size()));
+  return {static_cast<float>(r / n), static_cast<float>(g / n), static_cast<float>(b / n)};
 }
 
 }  // namespace
@@ -23,14 +39,17 @@ void Renderer::Impl::build_programs() {
   auto fs = [](std::vector<std::string> f) { return ShaderStage{GL_FRAGMENT_SHADER, std::move(f)}; };
   const std::vector<std::string> sphere_fs = {"camera.glsl", "sphere_hit.glsl"};
   auto with = [](std::vector<std::string> a, const char* f) { a.push_back(f); return a; };
-  mesh_prog = Program("mesh", {vs({"mesh.vert"}), fs({"mesh.frag"})});
-  cloth_prog = Program("cloth", {vs({"cloth.vert"}), fs({"mesh.frag"})});
+  // Surfaces that receive the virtual objects' shadows (shadow.glsl).
+  const std::vector<std::string> receiver = {"color.glsl", "shadow.glsl", "mesh.frag"};
+  mesh_prog = Program("mesh", {vs({"mesh.vert"}), fs(receiver)});
+  cloth_prog = Program("cloth", {vs({"cloth.vert"}), fs(receiver)});
   particle_prog = Program("particles", {vs({"sphere.vert"}), fs(with(sphere_fs, "particle.frag"))});
   fluid_depth_prog = Program("fluid depth", {vs({"sphere.vert"}), fs(with(sphere_fs, "ssfr_depth.frag"))});
   fluid_thick_prog = Program("fluid thickness", {vs({"sphere.vert"}), fs(with(sphere_fs, "ssfr_thickness.frag"))});
-  kinect_prog = Program("kinect view", {vs({"fullscreen.vert"}), fs({"camera.glsl", "kinect_bg.frag"})});
+  kinect_prog = Program("kinect view",
+                        {vs({"fullscreen.vert"}), fs({"camera.glsl", "color.glsl", "shadow.glsl", "kinect_bg.frag"})});
   auto screen = [&](const char* name, const char* body, const char* main) {
-    return Program(name, {vs({"fullscreen.vert"}), fs({"camera.glsl", body, main})});
+    return Program(name, {vs({"fullscreen.vert"}), fs({"camera.glsl", "color.glsl", body, main})});
   };
   filter_prog = screen("fluid filter", "ssfr_filter.glsl", "ssfr_filter.frag");
   normal_prog = screen("fluid normals", "ssfr_normal.glsl", "ssfr_normal.frag");
@@ -106,9 +125,11 @@ void Renderer::Impl::set_camera_uniforms(const Program& prog, const RenderCamera
   const Mat4 V = view_matrix(cam.world_T_camera), P = projection_matrix(cam.K, cam.znear, cam.zfar);
   glUniformMatrix4fv(prog.loc("u_view"), 1, GL_FALSE, V.data());
   glUniformMatrix4fv(prog.loc("u_proj"), 1, GL_FALSE, P.data());
+  glUniformMatrix4fv(prog.loc("u_world_T_camera"), 1, GL_FALSE, model_matrix(cam.world_T_camera).data());
   const vec3 l = light_eye(cam);
   glUniform3f(prog.loc("u_light"), l.x, l.y, l.z);
   glUniform1f(prog.loc("u_ambient"), p.ambient);
+  shadow_uniforms(prog);
 }
 
 void Renderer::Impl::draw_mesh(const GlMesh& m, const RenderCamera& cam, const Mat4& model, bool vertex_color,
@@ -242,16 +263,22 @@ void Renderer::Impl::upload_cloth(const std::vector<int3>& tris, std::int64_t n)
   cloth_first = lo;
 }
 
-void Renderer::Impl::draw_cloth(const RenderCamera& cam) {
-  set_camera_uniforms(cloth_prog, cam);
+// The particle positions and the sheets' rings for cloth.vert (camera or shadow map).
+void Renderer::Impl::bind_cloth(const Program& prog) {
   buffer_texture(pos_tbo, part_pos, GL_RGB32F);  // the buffer may have been re-allocated
   glActiveTexture(GL_TEXTURE0), glBindTexture(GL_TEXTURE_BUFFER, pos_tbo);
   glActiveTexture(GL_TEXTURE1), glBindTexture(GL_TEXTURE_BUFFER, ring_off_tbo);
   glActiveTexture(GL_TEXTURE2), glBindTexture(GL_TEXTURE_BUFFER, ring_tbo);
-  glUniform1i(cloth_prog.loc("u_pos"), 0);
-  glUniform1i(cloth_prog.loc("u_ring_off"), 1);
-  glUniform1i(cloth_prog.loc("u_ring"), 2);
-  glUniform1i(cloth_prog.loc("u_first"), cloth_first);
+  glActiveTexture(GL_TEXTURE0);
+  glUniform1i(prog.loc("u_pos"), 0);
+  glUniform1i(prog.loc("u_ring_off"), 1);
+  glUniform1i(prog.loc("u_ring"), 2);
+  glUniform1i(prog.loc("u_first"), cloth_first);
+}
+
+void Renderer::Impl::draw_cloth(const RenderCamera& cam) {
+  set_camera_uniforms(cloth_prog, cam);
+  bind_cloth(cloth_prog);
   glUniform3f(cloth_prog.loc("u_tint"), p.cloth_color.x, p.cloth_color.y, p.cloth_color.z);
   glUniform1i(cloth_prog.loc("u_lit"), 1);
   glUniform1i(cloth_prog.loc("u_two_sided"), 1);
@@ -295,6 +322,12 @@ void Renderer::Impl::draw_frame(const DrawList& list, std::int64_t n, const Rend
   glDisable(GL_BLEND);
   glEnable(GL_PROGRAM_POINT_SIZE);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  shadow_pass(list, n);  // binds its own targets; the scene's are bound again below
+  timer.mark("shadow");
+  glBindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
+  glViewport(0, 0, w, h);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
   draw_scene(cam);
   timer.mark("scene");
   draw_objects(list, n, cam);
@@ -321,6 +354,7 @@ void init(Renderer::Impl& m, const RenderParams& params, int width, int height) 
   else if (params.fluid_splat == "compute")
     spdlog::info("render: OpenGL {} has no compute shaders (4.3); fluid spheres are drawn as raster sprites",
                  epoxy_gl_version() / 10.0);
+  m.build_shadow_programs();
   m.empty_vao = VertexArray(new_name(glGenVertexArrays));
   m.make_targets();
   m.make_box();
@@ -417,6 +451,7 @@ void Renderer::set_kinect_view(const Image<uchar3>& rgb, const Image<float>& dep
   glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, K.width, K.height, GL_RED, GL_FLOAT, d.data());
   m.kin_K = K;
   m.kin_pose = world_T_camera;
+  m.kin_mean = mean_linear_color(c);
   m.has_kinect = true;
 }
 

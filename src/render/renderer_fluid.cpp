@@ -93,6 +93,7 @@ void Renderer::Impl::render_cube_map() {
   glDepthFunc(GL_LESS);
   glDisable(GL_CULL_FACE);
   const vec3 centre = (scene_lo + scene_hi) * 0.5f;
+  shadow_live = false;  // the cube map holds the scan alone, lit as recorded
   for (int f = 0; f < 6; ++f) {
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, cube, 0);
     glClearColor(p.background.x, p.background.y, p.background.z, 1.f);
@@ -246,17 +247,24 @@ void Renderer::Impl::composite_pass(const RenderCamera& cam) {
   bind_tex(2, GL_TEXTURE_2D, normals);
   bind_tex(3, GL_TEXTURE_2D, thick[0]);
   bind_tex(4, GL_TEXTURE_CUBE_MAP, cube);
-  const char* samplers[] = {"u_scene_color", "u_fluid_depth", "u_normal", "u_thickness", "u_cube"};
-  for (int i = 0; i < 5; ++i) glUniform1i(cp.loc(samplers[i]), i);
+  bind_tex(5, GL_TEXTURE_2D, scene_depth);
+  const char* samplers[] = {"u_scene_color", "u_fluid_depth", "u_normal", "u_thickness", "u_cube", "u_scene_depth"};
+  for (int i = 0; i < 6; ++i) glUniform1i(cp.loc(samplers[i]), i);
   const bool use_cube = has_cube && p.view == "mesh";
   glUniform1i(cp.loc("u_use_cube"), use_cube);
+  // Without a cube map, the Kinect image's mean colour (or the mesh view's background) is what
+  // the surface reflects.
+  const vec3 env = p.view == "kinect" && has_kinect ? kin_mean : srgb_to_linear(p.background);
+  glUniform3f(cp.loc("u_env"), env.x, env.y, env.z);
   const std::vector<float> R = {cam.world_T_camera.R.m[0][0], cam.world_T_camera.R.m[1][0], cam.world_T_camera.R.m[2][0],
                                 cam.world_T_camera.R.m[0][1], cam.world_T_camera.R.m[1][1], cam.world_T_camera.R.m[2][1],
                                 cam.world_T_camera.R.m[0][2], cam.world_T_camera.R.m[1][2], cam.world_T_camera.R.m[2][2]};
   glUniformMatrix3fv(cp.loc("u_world_R_eye"), 1, GL_FALSE, R.data());
   glUniform3f(cp.loc("u_absorption"), p.absorption.x, p.absorption.y, p.absorption.z);
-  glUniform1f(cp.loc("u_refraction"), p.refraction);
+  glUniform1f(cp.loc("u_ior"), p.ior);
   glUniform1f(cp.loc("u_f0"), p.fresnel_f0);
+  glUniform1f(cp.loc("u_roughness"), p.fluid_roughness);
+  glUniform1f(cp.loc("u_light_intensity"), p.light_intensity);
   if (compute) {
     const GLuint out[] = {final_color, reflect_color, refract_color};
     for (GLuint i = 0; i < 3; ++i) glBindImageTexture(i, out[i], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);

@@ -44,6 +44,9 @@ using Framebuffer = GlName<gl_delete_framebuffer>;
 using Renderbuffer = GlName<gl_delete_renderbuffer>;
 using VertexArray = GlName<gl_delete_vertex_array>;
 
+// sRGB-encoded 0..1 -> linear radiance (the host side of color.glsl).
+vec3 srgb_to_linear(vec3 c);
+
 Texture make_texture_2d(GLenum internal, int w, int h, GLenum filter = GL_NEAREST);
 GLuint new_name(void (*gen)(GLsizei, GLuint*));
 // Framebuffer with the given colour textures (attachments 0..n-1) and optional depth texture.
@@ -114,6 +117,7 @@ struct Renderer::Impl {
   bool has_cube = false;
   Texture kin_rgb, kin_depth;
   Intrinsics kin_K;
+  vec3 kin_mean{0.5f, 0.5f, 0.5f};  // the image's mean colour, linear
   SE3 kin_pose = SE3::identity();
   bool has_kinect = false;
 
@@ -131,6 +135,21 @@ struct Renderer::Impl {
   GlBuffer part_pos, part_phase;
   std::int64_t part_capacity = 0;
   std::int64_t fluid_count = -1;  // fluid particles of the last upload; -1: unknown (device data)
+
+  // Shadows of the virtual objects (renderer_shadow.cpp): built when the context has compute
+  // shaders and glClearTexImage (GL 4.4 or ARB_clear_texture).
+  bool has_shadow = false;
+  Program shadow_bounds_prog, shadow_splat_prog, shadow_resolve_prog, shadow_mesh_prog, shadow_cloth_prog;
+  Texture light_bounds;                   // 6 x 1 R32I: casters' bounds in the light frame (shadow.glsl)
+  Texture shadow_depth, shadow_map;       // rasterised casters' depth, the opaque map
+  Texture shadow_bits, shadow_thick;      // fluid splat: front depth bits, fixed-point path in fluid
+  Texture shadow_fluid;                   // RG32F: fluid front depth and path, in the splat's grid
+  bool fluid_shadow_live = false;         // this frame's fluid transmits into the map
+  float list_sphere_r = 0.f;              // this frame's fluid sphere radius (its splat level)
+  Framebuffer shadow_fbo;
+  int shadow_size = 0;
+  mat3 light_R = mat3::identity();        // world -> light frame
+  bool shadow_live = false;               // this frame's receivers read a map
 
   std::vector<StageImage> stages;
   std::vector<RenderTiming> timings;
@@ -172,6 +191,12 @@ struct Renderer::Impl {
   void fluid_depth_splat(std::int64_t n, float sphere_r, const RenderCamera& cam);
   void fluid_thickness_splat(std::int64_t n, float sphere_r, const RenderCamera& low);
   void capture_stages();
+  // renderer_shadow.cpp
+  void build_shadow_programs();
+  void make_shadow_targets();
+  void shadow_pass(const DrawList& list, std::int64_t n);
+  void shadow_uniforms(const Program& prog) const;  // the receivers' (shadow.glsl)
+  void bind_cloth(const Program& prog);
   void set_camera_uniforms(const Program& prog, const RenderCamera& cam) const;
   vec3 light_eye(const RenderCamera& cam) const;
 };

@@ -34,7 +34,7 @@ void Renderer::Impl::build_compute_programs() {
   thick_splat_prog = Program("fluid thickness splat", {cs("ssfr_thickness_splat.comp")});
   resolve_prog = Program("fluid splat resolve", {ShaderStage{GL_COMPUTE_SHADER, {"ssfr_resolve.comp"}}});
   auto screen = [](const char* name, const char* body, const char* main) {
-    return Program(name, {ShaderStage{GL_COMPUTE_SHADER, {"camera.glsl", "screen.glsl", body, main}}});
+    return Program(name, {ShaderStage{GL_COMPUTE_SHADER, {"camera.glsl", "color.glsl", "screen.glsl", body, main}}});
   };
   filter_cprog = screen("fluid filter (compute)", "ssfr_filter.glsl", "ssfr_filter.comp");
   normal_cprog = screen("fluid normals (compute)", "ssfr_normal.glsl", "ssfr_normal.comp");

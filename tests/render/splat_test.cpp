@@ -196,9 +196,11 @@ namespace {
 // same per-texel functions (ssfr_*.glsl) as the fragment versions, so the same frame. Where the
 // filtered depth agrees bit for bit over the 5 x 5 texels a pixel's normal and shading read, the
 // colours can differ only through the thickness (fixed point, within 1e-4 m: see thickness_tol):
-// Beer-Lambert exp(-6/m T) changes by < 6e-4 relative (0.15 of a level), the refraction offset
-// 0.06 T of the screen by < 0.01 pixel (0.25 of a level across the sharpest edge, 255 per pixel).
-// Below half a level before rounding: at most 1 level apart after it.
+// Beer-Lambert exp(-25/m T) (the red default) changes by < 2.5e-3 relative (0.64 of a level);
+// the refracted sample (at most the path T along a ray bent by at most 1/1.33 sideways) moves by
+// < 0.75 f / z 1e-4 m = 0.012 pixel over a wall of one colour whose only gradient is the fluid's
+// soft shadow (a few levels per pixel): < 0.1 level. Below one level before rounding: at most 1
+// level apart after it.
 TEST(RenderSplat, ComputeScreenPassesGiveTheRasterFrame) {
   SEAMLESS_REQUIRE_EGL();
   const Intrinsics K = intrinsics(400.f, 79.5f, 59.5f, 160, 120);

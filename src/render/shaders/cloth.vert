@@ -2,7 +2,8 @@
 // the element indices are particle ids, so gl_VertexID is the particle, and its position comes
 // from the buffer texture over the renderer's particle positions (filled by the host upload or by
 // CUDA interop). The smooth normal is computed here, per frame, as the area-weighted sum of the
-// normals of the triangles around the vertex (the same sum as render::vertex_normals).
+// normals of the triangles around the vertex (the same sum as render::vertex_normals). With
+// shadow_caster.glsl first (and shadow.glsl) the sheet goes into the shadow map instead.
 uniform samplerBuffer u_pos;        // particle positions, world (RGB32F)
 uniform isamplerBuffer u_ring_off;  // per cloth vertex (id - u_first): first entry in u_ring; +1: end
 uniform isamplerBuffer u_ring;      // (j, k) for each triangle (i, j, k) around vertex i, winding kept
@@ -11,6 +12,8 @@ uniform mat4 u_view, u_proj;
 uniform vec3 u_tint;
 
 out vec3 v_normal;
+out vec3 v_world;
+out vec3 v_world_normal;
 out vec3 v_color;
 
 void main() {
@@ -23,6 +26,12 @@ void main() {
     n += cross(texelFetch(u_pos, jk.x).xyz - p, texelFetch(u_pos, jk.y).xyz - p);  // |n| = twice the area
   }
   v_normal = mat3(u_view) * n;  // normalised per fragment (mesh.frag)
+  v_world = p;
+  v_world_normal = n;
   v_color = u_tint;
+#ifdef SEAMLESS_SHADOW_CASTER
+  gl_Position = light_clip(p);
+#else
   gl_Position = u_proj * (u_view * vec4(p, 1.0));
+#endif
 }

@@ -1,14 +1,23 @@
 // The Kinect's point of view (dissertation 4.3.1, without its hand-tuned field of view): the RGB
 // image as background, and its registered depth written as this pixel's depth so that virtual
 // objects behind the real surface fail the depth test. No reading (0) means nothing is there.
+// The same depth places the real surface in the world (unprojected with the intrinsics, moved by
+// the tracked pose), where the virtual objects' shadows darken it (shadow.glsl).
 uniform sampler2D u_rgb;
 uniform sampler2D u_depth;  // metres, registered to u_rgb
+uniform mat4 u_world_T_camera;
 
 layout(location = 0) out vec4 o_color;
 
 void main() {
-  vec2 uv = (frag_pixel() + 0.5) / u_size;  // image rows run down, as uploaded
-  o_color = vec4(texture(u_rgb, uv).rgb, 1.0);
+  vec2 px = frag_pixel();
+  vec2 uv = (px + 0.5) / u_size;  // image rows run down, as uploaded
+  vec3 rgb = texture(u_rgb, uv).rgb;
   float z = texture(u_depth, uv).r;
+  if (z > 0.0) {
+    vec3 world = (u_world_T_camera * vec4(z * pixel_ray(px), 1.0)).xyz;
+    rgb = shadowed_srgb(rgb, shadow_light(world, vec3(0.0), gl_FragCoord.xy));
+  }
+  o_color = vec4(rgb, 1.0);
   gl_FragDepth = z > 0.0 ? window_depth(clamp(z, u_near_far.x, u_near_far.y)) : 1.0;
 }

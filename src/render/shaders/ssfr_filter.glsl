@@ -8,7 +8,14 @@
 //    z - mu, so that a nearer surface cannot pull this one forward, yet its edge still smooths.
 //    mu = 3 range sigmas (where the bilateral weight has fallen to 1%).
 // Thickness: a plain Gaussian of fixed pixel width (u_range_sigma <= 0, u_skip_empty false).
-// Kernels wider than u_max_taps per side sample every k-th pixel (same Gaussian in pixels).
+// The spatial weight is the biweight (1 - (i/r)^2)^2 over the half-width r (close to a Gaussian
+// of sigma 0.38 r, and zero at the ends). Kernels wider than u_max_taps per side sample every
+// k-th pixel on a lattice fixed to the image (the multiples of k): neighbouring pixels read the
+// same texels with weights that shift smoothly, and a tap enters or leaves the window at weight
+// zero, so the result varies smoothly from pixel to pixel. (Taps at multiples of k from each
+// pixel instead split the pixels into k interleaved sets that read disjoint texels; wherever the
+// depth is not smooth, at the spheres' silhouettes, their results differ and show as stripes one
+// pixel apart in the normals.)
 // filter_at() is the pass at one texel; ssfr_filter.frag and ssfr_filter.comp run it.
 uniform sampler2D u_src;
 uniform ivec2 u_dir;            // (1, 0) or (0, 1)
@@ -26,14 +33,18 @@ float filter_at(ivec2 p) {
   int r = u_skip_empty ? int(min(float(u_max_px), u_world_radius * f / c)) : u_max_px;
   if (r < 1) return c;
   int stride = (r + u_max_taps - 1) / u_max_taps;
-  float inv2s2 = 2.0 / float(r * r);  // spatial sigma = r / 2
+  float rr = float(r + 1);  // the biweight is zero at +-(r + 1): the outermost taps still count
   float mu = 3.0 * u_range_sigma;
   ivec2 hi = textureSize(u_src, 0) - 1;
+  int at = u_dir.x != 0 ? p.x : p.y;
+  int lo = at - r;  // the first lattice point at or after lo (integer division truncates toward 0)
+  int first = (lo >= 0 ? (lo + stride - 1) / stride : -((-lo) / stride)) * stride - at;
   float sum = 0.0, wsum = 0.0;
-  for (int i = -(r / stride) * stride; i <= r; i += stride) {  // multiples of stride: the centre is one
+  for (int i = first; i <= r; i += stride) {
     float s = texelFetch(u_src, clamp(p + i * u_dir, ivec2(0), hi), 0).r;
     if (u_skip_empty && s <= 0.0) continue;
-    float w = exp(-float(i * i) * inv2s2);
+    float x = float(i) / rr;
+    float w = (1.0 - x * x) * (1.0 - x * x);
     if (u_range_sigma > 0.0) {
       if (u_narrow_range) {
         if (s > c + mu) continue;
@@ -46,5 +57,5 @@ float filter_at(ivec2 p) {
     sum += s * w;
     wsum += w;
   }
-  return sum / wsum;
+  return wsum > 0.0 ? sum / wsum : c;  // no tap on fluid (a sliver between lattice points): as it was
 }
