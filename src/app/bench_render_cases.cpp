@@ -34,11 +34,14 @@ void write_json(const std::string& path, const RenderBenchResult& r) {
 }
 }  // namespace
 
-// The default settings (compute splats, thickness_downsample, narrow-range filter, ...) and, for
-// comparison, the same with raster sprites, and with every speed remedy off.
+// The default settings (compute splats, thickness_downsample, narrow-range filter, shadows, ...)
+// and, for comparison, the same without shadows, with raster sprites, and with every speed remedy off.
 int run_render_bench(const BenchOptions& o, int reps, const std::string& json) {
   RenderBenchResult r = run_one("default settings", RenderParams{}, reps);
   if (o.scale != "paper") {
+    RenderParams no_shadows;  // what the shadow pass and the shadow lookups cost
+    no_shadows.shadows = false;
+    run_one("default settings without shadows", no_shadows, reps);
     RenderParams raster;
     raster.fluid_splat = "raster";
     run_one("default settings but raster sprites", raster, reps);
