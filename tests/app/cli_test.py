@@ -172,7 +172,8 @@ class Cli(unittest.TestCase):
             seamless("track", os.path.join(SRC, "configs", "tum_fr1.yaml"), "--device", "cpu", "--out", out,
                      "--set", f"input.path={room}", "--set", "input.intrinsics.preset=auto",
                      "--set", "tracker.mode=frame_to_frame", "--set", "refine.enabled=false")
-            r = seamless("eval", os.path.join(out, "trajectory.txt"), os.path.join(room, "groundtruth.txt"),
+            # Ground truth first (evo's and TUM's order).
+            r = seamless("eval", os.path.join(room, "groundtruth.txt"), os.path.join(out, "trajectory.txt"),
                          "--json", os.path.join(d, "ate.json"))
             with open(os.path.join(d, "ate.json")) as f:
                 ate = json.load(f)
