@@ -95,13 +95,14 @@ IntrinsicsChoice choose_intrinsics(const IntrinsicsParams& p, const std::string&
     std::string name = dir.filename().string();
     if (name.empty()) name = dir.parent_path().filename().string();  // "a/b/" names b
     const fs::path calibration = fs::path(folder) / "calibration.txt";
-    c.chosen = camera_in_folder_name(name);
+    const std::string named = camera_in_folder_name(name);
     if (fs::exists(calibration)) {
       c.K = read_calibration(calibration.string());
       c.chosen = "calibration.txt";
       c.reason = "preset auto: the folder has " + calibration.string();
       return c;  // its width and height are the recording's
-    } else if (!c.chosen.empty()) {
+    } else if (!named.empty()) {
+      c.chosen = named;
       c.K = intrinsics_preset(c.chosen);
       c.reason = "preset auto: the folder name '" + name + "' names " + c.chosen;
     } else {
