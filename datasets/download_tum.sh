@@ -6,7 +6,7 @@
 #
 # A NAME is the sequence name without the "rgbd_dataset_" prefix (freiburg1_desk, fr1/desk and
 # rgbd_dataset_freiburg1_desk are all accepted). The folder lands in DIR (default: datasets/tum),
-# ready for:  seamless run configs/tum_fr1_desk.yaml --set input.path=DIR/rgbd_dataset_freiburg1_desk
+# ready for:  seamless run configs/tum_fr1.yaml --set input.path=DIR/rgbd_dataset_freiburg1_desk
 set -euo pipefail
 
 BASE_URL="https://cvg.cit.tum.de/rgbd/dataset"

@@ -1,9 +1,10 @@
 // `seamless bench render`: src/render/bench_render times its passes with GL timer queries.
 #include <cstdio>
-#include <fstream>
 
 #include "app/bench_cases.hpp"
+#include "core/json.hpp"
 #include "render/bench_render.hpp"
+#include "seamless/build_config.hpp"
 
 namespace seamless::app {
 
@@ -23,14 +24,14 @@ RenderBenchResult run_one(const char* label, const RenderParams& settings, int r
 }
 
 void write_json(const std::string& path, const RenderBenchResult& r) {
-  std::ofstream f(path);
-  f << "{\"benchmark\": \"render\", \"gl\": \"" << r.gl_renderer << "\", \"median_gpu_ms\": " << r.median_gpu_ms
-    << ", \"median_frame_ms\": " << r.median_frame_ms << ", \"median_draw_ms\": " << r.median_draw_ms
-    << ", \"median_readback_ms\": " << r.median_readback_ms << ", \"median_interop_ms\": " << r.median_interop_ms
-    << ", \"passes_ms\": {";
-  for (std::size_t i = 0; i < r.passes.size(); ++i)
-    f << (i ? ", " : "") << "\"" << r.passes[i].pass << "\": " << r.passes[i].ms;
-  f << "}}\n";
+  JsonWriter w;
+  w.begin_object().field("benchmark", "render").field("seamless_version", SEAMLESS_VERSION);
+  w.field("gl", r.gl_renderer).field("median_gpu_ms", r.median_gpu_ms).field("median_frame_ms", r.median_frame_ms);
+  w.field("median_draw_ms", r.median_draw_ms).field("median_readback_ms", r.median_readback_ms);
+  w.field("median_interop_ms", r.median_interop_ms);
+  w.key("passes_ms").begin_object();
+  for (const RenderTiming& t : r.passes) w.field(t.pass, t.ms);
+  w.end_object().end_object().write_file(path);
 }
 }  // namespace
 

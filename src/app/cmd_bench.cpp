@@ -3,11 +3,12 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
 
 #include "app/bench.hpp"
 #include "app/commands.hpp"
+#include "core/json.hpp"
 #include "core/timing.hpp"
+#include "seamless/build_config.hpp"
 
 namespace seamless::app {
 
@@ -18,12 +19,22 @@ struct BenchArgs {
   bool list = false;
 };
 
-void write_json(const std::string& path, const std::string& bench, Device dev, const std::vector<std::string>& rows) {
-  std::ofstream f(path);
-  f << "{\n  \"benchmark\": \"" << bench << "\",\n  \"device\": \"" << device_name(dev) << "\",\n  \"gpu\": \""
-    << cuda_device_description() << "\",\n  \"cases\": [\n";
-  for (std::size_t i = 0; i < rows.size(); ++i) f << "    " << rows[i] << (i + 1 < rows.size() ? ",\n" : "\n");
-  f << "  ]\n}\n";
+struct CaseResult {
+  std::string name, detail;
+  int reps;
+  double min_ms, median_ms, max_ms;
+};
+
+void write_json(const std::string& path, const std::string& bench, Device dev, const std::vector<CaseResult>& rows) {
+  JsonWriter w;
+  w.begin_object().field("benchmark", bench).field("seamless_version", SEAMLESS_VERSION);
+  w.field("device", device_name(dev)).field("gpu", cuda_device_description());
+  w.key("cases").begin_array();
+  for (const CaseResult& c : rows) {
+    w.begin_object().field("name", c.name).field("reps", c.reps).field("min_ms", c.min_ms);
+    w.field("median_ms", c.median_ms).field("max_ms", c.max_ms).field("detail", c.detail).end_object();
+  }
+  w.end_array().end_object().write_file(path);
 }
 
 int run_bench(const BenchArgs& a) {
@@ -38,7 +49,7 @@ int run_bench(const BenchArgs& a) {
   BenchOptions o{resolve_device(a.device), a.data, a.filter, a.scale};
   if (it->second.custom) return it->second.custom(o, a.reps, a.json);
   spdlog::info("bench {} on {} {}", a.name, device_name(o.device), cuda_device_description());
-  std::vector<std::string> json_rows;
+  std::vector<CaseResult> json_rows;
   std::printf("%-32s %10s %10s %10s  %s\n", "case", "min ms", "median ms", "max ms", "detail");
   for (BenchCase& c : it->second.factory(o)) {
     if (!a.filter.empty() && c.name.find(a.filter) == std::string::npos) continue;
@@ -48,10 +59,7 @@ int run_bench(const BenchArgs& a) {
     double lo = *std::min_element(t.begin(), t.end()), hi = *std::max_element(t.begin(), t.end());
     double med = median(t);
     std::printf("%-32s %10.4f %10.4f %10.4f  %s\n", c.name.c_str(), lo, med, hi, c.detail.c_str());
-    char row[512];
-    std::snprintf(row, sizeof row, "{\"name\": \"%s\", \"reps\": %d, \"min_ms\": %.6f, \"median_ms\": %.6f, \"max_ms\": %.6f, \"detail\": \"%s\"}",
-                  c.name.c_str(), a.reps, lo, med, hi, c.detail.c_str());
-    json_rows.push_back(row);
+    json_rows.push_back({c.name, c.detail, a.reps, lo, med, hi});
     if (c.report) std::printf("%-32s %s\n", "", c.report().c_str());
   }
   if (!a.json.empty()) {

@@ -1,13 +1,19 @@
 // eval, record, config.
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
+#include <filesystem>
+#include <optional>
 
 #include "app/commands.hpp"
 #include "app/run_context.hpp"
 #include "config/config.hpp"
+#include "seamless/build_config.hpp"
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
+#include "core/json.hpp"
 #include "eval/trajectory_eval.hpp"
 #include "io/frame_source.hpp"
 #include "io/record.hpp"
@@ -16,43 +22,112 @@ namespace seamless::app {
 
 namespace {
 struct EvalArgs {
-  std::vector<std::string> files;
-  double max_dt = 0.02;
-  std::string json, aligned;
+  std::vector<std::string> files;  // ground truth, estimate (evo's and TUM's order)
+  EvalOptions opt;
+  std::string align = "se3", json, aligned;
 };
 
+bool named_like_groundtruth(const std::string& path) {
+  std::string name = std::filesystem::path(path).filename().string();
+  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return std::tolower(c); });
+  return name.find("groundtruth") != std::string::npos || name.find("ground_truth") != std::string::npos ||
+         name == "gt.txt" || name.rfind("gt_", 0) == 0;
+}
+
+bool named_like_estimate(const std::string& path) {
+  const std::string name = std::filesystem::path(path).filename().string();
+  // What seamless track and compare_trackers write, and ORB-SLAM's / ElasticFusion's usual names.
+  for (const char* n : {"trajectory.txt", "trajectory_odometry.txt", "aligned.txt", "CameraTrajectory.txt",
+                        "KeyFrameTrajectory.txt"})
+    if (name == n) return true;
+  return false;
+}
+
+// `seamless eval` took the estimate first until 0.2; people type evo's order (ground truth
+// first). Say so when the files look the other way round: the numbers are then those of the
+// ground truth against the estimate, with the alignment and "N of M matched" on the wrong file.
+void warn_if_swapped(const std::string& gt_path, const std::string& est_path, const Trajectory& gt,
+                     const Trajectory& est) {
+  std::string why;
+  if (named_like_groundtruth(est_path) && !named_like_groundtruth(gt_path))
+    why = "the second file is named like ground truth";
+  else if (named_like_estimate(gt_path) && !named_like_estimate(est_path))
+    why = "the first file is named like an estimated trajectory";
+  else if (!named_like_groundtruth(gt_path) && est.size() > 2 * gt.size())
+    // Motion capture (TUM: 100 Hz) samples far more often than a camera tracker (30 Hz).
+    why = "the second file has " + std::to_string(est.size()) + " poses, more than twice the first's " +
+          std::to_string(gt.size()) + ", as ground truth from motion capture usually has";
+  if (why.empty()) return;
+  spdlog::warn("seamless eval takes GROUND TRUTH FIRST, then the estimate (evo_ape's and TUM's evaluate_ate.py's "
+               "order; before seamless 0.2 it was the other way round), and {}: did you mean `seamless eval {} {}`?",
+               why, est_path, gt_path);
+}
+
+void write_stats(JsonWriter& w, const std::string& prefix, const ErrorStats& s, const char* unit) {
+  w.field(prefix + "_rmse_" + unit, s.rmse).field(prefix + "_mean_" + unit, s.mean);
+  w.field(prefix + "_median_" + unit, s.median).field(prefix + "_std_" + unit, s.std);
+  w.field(prefix + "_min_" + unit, s.min).field(prefix + "_max_" + unit, s.max);
+}
+
 int run_eval(const EvalArgs& a) {
-  Trajectory est = read_tum_trajectory(a.files[0]), gt = read_tum_trajectory(a.files[1]);
-  AteResult ate = compute_ate(est, gt, a.max_dt);
-  RpeResult rpe_f = compute_rpe(est, gt, 1, "frames", a.max_dt);
-  double span = est.empty() ? 0 : est.back().timestamp - est.front().timestamp;
-  std::printf("%zu of %zu estimated poses matched ground truth within %.3f s\n", ate.trans.count, est.size(), a.max_dt);
-  std::printf("%-22s %10s %10s %10s %10s\n", "", "rmse", "mean", "median", "max");
+  EvalOptions opt = a.opt;
+  opt.align = parse_alignment(a.align);
+  const std::string &gt_path = a.files[0], &est_path = a.files[1];
+  const Trajectory gt = read_tum_trajectory(gt_path), est = read_tum_trajectory(est_path);
+  warn_if_swapped(gt_path, est_path, gt, est);
+  const AteResult ate = compute_ate(est, gt, opt);
+  const RpeResult rpe_f = compute_rpe(est, gt, 1, "frames", opt);
+  // TUM's RPE over 1 s (m/s, deg/s); a trajectory shorter than that has none.
+  std::optional<RpeResult> rpe_s;
+  std::string no_rpe_s;
+  try {
+    rpe_s = compute_rpe(est, gt, 1.0, "seconds", opt);
+  } catch (const Error& e) {
+    no_rpe_s = e.what();
+  }
+  std::printf("ground truth %s (%zu poses), estimate %s (%zu poses)\n", gt_path.c_str(), gt.size(), est_path.c_str(),
+              est.size());
+  std::printf("%zu of %zu estimated poses matched ground truth within %.3f s (offset %g s); alignment %s", ate.trans.count,
+              est.size(), opt.t_max_diff, opt.offset, to_string(opt.align));
+  if (opt.align == Alignment::sim3) std::printf(", scale %.6f", ate.scale);
+  std::printf("\n%-24s %10s %10s %10s %10s %10s\n", "", "rmse", "mean", "median", "std", "max");
   auto row = [](const char* name, const ErrorStats& s, double scale) {
-    std::printf("%-22s %10.4f %10.4f %10.4f %10.4f\n", name, s.rmse * scale, s.mean * scale, s.median * scale,
-                s.max * scale);
+    std::printf("%-24s %10.4f %10.4f %10.4f %10.4f %10.4f\n", name, s.rmse * scale, s.mean * scale, s.median * scale,
+                s.std * scale, s.max * scale);
   };
   row("ATE (cm)", ate.trans, 100);
   row("RPE/frame trans (cm)", rpe_f.trans, 100);
   row("RPE/frame rot (deg)", rpe_f.rot, 1);
-  std::string rpe_s_json;
-  if (span > 1.0) {
-    RpeResult rpe_s = compute_rpe(est, gt, 1.0, "seconds", a.max_dt);
-    row("RPE/s trans (cm)", rpe_s.trans, 100);
-    row("RPE/s rot (deg)", rpe_s.rot, 1);
-    rpe_s_json = ",\n  \"rpe_second_trans_rmse_m\": " + std::to_string(rpe_s.trans.rmse) +
-                 ",\n  \"rpe_second_rot_rmse_deg\": " + std::to_string(rpe_s.rot.rmse);
+  if (rpe_s) {
+    row("RPE/1 s trans (cm/s)", rpe_s->trans, 100);
+    row("RPE/1 s rot (deg/s)", rpe_s->rot, 1);
+  } else {
+    std::printf("no RPE over 1 s: %s\n", no_rpe_s.c_str());
   }
   if (!a.aligned.empty()) write_tum_trajectory(a.aligned, ate.aligned);
   if (!a.json.empty()) {
-    std::FILE* f = std::fopen(a.json.c_str(), "w");
-    if (!f) throw Error("cannot write " + a.json);
-    std::fprintf(f,
-                 "{\n  \"pairs\": %zu,\n  \"ate_rmse_m\": %.9f,\n  \"ate_mean_m\": %.9f,\n  \"ate_median_m\": %.9f,\n"
-                 "  \"ate_max_m\": %.9f,\n  \"rpe_frame_trans_rmse_m\": %.9f,\n  \"rpe_frame_rot_rmse_deg\": %.9f%s\n}\n",
-                 ate.trans.count, ate.trans.rmse, ate.trans.mean, ate.trans.median, ate.trans.max, rpe_f.trans.rmse,
-                 rpe_f.rot.rmse, rpe_s_json.c_str());
-    std::fclose(f);
+    // Schema: docs/TRACKING.md, "seamless eval".
+    JsonWriter w;
+    w.begin_object().field("schema", "seamless-eval/1").field("seamless_version", SEAMLESS_VERSION);
+    w.field("groundtruth", gt_path).field("estimate", est_path);
+    w.field("groundtruth_poses", gt.size()).field("estimate_poses", est.size());
+    w.field("t_max_diff_s", opt.t_max_diff).field("offset_s", opt.offset);
+    w.field("align", to_string(opt.align)).field("scale", ate.scale);
+    w.field("pairs", ate.trans.count);
+    write_stats(w, "ate", ate.trans, "m");
+    w.field("rpe_frame_pairs", rpe_f.trans.count);
+    write_stats(w, "rpe_frame_trans", rpe_f.trans, "m");
+    write_stats(w, "rpe_frame_rot", rpe_f.rot, "deg");
+    w.field("rpe_second_delta_s", 1.0);
+    if (rpe_s) {
+      w.field("rpe_second_pairs", rpe_s->trans.count);
+      write_stats(w, "rpe_second_trans", rpe_s->trans, "m");  // metres over 1 s: m/s
+      write_stats(w, "rpe_second_rot", rpe_s->rot, "deg");    // deg/s
+    } else {
+      w.field("rpe_second_pairs", 0);
+      for (const char* k : {"rpe_second_trans_rmse_m", "rpe_second_rot_rmse_deg"}) w.key(k).null();
+    }
+    w.end_object().write_file(a.json);
   }
   return 0;
 }
@@ -60,10 +135,21 @@ int run_eval(const EvalArgs& a) {
 
 void add_eval_command(CLI::App& app, std::function<int()>& action) {
   auto a = std::make_shared<EvalArgs>();
-  auto* cmd = app.add_subcommand("eval", "ATE and RPE of an estimated trajectory against ground truth (TUM format)");
-  cmd->add_option("trajectories", a->files, "estimate.txt groundtruth.txt")->expected(2)->required()->check(CLI::ExistingFile);
-  cmd->add_option("--max-dt", a->max_dt, "largest timestamp difference of associated poses, seconds (TUM: 0.02)");
-  cmd->add_option("--json", a->json, "write the figures as JSON");
+  auto* cmd = app.add_subcommand(
+      "eval", "ATE and RPE of an estimated trajectory against ground truth (TUM format; ground truth first, as evo)");
+  cmd->add_option("trajectories", a->files, "groundtruth.txt estimate.txt (evo's and TUM's order)")
+      ->expected(2)
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--t_max_diff,--max-dt", a->opt.t_max_diff,
+                  "largest timestamp difference of associated poses, seconds (TUM: 0.02, evo: 0.01)")
+      ->capture_default_str();
+  cmd->add_option("--offset", a->opt.offset, "seconds added to the estimate's timestamps before association")
+      ->capture_default_str();
+  cmd->add_option("--align", a->align, "alignment before ATE: se3 (rigid), sim3 (rigid + scale) or none")
+      ->check(CLI::IsMember({"se3", "sim3", "none"}))
+      ->capture_default_str();
+  cmd->add_option("--json", a->json, "write the figures as JSON (schema in docs/TRACKING.md)");
   cmd->add_option("--aligned", a->aligned, "write the aligned estimate (TUM format) for plotting");
   cmd->callback([&action, a] { action = [a] { return run_eval(*a); }; });
 }

@@ -12,6 +12,7 @@
 #include "core/progress.hpp"
 #include "io/frame_source.hpp"
 #include "app/placement.hpp"
+#include "io/intrinsics_presets.hpp"
 #include "app/render_stage.hpp"
 #include "physics/builders.hpp"
 #include "physics/particle_solver.hpp"
@@ -44,12 +45,21 @@ void log_volume(const VolumeStats& s) {
                s.allocated_blocks, s.bytes_per_block, s.voxel_bytes / 1048576.0, s.device_bytes / 1048576.0,
                100 * s.hash_fill, s.failed_insertions, s.retries);
 }
+
+// The intrinsics the frames arrive with (after undistortion), in the log and in the run's folder
+// (intrinsics.txt, calibration.txt's format): a run says which camera model it tracked with.
+void record_intrinsics(RunContext& ctx, const FrameSource& source) {
+  const Intrinsics K = source.intrinsics();
+  write_calibration(ctx.out_path("intrinsics.txt"), K);
+  spdlog::info("intrinsics of the frames (after any undistortion): {} (intrinsics.txt)", describe_intrinsics(K));
+}
 }  // namespace
 
 ScanResult scan(RunContext& ctx, bool with_volume) {
   const Experiment& e = ctx.experiment();
   require_tracker(e.tracker.kind);
   auto source = make_source(e.input, ctx.device());
+  record_intrinsics(ctx, *source);
   ScanResult r;
   if (with_volume) r.volume = make_volume(e.volume, ctx.device());
 
@@ -294,6 +304,7 @@ class LiveLoop : public FrameLoop {
         session_(tracking_params(e_), ctx.device(), source_->intrinsics(), volume_.get()),
         solver_(e_.solver, ctx.device()), queue_(e_.spawn, e_.solver),
         total_(e_.frames > 0 ? e_.frames : source_->size().value_or(0)), progress_("live", total_) {
+    record_intrinsics(ctx, *source_);
     if (e_.output.write_trajectory) traj_ = std::make_unique<TrajectoryWriter>(ctx.out_path("trajectory.txt"));
     sp_.spacing = e_.solver.particle_diameter;
     sp_.interior_depth = e_.scene_interior_depth;

@@ -1,5 +1,7 @@
 #include "core/device.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <string>
 
 #include "core/cuda_check.hpp"
@@ -10,6 +12,8 @@ namespace seamless {
 
 #if SEAMLESS_HAS_CUDA
 namespace detail {
+cudaError_t probe_kernel_launch();  // core/device_probe.cu
+
 void throw_cuda_error(cudaError_t e, const char* what, const char* file, int line) {
   throw Error(std::string("CUDA error ") + cudaGetErrorName(e) + " (" + cudaGetErrorString(e) + ") in " + what +
               " at " + file + ":" + std::to_string(line));
@@ -19,18 +23,74 @@ void throw_cuda_error(cudaError_t e, const char* what, const char* file, int lin
 
 bool cuda_built() { return SEAMLESS_HAS_CUDA; }
 
-bool cuda_available() {
+namespace {
+
+// Whether a CUDA GPU is usable, found once: a GPU is present and this build's kernels run on it.
+// `problem` says why a GPU that is present is not usable (no kernel image for its architecture,
+// a driver too old for the runtime, ...), with what to do about it; it is empty when there is
+// simply no GPU.
+struct CudaState {
+  bool usable = false;
+  std::string problem;
+};
+
 #if SEAMLESS_HAS_CUDA
-  int n = 0;
-  if (cudaGetDeviceCount(&n) != cudaSuccess) {
-    cudaGetLastError();  // clear the sticky "no device" error
-    return false;
-  }
-  return n > 0;
-#else
-  return false;
+std::string cuda_error(cudaError_t e) { return std::string(cudaGetErrorName(e)) + ": " + cudaGetErrorString(e); }
+
+// The architectures the build compiled for (CMake's SEAMLESS_CUDA_ARCH, set on this file only).
+#ifndef SEAMLESS_CUDA_ARCHITECTURES
+#define SEAMLESS_CUDA_ARCHITECTURES "?"
 #endif
+
+std::string unusable_gpu(cudaError_t e) {
+  int dev = 0;
+  cudaDeviceProp p{};
+  std::string gpu = "the GPU", sm;
+  if (cudaGetDevice(&dev) == cudaSuccess && cudaGetDeviceProperties(&p, dev) == cudaSuccess) {
+    sm = std::to_string(p.major) + std::to_string(p.minor);
+    gpu = std::string("the GPU ") + p.name + " (compute capability " + std::to_string(p.major) + "." +
+          std::to_string(p.minor) + ", sm_" + sm + ")";
+  }
+  std::string m = gpu + " cannot run this build's CUDA kernels (" + cuda_error(e) + "); ";
+  if (e == cudaErrorNoKernelImageForDevice || e == cudaErrorInvalidDeviceFunction)
+    return m + "they were compiled for the CUDA architectures \"" SEAMLESS_CUDA_ARCHITECTURES
+               "\": rebuild with -DSEAMLESS_CUDA_ARCH=" + (sm.empty() ? "<its sm number>" : sm) +
+           " (or -DSEAMLESS_CUDA_ARCH=native on this machine)";
+  if (e == cudaErrorUnsupportedPtxVersion || e == cudaErrorInsufficientDriver)
+    return m + "the NVIDIA driver is older than this build's CUDA toolkit needs: update the driver";
+  return m + "CUDA's error above says why";
 }
+#endif
+
+const CudaState& cuda_state() {
+  static const CudaState state = [] {
+    CudaState s;
+#if SEAMLESS_HAS_CUDA
+    int n = 0;
+    const cudaError_t count = cudaGetDeviceCount(&n);
+    if (count != cudaSuccess || n == 0) {
+      cudaGetLastError();  // clear the sticky "no device" error
+      if (count == cudaErrorInsufficientDriver)
+        s.problem = "the NVIDIA driver is older than this build's CUDA toolkit needs (" + cuda_error(count) +
+                    "): update the driver";
+      return s;
+    }
+    const cudaError_t probe = detail::probe_kernel_launch();
+    if (probe == cudaSuccess) {
+      s.usable = true;
+    } else {
+      cudaGetLastError();
+      s.problem = unusable_gpu(probe);
+    }
+#endif
+    return s;
+  }();
+  return state;
+}
+
+}  // namespace
+
+bool cuda_available() { return cuda_state().usable; }
 
 std::string cuda_device_description() {
 #if SEAMLESS_HAS_CUDA
@@ -53,10 +113,21 @@ Device resolve_device(const std::string& name) {
       throw ConfigError("device 'cuda' was asked for, but this build has no CUDA backend "
                   "(reconfigure with -DSEAMLESS_CUDA=ON on a machine with nvcc, or use --device cpu)");
     if (!cuda_available())
-      throw ConfigError("device 'cuda' was asked for, but no CUDA GPU is usable on this machine (use --device cpu)");
+      throw ConfigError("device 'cuda' was asked for, but " +
+                  (cuda_state().problem.empty() ? std::string("no CUDA GPU is usable on this machine")
+                                                : cuda_state().problem) +
+                  " (or use --device cpu)");
     return Device::CUDA;
   }
-  if (name == "auto") return cuda_available() ? Device::CUDA : Device::CPU;
+  if (name == "auto") {
+    if (cuda_available()) return Device::CUDA;
+    if (!cuda_state().problem.empty()) {
+      static bool said = false;  // once per process, however often the device is resolved
+      if (!said) spdlog::warn("device auto: {}; running on the CPU", cuda_state().problem);
+      said = true;
+    }
+    return Device::CPU;
+  }
   throw ConfigError("unknown device '" + name + "' (expected cpu, cuda or auto)");
 }
 

@@ -27,9 +27,11 @@ TumPose from_iso(double timestamp, const Eigen::Isometry3d& T) {
   return p;
 }
 
+// The rotation angle of R, from both its sine and cosine (2 sin = |vee(R - R^T)|, 2 cos = tr R - 1):
+// acos of the trace alone loses half the digits near zero, where per-frame errors live.
 double rotation_angle_deg(const Eigen::Matrix3d& R) {
-  double c = std::clamp((R.trace() - 1.0) / 2.0, -1.0, 1.0);
-  return std::acos(c) * 180.0 / M_PI;
+  const Eigen::Vector3d v(R(2, 1) - R(1, 2), R(0, 2) - R(2, 0), R(1, 0) - R(0, 1));
+  return std::atan2(v.norm(), R.trace() - 1.0) * 180.0 / M_PI;
 }
 
 }  // namespace
@@ -53,17 +55,30 @@ ErrorStats error_stats(std::vector<double> e) {
   return s;
 }
 
-std::vector<std::pair<std::size_t, std::size_t>> associate(const Trajectory& est, const Trajectory& gt, double max_dt) {
+Alignment parse_alignment(const std::string& name) {
+  if (name == "se3") return Alignment::se3;
+  if (name == "sim3") return Alignment::sim3;
+  if (name == "none") return Alignment::none;
+  throw Error("unknown alignment '" + name + "': use se3 (rigid), sim3 (rigid + scale) or none");
+}
+
+const char* to_string(Alignment a) {
+  return a == Alignment::se3 ? "se3" : a == Alignment::sim3 ? "sim3" : "none";
+}
+
+std::vector<std::pair<std::size_t, std::size_t>> associate(const Trajectory& est, const Trajectory& gt, double max_dt,
+                                                           double offset) {
   struct Cand {
     double dt;
     std::size_t i, j;
   };
   std::vector<Cand> cands;
   for (std::size_t i = 0; i < est.size(); ++i) {
-    auto lo = std::lower_bound(gt.begin(), gt.end(), est[i].timestamp - max_dt,
+    const double te = est[i].timestamp + offset;
+    auto lo = std::lower_bound(gt.begin(), gt.end(), te - max_dt,
                                [](const TumPose& p, double t) { return p.timestamp < t; });
-    for (auto it = lo; it != gt.end() && it->timestamp <= est[i].timestamp + max_dt; ++it)
-      cands.push_back({std::fabs(it->timestamp - est[i].timestamp), i, static_cast<std::size_t>(it - gt.begin())});
+    for (auto it = lo; it != gt.end() && it->timestamp <= te + max_dt; ++it)
+      cands.push_back({std::fabs(it->timestamp - te), i, static_cast<std::size_t>(it - gt.begin())});
   }
   std::sort(cands.begin(), cands.end(), [](const Cand& a, const Cand& b) { return a.dt < b.dt; });
   std::vector<char> used_e(est.size(), 0), used_g(gt.size(), 0);
@@ -77,61 +92,117 @@ std::vector<std::pair<std::size_t, std::size_t>> associate(const Trajectory& est
   return pairs;
 }
 
-AteResult compute_ate(const Trajectory& est, const Trajectory& gt, double max_dt) {
-  auto pairs = associate(est, gt, max_dt);
-  if (pairs.size() < 3)
-    throw Error("ATE needs at least 3 poses whose timestamps match within " + std::to_string(max_dt) + " s; found " +
-                std::to_string(pairs.size()) + " (are both files TUM trajectories of the same sequence?)");
-  Eigen::Matrix3Xd src(3, pairs.size()), dst(3, pairs.size());
+namespace {
+
+using Pairs = std::vector<std::pair<std::size_t, std::size_t>>;
+
+// Positions of the associated poses, estimate (src) and ground truth (dst), one column each.
+void positions(const Trajectory& est, const Trajectory& gt, const Pairs& pairs, Eigen::Matrix3Xd& src,
+               Eigen::Matrix3Xd& dst) {
+  src.resize(3, pairs.size());
+  dst.resize(3, pairs.size());
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     const TumPose &e = est[pairs[k].first], &g = gt[pairs[k].second];
     src.col(k) = Eigen::Vector3d(e.t[0], e.t[1], e.t[2]);
     dst.col(k) = Eigen::Vector3d(g.t[0], g.t[1], g.t[2]);
   }
-  // Least-squares rigid alignment of the positions (Umeyama 1991 without scale; same as Horn).
-  Eigen::Matrix4d A = Eigen::umeyama(src, dst, false);
-  Eigen::Isometry3d gt_T_est(A);
+}
+
+// The least-squares similarity dst ~ s R src + t (Umeyama 1991, eq. 40-42; with_scale false
+// gives the rigid motion, the same as Horn 1987), as a 4x4 matrix [sR t; 0 1].
+Eigen::Matrix4d alignment(const Eigen::Matrix3Xd& src, const Eigen::Matrix3Xd& dst, Alignment a) {
+  if (a == Alignment::none) return Eigen::Matrix4d::Identity();
+  return Eigen::umeyama(src, dst, a == Alignment::sim3);
+}
+
+Pairs associated(const Trajectory& est, const Trajectory& gt, const EvalOptions& o, const char* what) {
+  Pairs pairs = associate(est, gt, o.t_max_diff, o.offset);
+  if (pairs.size() < 3)
+    throw Error(std::string(what) + " needs at least 3 poses whose timestamps match within " +
+                std::to_string(o.t_max_diff) + " s (offset " + std::to_string(o.offset) + " s); found " +
+                std::to_string(pairs.size()) + " (are both files TUM trajectories of the same sequence?)");
+  return pairs;
+}
+
+}  // namespace
+
+AteResult compute_ate(const Trajectory& est, const Trajectory& gt, const EvalOptions& o) {
+  const Pairs pairs = associated(est, gt, o, "ATE");
+  Eigen::Matrix3Xd src, dst;
+  positions(est, gt, pairs, src, dst);
+  const Eigen::Matrix4d A = alignment(src, dst, o.align);
   AteResult r;
+  r.align = o.align;
+  // A's upper-left block is s R with R a rotation: s is the length of any of its columns.
+  if (o.align == Alignment::sim3) r.scale = A.block<3, 1>(0, 0).norm();
+  const Eigen::Matrix3d R = A.block<3, 3>(0, 0) / r.scale;
   for (int i = 0; i < 3; ++i) {
     r.t[i] = A(i, 3);
-    for (int j = 0; j < 3; ++j) r.R[i][j] = A(i, j);
+    for (int j = 0; j < 3; ++j) r.R[i][j] = R(i, j);
   }
   for (std::size_t k = 0; k < pairs.size(); ++k) {
-    Eigen::Vector3d moved = gt_T_est * src.col(k);
+    const Eigen::Vector3d moved = A.block<3, 3>(0, 0) * src.col(k) + A.block<3, 1>(0, 3);
     r.errors.push_back((moved - dst.col(k)).norm());
-    r.times.push_back(est[pairs[k].first].timestamp);
-    r.aligned.push_back(from_iso(est[pairs[k].first].timestamp, gt_T_est * to_iso(est[pairs[k].first])));
+    const TumPose& e = est[pairs[k].first];
+    r.times.push_back(e.timestamp);
+    // The aligned pose: position moved by the similarity, orientation by its rotation only.
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = R * to_iso(e).linear();
+    T.translation() = moved;
+    r.aligned.push_back(from_iso(e.timestamp, T));
   }
   r.trans = error_stats(r.errors);
   return r;
 }
 
 RpeResult compute_rpe(const Trajectory& est, const Trajectory& gt, double delta, const std::string& unit,
-                      double max_dt) {
+                      const EvalOptions& o) {
   if (unit != "frames" && unit != "seconds") throw Error("RPE delta unit must be 'frames' or 'seconds', not '" + unit + "'");
   if (!(delta > 0)) throw Error("RPE delta must be positive");
-  auto pairs = associate(est, gt, max_dt);
+  const Pairs pairs = associated(est, gt, o, "RPE");
+  double scale = 1.0;
+  if (o.align == Alignment::sim3) {
+    Eigen::Matrix3Xd src, dst;
+    positions(est, gt, pairs, src, dst);
+    scale = alignment(src, dst, Alignment::sim3).block<3, 1>(0, 0).norm();
+  }
+  auto est_pose = [&](std::size_t k) {
+    Eigen::Isometry3d P = to_iso(est[pairs[k].first]);
+    P.translation() *= scale;
+    return P;
+  };
+  const std::size_t n = pairs.size();
   RpeResult r;
-  for (std::size_t a = 0; a < pairs.size(); ++a) {
-    std::size_t b = a;
+  for (std::size_t a = 0; a < n; ++a) {
+    std::size_t b;
     if (unit == "frames") {
       b = a + static_cast<std::size_t>(std::llround(delta));
+      if (b >= n) break;
     } else {
-      double t0 = est[pairs[a].first].timestamp;
-      while (b < pairs.size() && est[pairs[b].first].timestamp - t0 < delta) ++b;
+      // The pose closest in time to t_a + delta (ties to the earlier one); none when that is the
+      // last pose, as in TUM's evaluate_rpe.py.
+      const double target = est[pairs[a].first].timestamp + delta;
+      b = a;
+      while (b + 1 < n && std::fabs(est[pairs[b + 1].first].timestamp - target) <
+                              std::fabs(est[pairs[b].first].timestamp - target))
+        ++b;
+      if (b == n - 1) continue;
     }
-    if (b >= pairs.size()) break;
-    // E = (Q_a^-1 Q_b)^-1 (P_a^-1 P_b): TUM's relative pose error (Sturm et al. 2012, eq. 1).
-    Eigen::Isometry3d Pa = to_iso(est[pairs[a].first]), Pb = to_iso(est[pairs[b].first]);
-    Eigen::Isometry3d Qa = to_iso(gt[pairs[a].second]), Qb = to_iso(gt[pairs[b].second]);
-    Eigen::Isometry3d E = (Qa.inverse() * Qb).inverse() * (Pa.inverse() * Pb);
+    const Eigen::Isometry3d Pa = est_pose(a), Pb = est_pose(b);
+    const Eigen::Isometry3d Qa = to_iso(gt[pairs[a].second]), Qb = to_iso(gt[pairs[b].second]);
+    const Eigen::Isometry3d P = Pa.inverse() * Pb, Q = Qa.inverse() * Qb;
+    // Per frames E = Q^-1 P, the relative pose error of Sturm et al. 2012, eq. 1, as evo computes
+    // it. Per seconds E = P Q^-1, what TUM's evaluate_rpe.py computes (its ominus composition):
+    // the same rotation angle, a translation that differs by about the rotation error times the
+    // distance moved, so the m/s figure is the one TUM's benchmark and papers report.
+    const Eigen::Isometry3d E = unit == "frames" ? Q.inverse() * P : P * Q.inverse();
     r.trans_errors.push_back(E.translation().norm());
     r.rot_errors.push_back(rotation_angle_deg(E.linear()));
     r.times.push_back(est[pairs[a].first].timestamp);
   }
   if (r.trans_errors.empty())
-    throw Error("RPE: no pose pairs " + std::to_string(delta) + " " + unit + " apart among " +
-                std::to_string(pairs.size()) + " associated poses");
+    throw Error("RPE: no pose pairs " + std::to_string(delta) + " " + unit + " apart among " + std::to_string(n) +
+                " associated poses");
   r.trans = error_stats(r.trans_errors);
   r.rot = error_stats(r.rot_errors);
   return r;

@@ -168,14 +168,7 @@ FrameFolderSource::FrameFolderSource(const InputParams& params, bool pinned)
       spdlog::warn("'{}' gives gravity in the poses' world frame, but no frame has a pose: gravity unused", g);
   }
 
-  std::string origin;
-  K_ = resolve_intrinsics(params.intrinsics, folder_, &origin);
-  if (params.intrinsics.preset == "auto" && find_intrinsics_matrix(folder_).empty() &&
-      !fs::exists(fs::path(folder_) / "calibration.txt"))
-    spdlog::warn("frame folder '{}' has no camera-intrinsics.txt or intrinsics.K.txt (nor one above it): using {}; "
-                 "set input.intrinsics for this camera (7-Scenes: preset custom, fx fy 585, cx 320, cy 240)",
-                 folder_, origin);
-  log_intrinsics("frame folder '" + folder_ + "'", K_, origin);
+  K_ = resolve_intrinsics(params.intrinsics, folder_);  // logged, with a warning for the generic set
   spdlog::info("frame folder '{}': {} frames (numbers {}..{}), {} with a pose file{}{}, depth {} units per metre{}, "
                "timestamps number / {} fps",
                folder_, frames_.size(), frames_.front().number, frames_.back().number, with_pose,

@@ -1,5 +1,7 @@
 #include "io/intrinsics_presets.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -7,6 +9,8 @@
 #include <fstream>
 #include <sstream>
 #include <vector>
+
+#include <spdlog/spdlog.h>
 
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -40,43 +44,100 @@ Intrinsics intrinsics_preset(const std::string& name) {
   throw ConfigError("unknown intrinsics preset '" + name + "': use freiburg1, freiburg2, freiburg3, kinect_v1, custom or auto");
 }
 
-Intrinsics resolve_intrinsics(const IntrinsicsParams& p, const std::string& folder, std::string* origin) {
-  Intrinsics K;
-  std::string from;
-  if (p.preset == "custom") {
-    K = make(p.fx, p.fy, p.cx, p.cy);
-    from = "input.intrinsics (custom)";
-  } else if (p.preset == "auto") {
-    namespace fs = std::filesystem;
-    std::string name = folder.empty() ? "" : fs::path(folder).lexically_normal().filename().string();
-    if (name.empty() && !folder.empty()) name = fs::path(folder).lexically_normal().parent_path().filename().string();
-    if (!folder.empty() && fs::exists(fs::path(folder) / "calibration.txt")) {
-      const std::string file = (fs::path(folder) / "calibration.txt").string();
-      if (origin) *origin = "file '" + file + "' (preset auto)";
-      return read_calibration(file);
+std::string camera_in_folder_name(const std::string& name) {
+  std::string s(name.size(), ' ');
+  std::transform(name.begin(), name.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  auto alpha = [](char c) { return c >= 'a' && c <= 'z'; };
+  auto digit = [](char c) { return c >= '0' && c <= '9'; };
+  std::string found;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (i > 0 && alpha(s[i - 1])) continue;  // "fr" must start a word: not the end of "buffr1"
+    for (std::string key : {"freiburg", "fr"}) {
+      if (s.compare(i, key.size(), key) != 0) continue;
+      std::size_t j = i + key.size();
+      if (j < s.size() && (s[j] == '_' || s[j] == '-')) ++j;
+      if (j >= s.size() || s[j] < '1' || s[j] > '3' || (j + 1 < s.size() && digit(s[j + 1]))) continue;
+      std::string camera = std::string("freiburg") + s[j];
+      if (!found.empty() && found != camera) return "";  // names two cameras: cannot tell
+      found = camera;
     }
-    const std::string matrix = folder.empty() ? "" : find_intrinsics_matrix(folder);
-    const char* keys[3][2] = {{"freiburg1", "fr1"}, {"freiburg2", "fr2"}, {"freiburg3", "fr3"}};
-    K = intrinsics_preset("kinect_v1");
-    from = "preset kinect_v1 (auto: no calibration file, no freiburg name)";
-    if (!matrix.empty()) {
-      K = read_intrinsics_matrix(matrix);
-      from = "file '" + matrix + "' (preset auto)";
-    } else {
-      for (int i = 0; i < 3; ++i)
-        if (name.find(keys[i][0]) != std::string::npos || name.find(keys[i][1]) != std::string::npos) {
-          K = intrinsics_preset(keys[i][0]);
-          from = std::string("preset ") + keys[i][0] + " (auto: from the folder's name)";
-        }
-    }
-  } else {
-    K = intrinsics_preset(p.preset);
-    from = "preset " + p.preset;
   }
-  K.width = p.width;
-  K.height = p.height;
-  if (origin) *origin = from;
-  return K;
+  return found;
+}
+
+std::string describe_intrinsics(const Intrinsics& K) {
+  std::ostringstream s;
+  s.precision(7);
+  s << "fx " << K.fx << " fy " << K.fy << " cx " << K.cx << " cy " << K.cy << ", " << K.width << "x" << K.height
+    << ", distortion";
+  bool any = false;
+  for (float d : K.dist) any = any || d != 0.f;
+  if (!any) return s.str() + " none";
+  for (float d : K.dist) s << ' ' << d;
+  return s.str();
+}
+
+IntrinsicsChoice choose_intrinsics(const IntrinsicsParams& p, const std::string& folder) {
+  namespace fs = std::filesystem;
+  IntrinsicsChoice c;
+  if (p.preset == "custom") {
+    c.K = make(p.fx, p.fy, p.cx, p.cy);
+    c.chosen = "custom";
+    c.reason = "input.intrinsics.preset: custom (fx fy cx cy from the config)";
+  } else if (p.preset != "auto") {
+    c.K = intrinsics_preset(p.preset);
+    c.chosen = p.preset;
+    c.reason = "input.intrinsics.preset: " + p.preset;
+  } else if (folder.empty()) {
+    // The synthetic room renders with these intrinsics and a live Kinect v1 without a calibration
+    // delivers about them: for these sources the generic set is the right one, not a guess.
+    c.K = intrinsics_preset("kinect_v1");
+    c.chosen = "kinect_v1";
+    c.reason = "preset auto for a source without a folder";
+  } else {
+    fs::path dir = fs::path(folder).lexically_normal();
+    std::string name = dir.filename().string();
+    if (name.empty()) name = dir.parent_path().filename().string();  // "a/b/" names b
+    const fs::path calibration = fs::path(folder) / "calibration.txt";
+    const std::string named = camera_in_folder_name(name);
+    const std::string matrix = find_intrinsics_matrix(folder);
+    if (fs::exists(calibration)) {
+      c.K = read_calibration(calibration.string());
+      c.chosen = "calibration.txt";
+      c.reason = "preset auto: the folder has " + calibration.string();
+      return c;  // its width and height are the recording's
+    } else if (!matrix.empty()) {
+      c.K = read_intrinsics_matrix(matrix);
+      c.chosen = fs::path(matrix).filename().string();
+      c.reason = "preset auto: the camera matrix in " + matrix;
+    } else if (!named.empty()) {
+      c.chosen = named;
+      c.K = intrinsics_preset(c.chosen);
+      c.reason = "preset auto: the folder name '" + name + "' names " + c.chosen;
+    } else {
+      c.K = intrinsics_preset("kinect_v1");
+      c.chosen = "kinect_v1";
+      c.generic = true;
+      c.reason = "preset auto: the folder name '" + name +
+                 "' names no TUM camera (fr1/fr2/fr3, freiburg1/2/3) and the folder has no calibration.txt, "
+                 "camera-intrinsics.txt or intrinsics.K.txt";
+    }
+  }
+  c.K.width = p.width;
+  c.K.height = p.height;
+  return c;
+}
+
+Intrinsics resolve_intrinsics(const IntrinsicsParams& p, const std::string& folder) {
+  IntrinsicsChoice c = choose_intrinsics(p, folder);
+  if (c.generic)
+    spdlog::warn("intrinsics: {}: USING THE GENERIC KINECT v1 SET ({}), which can be off by several pixels for "
+                 "this camera; set input.intrinsics.preset (freiburg1, freiburg2, freiburg3, kinect_v1 or custom "
+                 "with fx fy cx cy) or put a calibration.txt in the folder",
+                 c.reason, describe_intrinsics(c.K));
+  else if (!folder.empty() || p.preset != "auto")
+    spdlog::info("intrinsics: {} ({}): {}", c.chosen, c.reason, describe_intrinsics(c.K));
+  return c.K;
 }
 
 std::string find_intrinsics_matrix(const std::string& folder) {
@@ -106,11 +167,6 @@ Intrinsics read_intrinsics_matrix(const std::string& path) {
   // A skew below 1e-3 px changes no projection by a thousandth of a pixel across a 640-pixel image.
   if (std::abs(v[1]) > 1e-3) throw bad("a skew of " + std::to_string(v[1]) + " px, which the pinhole model here lacks");
   return make(static_cast<float>(v[0]), static_cast<float>(v[4]), static_cast<float>(v[2]), static_cast<float>(v[5]));
-}
-
-void log_intrinsics(const std::string& what, const Intrinsics& K, const std::string& origin) {
-  spdlog::info("{}: intrinsics fx {} fy {} cx {} cy {}, {}x{}, distortion {} {} {} {} {}, from {}", what, K.fx, K.fy,
-               K.cx, K.cy, K.width, K.height, K.dist[0], K.dist[1], K.dist[2], K.dist[3], K.dist[4], origin);
 }
 
 Intrinsics read_calibration(const std::string& path) {

@@ -12,13 +12,23 @@ struct IntrinsicsParams;
 // "freiburg1", "freiburg2", "freiburg3", "kinect_v1". Throws seamless::Error for another name.
 Intrinsics intrinsics_preset(const std::string& name);
 
-// The preset named by p (or p's fx fy cx cy for "custom"); for "auto" the calibration file
-// `<folder>/calibration.txt` when present (written by record()), else a 3x3 camera matrix in
-// `camera-intrinsics.txt` or `intrinsics.K.txt` (frame folders; looked for in the folder, then in
-// its parent, where 3DMatch and 7-Scenes keep one for all the scene's sequence folders), else the
-// preset whose name the folder's name contains ("freiburg1" or "fr1", ...), else kinect_v1.
-// origin (optional): where the values came from, for the log ("file '...'", "preset kinect_v1 ...").
-Intrinsics resolve_intrinsics(const IntrinsicsParams& p, const std::string& folder = "", std::string* origin = nullptr);
+// What `input.intrinsics` gives for a source reading `folder` (empty for sources without one) and
+// why: `chosen` is the preset's name, "custom" or "calibration.txt"; `generic` is set when preset
+// auto found nothing that tells the camera in a folder and fell back to kinect_v1.
+struct IntrinsicsChoice {
+  Intrinsics K;
+  std::string chosen, reason;
+  bool generic = false;
+};
+// preset auto: `<folder>/calibration.txt` when present (written by record()), else a 3x3 camera
+// matrix in `camera-intrinsics.txt` or `intrinsics.K.txt` (frame folders; looked for in the folder,
+// then in its parent, where 3DMatch and 7-Scenes keep one for all of a scene's sequence folders),
+// else the preset the folder's name names (camera_in_folder_name), else kinect_v1 (generic).
+IntrinsicsChoice choose_intrinsics(const IntrinsicsParams& p, const std::string& folder = "");
+
+// choose_intrinsics(p, folder).K, logged: which values, from where and why; a warning when a
+// folder got the generic set.
+Intrinsics resolve_intrinsics(const IntrinsicsParams& p, const std::string& folder = "");
 
 // The file names of a 3x3 camera matrix the auto preset looks for (in this order).
 inline constexpr const char* kIntrinsicsMatrixFiles[] = {"camera-intrinsics.txt", "intrinsics.K.txt"};
@@ -26,13 +36,19 @@ inline constexpr const char* kIntrinsicsMatrixFiles[] = {"camera-intrinsics.txt"
 std::string find_intrinsics_matrix(const std::string& folder);
 
 // A 3x3 camera matrix K = [fx s cx; 0 fy cy; 0 0 1], nine numbers (whitespace or commas between
-// them, '#' comments). Throws an Error naming the file for another count, a bottom row that is not
-// 0 0 1, a non-zero second-row first entry, non-positive focal lengths or a skew s (the kernels' pinhole
-// has none). width and height are left at their defaults (the file does not say).
+// them, '#' comments). Throws an InputError naming the file for another count, a bottom row that
+// is not 0 0 1, a non-zero second-row first entry, non-positive focal lengths or a skew s (the
+// kernels' pinhole has none). width and height are left at their defaults (the file does not say).
 Intrinsics read_intrinsics_matrix(const std::string& path);
 
-// One info line: what intrinsics `what` uses, and where they came from.
-void log_intrinsics(const std::string& what, const Intrinsics& K, const std::string& origin);
+// The TUM camera a folder name names: "freiburg1" for "rgbd_dataset_freiburg1_desk" or
+// "tum_fr1_rpy" (freiburg or fr, an optional _ or -, then 1, 2 or 3 and no further digit, at the
+// start of a word); "" when it names none or two different ones. scripts/compare_trackers applies
+// the same rule.
+std::string camera_in_folder_name(const std::string& name);
+
+// "fx 517.3 fy 516.5 cx 318.6 cy 255.3, 640x480, distortion 0.2624 ..." for logs.
+std::string describe_intrinsics(const Intrinsics& K);
 
 // calibration.txt: one line `fx fy cx cy width height d0 d1 d2 d3 d4` (after '#' comments).
 Intrinsics read_calibration(const std::string& path);

@@ -178,8 +178,7 @@ TumSource::TumSource(const InputParams& params, bool pinned) : params_(params), 
   if (folder_.empty()) throw InputError("input.path is empty: set it to a TUM RGB-D folder (source: tum)");
   if (!fs::is_directory(folder_))
     throw InputError("input.path '" + folder_ + "' is not a folder: download one with datasets/download_tum.sh");
-  std::string origin;
-  K_ = resolve_intrinsics(params.intrinsics, folder_, &origin);
+  K_ = resolve_intrinsics(params.intrinsics, folder_);
   fs::path dir(folder_);
   pairs_ = tum_folder_pairs(folder_, params);
   if (pairs_.empty())
@@ -194,7 +193,6 @@ TumSource::TumSource(const InputParams& params, bool pinned) : params_(params), 
   if (fs::exists(dir / "groundtruth.txt")) groundtruth_ = read_tum_trajectory((dir / "groundtruth.txt").string());
   if (fs::exists(dir / "accelerometer.txt")) accel_ = read_accelerometer((dir / "accelerometer.txt").string());
   scale_check_ = std::make_unique<DepthScaleCheck>(effective_depth_scale(params), params.check_depth_scale);
-  log_intrinsics("TUM folder '" + folder_ + "'", K_, origin);
 }
 
 TumSource::~TumSource() = default;

@@ -172,13 +172,41 @@ class Cli(unittest.TestCase):
             seamless("track", os.path.join(SRC, "configs", "tum_fr1.yaml"), "--device", "cpu", "--out", out,
                      "--set", f"input.path={room}", "--set", "input.intrinsics.preset=auto",
                      "--set", "tracker.mode=frame_to_frame", "--set", "refine.enabled=false")
-            r = seamless("eval", os.path.join(out, "trajectory.txt"), os.path.join(room, "groundtruth.txt"),
+            # Ground truth first (evo's and TUM's order).
+            r = seamless("eval", os.path.join(room, "groundtruth.txt"), os.path.join(out, "trajectory.txt"),
                          "--json", os.path.join(d, "ate.json"))
             with open(os.path.join(d, "ate.json")) as f:
                 ate = json.load(f)
             self.assertEqual(ate["pairs"], 4)
             # Noise-on synthetic frames, 4 frames of slow motion: frame-to-frame ICP stays within 1 cm.
             self.assertLess(ate["ate_rmse_m"], 0.01)
+
+    def test_eval_json_escapes_names_and_warns_on_swapped_files(self):
+        # Issue 23: the JSON holds the paths as given, whatever characters they have (it was
+        # built by string concatenation), and files in the old order (estimate first) get a warning.
+        with tempfile.TemporaryDirectory() as d:
+            odd = os.path.join(d, 'run "a"\\b\nc')
+            os.makedirs(odd)
+            gt, est = os.path.join(odd, "groundtruth.txt"), os.path.join(odd, "trajectory.txt")
+            with open(gt, "w") as g, open(est, "w") as e:
+                for i in range(25):  # 0.8 s at 30 Hz
+                    t = 1000 + i / 30
+                    g.write(f"{t:.6f} {0.01 * i} 0 0 0 0 0 1\n")
+                    e.write(f"{t:.6f} {0.01 * i} 0.001 0 0 0 0 1\n")
+            out = os.path.join(odd, "eval.json")
+            r = seamless("eval", gt, est, "--json", out)
+            self.assertNotIn("GROUND TRUTH FIRST", r.stderr + r.stdout)
+            with open(out) as f:
+                doc = json.load(f)
+            self.assertEqual(doc["groundtruth"], gt)
+            self.assertEqual(doc["estimate"], est)
+            self.assertEqual(doc["schema"], "seamless-eval/1")
+            self.assertEqual(doc["pairs"], 25)
+            self.assertLess(doc["ate_rmse_m"], 1e-9)  # a constant 1 mm offset: the alignment removes it
+            self.assertIsNone(doc["rpe_second_trans_rmse_m"])  # 0.8 s: no RPE over 1 s
+            self.assertEqual(doc["rpe_frame_pairs"], 24)
+            r = seamless("eval", est, gt)
+            self.assertIn("GROUND TRUTH FIRST", r.stderr + r.stdout)
 
 
 if __name__ == "__main__":

@@ -99,4 +99,101 @@ TEST(Associate, MatchesWithinToleranceOnly) {
   EXPECT_THROW(compute_ate(est, gt), Error);  // only 2 pairs
 }
 
+TEST(Ate, Sim3RecoversTheScaleOfAScaledCopy) {
+  // est = (1/s) * (rotated, moved gt): a monocular estimate in the wrong unit. Sim(3) alignment
+  // recovers s and leaves no error (double rounding only); SE(3) cannot absorb the scale.
+  Trajectory gt = wiggle(200), est;
+  const double s = 1.25, c = std::cos(0.3), sn = std::sin(0.3);
+  for (const TumPose& p : gt) {
+    TumPose e = p;
+    e.t[0] = (c * p.t[0] - sn * p.t[1] + 0.5) / s;
+    e.t[1] = (sn * p.t[0] + c * p.t[1] - 1.0) / s;
+    e.t[2] = (p.t[2] + 2.0) / s;
+    est.push_back(e);
+  }
+  EvalOptions o;
+  o.align = Alignment::sim3;
+  AteResult r = compute_ate(est, gt, o);
+  EXPECT_NEAR(r.scale, s, 1e-9);
+  EXPECT_LT(r.trans.rmse, 1e-9);
+  o.align = Alignment::se3;
+  EXPECT_GT(compute_ate(est, gt, o).trans.rmse, 0.05);  // the path spans metres: 20% off is centimetres at least
+  EXPECT_EQ(compute_ate(est, gt, o).scale, 1.0);
+}
+
+TEST(Ate, NoAlignmentKeepsAConstantOffset) {
+  // Every estimated position 3 cm, 4 cm off (5 cm): without alignment every error is 5 cm; the
+  // rigid alignment takes the offset away entirely.
+  Trajectory gt = wiggle(100), est = gt;
+  for (TumPose& p : est) p.t[0] += 0.03, p.t[2] -= 0.04;
+  EvalOptions o;
+  o.align = Alignment::none;
+  AteResult r = compute_ate(est, gt, o);
+  EXPECT_NEAR(r.trans.rmse, 0.05, 1e-12);
+  EXPECT_NEAR(r.trans.min, 0.05, 1e-12);
+  EXPECT_NEAR(r.aligned[7].t[0], est[7].t[0], 0.0);  // not moved
+  o.align = Alignment::se3;
+  EXPECT_LT(compute_ate(est, gt, o).trans.rmse, 1e-9);
+  EXPECT_THROW(parse_alignment("affine"), Error);
+}
+
+TEST(Associate, OffsetIsAddedToTheEstimatesTimestamps) {
+  // The estimate's clock runs 0.5 s ahead: with offset -0.5 every pose meets its ground truth.
+  Trajectory gt = wiggle(60), est = gt;
+  for (TumPose& p : est) p.timestamp += 0.5;
+  EvalOptions o;
+  EXPECT_EQ(associate(est, gt, o.t_max_diff, -0.5).size(), 60u);
+  o.offset = -0.5;
+  AteResult r = compute_ate(est, gt, o);
+  EXPECT_EQ(r.trans.count, 60u);
+  EXPECT_LT(r.trans.rmse, 1e-9);
+  // Without it the poses pair with those 15 frames later (0.5 s at 30 Hz): a wrong answer, not 0.
+  EXPECT_GT(compute_ate(est, gt).trans.rmse, 0.01);
+}
+
+TEST(Associate, TMaxDiffBoundsThePairs) {
+  // Estimates 15 ms after each ground-truth sample: TUM's 0.02 s pairs them all, evo's 0.01 none.
+  Trajectory gt = wiggle(30), est = gt;
+  for (TumPose& p : est) p.timestamp += 0.015;
+  EXPECT_EQ(associate(est, gt, 0.02).size(), 30u);
+  EXPECT_TRUE(associate(est, gt, 0.01).empty());
+  EvalOptions o;
+  o.t_max_diff = 0.01;
+  EXPECT_THROW(compute_ate(est, gt, o), Error);
+}
+
+TEST(Rpe, OneSecondFollowsTumsPairing) {
+  // 90 poses at 30 Hz, 1 m/s along x, the estimate 2% too fast. TUM's evaluate_rpe.py pairs each
+  // pose i with the pose closest to t_i + 1 s (i + 30) unless that is the last pose (89): i = 0..58,
+  // 59 pairs, each 2 cm off over its second: 0.02 m/s.
+  Trajectory gt, est;
+  for (int i = 0; i < 90; ++i) {
+    double t = 1000.0 + i / 30.0;
+    gt.push_back(pose(t, i / 30.0, 0, 0));
+    est.push_back(pose(t, 1.02 * i / 30.0, 0, 0));
+  }
+  RpeResult s = compute_rpe(est, gt, 1.0, "seconds", EvalOptions{});
+  EXPECT_EQ(s.trans.count, 59u);
+  EXPECT_NEAR(s.trans.rmse, 0.02, 1e-9);
+  EXPECT_NEAR(s.trans.max, 0.02, 1e-9);
+  EXPECT_NEAR(s.rot.max, 0.0, 1e-9);
+  // Sim(3) takes the 2% away (evo_rpe -as): the scaled estimate moves exactly like the truth.
+  EvalOptions o;
+  o.align = Alignment::sim3;
+  EXPECT_LT(compute_rpe(est, gt, 1.0, "seconds", o).trans.max, 1e-9);
+  // Per frame every pair (i, i+1) counts, the last one included (evo's pairing): 89 pairs.
+  EXPECT_EQ(compute_rpe(est, gt, 1, "frames", EvalOptions{}).trans.count, 89u);
+}
+
+TEST(Rpe, SmallRotationAnglesKeepTheirDigits) {
+  // 1e-6 degree of yaw per frame: acos of the trace alone would return 0 or ~1e-6 +- 100%.
+  Trajectory gt, est;
+  const double step = 1e-6 * M_PI / 180;
+  for (int i = 0; i < 10; ++i) {
+    gt.push_back(pose(i / 30.0, 0, 0, 0));
+    est.push_back(pose(i / 30.0, 0, 0, 0, i * step));
+  }
+  EXPECT_NEAR(compute_rpe(est, gt, 1, "frames").rot.mean, 1e-6, 1e-12);
+}
+
 }  // namespace

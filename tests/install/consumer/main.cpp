@@ -1,0 +1,56 @@
+// Uses each exported library of an installed seamless once, against known answers; exits 0 when
+// all hold. Built by tests/install/install_test.py against `cmake --install`'s prefix.
+#include <cmath>
+#include <cstdio>
+
+#include "core/buffer.hpp"
+#include "core/exec.hpp"
+#include "core/json.hpp"
+#include "eval/trajectory_eval.hpp"
+#include "io/intrinsics_presets.hpp"
+#include "kernels/recon/preprocess.hpp"
+#include "seamless/build_config.hpp"
+
+using namespace seamless;
+
+int main() {
+  int failures = 0;
+  auto check = [&](bool ok, const char* what) {
+    std::printf("%s: %s\n", ok ? "ok" : "FAILED", what);
+    failures += !ok;
+  };
+  // io: TUM's published freiburg1 calibration.
+  const Intrinsics K = intrinsics_preset("freiburg1");
+  check(K.fx == 517.3f && K.cy == 255.3f, "io: intrinsics_preset(freiburg1)");
+
+  // kernels + core: a wall 2 m away back-projects to z = 2, and the pixel at the principal
+  // point's column and row lies on the optical axis.
+  Image<float> depth = Image<float>::from_host(std::vector<float>(64 * 48, 2.0f), 64, 48, Device::CPU);
+  Image<vec3> vertices(64, 48, Device::CPU);
+  Intrinsics small = K;
+  small.cx = 32, small.cy = 24;
+  with_exec(Device::CPU, [&](const auto& ex) { kernels::depth_to_vertices(ex, depth.cview(), small, vertices.view()); });
+  const vec3 v = vertices.to_host()[24 * 64 + 32];
+  check(v.z == 2.0f && std::fabs(v.x) < 1e-6f && std::fabs(v.y) < 1e-6f, "kernels: depth_to_vertices on the CPU");
+
+  // eval: a trajectory moved 5 cm along x has no ATE after SE(3) alignment and 5 cm without.
+  Trajectory gt, est;
+  for (int i = 0; i < 10; ++i) {
+    TumPose p;
+    p.timestamp = i / 30.0;
+    p.t[0] = std::sin(i * 0.3), p.t[1] = 0.1 * i, p.t[2] = std::cos(i * 0.2);
+    gt.push_back(p);
+    p.t[0] += 0.05;
+    est.push_back(p);
+  }
+  EvalOptions none;
+  none.align = Alignment::none;
+  check(compute_ate(est, gt).trans.rmse < 1e-9 && std::fabs(compute_ate(est, gt, none).trans.rmse - 0.05) < 1e-12,
+        "eval: compute_ate");
+
+  // core: JSON with a name that needs escaping.
+  JsonWriter w(0);
+  w.begin_object().field("version", SEAMLESS_VERSION).field("name", "a \"b\"").end_object();
+  check(w.str() == std::string("{\"version\":\"") + SEAMLESS_VERSION + "\",\"name\":\"a \\\"b\\\"\"}\n", "core: JsonWriter");
+  return failures == 0 ? 0 : 1;
+}
