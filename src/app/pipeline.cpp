@@ -14,6 +14,7 @@
 #include "app/placement.hpp"
 #include "io/intrinsics_presets.hpp"
 #include "app/render_stage.hpp"
+#include "app/run_summary.hpp"
 #include "physics/builders.hpp"
 #include "physics/particle_solver.hpp"
 #include "recon/ply.hpp"
@@ -100,28 +101,33 @@ namespace {
 // key G can take the next one early without it being spawned twice.
 class SpawnQueue {
  public:
-  SpawnQueue(const std::vector<SpawnParams>& spawns, const SolverParams& p) : pending_(spawns.begin(), spawns.end()) {
+  SpawnQueue(const std::vector<SpawnParams>& spawns, const SolverParams& p) {
     check_spawn_capacity(spawns, p);  // the whole list fits, or an Error naming the entry
+    for (int i = 0; i < static_cast<int>(spawns.size()); ++i) pending_.push_back({i, spawns[i]});
   }
   // Before the step that starts at `time` (seconds). `ready`, if given, may hold an entry back
   // (live mode: its placement needs a surface not scanned yet); it is tried again next time.
-  void due(ParticleSolver& solver, double time, const std::function<bool(SpawnParams&)>& ready = {}) {
+  void due(ParticleSolver& solver, double time, const std::function<bool(int, SpawnParams&)>& ready = {}) {
     for (auto it = pending_.begin(); it != pending_.end();)
-      if (it->time <= time + 1e-9 && (!ready || ready(*it))) solver.spawn(*it), it = pending_.erase(it);
+      if (it->s.time <= time + 1e-9 && (!ready || ready(it->index, it->s))) solver.spawn(it->s), it = pending_.erase(it);
       else ++it;
   }
   std::size_t pending() const { return pending_.size(); }
   void next_now(ParticleSolver& solver) {
     if (pending_.empty()) return spdlog::info("spawn: every configured object is spawned already");
     auto it = std::min_element(pending_.begin(), pending_.end(),
-                               [](const SpawnParams& a, const SpawnParams& b) { return a.time < b.time; });
-    spdlog::info("spawn: {} (configured for t = {:.2f} s) now", it->kind, it->time);
-    solver.spawn(*it);
+                               [](const Pending& a, const Pending& b) { return a.s.time < b.s.time; });
+    spdlog::info("spawn: {} (configured for t = {:.2f} s) now", it->s.kind, it->s.time);
+    solver.spawn(it->s);
     pending_.erase(it);
   }
 
  private:
-  std::vector<SpawnParams> pending_;
+  struct Pending {
+    int index;  // in the experiment's spawn list
+    SpawnParams s;
+  };
+  std::vector<Pending> pending_;
 };
 
 // The input frames of a replay in output order, each with its tracked pose and its time since the
@@ -327,7 +333,8 @@ class LiveLoop : public FrameLoop {
       // otherwise one step a frame, as the dissertation's live loop.
       const double target = e_.render.camera == "recorded" ? frame_.timestamp - *t0_ : time_ + 0.5 * e_.solver.dt;
       while (time_ + 0.5 * e_.solver.dt <= target) {
-        queue_.due(solver_, time_, [&](SpawnParams& sp) { return place_live(sp, rec.result.world_T_camera); });
+        queue_.due(solver_, time_,
+                   [&](int i, SpawnParams& sp) { return place_live(i, sp, rec.result.world_T_camera); });
         solver_.step();
         time_ += e_.solver.dt;
       }
@@ -377,7 +384,9 @@ class LiveLoop : public FrameLoop {
                  records_.size(), session_.lost_frames(), ctx_.timer().median_ms("track"),
                  ctx_.timer().median_ms("physics"), ctx_.timer().median_ms("extract"));
     log_volume(volume_->stats());
-    if (e_.output.write_mesh) write_ply(ctx_.out_path("mesh.ply"), volume_->extract_mesh());
+    const Mesh mesh = volume_->extract_mesh();
+    if (e_.output.write_mesh) write_ply(ctx_.out_path("mesh.ply"), mesh);
+    write_live_summary(mesh);
   }
 
  private:
@@ -390,9 +399,37 @@ class LiveLoop : public FrameLoop {
     solver_.add_static_particles(points_);
   }
 
+  // summary.json of a live run: as scan_then_simulate's, with the scene as it was at the end.
+  void write_live_summary(const Mesh& mesh) {
+    RunSummary sum;
+    sum.command = "run (live)", sum.config = e_.name, sum.device = device_name(ctx_.device());
+    sum.intrinsics = source_->intrinsics();
+    sum.frames_read = static_cast<std::int64_t>(records_.size());
+    sum.frames_lost = session_.lost_frames();
+    sum.frames_unreadable = source_->skipped_frames();
+    for (const FrameRecord& r : records_) sum.frames_fused += r.fused;
+    const vec3 up = -normalize(e_.solver.gravity);
+    std::vector<vec3> cameras;
+    for (const TumPose& p : poses_) cameras.push_back(p.se3().t);
+    sum.surfaces = find_horizontal_surfaces(mesh, up, cameras);
+    SceneBounds b;
+    b.up = up;
+    if (const HorizontalSurface* f = find_floor(sum.surfaces)) b.floor = sum.floor_height = f->height;
+    if (!mesh.positions.empty()) {
+      b.lo = b.hi = mesh.positions[0];
+      for (vec3 p : mesh.positions) b.lo = vmin(b.lo, p), b.hi = vmax(b.hi, p);
+    }
+    sum.placements = placements_;
+    sum.spawns = spawns_;
+    sum.physics = solver_.stats();
+    sum.escaped = count_escaped(solver_.download_state(), b, e_.solver.particle_diameter);
+    add_stage_medians(sum, ctx_.timer());
+    write_summary(ctx_.out_path("summary.json"), sum);
+  }
+
   // A due entry with `place`: resolved against the surface scanned so far. Not yet possible (no
   // such surface, or it would start inside the scan): held back until the next re-extraction.
-  bool place_live(SpawnParams& sp, const SE3& pose) {
+  bool place_live(int i, SpawnParams& sp, const SE3& pose) {
     if (!sp.place.active()) return true;
     if (tried_at_ == fused_) return false;  // nothing new since the last try
     tried_at_ = fused_;
@@ -405,14 +442,15 @@ class LiveLoop : public FrameLoop {
     ps.volume = volume_.get();
     ps.trajectory = &poses_;
     ps.K = source_->intrinsics();
-    std::vector<SpawnParams> one{sp};
+    SpawnParams trial = sp;
     try {
-      resolve_placements(one, e_.solver, ps);
+      placements_.push_back(resolve_placement(i, trial, e_.solver, ps));
     } catch (const Error& err) {
       spdlog::debug("live: placement not possible yet: {}", err.what());
       return false;
     }
-    sp.position = one[0].position;
+    sp.position = trial.position;
+    spawns_[i].position = trial.position;
     return true;
   }
 
@@ -435,6 +473,8 @@ class LiveLoop : public FrameLoop {
   std::optional<double> t0_;  // timestamp of the first fused frame
   std::vector<vec3> points_;  // the scene particles of the last extraction
   Trajectory poses_;          // tracked so far (pixel placements)
+  std::vector<SpawnParams> spawns_ = e_.spawn;       // with the live placements resolved
+  std::vector<ResolvedPlacement> placements_;
   bool finished_ = false;
 };
 

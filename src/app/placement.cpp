@@ -138,40 +138,41 @@ std::string describe_surfaces(const std::vector<HorizontalSurface>& surfaces) {
   return out;
 }
 
+ResolvedPlacement resolve_placement(int i, SpawnParams& s, const SolverParams& solver, const PlacementScene& scene) {
+  ResolvedPlacement r;
+  r.spawn = i;
+  if (!s.place.pixel.empty()) {
+    r.surface_point = pixel_point(i, s, scene);
+    r.how = "pixel (" + std::to_string(s.place.pixel[0]) + ", " + std::to_string(s.place.pixel[1]) + ") of frame " +
+            std::to_string(s.place.frame);
+  } else {
+    const HorizontalSurface& f = surface_pick(i, s, scene);
+    r.surface_point = s.place.offset.empty() ? f.centre : offset_point(i, s, f, scene.up);
+    r.how = "on " + s.place.on + (s.place.on == "support" ? " " + std::to_string(s.place.index) : "") + ": " +
+            describe(f);
+  }
+  r.position = r.surface_point + normalize(scene.up) * s.place.above;
+  s.position = r.position;
+  if (scene.scene_points && !scene.scene_points->empty()) {
+    const auto [inside, total] = overlap(s, solver, *scene.scene_points);
+    // A few particles of a sheet or block may graze the scan's noisy surface (each one is pushed
+    // out by its contact); a tenth inside means the entry starts in a wall or under the surface.
+    if (inside * 10 > total)
+      throw Error(entry_name(i, s) + ".place (" + r.how + ", " + std::to_string(s.place.above) + " m above) puts " +
+                  std::to_string(inside) + " of its " + std::to_string(total) +
+                  " particles inside the scanned geometry at " + fmt_vec(r.position) + ": raise `above`");
+  }
+  spdlog::info("place: {} at {} ({}, {:.2f} m above {})", entry_name(i, s), fmt_vec(r.position), r.how, s.place.above,
+               fmt_vec(r.surface_point));
+  return r;
+}
+
 std::vector<ResolvedPlacement> resolve_placements(std::vector<SpawnParams>& spawns, const SolverParams& solver,
                                                   const PlacementScene& scene) {
   check_placements(spawns);
   std::vector<ResolvedPlacement> out;
-  for (int i = 0; i < static_cast<int>(spawns.size()); ++i) {
-    SpawnParams& s = spawns[i];
-    if (!s.place.active()) continue;
-    ResolvedPlacement r;
-    r.spawn = i;
-    if (!s.place.pixel.empty()) {
-      r.surface_point = pixel_point(i, s, scene);
-      r.how = "pixel (" + std::to_string(s.place.pixel[0]) + ", " + std::to_string(s.place.pixel[1]) + ") of frame " +
-              std::to_string(s.place.frame);
-    } else {
-      const HorizontalSurface& f = surface_pick(i, s, scene);
-      r.surface_point = s.place.offset.empty() ? f.centre : offset_point(i, s, f, scene.up);
-      r.how = "on " + s.place.on + (s.place.on == "support" ? " " + std::to_string(s.place.index) : "") + ": " +
-              describe(f);
-    }
-    r.position = r.surface_point + normalize(scene.up) * s.place.above;
-    s.position = r.position;
-    if (scene.scene_points && !scene.scene_points->empty()) {
-      const auto [inside, total] = overlap(s, solver, *scene.scene_points);
-      // A few particles of a sheet or block may graze the scan's noisy surface (each one is pushed
-      // out by its contact); a tenth inside means the entry starts in a wall or under the surface.
-      if (inside * 10 > total)
-        throw Error(entry_name(i, s) + ".place (" + r.how + ", " + std::to_string(s.place.above) +
-                    " m above) puts " + std::to_string(inside) + " of its " + std::to_string(total) +
-                    " particles inside the scanned geometry at " + fmt_vec(r.position) + ": raise `above`");
-    }
-    spdlog::info("place: {} at {} ({}, {:.2f} m above {})", entry_name(i, s), fmt_vec(r.position), r.how,
-                 s.place.above, fmt_vec(r.surface_point));
-    out.push_back(r);
-  }
+  for (int i = 0; i < static_cast<int>(spawns.size()); ++i)
+    if (spawns[i].place.active()) out.push_back(resolve_placement(i, spawns[i], solver, scene));
   return out;
 }
 

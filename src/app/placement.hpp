@@ -40,6 +40,9 @@ struct ResolvedPlacement {
   vec3 position{0, 0, 0};
 };
 
+// Resolves entry i (which has an active place) into its position; throws as resolve_placements.
+ResolvedPlacement resolve_placement(int i, SpawnParams& s, const SolverParams& solver, const PlacementScene& scene);
+
 // Resolves every entry with an active place into its position (and leaves the others alone).
 // Throws seamless::Error saying what was seen when a placement hits nothing, finds no such surface
 // or would start the entry inside the scanned geometry.
