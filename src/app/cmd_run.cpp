@@ -144,14 +144,9 @@ int run(const CommonOptions& o) {
   std::optional<kernels::SceneSdf> floor = floor_plane(floor_surface, ps.up);
   if (floor) spdlog::info("floor plane at height {:.3f} m along -gravity", floor->prims[0].b.x);
   else if (e.floor_plane) spdlog::info("no floor plane: the scan shows no floor");
-  SceneBounds bounds;
-  bounds.up = ps.up;
-  if (floor_surface) bounds.floor = summary.floor_height = floor_surface->height;
+  const SceneBounds bounds = scene_bounds(scan_result.mesh, ps.up, floor_surface);
+  summary.floor_height = bounds.floor;
   summary.surfaces = ps.surfaces;
-  if (!scan_result.mesh.positions.empty()) {
-    bounds.lo = bounds.hi = scan_result.mesh.positions[0];
-    for (vec3 p : scan_result.mesh.positions) bounds.lo = vmin(bounds.lo, p), bounds.hi = vmax(bounds.hi, p);
-  }
   if (grid) points.clear();  // collide with the TSDF instead of scene particles
   Replay replay{&traj, e.render.replay_start};
   const bool replaying = e.render.camera == "recorded" && renderer;

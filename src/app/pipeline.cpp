@@ -412,13 +412,8 @@ class LiveLoop : public FrameLoop {
     std::vector<vec3> cameras;
     for (const TumPose& p : poses_) cameras.push_back(p.se3().t);
     sum.surfaces = find_horizontal_surfaces(mesh, up, cameras);
-    SceneBounds b;
-    b.up = up;
-    if (const HorizontalSurface* f = find_floor(sum.surfaces)) b.floor = sum.floor_height = f->height;
-    if (!mesh.positions.empty()) {
-      b.lo = b.hi = mesh.positions[0];
-      for (vec3 p : mesh.positions) b.lo = vmin(b.lo, p), b.hi = vmax(b.hi, p);
-    }
+    const SceneBounds b = scene_bounds(mesh, up, find_floor(sum.surfaces));
+    sum.floor_height = b.floor;
     sum.placements = placements_;
     sum.spawns = spawns_;
     sum.physics = solver_.stats();

@@ -14,6 +14,17 @@
 
 namespace seamless::app {
 
+SceneBounds scene_bounds(const Mesh& mesh, vec3 up, const HorizontalSurface* floor) {
+  SceneBounds b;
+  b.up = up;
+  if (floor) b.floor = floor->height;
+  if (!mesh.positions.empty()) {
+    b.lo = b.hi = mesh.positions[0];
+    for (vec3 p : mesh.positions) b.lo = vmin(b.lo, p), b.hi = vmax(b.hi, p);
+  }
+  return b;
+}
+
 EscapedParticles count_escaped(const ParticleState& s, const SceneBounds& b, float diameter) {
   EscapedParticles e;
   const float margin = 2.f * diameter;

@@ -25,6 +25,8 @@ struct SceneBounds {
   std::optional<float> floor;     // floor height along up, when the floor was seen
   vec3 up{0, 1, 0};
 };
+// The scanned mesh's bounds, `up`, and the floor's height when `floor` is not null.
+SceneBounds scene_bounds(const Mesh& mesh, vec3 up, const HorizontalSurface* floor);
 constexpr float kFallSpeed = 0.5f;  // m/s: free fall reaches it in 0.05 s (12 mm of drop)
 EscapedParticles count_escaped(const ParticleState& s, const SceneBounds& b, float diameter);
 
