@@ -282,9 +282,12 @@ SimulationResult simulate(RunContext& ctx, const std::vector<vec3>& scene_partic
     while (loop.advance()) {
     }
   loop.finish();
-  if (!loop.complete())
+  if (!loop.complete() && replay)
     spdlog::warn("stopped after {} steps (window closed or interrupted): the outputs hold the state reached",
                  loop.done_steps());
+  else if (!loop.complete())
+    spdlog::warn("stopped after {} of {} steps (window closed or interrupted): the outputs hold the state reached",
+                 loop.done_steps(), loop.steps());
   if (renderer) renderer->finish();
   SimulationResult result{solver.download_state(), solver.stats()};
   write_particles_ply(ctx.out_path("particles.ply"), result.state);

@@ -35,7 +35,10 @@ class VirtualDisplay {
       const std::string name = ":" + std::to_string(n);
       pid_ = fork();
       if (pid_ == 0) {
-        execlp("Xvfb", "Xvfb", name.c_str(), "-screen", "0", "320x240x24", "-nolisten", "tcp", static_cast<char*>(nullptr));
+        // -noreset: Xvfb otherwise resets when its last client leaves (window_available() connects and
+        // disconnects), and the next connection can land in the reset and fail.
+        execlp("Xvfb", "Xvfb", name.c_str(), "-screen", "0", "320x240x24", "-nolisten", "tcp", "-noreset",
+               static_cast<char*>(nullptr));
         _exit(127);  // not installed
       }
       int status = 0;
