@@ -381,7 +381,8 @@ class LiveLoop : public FrameLoop {
     if (renderer_) renderer_->finish();
     if (e_.output.write_stats) write_tracking_stats(ctx_.out_path("tracking_stats.csv"), records_);
     ctx_.report_tracking(static_cast<std::int64_t>(records_.size()), session_.lost_frames());
-    write_particles_ply(ctx_.out_path("particles.ply"), solver_.download_state());
+    const ParticleState state = solver_.download_state();  // one download for the file and the summary
+    write_particles_ply(ctx_.out_path("particles.ply"), state);
     write_run_objects(ctx_.out_path("objects.txt"), collect_run_objects(solver_, e_.spawn));  // for `seamless render`
     spdlog::info("live: {} frames ({} lost), median track {:.3f} ms, physics {:.3f} ms, extraction {:.3f} ms",
                  records_.size(), session_.lost_frames(), ctx_.timer().median_ms("track"),
@@ -389,7 +390,7 @@ class LiveLoop : public FrameLoop {
     log_volume(volume_->stats());
     const Mesh mesh = volume_->extract_mesh();
     if (e_.output.write_mesh) write_ply(ctx_.out_path("mesh.ply"), mesh);
-    write_live_summary(mesh);
+    write_live_summary(mesh, state);
   }
 
  private:
@@ -403,7 +404,7 @@ class LiveLoop : public FrameLoop {
   }
 
   // summary.json of a live run: as scan_then_simulate's, with the scene as it was at the end.
-  void write_live_summary(const Mesh& mesh) {
+  void write_live_summary(const Mesh& mesh, const ParticleState& state) {
     RunSummary sum;
     sum.command = "run (live)", sum.config = e_.name, sum.device = device_name(ctx_.device());
     sum.intrinsics = source_->intrinsics();
@@ -420,7 +421,7 @@ class LiveLoop : public FrameLoop {
     sum.placements = placements_;
     sum.spawns = spawns_;
     sum.physics = solver_.stats();
-    sum.escaped = count_escaped(solver_.download_state(), b, e_.solver.particle_diameter);
+    sum.escaped = count_escaped(state, b, e_.solver.particle_diameter);
     add_stage_medians(sum, ctx_.timer());
     write_summary(ctx_.out_path("summary.json"), sum);
   }

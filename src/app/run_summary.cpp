@@ -1,13 +1,11 @@
 #include "app/run_summary.hpp"
 
 #include <cmath>
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <set>
-#include <sstream>
 
 #include "core/error.hpp"
+#include "core/json.hpp"
+#include "core/output_file.hpp"
 #include "eval/trajectory_eval.hpp"
 #include "seamless/build_config.hpp"
 #include "seamless/git_commit.hpp"
@@ -63,89 +61,62 @@ void add_stage_medians(RunSummary& s, const StageTimer& t) {
 }
 
 namespace {
-
-// A minimal JSON writer: objects and arrays by hand, strings escaped (RFC 8259 section 7).
-std::string quote(const std::string& v) {
-  std::string out = "\"";
-  for (unsigned char c : v) {
-    if (c == '"' || c == '\\') out += '\\', out += static_cast<char>(c);
-    else if (c == '\n') out += "\\n";
-    else if (c == '\t') out += "\\t";
-    else if (c < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else out += static_cast<char>(c);
-  }
-  return out + "\"";
-}
-std::string num(double v) {
-  if (!std::isfinite(v)) return "null";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
-std::string vec(vec3 v) { return "[" + num(v.x) + ", " + num(v.y) + ", " + num(v.z) + "]"; }
-
+void vec_value(JsonWriter& j, vec3 v) { j.begin_array().value(v.x).value(v.y).value(v.z).end_array(); }
 }  // namespace
 
 void write_summary(const std::string& path, const RunSummary& s) {
-  std::ostringstream j;
-  j << "{\n  \"seamless_version\": " << quote(SEAMLESS_VERSION) << ",\n  \"commit\": " << quote(SEAMLESS_GIT_COMMIT)
-    << ",\n  \"command\": " << quote(s.command) << ",\n  \"config\": " << quote(s.config)
-    << ",\n  \"device\": " << quote(s.device) << ",\n";
+  JsonWriter j;
+  j.begin_object();
+  j.field("seamless_version", SEAMLESS_VERSION).field("commit", SEAMLESS_GIT_COMMIT);
+  j.field("command", s.command).field("config", s.config).field("device", s.device);
   if (s.intrinsics) {
     const Intrinsics& K = *s.intrinsics;
-    j << "  \"intrinsics\": {\"fx\": " << num(K.fx) << ", \"fy\": " << num(K.fy) << ", \"cx\": " << num(K.cx)
-      << ", \"cy\": " << num(K.cy) << ", \"width\": " << K.width << ", \"height\": " << K.height << "},\n";
+    j.key("intrinsics").begin_object().field("fx", K.fx).field("fy", K.fy).field("cx", K.cx).field("cy", K.cy);
+    j.field("width", K.width).field("height", K.height).end_object();
   }
-  j << "  \"frames\": {\"read\": " << s.frames_read << ", \"lost\": " << s.frames_lost
-    << ", \"fused\": " << s.frames_fused << ", \"unreadable\": " << s.frames_unreadable << "},\n";
-  if (s.ate_rmse_m) j << "  \"ate\": {\"rmse_m\": " << num(*s.ate_rmse_m) << ", \"pairs\": " << s.ate_pairs << "},\n";
-  if (s.floor_height) j << "  \"floor_height\": " << num(*s.floor_height) << ",\n";
-  j << "  \"surfaces\": [";
+  j.key("frames").begin_object().field("read", s.frames_read).field("lost", s.frames_lost);
+  j.field("fused", s.frames_fused).field("unreadable", s.frames_unreadable).end_object();
+  if (s.ate_rmse_m) j.key("ate").begin_object().field("rmse_m", *s.ate_rmse_m).field("pairs", s.ate_pairs).end_object();
+  if (s.floor_height) j.field("floor_height", *s.floor_height);
+  j.key("surfaces").begin_array();
   for (std::size_t i = 0; i < s.surfaces.size() && i < 10; ++i) {
     const HorizontalSurface& h = s.surfaces[i];
-    j << (i ? ", " : "") << "{\"area_m2\": " << num(h.area) << ", \"height\": " << num(h.height)
-      << ", \"centre\": " << vec(h.centre) << ", \"open_radius\": " << num(h.open_radius)
-      << ", \"floor\": " << (h.floor ? "true" : "false") << "}";
+    j.begin_object().field("area_m2", h.area).field("height", h.height).key("centre");
+    vec_value(j, h.centre);
+    j.field("open_radius", h.open_radius).field("floor", h.floor).end_object();
   }
-  j << "],\n";
-  j << "  \"spawns\": [";
+  j.end_array();
+  j.key("spawns").begin_array();
   for (std::size_t i = 0; i < s.spawns.size(); ++i) {
     const SpawnParams& sp = s.spawns[i];
-    j << (i ? ",\n" : "\n") << "    {\"index\": " << i << ", \"kind\": " << quote(sp.kind)
-      << ", \"time\": " << num(sp.time) << ", \"position\": " << vec(sp.position);
+    j.begin_object().field("index", i).field("kind", sp.kind).field("time", sp.time).key("position");
+    vec_value(j, sp.position);
     for (const ResolvedPlacement& r : s.placements)
-      if (r.spawn == static_cast<int>(i))
-        j << ", \"placed\": " << quote(r.how) << ", \"surface_point\": " << vec(r.surface_point);
-    j << "}";
+      if (r.spawn == static_cast<int>(i)) {
+        j.field("placed", r.how).key("surface_point");
+        vec_value(j, r.surface_point);
+      }
+    j.end_object();
   }
-  j << (s.spawns.empty() ? "],\n" : "\n  ],\n");
+  j.end_array();
   if (s.physics) {
     const SolverStats& p = *s.physics;
-    j << "  \"particles\": {\"dynamic\": " << p.particles << ", \"fluid\": " << p.fluid_particles
-      << ", \"cloth\": " << p.cloth_particles << ", \"rigid\": " << p.rigid_particles
-      << ", \"rigid_bodies\": " << p.rigid_bodies << ", \"static\": " << p.static_particles
-      << ", \"simulated_s\": " << num(p.time) << ", \"steps\": " << p.steps
-      << ", \"neighbour_overflow\": " << p.neighbour_overflow << ", \"emitter_dropped\": " << p.emitter_dropped;
-    if (s.escaped)
-      j << ", \"escaped\": " << s.escaped->total() << ", \"escaped_below_floor\": " << s.escaped->below_floor
-        << ", \"escaped_outside\": " << s.escaped->outside << ", \"escaped_falling\": " << s.escaped->falling;
-    j << "},\n";
+    j.key("particles").begin_object().field("dynamic", p.particles).field("fluid", p.fluid_particles);
+    j.field("cloth", p.cloth_particles).field("rigid", p.rigid_particles).field("rigid_bodies", p.rigid_bodies);
+    j.field("static", p.static_particles).field("simulated_s", p.time).field("steps", p.steps);
+    j.field("neighbour_overflow", p.neighbour_overflow).field("emitter_dropped", p.emitter_dropped);
+    if (s.escaped) {
+      j.field("escaped", s.escaped->total()).field("escaped_below_floor", s.escaped->below_floor);
+      j.field("escaped_outside", s.escaped->outside).field("escaped_falling", s.escaped->falling);
+    }
+    j.end_object();
   }
-  j << "  \"stage_median_ms\": {";
-  for (std::size_t i = 0; i < s.stage_median_ms.size(); ++i)
-    j << (i ? ", " : "") << quote(s.stage_median_ms[i].first) << ": " << num(s.stage_median_ms[i].second);
-  j << "}\n}\n";
-
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    out << j.str();
-    if (!out) throw Error("cannot write '" + tmp + "' (is the output folder writable?)");
-  }
-  std::filesystem::rename(tmp, path);
+  j.key("stage_median_ms").begin_object();
+  for (const auto& [stage, ms] : s.stage_median_ms) j.field(stage, ms);
+  j.end_object().end_object();
+  // Written complete under a temporary name, then renamed: a reader never sees half a file.
+  j.write_file(partial_path(path));
+  commit_partial(path);
 }
 
 }  // namespace seamless::app

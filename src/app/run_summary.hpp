@@ -50,7 +50,7 @@ void add_tracking(RunSummary& s, const TrackSequenceResult& r, std::int64_t unre
                   const std::string& groundtruth);
 // The medians of every stage in the run's timer.
 void add_stage_medians(RunSummary& s, const StageTimer& t);
-// Writes summary.json (to a temporary name, then renamed: a reader never sees half a file).
+// Writes summary.json (as NAME.partial, then renamed: a reader never sees half a file).
 void write_summary(const std::string& path, const RunSummary& s);
 
 }  // namespace seamless::app
