@@ -22,6 +22,7 @@ constexpr int kMaxProbe = 128;   // linear probing at <= 50% fill rarely probes 
 // Allocation passes after growing, per frame. Each growth at least doubles the pool or the table,
 // so this bound is never the one that stops growth: the pool's 2^30 blocks (grow_pool) come first.
 constexpr int kMaxGrowths = 40;
+constexpr std::int64_t kMaxSlots = std::int64_t{1} << 30;
 
 std::int64_t next_pow2(std::int64_t n) {
   std::int64_t p = 1;
@@ -157,9 +158,19 @@ void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTime
 void VoxelHashVolume::handle_failures(const HashCounters& c) {
   // Logged once per frame by allocate_and_list, with the sizes reached.
   if (c.probe_failures > 0) {
-    spdlog::debug("voxel hashing: hash table of {} slots too crowded ({} insertions failed); rehashing into {} slots",
-                  keys_.size(), c.probe_failures, 2 * keys_.size());
-    rehash(2 * keys_.size());
+    // Insertion never reuses a tombstone, so a block that is freed and allocated again frame after
+    // frame (a surface seen, then seen through) leaves one more tombstone before its key each time:
+    // after max_probe such frames its insertion fails in a table that is nearly empty. Clearing the
+    // tombstones in place is then the remedy; doubling is for a table that is really full (a
+    // 10,000-frame run doubled 11 times with 65,536 blocks and overflowed 32-bit slot indices).
+    const std::int64_t slots = keys_.size();
+    const std::int64_t live = free_list_.size() - std::max(c.free_top, 0);
+    // (No tombstones left, as after an in-place rehash, and still failing: a real cluster; grow.)
+    const bool crowded = 4 * live > slots || c.tombstones == 0;
+    spdlog::debug("voxel hashing: {} insertions found no slot in a table of {} slots ({} blocks, {} tombstones); "
+                  "rehashing into {} slots",
+                  c.probe_failures, slots, live, c.tombstones, crowded ? 2 * slots : slots);
+    rehash(crowded ? 2 * slots : slots);
   }
   if (c.pool_failures > 0) {
     std::int64_t cap = free_list_.size();
@@ -190,6 +201,10 @@ std::int64_t VoxelHashVolume::live_slots(Buffer<std::int32_t>& slots) const {
 }
 
 void VoxelHashVolume::rehash(std::int64_t new_slots) {
+  // Slots are indexed by 32-bit integers in the kernels (HashTable::mask, block slot lists).
+  if (new_slots > kMaxSlots)
+    throw Error("voxel hashing: the hash table cannot grow beyond " + std::to_string(kMaxSlots) +
+                " slots; raise volume.voxel_size or lower volume.max_depth");
   Buffer<std::int32_t> slots;
   const std::int64_t n = live_slots(slots);
   Buffer<kernels::HashKey> keys(n, device_);

@@ -256,6 +256,27 @@ TEST(TsdfFusion, GrowthKeepsUpWithAFrameThatNeedsManyDoublings) {
   EXPECT_EQ(grown.allocated_block_coords(), ref.allocated_block_coords());
 }
 
+// Issue 20: a 10,000-frame run doubled its hash table 11 times while holding at most 65,536 blocks,
+// then overflowed 32-bit slot indices. Insertion never reuses tombstones, and a block that the
+// truncation band only grazes (every voxel in it ends at +truncation) is allocated and freed again
+// in every frame, one more tombstone before its key each time: after max_probe (128) frames its
+// insertion fails in a table that is nearly empty (the between-frames rehash waits for half the
+// slots to be used, which a large table never reaches). A still camera on a wall and a sphere for
+// 140 frames: the table must keep its size and no insertion may fail.
+TEST(TsdfFusion, BlocksFreedAndAllocatedAgainDoNotGrowTheTable) {
+  VolumeParams p = test::small_volume_params();
+  p.hash_buckets = 1 << 18;  // large: tombstones never fill half of it in 140 frames
+  VoxelHashVolume vol(p, Device::CPU);
+  Intrinsics K = test::camera(80, 60, 70.f);
+  Scene s;
+  fuse(vol, s, K, std::vector<SE3>(140, SE3::identity()));
+  const VolumeStats st = vol.stats();
+  ASSERT_LE(4 * st.allocated_blocks, st.hash_slots);  // the premise: never crowded
+  EXPECT_EQ(st.hash_slots, p.hash_buckets);
+  EXPECT_EQ(st.failed_insertions, 0);
+  EXPECT_EQ(st.block_capacity, p.capacity);
+}
+
 TEST(TsdfFusion, RejectsTruncationBelowTwoVoxels) {
   VolumeParams p = test::small_volume_params();
   p.truncation = 0.015f;
