@@ -22,6 +22,17 @@
 namespace seamless::app {
 
 namespace {
+
+// Closes the renderer's outputs (the video encoder) after the run: a failed encoder (say, one
+// stopped by the same Ctrl-C) is reported, not thrown, so that the particles, trajectory, stats
+// and summary that follow are still written (issue 20).
+void finish_renderer(RunContext& ctx, RunRenderer& r) {
+  try {
+    r.finish();
+  } catch (const std::exception& e) {
+    ctx.report_output_failure(e.what());
+  }
+}
 TrackSequenceParams tracking_params(const Experiment& e) {
   TrackSequenceParams p;
   p.tracker = e.tracker;
@@ -288,7 +299,7 @@ SimulationResult simulate(RunContext& ctx, const std::vector<vec3>& scene_partic
   else if (!loop.complete())
     spdlog::warn("stopped after {} of {} steps (window closed or interrupted): the outputs hold the state reached",
                  loop.done_steps(), loop.steps());
-  if (renderer) renderer->finish();
+  if (renderer) finish_renderer(ctx, *renderer);
   SimulationResult result{solver.download_state(), solver.stats()};
   write_particles_ply(ctx.out_path("particles.ply"), result.state);
   write_run_objects(ctx.out_path("objects.txt"), collect_run_objects(solver, e.spawn));  // for `seamless render`
@@ -378,7 +389,7 @@ class LiveLoop : public FrameLoop {
     if (queue_.pending())
       spdlog::warn("live: {} spawn entries were never spawned (their time or their placement's surface never "
                    "came)", queue_.pending());
-    if (renderer_) renderer_->finish();
+    if (renderer_) finish_renderer(ctx_, *renderer_);
     if (e_.output.write_stats) write_tracking_stats(ctx_.out_path("tracking_stats.csv"), records_);
     ctx_.report_tracking(static_cast<std::int64_t>(records_.size()), session_.lost_frames());
     const ParticleState state = solver_.download_state();  // one download for the file and the summary

@@ -91,6 +91,11 @@ void RunContext::report_tracking(std::int64_t frames, std::int64_t lost) {
                 lost, frames, 100 * fraction, exp_.output.max_lost_fraction, kExitLostFrames);
 }
 
+void RunContext::report_output_failure(const std::string& what) {
+  spdlog::error("{} (the run's other outputs are written; exit code {})", what, kExitError);
+  if (exit_code_ == kExitOk) exit_code_ = kExitError;
+}
+
 RunContext::~RunContext() {
   if (!exp_.output.write_timings || !timer_ || timer_->rows().empty()) return;
   try {

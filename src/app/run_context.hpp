@@ -54,6 +54,9 @@ class RunContext {
   // error naming the likely causes and exit_code() becomes kExitLostFrames.
   void report_tracking(std::int64_t frames, std::int64_t lost);
   // What the subcommand returns when it got to the end: kExitOk or kExitLostFrames.
+  // An output that failed after the results were computed (the video encoder): logged as an error;
+  // the caller goes on writing the other outputs, and the run exits with kExitError.
+  void report_output_failure(const std::string& what);
   int exit_code() const { return exit_code_; }
 
  private:

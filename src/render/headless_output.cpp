@@ -55,7 +55,9 @@ void HeadlessOutput::open_video(int w, int h) {
     video_failed_ = true;
     return;
   }
-  const std::string cmd = "'" + ffmpeg + "' -loglevel error -y -f rawvideo -pix_fmt rgb24 -s " +
+  // setsid: ffmpeg in a session of its own, so that a Ctrl-C meant for the run (which then
+  // finishes its frame and writes its outputs) does not kill the encoder mid-file.
+  const std::string cmd = "exec setsid -w '" + ffmpeg + "' -loglevel error -y -f rawvideo -pix_fmt rgb24 -s " +
                           std::to_string(w) + "x" + std::to_string(h) + " -r " + std::to_string(p_.fps) +
                           " -i - -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' -pix_fmt yuv420p '" + video_path() + "'";
   pipe_ = popen(cmd.c_str(), "w");

@@ -41,9 +41,10 @@ def list_lines(path):
         return [l.split() for l in f if l.strip() and not l.startswith("#")]
 
 
-def interrupt_when(cmd, ready, timeout=300):
-    """Starts cmd, sends SIGINT once ready() is true (polled), returns (returncode, stderr)."""
-    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+def interrupt_when(cmd, ready, timeout=300, group=False):
+    """Starts cmd, sends SIGINT once ready() is true (polled), returns (returncode, stderr).
+    group: to cmd's whole process group, as a Ctrl-C in a terminal does (its children too)."""
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=group)
     t0 = time.monotonic()
     while not ready():
         if p.poll() is not None:
@@ -53,7 +54,10 @@ def interrupt_when(cmd, ready, timeout=300):
             p.kill()
             raise AssertionError(f"{' '.join(cmd)}: never got ready to be interrupted")
         time.sleep(0.05)
-    p.send_signal(signal.SIGINT)
+    if group:
+        os.killpg(p.pid, signal.SIGINT)
+    else:
+        p.send_signal(signal.SIGINT)
     out, err = p.communicate(timeout=600)
     return p.returncode, err
 
@@ -208,6 +212,33 @@ class Interrupted(unittest.TestCase):
             self.assertTrue(rows(os.path.join(out, "timings.csv")))
             for f in ["log.txt", "mesh.ply", "particles.ply", "config.yaml"]:
                 self.assertGreater(os.path.getsize(os.path.join(out, f)), 0, f)
+
+
+    @unittest.skipUnless(shutil.which("ffprobe"), "no ffprobe (Debian package ffmpeg)")
+    def test_live_run_with_video_stopped_by_ctrl_c_in_a_terminal(self):
+        # A Ctrl-C in a terminal reaches the whole process group: it killed the video encoder too,
+        # whose failure then stopped the live run before tracking_stats.csv, particles.ply and
+        # summary.json were written. The encoder runs in its own session now, and the video holds
+        # every frame rendered.
+        with tempfile.TemporaryDirectory() as d:
+            out = os.path.join(d, "live")
+            code, err = interrupt_when(
+                [EXE, "run", DEMO, "--device", "cpu", "--out", out, "--set", "mode=live",
+                 "--set", "input.synthetic.frames=1000", "--set", "render.mode=headless",
+                 "--set", "render.view=kinect", "--set", "render.width=160", "--set", "render.height=120",
+                 "--set", "render.video=true", "--set", "output.particles_every=0",
+                 "--set", "volume.voxel_size=0.02", "--set", "volume.truncation=0.08"],
+                lambda: count_poses(os.path.join(out, "trajectory.txt.partial")) >= 3, group=True)
+            self.assertEqual(code, SIGINT_CODE, err)
+            n = len(poses(os.path.join(out, "trajectory.txt")))
+            self.assertEqual(len(rows(os.path.join(out, "tracking_stats.csv"))), n)
+            for f in ["log.txt", "particles.ply", "summary.json", "timings.csv", "video.mp4"]:
+                self.assertGreater(os.path.getsize(os.path.join(out, f)), 0, f)
+            probe = subprocess.run(["ffprobe", "-v", "error", "-count_frames", "-show_entries",
+                                    "stream=nb_read_frames", "-of", "csv=p=0", os.path.join(out, "video.mp4")],
+                                   capture_output=True, text=True)
+            self.assertEqual(probe.returncode, 0, probe.stderr)
+            self.assertGreaterEqual(int(probe.stdout.strip()), n)  # one rendered frame per input frame
 
 
 class FailedMidway(unittest.TestCase):
