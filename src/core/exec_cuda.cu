@@ -114,36 +114,41 @@ void CudaGraph::reset() {
 
 namespace cuda_detail {
 
-void* scratch(std::size_t bytes) {
-  static void* ptr = nullptr;
-  static std::size_t size = 0;
-  if (bytes > size) {
-    if (ptr) SEAMLESS_CUDA_CHECK(cudaFree(ptr));
-    size = bytes + bytes / 2;
-    SEAMLESS_CUDA_CHECK(cudaMalloc(&ptr, size));
+namespace {
+// A process-lifetime device buffer that only grows. Freed at exit (the error, if the CUDA runtime
+// is already unloading, is of no consequence), so that compute-sanitizer's leak check reports only
+// real leaks.
+struct GrowingBlock {
+  void* ptr = nullptr;
+  std::size_t size = 0;
+  void* at_least(std::size_t bytes, std::size_t reserve) {
+    if (bytes > size) {
+      if (ptr) SEAMLESS_CUDA_CHECK(cudaFree(ptr));
+      size = reserve;
+      SEAMLESS_CUDA_CHECK(cudaMalloc(&ptr, size));
+    }
+    return ptr;
   }
-  return ptr;
+  ~GrowingBlock() {
+    if (ptr) cudaFree(ptr);
+  }
+};
+}  // namespace
+
+void* scratch(std::size_t bytes) {
+  static GrowingBlock block;
+  return block.at_least(bytes, bytes + bytes / 2);
 }
 
 void* result_slot(std::size_t bytes) {
-  static void* ptr = nullptr;
-  static std::size_t size = 0;
-  if (bytes > size) {
-    if (ptr) SEAMLESS_CUDA_CHECK(cudaFree(ptr));
-    size = bytes;
-    SEAMLESS_CUDA_CHECK(cudaMalloc(&ptr, size));
-  }
-  return ptr;
+  static GrowingBlock block;
+  return block.at_least(bytes, bytes);
 }
 
 unsigned* reduce_counter() {
-  static unsigned* counter = [] {
-    unsigned* c = nullptr;
-    SEAMLESS_CUDA_CHECK(cudaMalloc(&c, sizeof(unsigned)));
-    SEAMLESS_CUDA_CHECK(cudaMemset(c, 0, sizeof(unsigned)));
-    return c;
-  }();
-  return counter;
+  static GrowingBlock block;
+  if (!block.ptr) SEAMLESS_CUDA_CHECK(cudaMemset(block.at_least(sizeof(unsigned), sizeof(unsigned)), 0, sizeof(unsigned)));
+  return static_cast<unsigned*>(block.ptr);
 }
 
 int multiprocessors() {
