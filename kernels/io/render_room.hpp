@@ -1,4 +1,4 @@
-// Renders the synthetic room (kernels/io/synthetic_room.hpp) as a Kinect v1 would see it: exact
+// Renders the synthetic room (kernels/scene/synthetic_room.hpp) as a Kinect v1 would see it: exact
 // ray-primitive intersection per pixel, then an optional sensor model.
 //
 // Sensor model (noise.enabled), after Khoshelham & Elberink 2012 ("Accuracy and resolution of

@@ -2,7 +2,7 @@
 #include <cmath>
 
 #include "kernels/io/render_room.hpp"
-#include "kernels/io/synthetic_room.hpp"
+#include "kernels/scene/synthetic_room.hpp"
 
 namespace seamless::kernels {
 

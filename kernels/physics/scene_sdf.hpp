@@ -3,7 +3,7 @@
 //
 // Sources, combined as a union (minimum distance):
 //   - up to kMaxSdfPrimitives analytic primitives (half-space, solid box, container box, sphere);
-//   - the built-in synthetic room (kernels/io/synthetic_room.hpp), exact analytic SDF;
+//   - the built-in synthetic room (kernels/scene/synthetic_room.hpp), exact analytic SDF;
 //   - a dense sampled grid (values filled on the host or by a TSDF sampler), trilinear with a
 //     central-difference gradient. A TSDF from kernels/recon plugs in by filling this grid.
 #pragma once
@@ -11,7 +11,7 @@
 
 #include "core/hd.hpp"
 #include "core/math.hpp"
-#include "kernels/io/synthetic_room.hpp"
+#include "kernels/scene/synthetic_room.hpp"
 
 namespace seamless::kernels {
 

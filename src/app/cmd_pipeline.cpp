@@ -6,7 +6,7 @@
 #include "app/run_context.hpp"
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
-#include "kernels/io/synthetic_room.hpp"
+#include "kernels/scene/synthetic_room.hpp"
 #include "recon/refine/refine.hpp"
 
 namespace seamless::app {

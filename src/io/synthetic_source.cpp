@@ -6,7 +6,7 @@
 #include "core/error.hpp"
 #include "core/exec.hpp"
 #include "io/intrinsics_presets.hpp"
-#include "kernels/io/synthetic_room.hpp"
+#include "kernels/scene/synthetic_room.hpp"
 
 namespace seamless {
 namespace {

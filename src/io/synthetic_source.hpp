@@ -1,4 +1,4 @@
-// The built-in synthetic room as a frame source: the analytic scene of kernels/io/synthetic_room.hpp
+// The built-in synthetic room as a frame source: the analytic scene of kernels/scene/synthetic_room.hpp
 // seen along a smooth, deterministic, hand-held-like camera path, rendered by the kernel family
 // kernels/io/render_room (exact depth, optional Kinect v1 sensor model). Ground truth is exact.
 #pragma once

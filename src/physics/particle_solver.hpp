@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/device.hpp"
+#include "core/geometry.hpp"
 #include "core/math.hpp"
 #include "kernels/physics/scene_sdf.hpp"
 #include "physics/builders.hpp"
@@ -32,20 +33,6 @@ struct SolverStats {
   int max_neighbours_seen = 0, max_static_neighbours_seen = 0;
   std::int64_t emitter_dropped = 0;  // particles an emitter could not create (capacity)
   float max_speed = 0.f;             // m/s, after the last step (0 before the first)
-};
-
-// Particle state in id order (ids are given in spawn order and never change).
-struct ParticleState {
-  std::vector<vec3> x, v;
-  std::vector<float> inv_mass;
-  std::vector<std::uint32_t> phase;  // kernels::phase flags and group
-};
-
-// One rigid body's frame: x = R q + c for its rest offsets q.
-struct RigidFrame {
-  vec3 centre;
-  vec4 rotation;  // quaternion (x, y, z, w)
-  std::int64_t first = 0, count = 0;  // particle ids
 };
 
 class ParticleSolver {

@@ -7,6 +7,7 @@
 
 #include "core/buffer.hpp"
 #include "core/camera.hpp"
+#include "core/geometry.hpp"  // Mesh
 #include "core/math.hpp"
 #include "core/timing.hpp"
 #include "recon/scene_particles.hpp"
@@ -22,14 +23,6 @@ struct RaycastMaps {
   Image<vec3> vertex;
   Image<vec3> normal;
   Image<uchar3> color;
-};
-
-// Triangle mesh on the host; triangles index into the vertex arrays.
-struct Mesh {
-  std::vector<vec3> positions;
-  std::vector<vec3> normals;
-  std::vector<uchar3> colors;
-  std::vector<int3> triangles;
 };
 
 // Per-frame statistics (counts of the last integrate(), totals for the rest).

@@ -10,7 +10,7 @@
 #include "core/buffer.hpp"
 #include "core/device.hpp"
 #include "kernels/physics/particle_math.hpp"
-#include "recon/volume.hpp"
+#include "core/geometry.hpp"
 #include "seamless/build_config.hpp"
 #if SEAMLESS_HAS_CUDA
 #include "render/cuda_interop.hpp"

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/geometry.hpp"
 #include "kernels/physics/particle_math.hpp"
-#include "physics/particle_solver.hpp"
 
 namespace seamless {
 

@@ -6,12 +6,10 @@
 #include <span>
 #include <vector>
 
+#include "core/geometry.hpp"
 #include "core/math.hpp"
 
 namespace seamless {
-
-struct ParticleState;
-struct RigidFrame;
 
 // A rigid body's surface in its body frame (the frame of its rest offsets q), shaded smooth or
 // flat as its normals say. The renderer uploads each one once (keyed by the object).

@@ -6,7 +6,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "kernels/physics/particle_math.hpp"
-#include "recon/volume.hpp"
+#include "core/geometry.hpp"
 #include "render/renderer_impl.hpp"
 
 namespace seamless {

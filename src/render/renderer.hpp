@@ -24,7 +24,6 @@
 
 namespace seamless {
 
-struct Mesh;
 
 // An intermediate image of the fluid renderer, made viewable (depth as grey, normals as colour).
 struct StageImage {

@@ -10,7 +10,7 @@ Bounds (tracker world of the demo: gravity -y, metres; configs/demo.yaml explain
   height of the scene particles over the desk, so the camera's shake (a few cm) does not matter;
 - a fluid particle resting on a surface has its centre a radius r above it, and contacts compress
   by well under a radius: a centre more than d = 2r below the surface has gone into or through it;
-- "over the desk" is its 1.4 x 0.7 m top (kernels/io/synthetic_room.hpp, moved to the first
+- "over the desk" is its 1.4 x 0.7 m top (kernels/scene/synthetic_room.hpp, moved to the first
   camera) shrunk by 0.1 m a side: the world's yaw is off by up to ~2 degrees (5.6 cm at 1.6 m);
 - a crossing is a particle over the desk and above desk - d in one snapshot and over the desk
   below desk - d in the next, 0.05 s later: fluid spilling over an edge moves well under the

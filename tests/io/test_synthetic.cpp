@@ -9,7 +9,7 @@
 #include "io/input_params.hpp"
 #include "io/synthetic_source.hpp"
 #include "kernels/io/render_room.hpp"
-#include "kernels/io/synthetic_room.hpp"
+#include "kernels/scene/synthetic_room.hpp"
 
 using namespace seamless;
 namespace room = seamless::kernels::room;

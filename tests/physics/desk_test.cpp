@@ -1,11 +1,11 @@
 // Fluid poured onto the synthetic room's desk, represented by static scene particles sampled
-// from the room's analytic SDF (kernels/io/synthetic_room.hpp; world z up, floor at z = 0).
+// from the room's analytic SDF (kernels/scene/synthetic_room.hpp; world z up, floor at z = 0).
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 
-#include "kernels/io/synthetic_room.hpp"
+#include "kernels/scene/synthetic_room.hpp"
 #include "physics/particle_solver.hpp"
 #include "physics_test_util.hpp"
 

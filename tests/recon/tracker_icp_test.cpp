@@ -11,7 +11,7 @@
 #include "io/synthetic_source.hpp"
 #include "kernels/recon/preprocess.hpp"
 #include "kernels/recon/rgbd.hpp"
-#include "kernels/io/synthetic_room.hpp"
+#include "kernels/scene/synthetic_room.hpp"
 #include "recon/tracker.hpp"
 #include "recon/tracker_gravity.hpp"
 #include "recon/volume.hpp"

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "io/synthetic_source.hpp"
-#include "kernels/io/synthetic_room.hpp"
+#include "kernels/scene/synthetic_room.hpp"
 #include "kernels/recon/voxel_hash.hpp"
 #include "recon/voxel_hash_volume.hpp"
 #include "tsdf_scene.hpp"
