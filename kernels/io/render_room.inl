@@ -19,22 +19,25 @@ SEAMLESS_HD inline uchar3 shade(vec3 albedo, vec3 n) {
 }
 
 // True when the projector (offset by the baseline along the camera's x axis) cannot see p.
-SEAMLESS_HD inline bool in_projector_shadow(vec3 p, vec3 n, vec3 projector) {
+SEAMLESS_HD inline bool in_projector_shadow(vec3 p, vec3 n, vec3 projector, const movers::Scene& ms) {
   vec3 to = projector - p;
   float dist = length(to);
   vec3 o = p + n * 1e-4f;
   room::Hit h = room::room_raycast(o, to / dist, dist - 2e-4f);
-  return h.t > 0.f;
+  return h.t > 0.f || movers::raycast(ms, o, to / dist, dist - 2e-4f).t > 0.f;
 }
 
 }  // namespace render_detail
 
 template <class Exec>
 void render_room(const Exec& ex, Intrinsics K, SE3 world_T_camera, DepthNoise noise, std::uint32_t seed,
-                 std::uint32_t frame, View2D<float> scratch, View2D<float> depth, View2D<uchar3> rgb) {
+                 std::uint32_t frame, const movers::Scene& movers, View2D<float> scratch, View2D<float> depth,
+                 View2D<uchar3> rgb, View2D<std::uint8_t> mask) {
   const int w = depth.width;
   const SE3 T = world_T_camera;
   const vec3 projector = T * vec3{noise.baseline, 0.f, 0.f};
+  const movers::Scene ms = movers;  // by value into the kernel
+  const bool want_mask = mask.width > 0;
   // Pass 1: exact first hit. scratch = z (> 0), -z where the sensor cannot measure it (shadow or
   // grazing incidence; edges need the neighbours and come in pass 2), 0 where the ray hits nothing.
   ex.for_each(depth.count(), [=] SEAMLESS_HD(std::int64_t i) {
@@ -43,17 +46,21 @@ void render_room(const Exec& ex, Intrinsics K, SE3 world_T_camera, DepthNoise no
     float len = length(dc);
     vec3 dir = T.rotate(dc / len);
     room::Hit h = room::room_raycast(T.t, dir);
-    if (h.t <= 0.f) {
+    const movers::Hit m = movers::raycast(ms, T.t, dir, h.t > 0.f ? h.t : 1e30f);  // only in front of the room
+    if (want_mask) mask(x, y) = m.t > 0.f ? static_cast<std::uint8_t>(ms.c[m.capsule].mover) : 0;
+    const float t = m.t > 0.f ? m.t : h.t;
+    if (t <= 0.f) {
       scratch(x, y) = 0.f;
       rgb(x, y) = {0, 0, 0};
       return;
     }
-    vec3 p = T.t + dir * h.t;
-    float z = h.t / len;  // along the optical axis: |dc| = len for the unit-z ray
-    bool lost = noise.enabled && (dot(h.normal, -dir) < noise.min_incidence_cos ||
-                                  (noise.projector_shadow && render_detail::in_projector_shadow(p, h.normal, projector)));
+    const vec3 normal = m.t > 0.f ? m.normal : h.normal;
+    vec3 p = T.t + dir * t;
+    float z = t / len;  // along the optical axis: |dc| = len for the unit-z ray
+    bool lost = noise.enabled && (dot(normal, -dir) < noise.min_incidence_cos ||
+                                  (noise.projector_shadow && render_detail::in_projector_shadow(p, normal, projector, ms)));
     scratch(x, y) = lost ? -z : z;
-    rgb(x, y) = render_detail::shade(room::surface_colour(h.id, p), h.normal);
+    rgb(x, y) = render_detail::shade(m.t > 0.f ? ms.c[m.capsule].albedo : room::surface_colour(h.id, p), normal);
   });
   // Pass 2: edges, range, disparity quantisation and noise.
   const std::int64_t n_pix = depth.count();
@@ -82,5 +89,6 @@ void render_room(const Exec& ex, Intrinsics K, SE3 world_T_camera, DepthNoise no
 #define SEAMLESS_INSTANTIATE_RENDER_ROOM(EXEC)                                                        \
   namespace seamless::kernels {                                                                      \
   template void render_room<EXEC>(const EXEC&, Intrinsics, SE3, DepthNoise, std::uint32_t, std::uint32_t, \
-                                  View2D<float>, View2D<float>, View2D<uchar3>);                     \
+                                  const movers::Scene&, View2D<float>, View2D<float>, View2D<uchar3>,  \
+                                  View2D<std::uint8_t>);                                             \
   }

@@ -10,6 +10,7 @@
 #include "core/camera.hpp"
 #include "core/device.hpp"
 #include "core/math.hpp"
+#include "kernels/scene/movers.hpp"
 
 namespace seamless {
 
@@ -25,6 +26,10 @@ struct RgbdFrame {
   // z forward): at rest it points up, e.g. (0, -9.81, 0) for a level camera.
   std::optional<vec3> accelerometer;
   std::optional<SE3> ground_truth;  // world_T_camera when the source knows it
+  // Ground truth of moving things (the synthetic room with input.synthetic.movers): the mover id
+  // each pixel sees (0: the static room), and the movers' capsules in the ground truth's frame.
+  Image<std::uint8_t> mover_mask;
+  std::optional<kernels::movers::Scene> movers;
 };
 
 class FrameSource {

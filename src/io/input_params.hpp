@@ -3,7 +3,9 @@
 #pragma once
 #include <cstdint>
 #include <string>
+#include <vector>
 
+#include "core/math.hpp"
 #include "core/params.hpp"
 
 namespace seamless {
@@ -51,6 +53,29 @@ struct SyntheticNoiseParams {
   }
 };
 
+// Something that moves through the synthetic room (issue 22's test material): a person walking or
+// a ball rolling along a path on the floor, at constant speed, present from `start` until the
+// path's end (then gone, as if it left the room). Posed per frame by src/io/movers.cpp.
+struct MoverParams {
+  std::string kind = "person";
+  std::vector<vec3> path;            // waypoints on the floor, room frame (x, y; z is ignored)
+  float speed = 1.0f;                // metres per second along the path
+  double start = 0.0;                // seconds: when it stands at the path's first point
+  float height = 1.75f;              // person: standing height, metres
+  float radius = 0.12f;              // ball: radius, metres
+
+  template <class V> void visit(V& v) {
+    v("kind", kind, "person (torso, head, arms and legs swinging as it walks) or ball (rolling)",
+      Choices{"person", "ball"});
+    v("path", path, "waypoints on the floor in the room frame of groundtruth.txt (x, y, z ignored), metres");
+    v("speed", speed, "speed along the path, m/s", Range{0.01, 10.0});
+    v("start", start, "time it appears at the path's first point, seconds (it leaves at the path's end)",
+      Range{0.0, 1e6});
+    v("height", height, "person: standing height, metres", Range{0.5, 2.5});
+    v("radius", radius, "ball: radius, metres", Range{0.01, 1.0});
+  }
+};
+
 // The built-in synthetic room (no data needed; ground-truth poses known exactly).
 struct SyntheticParams {
   std::uint64_t seed = 1;
@@ -64,6 +89,7 @@ struct SyntheticParams {
   float start_deg = -90.f;           // orbit: start angle (-90: in front of the desk, behind the chair)
   float shake = 1.f;                 // scale of the hand-held wobble (0 = a perfectly smooth path)
   SyntheticNoiseParams sensor;
+  std::vector<MoverParams> movers;   // people and balls moving through the room (ground-truth masks)
 
   template <class V> void visit(V& v) {
     v("seed", seed, "random seed for the noise and the hand-held wobble");
@@ -78,6 +104,8 @@ struct SyntheticParams {
     v("start_deg", start_deg, "orbit start angle, degrees", Range{-360.0, 360.0});
     v("shake", shake, "hand-held wobble scale (0 = smooth)", Range{0.0, 5.0});
     v("sensor", sensor, "Kinect v1 sensor model used when noise is on");
+    v("movers", movers, "people and balls that move through the room; `seamless record` writes their masks "
+      "(mask/) and capsules (movers.txt)");
   }
 };
 

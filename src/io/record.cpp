@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
 #include "io/intrinsics_presets.hpp"
+#include "io/movers.hpp"
 #include "io/png_io.hpp"
 #include "io/trajectory.hpp"
 
@@ -53,7 +54,7 @@ std::int64_t record(FrameSource& source, const std::string& out_dir, const Recor
   std::ofstream rgb_txt = open_list(dir / "rgb.txt", "# color images\n" + origin + "# timestamp filename\n");
   std::ofstream depth_txt = open_list(dir / "depth.txt", "# depth maps\n" + origin + "# timestamp filename\n");
   std::ofstream assoc_txt = open_list(dir / "associations.txt", "");
-  std::ofstream accel_txt;
+  std::ofstream accel_txt, movers_txt;
   std::unique_ptr<TrajectoryWriter> gt;
   write_calibration((dir / "calibration.txt").string(), source.intrinsics());
   RgbdFrame f;
@@ -63,6 +64,14 @@ std::int64_t record(FrameSource& source, const std::string& out_dir, const Recor
     std::string name = stamp(f.timestamp) + ".png";
     write_png_rgb((dir / "rgb" / name).string(), f.rgb);
     write_png_u16((dir / "depth" / name).string(), to_u16(f.depth, opt.depth_scale));
+    if (f.mover_mask.width() > 0) {  // the movers' ground truth: masks first, then their list line
+      fs::create_directories(dir / "mask", ec);
+      write_png_u8((dir / "mask" / name).string(), f.mover_mask);
+      if (!movers_txt.is_open())
+        movers_txt = open_list(dir / "movers.txt", "# movers (capsules) of the synthetic room, frame of groundtruth.txt\n" +
+                                                       origin + "# timestamp mover ax ay az bx by bz radius\n");
+      if (f.movers) movers_txt << movers_lines(f.timestamp, *f.movers) << std::flush;
+    }
     // The lists name a frame only once both its images are written, and reach the disk with every
     // frame: a recording that is killed is a folder that loads, up to its last whole frame.
     rgb_txt << stamp(f.timestamp) << " rgb/" << name << '\n' << std::flush;
@@ -82,7 +91,7 @@ std::int64_t record(FrameSource& source, const std::string& out_dir, const Recor
     }
     ++n;
   }
-  for (std::ofstream* s : {&rgb_txt, &depth_txt, &assoc_txt, &accel_txt})
+  for (std::ofstream* s : {&rgb_txt, &depth_txt, &assoc_txt, &accel_txt, &movers_txt})
     if (s->is_open() && !s->flush()) throw Error("cannot write the lists of recording '" + out_dir + "'");
   if (gt) gt->close();
   return n;

@@ -6,6 +6,7 @@
 #include "core/error.hpp"
 #include "core/exec.hpp"
 #include "io/intrinsics_presets.hpp"
+#include "io/movers.hpp"
 #include "kernels/scene/synthetic_room.hpp"
 
 namespace seamless {
@@ -104,14 +105,30 @@ SyntheticSource::SyntheticSource(const InputParams& params, Device device)
 }
 
 void SyntheticSource::render(const SE3& T, std::uint32_t frame_number, Image<float>& depth, Image<uchar3>& rgb) {
+  Image<std::uint8_t> mask;
+  render(T, frame_number, depth, rgb, mask);
+}
+
+void SyntheticSource::render(const SE3& T, std::uint32_t frame_number, Image<float>& depth, Image<uchar3>& rgb,
+                             Image<std::uint8_t>& mask) {
   kernels::DepthNoise noise = synthetic_noise_model(p_);
   std::uint32_t seed = static_cast<std::uint32_t>(p_.seed ^ (p_.seed >> 32));
+  const kernels::movers::Scene movers = pose_movers(p_.movers, frame_number / p_.fps);
+  const bool with_mask = !p_.movers.empty();
+  if (with_mask && mask_dev_.width() != K_.width) mask_dev_ = Image<std::uint8_t>(K_.width, K_.height, device_);
   with_exec(device_, [&](const auto& ex) {
-    kernels::render_room(ex, K_, T, noise, seed, frame_number, scratch_.view(), depth_dev_.view(), rgb_dev_.view());
+    kernels::render_room(ex, K_, T, noise, seed, frame_number, movers, scratch_.view(), depth_dev_.view(),
+                         rgb_dev_.view(), with_mask ? mask_dev_.view() : View2D<std::uint8_t>{});
     ex.synchronize();
   });
   depth.buffer().copy_from(depth_dev_.buffer());
   rgb.buffer().copy_from(rgb_dev_.buffer());
+  if (!with_mask) {
+    mask = Image<std::uint8_t>();
+    return;
+  }
+  if (mask.width() != K_.width || mask.height() != K_.height) mask = Image<std::uint8_t>(K_.width, K_.height, Device::CPU);
+  mask.buffer().copy_from(mask_dev_.buffer());
 }
 
 bool SyntheticSource::next(RgbdFrame& frame) {
@@ -120,7 +137,8 @@ bool SyntheticSource::next(RgbdFrame& frame) {
   double t = k / p_.fps;
   SE3 T = synthetic_camera_pose(p_, t);
   reserve_frame_images(frame, K_.width, K_.height, device_ == Device::CUDA);
-  render(T, static_cast<std::uint32_t>(k), frame.depth, frame.rgb);
+  render(T, static_cast<std::uint32_t>(k), frame.depth, frame.rgb, frame.mover_mask);
+  if (!p_.movers.empty()) frame.movers = pose_movers(p_.movers, t);
   frame.index = next_++;
   frame.timestamp = t;
   frame.intrinsics = K_;

@@ -29,8 +29,11 @@ class SyntheticSource : public FrameSource {
   std::string name() const override { return "synthetic room"; }
   Intrinsics intrinsics() const override { return K_; }
 
-  // Renders one view (any pose) with this source's camera and sensor model into host images.
+  // Renders one view (any pose) with this source's camera and sensor model into host images, with
+  // the movers as they are at frame_number's time (mask: their ids, or empty when there are none).
   void render(const SE3& world_T_camera, std::uint32_t frame_number, Image<float>& depth, Image<uchar3>& rgb);
+  void render(const SE3& world_T_camera, std::uint32_t frame_number, Image<float>& depth, Image<uchar3>& rgb,
+              Image<std::uint8_t>& mask);
 
  private:
   SyntheticParams p_;
@@ -39,6 +42,7 @@ class SyntheticSource : public FrameSource {
   std::int64_t first_, count_, next_ = 0;
   Image<float> scratch_, depth_dev_;
   Image<uchar3> rgb_dev_;
+  Image<std::uint8_t> mask_dev_;
 };
 
 }  // namespace seamless
