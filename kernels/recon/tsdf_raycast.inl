@@ -141,14 +141,15 @@ SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z
   bool have_prev = false;
   for (int it = 0; it < 8192 && z < z_end; ++it) {
     vec3 q = o + d * z;
-    int3 b = block_of_voxel(floor_to_int(q));
-    if (cached_block(a, b, c) < 0) {  // empty space: skip the whole block (Niessner section 4.3)
+    const int3 g0 = floor_to_int(q), b = block_of_voxel(g0);
+    const std::int32_t i0 = cached_block(a, b, c);
+    if (i0 < 0) {  // empty space: skip the whole block (Niessner section 4.3)
       z = fmaxf(block_exit(o, d, inv_d, b), z) + min_step * 0.1f;
       have_prev = false;
       continue;
     }
     float f;
-    if (!sample_tsdf(a, q, c, &f)) {
+    if (!sample_tsdf_in(a, q, g0, i0, c, &f)) {  // the block just found: no second lookup
       z += unobserved_step;
       have_prev = false;
       continue;

@@ -5,7 +5,9 @@
 #include <cstdio>
 
 #include "app/bench.hpp"
+#include "app/bench_pipeline.hpp"
 #include "app/commands.hpp"
+#include "core/error.hpp"
 #include "core/json.hpp"
 #include "core/timing.hpp"
 #include "seamless/build_config.hpp"
@@ -15,9 +17,26 @@ namespace seamless::app {
 namespace {
 struct BenchArgs {
   std::string name, device = "auto", json, data, filter, scale = "all";
-  int reps = 50, warmup = 5;
+  int reps = 0, warmup = 5;  // reps 0: the benchmark's default (50; pipeline 1)
   bool list = false;
+  // bench pipeline only
+  std::string config, tracker, mode = "scan", out;
+  std::vector<std::string> sets;
+  std::int64_t frames = 0;
+  bool no_volume_stages = false;
 };
+
+const char* kPipelineDescription =
+    "a real sequence replayed once through `seamless track` (--mode scan) or live mode (--mode live: + 10k fluid "
+    "particles, Kinect-view render 640x480): per-stage and per-frame median/p90/max, peak memory; --data TUM folder";
+
+int run_pipeline(const BenchArgs& a) {
+  PipelineBenchOptions p;
+  p.data = a.data, p.config = a.config, p.sets = a.sets, p.tracker = a.tracker, p.mode = a.mode;
+  p.frames = a.frames, p.reps = a.reps > 0 ? a.reps : 1, p.device = resolve_device(a.device);
+  p.out = a.out, p.json = a.json, p.volume_stages = !a.no_volume_stages;
+  return run_pipeline_bench(p);
+}
 
 struct CaseResult {
   std::string name, detail;
@@ -37,12 +56,19 @@ void write_json(const std::string& path, const std::string& bench, Device dev, c
   w.end_array().end_object().write_file(path);
 }
 
-int run_bench(const BenchArgs& a) {
+int run_bench(BenchArgs a) {
+  if (a.name == "pipeline") return run_pipeline(a);
+  if (!a.config.empty() || !a.tracker.empty() || !a.out.empty() || !a.sets.empty() || a.frames > 0 ||
+      a.no_volume_stages || a.mode != "scan")
+    throw UsageError("--config, --set, --tracker, --mode, --frames, --out and --no-volume-stages are options of "
+                     "`seamless bench pipeline` only");
+  if (a.reps == 0) a.reps = 50;
   auto& reg = bench_registry();
   auto it = reg.find(a.name);
   if (it == reg.end()) {
     std::string names;
     for (auto& [n, info] : reg) names += "\n  " + n + ": " + info.description;
+    names += std::string("\n  pipeline: ") + kPipelineDescription;
     spdlog::error("no benchmark named '{}'; this build has:{}", a.name, names);
     return 1;
   }
@@ -74,7 +100,8 @@ void add_bench_command(CLI::App& app, std::function<int()>& action) {
   auto a = std::make_shared<BenchArgs>();
   auto* cmd = app.add_subcommand("bench", "run a named benchmark (warm-up, repetitions, min/median/max, JSON)");
   cmd->add_option("name", a->name, "benchmark name (seamless bench --list)");
-  cmd->add_option("--reps", a->reps, "timed repetitions")->check(CLI::PositiveNumber);
+  cmd->add_option("--reps", a->reps, "timed repetitions (default 50; pipeline: whole replays, default 1)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--warmup", a->warmup, "untimed repetitions first")->check(CLI::NonNegativeNumber);
   cmd->add_option("--device", a->device, "cpu, cuda or auto")->check(CLI::IsMember({"cpu", "cuda", "auto"}));
   cmd->add_option("--json", a->json, "write the results as JSON to this file");
@@ -83,10 +110,25 @@ void add_bench_command(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--scale", a->scale, "scene sizes for `physics`: paper (Table 5.1), large or all")
       ->check(CLI::IsMember({"paper", "large", "all"}));
   cmd->add_flag("--list", a->list, "list the benchmarks");
+  cmd->add_option("--config", a->config, "pipeline: experiment file (default: every key at its default)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--set", a->sets, "pipeline: override a config key (repeatable), after the benchmark's own")
+      ->allow_extra_args(false);
+  cmd->add_option("--tracker", a->tracker, "pipeline: tracker.kind (icp, rgbd, ...)");
+  cmd->add_option("--mode", a->mode, "pipeline: scan (seamless track) or live (seamless run, mode: live)")
+      ->check(CLI::IsMember({"scan", "live"}));
+  cmd->add_option("--frames", a->frames, "pipeline: replay the first N frames (default: the config's frames)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--out", a->out, "pipeline: keep each replay's run folder here as rep_<k> (default: a temporary "
+                                   "folder, removed)");
+  cmd->add_flag("--no-volume-stages", a->no_volume_stages,
+                "pipeline: do not time the volume's kernel steps (allocate is then part of fuse; saves two CUDA "
+                "events per step)");
   cmd->callback([&action, a] {
     action = [a] {
       if (a->list || a->name.empty()) {
         for (auto& [n, info] : bench_registry()) std::printf("%-12s %s\n", n.c_str(), info.description.c_str());
+        std::printf("%-12s %s\n", "pipeline", kPipelineDescription);
         return a->list ? 0 : 2;
       }
       return run_bench(*a);

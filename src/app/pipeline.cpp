@@ -33,8 +33,10 @@ void finish_renderer(RunContext& ctx, RunRenderer& r) {
     ctx.report_output_failure(e.what());
   }
 }
-TrackSequenceParams tracking_params(const Experiment& e) {
+
+TrackSequenceParams tracking_params(const Experiment& e, StageTimer* volume_stages) {
   TrackSequenceParams p;
+  p.volume_stages = volume_stages;
   p.tracker = e.tracker;
   p.preprocess = e.preprocess;
   p.volume = e.volume;
@@ -67,7 +69,7 @@ void record_intrinsics(RunContext& ctx, const FrameSource& source) {
 }
 }  // namespace
 
-ScanResult scan(RunContext& ctx, bool with_volume) {
+ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
   const Experiment& e = ctx.experiment();
   require_tracker(e.tracker.kind);
   auto source = make_source(e.input, ctx.device());
@@ -87,7 +89,8 @@ ScanResult scan(RunContext& ctx, bool with_volume) {
     if (n == 0) r.first_frame = host_copy(frame);
     progress.update(++n, to_string(f.result.status));
   };
-  r.tracking = track_sequence(*source, tracking_params(e), ctx.device(), ctx.out_dir(), r.volume.get(), on_frame);
+  r.tracking = track_sequence(*source, tracking_params(e, volume_stages), ctx.device(), ctx.out_dir(), r.volume.get(),
+                              on_frame);
   r.unreadable = source->skipped_frames();
   progress.finish();
   spdlog::info("{} frames from {} ({} unreadable, skipped); {} lost by tracking; median track {:.3f} ms, frame {:.3f} ms",
@@ -318,10 +321,10 @@ namespace {
 // live()'s loop: one input frame per displayed frame (track, fuse, re-extract, one solver step).
 class LiveLoop : public FrameLoop {
  public:
-  LiveLoop(RunContext& ctx, RunRenderer* renderer)
+  LiveLoop(RunContext& ctx, RunRenderer* renderer, StageTimer* volume_stages)
       : ctx_(ctx), e_(ctx.experiment()), renderer_(renderer), source_(make_source(e_.input, ctx.device())),
         volume_(make_volume(e_.volume, ctx.device())),
-        session_(tracking_params(e_), ctx.device(), source_->intrinsics(), volume_.get()),
+        session_(tracking_params(e_, volume_stages), ctx.device(), source_->intrinsics(), volume_.get()),
         solver_(e_.solver, ctx.device()), queue_(e_.spawn, e_.solver),
         total_(e_.frames > 0 ? e_.frames : source_->size().value_or(0)), progress_("live", total_) {
     record_intrinsics(ctx, *source_);
@@ -360,6 +363,7 @@ class LiveLoop : public FrameLoop {
         renderer_->set_scene(volume_->extract_mesh(), rec.result.world_T_camera);
       renderer_->draw(solver_);
     }
+    ctx_.timer().add(k, "preprocess", rec.preprocess_ms);  // as scan()'s rows: upload included
     ctx_.timer().add(k, "track", rec.track_ms);
     ctx_.timer().add(k, "fuse", rec.fuse_ms);
     ctx_.timer().end_frame(k);
@@ -371,6 +375,7 @@ class LiveLoop : public FrameLoop {
   }
   void spawn_next() override { queue_.next_now(solver_); }
   const ParticleSolver& solver() const override { return solver_; }
+  const std::vector<FrameRecord>& records() const { return records_; }
 
   // A frame failed: the statistics of the frames before it are written (the trajectory is as it goes).
   void finish_failed() {
@@ -490,9 +495,9 @@ class LiveLoop : public FrameLoop {
 
 }  // namespace
 
-void live(RunContext& ctx, RunRenderer* renderer) {
+std::vector<FrameRecord> live(RunContext& ctx, RunRenderer* renderer, StageTimer* volume_stages) {
   require_tracker(ctx.experiment().tracker.kind);
-  LiveLoop loop(ctx, renderer);
+  LiveLoop loop(ctx, renderer, volume_stages);
   try {
     if (renderer) renderer->run(loop);
     else
@@ -503,6 +508,7 @@ void live(RunContext& ctx, RunRenderer* renderer) {
     throw;
   }
   loop.finish();
+  return loop.records();
 }
 
 }  // namespace seamless::app

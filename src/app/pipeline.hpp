@@ -24,11 +24,14 @@ class RunRenderer;
 
 // Tracks the experiment's input (and fuses it into a new volume when with_volume), writing
 // trajectory.txt, tracking_stats.csv and, with a volume, mesh.ply (output.write_mesh).
-ScanResult scan(RunContext& ctx, bool with_volume);
+// volume_stages: see TrackSequenceParams::volume_stages (`seamless bench pipeline`).
+ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages = nullptr);
 
 // Live mode (dissertation, section 5.2): track, fuse and simulate every frame; the scene particles
-// are re-extracted from the volume every experiment.reextract_every fused frames.
-void live(RunContext& ctx, RunRenderer* renderer);
+// are re-extracted from the volume every experiment.reextract_every fused frames. Returns each
+// frame's tracking record; frame k's other stages (physics, extract, render) are ctx.timer()'s rows
+// of frame k.
+std::vector<FrameRecord> live(RunContext& ctx, RunRenderer* renderer, StageTimer* volume_stages = nullptr);
 
 // Runs the particle solver for experiment.duration seconds on the given static scene (particles
 // and/or an SDF), spawning experiment.spawn, writing particles_<step>.ply every

@@ -61,8 +61,9 @@ void prepare_output_folder(const std::string& out, bool force, const std::vector
   spdlog::info("--force: cleared {} entries of the earlier run in {}", entries.size(), out);
 }
 
-RunContext::RunContext(const CommonOptions& o) : window_frames_(o.window_frames) {
-  exp_ = load_experiment(o.config, overrides(o));
+RunContext::RunContext(const CommonOptions& o) : RunContext(o, load_experiment(o.config, overrides(o))) {}
+
+RunContext::RunContext(const CommonOptions& o, Experiment e) : exp_(std::move(e)), window_frames_(o.window_frames) {
   device_ = resolve_device(exp_.device);
 
   out_ = o.out.empty() ? exp_.output.dir + "/" + fs::path(o.config).stem().string() + "-" + timestamp() : o.out;
@@ -70,7 +71,7 @@ RunContext::RunContext(const CommonOptions& o) : window_frames_(o.window_frames)
   std::error_code ec;
   fs::create_directories(out_, ec);
   if (ec) throw Error("cannot create the output folder " + out_ + ": " + ec.message());
-  log_to_file(out_path("log.txt"));
+  log_file_ = log_to_file(out_path("log.txt"));
   if (exp_.output.write_config) write_effective_config(exp_, out_path("config.yaml"));
   timer_ = std::make_unique<StageTimer>(device_);
   install_interrupt_handlers();
@@ -97,12 +98,14 @@ void RunContext::report_output_failure(const std::string& what) {
 }
 
 RunContext::~RunContext() {
-  if (!exp_.output.write_timings || !timer_ || timer_->rows().empty()) return;
-  try {
-    timer_->write_csv(out_path("timings.csv"));
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
+  if (exp_.output.write_timings && timer_ && !timer_->rows().empty()) {
+    try {
+      timer_->write_csv(out_path("timings.csv"));
+    } catch (const std::exception& e) {
+      spdlog::error("{}", e.what());
+    }
   }
+  if (log_file_) stop_log_file(log_file_);
 }
 
 int not_built(const std::string& command, const std::string& what) {

@@ -12,6 +12,7 @@
 #include "app/exit_codes.hpp"
 #include "config/experiment.hpp"
 #include "core/device.hpp"
+#include "core/log.hpp"
 #include "core/timing.hpp"
 
 namespace seamless::app {
@@ -39,7 +40,11 @@ class RunContext {
   // clears it), starts the log file, writes the effective config and installs the Ctrl-C / SIGTERM
   // handlers (core/interrupt.hpp) that the frame loops check.
   explicit RunContext(const CommonOptions& o);
+  // The same with an experiment the caller loaded (and adjusted) itself; o.config only names it.
+  RunContext(const CommonOptions& o, Experiment e);
   ~RunContext();
+  RunContext(const RunContext&) = delete;
+  RunContext& operator=(const RunContext&) = delete;
 
   const Experiment& experiment() const { return exp_; }
   Experiment& experiment() { return exp_; }
@@ -66,6 +71,7 @@ class RunContext {
   int window_frames_ = 0;
   int exit_code_ = kExitOk;
   std::unique_ptr<StageTimer> timer_;
+  std::shared_ptr<spdlog::sinks::sink> log_file_;
 };
 
 // An output folder holds one run's files only: when `out` holds any of `marks` (files an earlier

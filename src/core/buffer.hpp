@@ -27,6 +27,8 @@ bool is_pinned(const void* p);  // allocated by allocate_pinned and actually pag
 void copy_async(void* dst, Device dst_dev, const void* src, Device src_dev, std::size_t bytes, void* stream = nullptr);
 void fill_zero(void* p, Device d, std::size_t bytes);
 std::size_t bytes_in_use(Device d);  // live bytes allocated through Buffer on this device
+std::size_t peak_bytes(Device d);    // the most bytes_in_use(d) has been since the start or reset_peak(d)
+void reset_peak(Device d);           // the peak starts again from the bytes in use now
 }  // namespace memory
 
 template <class T>

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
@@ -18,6 +19,7 @@ struct Ledger {
   std::unordered_map<void*, std::size_t> sizes;
   std::unordered_set<void*> pinned;  // host allocations from cudaMallocHost (freed by cudaFreeHost)
   std::size_t bytes[2] = {0, 0};
+  std::size_t peak[2] = {0, 0};
 };
 Ledger& ledger() {
   static Ledger l;
@@ -27,7 +29,9 @@ void record(void* p, std::size_t bytes, Device d, bool pinned = false) {
   Ledger& l = ledger();
   std::lock_guard lock(l.mutex);
   l.sizes[p] = bytes;
-  l.bytes[static_cast<int>(d)] += bytes;
+  const int i = static_cast<int>(d);
+  l.bytes[i] += bytes;
+  l.peak[i] = std::max(l.peak[i], l.bytes[i]);
   if (pinned) l.pinned.insert(p);
 }
 // Forgets p; true when it was page-locked host memory.
@@ -149,6 +153,18 @@ std::size_t bytes_in_use(Device d) {
   Ledger& l = ledger();
   std::lock_guard lock(l.mutex);
   return l.bytes[static_cast<int>(d)];
+}
+
+std::size_t peak_bytes(Device d) {
+  Ledger& l = ledger();
+  std::lock_guard lock(l.mutex);
+  return l.peak[static_cast<int>(d)];
+}
+
+void reset_peak(Device d) {
+  Ledger& l = ledger();
+  std::lock_guard lock(l.mutex);
+  l.peak[static_cast<int>(d)] = l.bytes[static_cast<int>(d)];
 }
 
 }  // namespace seamless::memory

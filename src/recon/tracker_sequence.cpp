@@ -19,7 +19,7 @@ namespace seamless {
 
 // Where a frame's stages end on the device's timeline (TrackingSession::marks_).
 namespace {
-enum Mark { kStart, kPreprocessed, kTracked, kEnd, kMarks };
+enum Mark { kStart, kUploaded, kPreprocessed, kTracked, kFused, kEnd, kMarks };
 }  // namespace
 
 // The colour image goes up on a stream of its own: only fusion (and the RGB-D tracker's intensity)
@@ -132,6 +132,10 @@ void TrackingSession::upload(const RgbdFrame& frame) {
   if (colour && rgb_.width() != K_.width) rgb_ = Image<uchar3>(K_.width, K_.height, device_);
   if (colour) upload_colour(frame);
   if (!colour) rgb_ = Image<uchar3>();
+}
+
+void TrackingSession::preprocess() {
+  const bool colour = rgb_.width() == K_.width;  // upload() keeps rgb_ only for a matching colour image
   const Image<float>* intensity = nullptr;
   if (colour && p_.tracker.kind == "rgbd") {
     if (intensity_.width() != K_.width) intensity_ = Image<float>(K_.width, K_.height, device_);
@@ -166,7 +170,7 @@ void TrackingSession::join_colour() {
 
 void TrackingSession::update_reference(const SE3& pose) {
   if (volume_ && p_.tracker.mode == "frame_to_model") {
-    volume_->raycast(K_, pose, maps_);
+    volume_->raycast(K_, pose, maps_, p_.volume_stages);
     // The current pyramid is the frame just tracked at `pose`, the pose the raycast is seen from.
     const bool frame_colour = p_.tracker.photometric_reference == "frame";
     ref_.set_from_raycast(maps_, K_, pose, pyr_.levels(), p_.preprocess.pyramid_max_diff,
@@ -179,9 +183,10 @@ void TrackingSession::update_reference(const SE3& pose) {
 void TrackingSession::accept(const RgbdFrame& frame, const SE3& pose, FrameRecord& rec) {
   if (volume_) {
     join_colour();
-    volume_->integrate(depth_, rgb_, K_, pose);
+    volume_->integrate(depth_, rgb_, K_, pose, p_.volume_stages);
     rec.fused = true;
   }
+  marks_.mark(kFused);
   if (tracker_) update_reference(pose);
   if (odometry_) last_good_frame_ = host_copy(frame);
   prev_good_ = started_ ? last_good_ : pose;
@@ -271,7 +276,10 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
   marks_.mark(kStart);
   // External trackers read the host frame; our pyramid is needed only for the floor-plane gravity
   // of the first frame and for a volume to fuse into.
-  if (!odometry_ || !started_ || volume_) upload(frame);
+  const bool pyramid = !odometry_ || !started_ || volume_;
+  if (pyramid) upload(frame);
+  marks_.mark(kUploaded);
+  if (pyramid) preprocess();
   marks_.mark(kPreprocessed);
   const bool tracked = started_;
   if (!started_) {
@@ -290,10 +298,29 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
   join_colour();  // a lost frame's colour copy too: the caller may reuse the frame after we return
   marks_.mark(kEnd);
   rec.preprocess_ms = marks_.ms(kStart, kPreprocessed);
+  rec.upload_ms = marks_.ms(kStart, kUploaded);
   if (tracked) rec.track_ms = marks_.ms(kPreprocessed, kTracked);
-  if (rec.result.ok()) rec.fuse_ms = marks_.ms(kTracked, kEnd);  // accept() ran: fusion and the next reference
+  if (rec.result.ok()) {  // accept() ran: fusion and the next reference
+    rec.fuse_ms = marks_.ms(kTracked, kEnd);
+    rec.raycast_ms = marks_.ms(kFused, kEnd);
+  }
   rec.frame_ms = marks_.ms(kStart, kEnd);
+  if (p_.volume_stages) {
+    const std::size_t first_row = p_.volume_stages->rows().size();
+    p_.volume_stages->end_frame(rec.frame);
+    rec.allocate_ms = volume_allocate_ms(first_row);
+  }
   return rec;
+}
+
+// Allocation as Niessner et al. (2013, section 4) count it: inserting the frame's blocks and listing
+// the visible ones (every pass, when a full table or pool made the volume grow and repeat them).
+double TrackingSession::volume_allocate_ms(std::size_t first_row) const {
+  double ms = 0;
+  const auto& rows = p_.volume_stages->rows();
+  for (std::size_t i = first_row; i < rows.size(); ++i)
+    if (rows[i].stage == "allocate" || rows[i].stage == "visible") ms += rows[i].ms;
+  return ms;
 }
 
 void write_tracking_stats(const std::string& path, const std::vector<FrameRecord>& frames) {

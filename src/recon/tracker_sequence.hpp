@@ -6,6 +6,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -29,6 +30,10 @@ struct TrackSequenceParams {
   VolumeParams volume;
   std::int64_t max_frames = 0;  // 0 = all the source has
   bool write_files = true;      // trajectory.txt and tracking_stats.csv into out_dir
+  // When set, the volume's kernel steps (allocate, visible, fuse, remove_empty, raycast) are timed
+  // into it, one end_frame(frame index) a processed frame, and FrameRecord::allocate_ms is filled
+  // (`seamless bench pipeline`). Off in ordinary runs: on CUDA each step costs two more events.
+  StageTimer* volume_stages = nullptr;
 };
 
 // One frame's outcome, one row of tracking_stats.csv.
@@ -38,8 +43,12 @@ struct FrameRecord {
   TrackResult result;          // result.world_T_camera is the pose written for this frame
   bool fused = false;          // integrated into the volume (never when tracking was lost)
   // Times on the device's timeline (CUDA events; the host clock on the CPU): preprocess includes
-  // the upload, fuse the raycast of the next reference view.
+  // the upload, fuse the raycast of the next reference view (the columns of tracking_stats.csv).
   double preprocess_ms = 0, track_ms = 0, fuse_ms = 0, frame_ms = 0;
+  // Parts of those: upload_ms of preprocess_ms (the frame's host-to-device copies), raycast_ms of
+  // fuse_ms (the next reference view: raycast and its pyramid), allocate_ms of fuse_ms (block
+  // allocation and the visible-block list; NaN unless TrackSequenceParams::volume_stages is set).
+  double upload_ms = 0, raycast_ms = 0, allocate_ms = std::numeric_limits<double>::quiet_NaN();
 };
 
 // The per-frame state machine. World frame: the first camera, rotated so that gravity is world -y
@@ -65,12 +74,14 @@ class TrackingSession {
  private:
   bool uses_volume() const;
   void upload(const RgbdFrame& frame);
+  void preprocess();  // the pyramid (and intensity) of the uploaded frame
   void upload_colour(const RgbdFrame& frame);
   void join_colour();  // the default stream waits for the colour upload
   void first_frame(const RgbdFrame& frame, FrameRecord& rec);
   TrackResult track_frame(const RgbdFrame& frame);
   TrackResult track_external(const RgbdFrame& frame);
   void accept(const RgbdFrame& frame, const SE3& pose, FrameRecord& rec);
+  double volume_allocate_ms(std::size_t first_row) const;
   void update_reference(const SE3& pose);
 
   TrackSequenceParams p_;
