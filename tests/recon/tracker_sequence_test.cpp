@@ -151,8 +151,8 @@ TEST(TrackSequence, UnavailableTrackerSaysSo) {
   }
 }
 
-// Our best tracker on freiburg1 (the tracker section of configs/tum_fr1.yaml): RGB-D frame-to-model
-// with robust self-balancing weights, the Kinect's depth-squared noise, a colour row for every
+// The tracker section of configs/tum_fr1.yaml before issue 24 (it is frame to frame now: see
+// docs/TRACKING.md, "Issue 24", and ctest compare_trackers_fr1_rpy): RGB-D frame-to-model with robust self-balancing weights, the Kinect's depth-squared noise, a colour row for every
 // visible pixel and the last frame's image as the photometric reference, a constant-velocity
 // prediction, photometric weight 1. Volume at 1 cm (see default_params).
 TrackSequenceParams best_tum_params() {
