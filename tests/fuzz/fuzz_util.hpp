@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -61,6 +62,11 @@ inline std::vector<std::string_view> parts(const std::uint8_t* data, std::size_t
   out.resize(n);
   return out;
 }
+
+// A property a reader's result must have and did not (not a seamless::Error: it is a bug).
+struct Violation : std::logic_error {
+  using std::logic_error::logic_error;
+};
 
 // Runs f; a seamless::Error (bad input, with a message) is the expected outcome of most inputs.
 // Anything else escapes and libFuzzer reports it as a crash: a reader must never let a std::
