@@ -48,3 +48,29 @@ TEST(FuzzRegressions, Png) { EXPECT_GT(run_all("png", seamless::fuzz::png), 0u);
 TEST(FuzzRegressions, Jpeg) { EXPECT_GT(run_all("jpeg", seamless::fuzz::jpeg), 0u); }
 TEST(FuzzRegressions, Ply) { EXPECT_GT(run_all("ply", seamless::fuzz::ply), 0u); }
 TEST(FuzzRegressions, Obj) { EXPECT_GT(run_all("obj", seamless::fuzz::obj), 0u); }
+
+// Image headers that claim more pixels than any camera gives are rejected before anything is
+// allocated (they made the decoders ask for 10-20 GB: out of memory under the fuzzer).
+TEST(FuzzRegressions, HugeImageHeadersAreInputErrors) {
+  const fs::path dir = fs::path(SEAMLESS_FUZZ_DIR) / "regressions";
+  const std::string png = (dir / "png" / "header_claims_100000x100000").string();
+  const std::string jpg = (dir / "jpeg" / "header_claims_60000x60000").string();
+  for (auto read : {+[](const std::string& p) { (void)seamless::read_png_u16(p); },
+                    +[](const std::string& p) { (void)seamless::read_colour_image(p); }}) {
+    try {
+      read(png);
+      ADD_FAILURE() << "no error for " << png;
+    } catch (const seamless::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("is 100000x100000 pixels, more than the readers decode"), std::string::npos)
+          << e.what();
+    }
+  }
+  try {
+    (void)seamless::read_jpeg_rgb(jpg);
+    ADD_FAILURE() << "no error for " << jpg;
+  } catch (const seamless::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("is 60000x60000 pixels"), std::string::npos) << e.what();
+  }
+  // png_info reads the header only: it reports the size as it is.
+  EXPECT_EQ(seamless::png_info(png).width, 100000);
+}
