@@ -147,7 +147,10 @@ SEAMLESS_HD inline F slab_gap(F v, int i, float cs, float pad) {
 // larger by pad (for_each_run_in_radius). F, I: float and int, or the CPU's SIMD lanes.
 template <class F, class I>
 SEAMLESS_HD inline void row_cells(const GridSpec& g, F px, I cx, float R2, float pad, F d2, I& lo, I& hi) {
-  const F rx = fsqrt(R2 - d2) + pad;
+  // Lanes of rows the sphere misses (d2 >= R2, skipped by the callers) take a square root of 0, not
+  // of a negative number: a NaN there made floor_int's conversion overflow (UBSan).
+  const F q = R2 - d2;
+  const F rx = fsqrt(select(q > 0.f, q, F(0.f))) + pad;
   const I a = floor_int((px - rx) * g.inv_cell), b = floor_int((px + rx) * g.inv_cell);
   lo = select(a > cx - GridSpec::reach, a, I(cx - GridSpec::reach));
   hi = select(b < cx + GridSpec::reach, b, I(cx + GridSpec::reach));

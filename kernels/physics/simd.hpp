@@ -134,6 +134,17 @@ SEAMLESS_SIMD_INL i8 pack_lanes(int bits) {
   std::memcpy(&r, kPack.lane[bits], sizeof r);
   return r;
 }
+// Lane l of the result is v[idx[l]]: GCC's __builtin_shuffle with a run-time index vector; Clang
+// (the fuzzing build, tests/fuzz) has no such builtin and gets the same lanes by a loop.
+SEAMLESS_SIMD_INL i8 permute(i8 v, i8 idx) {
+#if defined(__clang__)
+  i8 r;
+  for (int l = 0; l < kWidth; ++l) r[l] = v[idx[l] & (kWidth - 1)];
+  return r;
+#else
+  return __builtin_shuffle(v, idx);
+#endif
+}
 
 struct v3 {
   vf x, y, z;

@@ -1571,7 +1571,7 @@ int scan_candidates_simd(const SimViews& S, vec3 p, float R2, int s, const int* 
       const simd::vm ok = (length2(pv - q) < simd::vf(R2)) & simd::vm{jv != self};
       const int m = simd::bits(ok);
       if (cnt + simd::kWidth <= cap) {
-        const simd::i8 kept = __builtin_shuffle(jv, simd::pack_lanes(m));
+        const simd::i8 kept = simd::permute(jv, simd::pack_lanes(m));
         std::memcpy(list + cnt, &kept, sizeof kept);
         cnt += simd::kPack.count[m];
       } else {
@@ -1731,7 +1731,7 @@ bool neighbors_tile(const SimViews& S, int s0) {
           if (c + simd::kWidth <= cap) {
             simd::i8 j;
             std::memcpy(&j, cand + k + q, sizeof j);
-            const simd::i8 kept = __builtin_shuffle(j, simd::pack_lanes(b));
+            const simd::i8 kept = simd::permute(j, simd::pack_lanes(b));
             std::memcpy(list[l] + c, &kept, sizeof kept);
             c += simd::kPack.count[b];
           } else {

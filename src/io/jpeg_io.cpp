@@ -75,6 +75,11 @@ Image<uchar3> read_jpeg_rgb(const std::string& path) {
   jpeg_create_decompress(d.get());
   jpeg_stdio_src(d.get(), f.get());
   jpeg_read_header(d.get(), TRUE);
+  if (static_cast<std::int64_t>(d->image_width) * d->image_height > kMaxImagePixels) {
+    const std::int64_t w = d->image_width, h = d->image_height;
+    jpeg_destroy_decompress(d.get());
+    check_image_size(w, h, "JPEG file '" + path + "'");
+  }
   d->out_color_space = JCS_RGB;  // libjpeg converts YCbCr and greyscale; CMYK is an error above
   jpeg_start_decompress(d.get());
   if (const int channels = d->output_components; channels != 3) {  // not with JCS_RGB; guards the rows below

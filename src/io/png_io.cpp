@@ -53,6 +53,17 @@ std::string describe(const PngInfo& i) {
   return std::to_string(i.bit_depth) + "-bit " + kind[i.channels < 5 ? i.channels : 0];
 }
 
+}  // namespace
+
+void check_image_size(std::int64_t width, std::int64_t height, const std::string& what) {
+  if (width <= 0 || height <= 0 || width * height > kMaxImagePixels)
+    throw InputError(what + " is " + std::to_string(width) + "x" + std::to_string(height) +
+                     " pixels, more than the readers decode (" + std::to_string(kMaxImagePixels) +
+                     "): a corrupt header?");
+}
+
+namespace {
+
 // Chooses libpng transforms for `want`; returns a message when the file cannot be read that way.
 std::string set_transforms(png_structp png, int color_type, int bit_depth, Want want, const PngInfo& info) {
   bool gray = color_type == PNG_COLOR_TYPE_GRAY;
@@ -93,6 +104,10 @@ void read_png(const std::string& path, Want want, State* s) {
   s->info.height = static_cast<int>(png_get_image_height(png, info));
   s->info.bit_depth = bit_depth;
   s->info.channels = color_type == PNG_COLOR_TYPE_PALETTE ? 3 : png_get_channels(png, info);
+  if (want != Want::Info && static_cast<std::int64_t>(s->info.width) * s->info.height > kMaxImagePixels) {
+    png_destroy_read_struct(&png, &info, nullptr);
+    check_image_size(s->info.width, s->info.height, "PNG file '" + path + "'");
+  }
   if (want != Want::Info) s->format_problem = set_transforms(png, color_type, bit_depth, want, s->info);
   if (want != Want::Info && s->format_problem.empty()) {
     png_read_update_info(png, info);

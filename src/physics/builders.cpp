@@ -1,6 +1,8 @@
 #include "physics/builders.hpp"
 
 #include <algorithm>
+#include <charconv>
+#include <climits>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -258,30 +260,58 @@ struct ObjMesh {
   std::vector<int3> f;
 };
 
+// One vertex reference of an OBJ face ("7", "7/1", "-2//3") as a 0-based index: 1-based, or
+// negative, counted back from the last vertex defined so far (`defined`). A positive index is
+// checked against all the file's vertices once they are read.
+long long obj_index(const std::string& tok, std::size_t defined, const std::string& where) {
+  const std::string num = tok.substr(0, tok.find('/'));
+  long long i = 0;
+  const auto [end, ec] = std::from_chars(num.data(), num.data() + num.size(), i);
+  if (num.empty() || ec != std::errc() || end != num.data() + num.size() || i == 0)
+    throw InputError(where + ": face vertex '" + tok + "' is not a vertex number (1, 2, ... or -1, -2, ...)");
+  if (i > 0) return i - 1;
+  if (-i > static_cast<long long>(defined))
+    throw InputError(where + ": face vertex " + tok + " counts back past the " + std::to_string(defined) +
+                     " vertices defined before it");
+  return static_cast<long long>(defined) + i;
+}
+
 ObjMesh read_obj(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw InputError("cannot open mesh file '" + path + "' (spawn rigid, shape: mesh); check the path");
   ObjMesh m;
+  std::vector<int> face_line;  // the line of each triangle, for the index check below
   std::string line;
-  while (std::getline(in, line)) {
+  for (int n = 1; std::getline(in, line); ++n) {
+    const std::string where = "mesh file '" + path + "' line " + std::to_string(n);
     std::istringstream ls(line);
     std::string tag;
     ls >> tag;
     if (tag == "v") {
       vec3 p{};
-      ls >> p.x >> p.y >> p.z;
+      if (!(ls >> p.x >> p.y >> p.z) || !std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+        throw InputError(where + ": a vertex needs three finite numbers ('v x y z'), got '" + line + "'");
       m.v.push_back(p);
     } else if (tag == "f") {
-      std::vector<int> idx;
+      std::vector<long long> idx;
       std::string tok;
-      while (ls >> tok) {
-        int i = std::stoi(tok.substr(0, tok.find('/')));
-        idx.push_back(i < 0 ? static_cast<int>(m.v.size()) + i : i - 1);
+      while (ls >> tok) idx.push_back(obj_index(tok, m.v.size(), where));
+      for (std::size_t k = 2; k < idx.size(); ++k) {
+        m.f.push_back({static_cast<int>(std::min<long long>(idx[0], INT_MAX)),
+                       static_cast<int>(std::min<long long>(idx[k - 1], INT_MAX)),
+                       static_cast<int>(std::min<long long>(idx[k], INT_MAX))});
+        face_line.push_back(n);
       }
-      for (std::size_t k = 2; k < idx.size(); ++k) m.f.push_back({idx[0], idx[k - 1], idx[k]});
     }
   }
   if (m.v.empty() || m.f.empty()) throw InputError("mesh file '" + path + "' has no triangles (expected OBJ 'v' and 'f' lines)");
+  const int nv = static_cast<int>(std::min<std::size_t>(m.v.size(), INT_MAX));
+  for (std::size_t t = 0; t < m.f.size(); ++t)
+    for (int i : {m.f[t].x, m.f[t].y, m.f[t].z})
+      if (i >= nv)
+        throw InputError("mesh file '" + path + "' line " + std::to_string(face_line[t]) + ": face vertex " +
+                         std::to_string(static_cast<long long>(i) + 1) + " does not exist (the file has " +
+                         std::to_string(m.v.size()) + " vertices)");
   return m;
 }
 

@@ -122,9 +122,10 @@ std::vector<HorizontalSurface> find_horizontal_surfaces(const Mesh& mesh, vec3 u
   for (const auto& [key, c] : cells) {
     const auto [i, j, k] = key;
     const float h = static_cast<float>(c.area_h / c.area);
+    const int component = c.component;  // a lambda may not capture a structured binding before Clang 16
     auto open = [&](int ci, int cj) {  // this column is the surface's and nothing stands on it
       auto o = owners.find({ci, cj});
-      if (o == owners.end() || !o->second.count(c.component)) return false;
+      if (o == owners.end() || !o->second.count(component)) return false;
       auto col = columns.find({ci, cj});
       if (col == columns.end()) return true;
       for (float vh : col->second)

@@ -32,6 +32,7 @@ const char* to_string(TrackStatus s) {
     case TrackStatus::implausible_jump: return "implausible_jump";
     case TrackStatus::degenerate: return "degenerate";
     case TrackStatus::no_reference: return "no_reference";
+    case TrackStatus::relocalisation_rejected: return "relocalisation_rejected";
   }
   return "?";
 }

@@ -63,6 +63,9 @@ enum class TrackStatus {
   implausible_jump,  // more motion than tracker.max_translation_jump / max_rotation_jump_deg
   degenerate,        // the 6x6 system is singular or worse conditioned than tracker.max_condition
   no_reference,      // nothing to align to (first frame, or no ground truth for this frame)
+  // after lost frames: the estimate moved farther than the time lost allows, or fits the model
+  // worse than the good frames did (tracker.relocalise_*); the next frame tries again
+  relocalisation_rejected,
 };
 const char* to_string(TrackStatus s);
 

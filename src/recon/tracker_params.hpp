@@ -42,6 +42,15 @@ struct TrackerParams {
   bool constant_velocity = false;         // start each frame from the last motion instead of the last pose
   float max_translation_jump = 0.3f;      // metres per frame
   float max_rotation_jump_deg = 30.f;     // degrees per frame
+  // Relocalisation: the first frame tracked after lost ones is accepted only when its pose is within
+  // what a handheld camera can move in the time since the last good frame, and its residual against
+  // the model is within relocalise_max_residual_ratio of the recent good frames' (docs/TRACKING.md,
+  // "Relocalisation"). The speeds are above the fastest handheld motion of the TUM benchmark: its
+  // freiburg1 sequences average at most 0.43 m/s (fr1/desk2) and 50 deg/s (fr1/rpy) (Sturm et al.
+  // 2012, Table I), and fr1/rpy peaks at ~6 degrees in one 1/30 s frame (180 deg/s).
+  float relocalise_max_speed = 1.0f;                // m/s
+  float relocalise_max_angular_speed_deg = 180.f;   // deg/s
+  float relocalise_max_residual_ratio = 2.0f;
   std::string gravity = "auto";
   vec3 fixed_gravity{0.f, 1.f, 0.f};      // camera frame (y down), used when gravity: fixed
 
@@ -98,6 +107,18 @@ struct TrackerParams {
       Range{0.0, 100.0});
     v("max_rotation_jump_deg", max_rotation_jump_deg, "tracking is lost above this per-frame rotation, degrees",
       Range{0.0, 180.0});
+    v("relocalise_max_speed", relocalise_max_speed,
+      "after lost frames, a frame is accepted only if its pose moved at most this speed (m/s) times the time "
+      "since the last good frame, plus 2 cm",
+      Range{0.0, 100.0});
+    v("relocalise_max_angular_speed_deg", relocalise_max_angular_speed_deg,
+      "after lost frames, a frame is accepted only if it turned at most this (deg/s) times the time since the "
+      "last good frame, plus 2 degrees",
+      Range{0.0, 100000.0});
+    v("relocalise_max_residual_ratio", relocalise_max_residual_ratio,
+      "after lost frames, a frame is accepted only if its residual against the model is at most this multiple "
+      "of the median of the last 10 good frames' (0: no residual test)",
+      Range{0.0, 1000.0});
     v("gravity", gravity, "where 'down' comes from (auto: accelerometer if present, else floor plane)",
       Choices{"auto", "accelerometer", "floor", "fixed", "none"});
     v("fixed_gravity", fixed_gravity, "down direction in the first camera frame (gravity: fixed)");

@@ -1,6 +1,7 @@
 #include "recon/tracker_sequence.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
@@ -189,8 +190,10 @@ void TrackingSession::accept(const RgbdFrame& frame, const SE3& pose, FrameRecor
   marks_.mark(kFused);
   if (tracker_) update_reference(pose);
   if (odometry_) last_good_frame_ = host_copy(frame);
-  prev_good_ = started_ ? last_good_ : pose;
+  // After lost frames the motion since prev_good_ spans all of them: no velocity to extrapolate.
+  prev_good_ = started_ && lost_run_ == 0 ? last_good_ : pose;
   last_good_ = pose;
+  last_good_time_ = frame.timestamp;
 }
 
 void TrackingSession::first_frame(const RgbdFrame& frame, FrameRecord& rec) {
@@ -217,20 +220,87 @@ TrackResult TrackingSession::track_frame(const RgbdFrame& frame) {
     return r;  // no ground truth for this frame: reported as no_reference
   }
   if (odometry_) return track_external(frame);
+  if (lost_run_ > 0) return relocalise(frame);
   // KinectFusion starts from the last pose; a constant-velocity prediction helps fast motion.
-  SE3 initial = p_.tracker.constant_velocity ? last_good_ * (prev_good_.inverse() * last_good_) : last_good_;
+  SE3 initial = p_.tracker.constant_velocity ? last_good_ * last_motion(1) : last_good_;
   r = tracker_->track(pyr_, ref_, initial);
   if (p_.tracker.constant_velocity && !r.ok()) {
     // The motion model may have overshot (the camera stopped): retry from the last pose.
     TrackResult r2 = tracker_->track(pyr_, ref_, last_good_);
     if (r2.ok()) r = r2;
   }
-  // The overlap of consecutive views changes gradually with motion; a sudden collapse of the inlier
-  // ratio means the view changed place (a cut), even if some floor or wall still fits.
-  if (r.ok() && r.inlier_ratio < p_.tracker.min_inlier_ratio_vs_last * last_inlier_ratio_)
-    r.status = TrackStatus::too_few_inliers;
+  check_cut(r);
   if (r.ok()) last_inlier_ratio_ = r.inlier_ratio;
   return r;
+}
+
+// The overlap of consecutive views changes gradually with motion; a sudden collapse of the inlier
+// ratio means the view changed place (a cut), even if some floor or wall still fits.
+void TrackingSession::check_cut(TrackResult& r) const {
+  if (r.ok() && r.inlier_ratio < p_.tracker.min_inlier_ratio_vs_last * last_inlier_ratio_)
+    r.status = TrackStatus::too_few_inliers;
+}
+
+SE3 TrackingSession::last_motion(std::int64_t frames) const {
+  const SE3 step = prev_good_.inverse() * last_good_;
+  SE3 m = SE3::identity();
+  for (std::int64_t i = 0; i < frames; ++i) m = m * step;
+  return m;
+}
+
+namespace {
+// Relocalisation extrapolates the last motion over at most this many frames (half a second at 30 Hz).
+constexpr std::int64_t kMaxExtrapolatedFrames = 15;
+}  // namespace
+
+// Frames tracked after lost ones (lost_run_ of them since the last good frame): the camera is
+// searched for where it was (a covered camera held still) and where its last motion, repeated for
+// every frame since, took it (one that kept turning: fr1_rpy turns 2.6 degrees a frame, 15 degrees
+// over a 5-frame gap, beyond the basin of ICP from the old pose). Motion is extrapolated over at
+// most half a second, beyond which a hand's motion is no longer predictable. Each estimate must
+// pass check_relocalisation; the one that fits the model best is kept.
+TrackResult TrackingSession::relocalise(const RgbdFrame& frame) {
+  std::vector<SE3> guesses{last_good_};
+  const SE3 step = last_motion(1);
+  const bool moving = length(step.t) > 0 || rotation_angle_deg(step.R) > 0;
+  if (moving && lost_run_ + 1 <= kMaxExtrapolatedFrames) guesses.push_back(last_good_ * last_motion(lost_run_ + 1));
+  TrackResult best;
+  for (std::size_t i = 0; i < guesses.size(); ++i) {
+    TrackResult r = tracker_->track(pyr_, ref_, guesses[i]);
+    check_cut(r);
+    if (r.ok()) check_relocalisation(frame, r);
+    const bool better = r.ok() != best.ok() ? r.ok() : r.residual_rms < best.residual_rms;
+    if (i == 0 || better) best = r;
+  }
+  if (best.ok()) last_inlier_ratio_ = best.inlier_ratio;
+  return best;
+}
+
+// After lost frames the tracker searches from the last good pose against the last good view, and
+// may settle in a wrong minimum that still passes the per-frame tests: five covered frames of
+// fr1_rpy were followed by a 23 cm / 11 degree "recovery" marked ok while the camera had moved
+// 1.6 cm, and every later frame was offset (issue 20). Two independent tests reject such a frame
+// (it is then lost like the others, and the next frame tries again):
+// - the pose moved no farther from the last good one than a handheld camera can in the time lost
+//   (tracker.relocalise_max_speed / _angular_speed_deg, TrackerParams says why those speeds);
+// - the frame fits the model about as well as the good frames did: a wrong minimum leaves
+//   residuals near the correspondence threshold, a right one at the sensor's noise, so its RMS
+//   residual may be at most relocalise_max_residual_ratio times the median of the recent good
+//   frames' (2: twice the noise level; the false recovery above had 4 times).
+void TrackingSession::check_relocalisation(const RgbdFrame& frame, TrackResult& r) const {
+  // The margins cover the tracking error of the last good pose and of this one: a few millimetres
+  // and a fraction of a degree a frame on freiburg1 (docs/TRACKING.md), five times over.
+  constexpr double kMarginM = 0.02, kMarginDeg = 2.0;
+  constexpr double kFrameRate = 30.0;  // timestamps that do not advance: the Kinect's rate is assumed
+  double elapsed = frame.timestamp - last_good_time_;
+  if (!(elapsed > 0)) elapsed = static_cast<double>(lost_run_ + 1) / kFrameRate;
+  const SE3 jump = last_good_.inverse() * r.world_T_camera;
+  const bool too_far = length(jump.t) > p_.tracker.relocalise_max_speed * elapsed + kMarginM ||
+                       rotation_angle_deg(jump.R) > p_.tracker.relocalise_max_angular_speed_deg * elapsed + kMarginDeg;
+  const double typical = good_residuals_.empty() ? 0.0 : median(good_residuals_);
+  const bool misfit = p_.tracker.relocalise_max_residual_ratio > 0 && typical > 0 && std::isfinite(r.residual_rms) &&
+                      r.residual_rms > p_.tracker.relocalise_max_residual_ratio * typical;
+  if (too_far || misfit) r.status = TrackStatus::relocalisation_rejected;
 }
 
 // The relative pose of an external library, chained onto the last good pose. The prediction is
@@ -243,7 +313,10 @@ TrackResult TrackingSession::track_external(const RgbdFrame& frame) {
   r.world_T_camera = last_good_;
   r.residual_rms = r.inlier_ratio = r.condition = nan;
   std::optional<SE3> guess;
-  if (p_.tracker.constant_velocity) guess = prev_good_.inverse() * last_good_;
+  if (lost_run_ > 0 && lost_run_ + 1 <= kMaxExtrapolatedFrames)
+    guess = last_motion(lost_run_ + 1);  // where the last motion took it, then where it was (relocalise())
+  else if (p_.tracker.constant_velocity)
+    guess = last_motion(1);
   std::optional<external::OdometryEstimate> e = odometry_->prev_T_cur(last_good_frame_, frame, guess);
   if (!e && guess) {
     guess.reset();
@@ -264,6 +337,7 @@ TrackResult TrackingSession::track_external(const RgbdFrame& frame) {
   bool implausible = r.translation_jump > p_.tracker.max_translation_jump ||
                      r.rotation_jump_deg > p_.tracker.max_rotation_jump_deg;
   r.status = implausible ? TrackStatus::implausible_jump : TrackStatus::ok;
+  if (r.ok() && lost_run_ > 0) check_relocalisation(frame, r);
   return r;
 }
 
@@ -289,9 +363,21 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
   }
   marks_.mark(kTracked);
   if (rec.result.ok()) {
+    if (lost_run_ > 0)
+      spdlog::info("frame {}: relocalised after {} lost frames, {:.3f} m / {:.1f} deg from the last good pose",
+                   frame.index, lost_run_, length((last_good_.inverse() * rec.result.world_T_camera).t),
+                   rotation_angle_deg((last_good_.inverse() * rec.result.world_T_camera).R));
     accept(frame, rec.result.world_T_camera, rec);
+    lost_run_ = 0;
+    // The relocalisation test's reference: residuals of frames tracked against the model (the
+    // first frame has none; external trackers may report NaN).
+    if (tracked && rec.result.residual_rms > 0 && std::isfinite(rec.result.residual_rms)) {
+      if (good_residuals_.size() == 10) good_residuals_.erase(good_residuals_.begin());
+      good_residuals_.push_back(rec.result.residual_rms);
+    }
   } else {
     ++lost_;
+    ++lost_run_;
     rec.result.world_T_camera = last_good_;  // the estimate was not trusted: keep the last good pose
   }
   started_ = true;

@@ -53,7 +53,9 @@ struct FrameRecord {
 
 // The per-frame state machine. World frame: the first camera, rotated so that gravity is world -y
 // when tracker.gravity finds it. A lost frame keeps the last good pose, is not fused, and the
-// reference stays the last good view, so the next frames try to recover against it.
+// reference stays the last good view, so the next frames try to recover against it: from the last
+// good pose (the motion model is stale), and accepted only when the pose moved no more than the
+// time lost allows and the frame fits the model as well as the good frames did.
 // External trackers (registry entries with make_external: OpenCV, PCL) are frame to frame whatever
 // tracker.mode says: their relative poses prev_T_cur are chained from the same world frame, against
 // the last good frame, and a frame the library fails on is lost like ours (docs/TRACKING.md).
@@ -80,6 +82,10 @@ class TrackingSession {
   void first_frame(const RgbdFrame& frame, FrameRecord& rec);
   TrackResult track_frame(const RgbdFrame& frame);
   TrackResult track_external(const RgbdFrame& frame);
+  TrackResult relocalise(const RgbdFrame& frame);
+  void check_cut(TrackResult& r) const;
+  void check_relocalisation(const RgbdFrame& frame, TrackResult& r) const;
+  SE3 last_motion(std::int64_t frames) const;  // the last frame-to-frame motion, repeated `frames` times
   void accept(const RgbdFrame& frame, const SE3& pose, FrameRecord& rec);
   double volume_allocate_ms(std::size_t first_row) const;
   void update_reference(const SE3& pose);
@@ -105,7 +111,10 @@ class TrackingSession {
   SE3 last_good_ = SE3::identity(), prev_good_ = SE3::identity();
   SE3 world_T_gt_ = SE3::identity();  // ground_truth tracker: maps the source's poses into our world
   std::int64_t lost_ = 0;
+  std::int64_t lost_run_ = 0;     // consecutive lost frames just before this one: > 0 means relocalising
+  double last_good_time_ = 0;     // timestamp of the last good frame
   double last_inlier_ratio_ = 0;  // of the last frame tracked (not the first), 0 before
+  std::vector<double> good_residuals_;  // residual_rms of the last good tracked frames (at most 10)
 };
 
 struct TrackSequenceResult {

@@ -6,7 +6,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 
+#include "core/error.hpp"
+#include "physics/builders.hpp"
 #include "physics/particle_solver.hpp"
 #include "physics_test_util.hpp"
 
@@ -136,6 +139,60 @@ TEST(PhysicsFriction, CubeOnIncline) {
     const double expect = g * (std::sin(th) - mu * std::cos(th));
     std::printf("incline mu %.1f: acceleration %.4f m/s^2, expected %.4f\n", mu, slide.accel, expect);
     EXPECT_NEAR(slide.accel, expect, 0.1 * expect);
+  }
+}
+
+// The OBJ reader of rigid mesh bodies (issue 20: fuzzing found std::stoi's exception escape and
+// face indices past the vertices read out of bounds). A valid file with every kind of face
+// reference gives a solid; each bad file is an InputError naming the file, line and problem.
+std::string write_obj(const std::string& name, const std::string& text) {
+  const std::string path = std::string(SEAMLESS_BUILD_DIR) + "/" + name;
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  std::fputs(text.c_str(), f);
+  std::fclose(f);
+  return path;
+}
+
+TEST(ObjReader, FaceReferencesOfEveryKindMakeAClosedCube) {
+  // A unit cube: quads of 1-based, "i/t", "i//n" and negative (relative) references.
+  const std::string cube =
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 1\n"
+      "f 1 3 4 2\nf 5/1 6/1 8/1 7/1\nf 1//1 2//1 6//1 5//1\nf -6 -5 -1 -2\nf 1 5 7 3\nf 2 4 8 6\n";
+  // Fitted into 0.5 m at 0.05 m: the cube spans [-0.25, 0.25] on each axis and the cell centres
+  // are multiples of 0.05. Every centre strictly inside (|coordinate| <= 0.2: 9 x 9 x 9) is
+  // filled; those on the faces (+-0.25) may or may not be (ray parity on a face): 729 to 1331.
+  const std::vector<vec3> cells = voxelize_obj(write_obj("cube.obj", cube), 0.05f, vec3{0.5f, 0.5f, 0.5f});
+  for (const vec3& c : cells) {
+    EXPECT_LE(std::fabs(c.x), 0.25f + 1e-5f);
+    EXPECT_LE(std::fabs(c.y), 0.25f + 1e-5f);
+    EXPECT_LE(std::fabs(c.z), 0.25f + 1e-5f);
+  }
+  EXPECT_GE(cells.size(), 729u);
+  EXPECT_LE(cells.size(), 1331u);
+}
+
+TEST(ObjReader, BadFilesSayWhatAndWhere) {
+  const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  struct Case {
+    std::string text, message;
+  } cases[] = {
+      {tri + "f 1 2 x\n", "line 4: face vertex 'x' is not a vertex number"},
+      {tri + "f 1 2 99999999999999999999\n", "is not a vertex number"},
+      {tri + "f 1 2 0\n", "face vertex '0' is not a vertex number"},
+      {tri + "f 1 2 4\n", "line 4: face vertex 4 does not exist (the file has 3 vertices)"},
+      {tri + "f -1 -2 -4\n", "line 4: face vertex -4 counts back past the 3 vertices"},
+      {"v 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "line 1: a vertex needs three finite numbers"},
+      {tri, "has no triangles"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.text);
+    try {
+      voxelize_obj(write_obj("bad.obj", c.text), 0.05f, vec3{0.5f, 0.5f, 0.5f});
+      ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(c.message), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("bad.obj"), std::string::npos) << e.what();
+    }
   }
 }
 

@@ -1,0 +1,7 @@
+// libFuzzer's entry for the target `tum` (fuzz_targets.hpp).
+#include "fuzz_targets.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  seamless::fuzz::tum(data, size);
+  return 0;
+}
