@@ -101,8 +101,13 @@ SEAMLESS_HD inline float akinci_spline(float r, float h) { return SphKernel::mak
 
 // ---- neighbour grid -------------------------------------------------------------------------
 // floor as an int without a libm call on the CPU (x86-64 without SSE4.1 calls floorf); equal to
-// static_cast<int>(floorf(x)) wherever that is defined.
+// static_cast<int>(floorf(x)) wherever that is defined. x is first held within +-kFloorIntRange
+// (a NaN goes to its lower end): a particle that has flown off to infinity, or a NaN, gets a far
+// cell instead of a conversion whose result is undefined (UBSan: the cell index INT_MIN, then
+// INT_MIN - 2 in the neighbour search). Cells are wrapped by the periodic grid anyway.
+constexpr float kFloorIntRange = 1e9f;
 SEAMLESS_HD inline int floor_int(float x) {
+  x = x >= -kFloorIntRange ? (x <= kFloorIntRange ? x : kFloorIntRange) : -kFloorIntRange;
   int i = static_cast<int>(x);
   return static_cast<float>(i) > x ? i - 1 : i;
 }
