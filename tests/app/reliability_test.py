@@ -125,13 +125,17 @@ class ExitCodes(unittest.TestCase):
         # Found 3: 9 of 10 frames lost at depth_scale 1000 (TUM is 5000), exit 0. The median depth of
         # 6 m passes the reader's 0.2-10 m plausibility check. The depth-scale check (the Kinect's
         # disparity steps, issue 17) now stops it as a config error naming the right scale; with that
-        # check off, tracking is what tells, and the lost frames give their own exit code.
+        # check off, tracking is what tells, and the lost frames give their own exit code. Frame to
+        # model: depth five times too far falls beyond volume.max_depth, the model stays empty and the
+        # frames are lost (frame to frame, configs/tum_fr1.yaml's tracker since issue 24, tracks the
+        # scaled room consistently and loses nothing; only the depth-scale check can tell there).
+        fm = "tracker.mode=frame_to_model"
         with tempfile.TemporaryDirectory() as d:
             out = os.path.join(d, "trk")
             r = seamless(*track_tum(TUM, out, "frames=10", "input.depth_scale=1000"))
             self.assertEqual(r.returncode, CONFIG, r.stderr)
             self.assertIn("set input.depth_scale: 5000", r.stderr)
-            r = seamless(*track_tum(TUM, out, "frames=10", "input.depth_scale=1000", "input.check_depth_scale=false"),
+            r = seamless(*track_tum(TUM, out, "frames=10", "input.depth_scale=1000", "input.check_depth_scale=false", fm),
                          "--force")
             self.assertEqual(r.returncode, LOST, r.stderr)
             self.assertIn("more than output.max_lost_fraction = 0.2", r.stderr)
@@ -140,7 +144,7 @@ class ExitCodes(unittest.TestCase):
             self.assertEqual(len(stats), 10)  # the outputs are written all the same
             self.assertGreater(sum(s["status"] != "ok" for s in stats), 2)
             # The threshold is the key's: at 1 the same run passes.
-            r = seamless(*track_tum(TUM, out, "frames=10", "input.depth_scale=1000", "input.check_depth_scale=false",
+            r = seamless(*track_tum(TUM, out, "frames=10", "input.depth_scale=1000", "input.check_depth_scale=false", fm,
                                     "output.max_lost_fraction=1"), "--force")
             self.assertEqual(r.returncode, 0, r.stderr)
 
