@@ -31,18 +31,21 @@ bool along_path(const std::vector<vec3>& path, float s, vec3* at, vec3* facing) 
 // A person of height H walking: one gait cycle (two steps of 0.4 H) per 0.8 H travelled; legs
 // swing +-0.45 rad about the hips, arms +-0.35 rad in opposition (a plain pendulum gait, enough to
 // give the depth camera moving limbs). Proportions after the usual artists' canon.
+// Appends one capsule; the renderer takes at most kMaxCapsules a frame.
+void push(kernels::movers::Scene& s, const kernels::movers::Capsule& c) {
+  if (s.count == kernels::movers::kMaxCapsules)
+    throw ConfigError("input.synthetic.movers: more than " + std::to_string(kernels::movers::kMaxCapsules) +
+                      " capsules in view at once (a person takes 6, a ball 1)");
+  s.c[s.count++] = c;
+}
+
 void add_person(kernels::movers::Scene& s, int id, vec3 at, vec3 facing, float travelled, float H) {
   const vec3 up{0.f, 0.f, 1.f}, side = cross(facing, up);  // side: the person's right
   const float phase = 2.f * kPi * travelled / (0.8f * H);
   const float leg_swing = 0.45f * std::sin(phase), arm_swing = -0.35f * std::sin(phase);
   const vec3 shirt{0.2f, 0.35f, 0.65f}, trousers{0.15f, 0.15f, 0.22f}, skin{0.85f, 0.62f, 0.5f};
   const float leg_r = 0.035f * H, arm_r = 0.026f * H, hip_z = 0.53f * H, shoulder_z = 0.81f * H;
-  auto add = [&](vec3 a, vec3 b, float r, vec3 albedo) {
-    if (s.count == kernels::movers::kMaxCapsules)
-      throw ConfigError("input.synthetic.movers: more than " + std::to_string(kernels::movers::kMaxCapsules) +
-                        " capsules in view at once (a person takes 6, a ball 1)");
-    s.c[s.count++] = {a, b, r, id, albedo};
-  };
+  auto add = [&](vec3 a, vec3 b, float r, vec3 albedo) { push(s, {a, b, r, id, albedo}); };
   const vec3 pelvis = at + up * hip_z;
   add(pelvis + up * 0.04f * H, at + up * (shoulder_z - 0.03f * H), 0.09f * H, shirt);  // torso
   add(at + up * 0.93f * H, at + up * 0.93f * H, 0.065f * H, skin);                     // head
@@ -75,10 +78,7 @@ kernels::movers::Scene pose_movers(const std::vector<MoverParams>& movers, doubl
     const int id = static_cast<int>(i) + 1;
     if (m.kind == "ball") {
       const vec3 c = at + vec3{0.f, 0.f, m.radius};
-      if (s.count == kernels::movers::kMaxCapsules)
-        throw ConfigError("input.synthetic.movers: more than " + std::to_string(kernels::movers::kMaxCapsules) +
-                          " capsules in view at once (a person takes 6, a ball 1)");
-      s.c[s.count++] = {c, c, m.radius, id, {0.9f, 0.4f, 0.1f}};
+      push(s, {c, c, m.radius, id, {0.9f, 0.4f, 0.1f}});
     } else {
       add_person(s, id, at, facing, travelled, m.height);
     }

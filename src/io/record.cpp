@@ -65,7 +65,7 @@ std::int64_t record(FrameSource& source, const std::string& out_dir, const Recor
     write_png_rgb((dir / "rgb" / name).string(), f.rgb);
     write_png_u16((dir / "depth" / name).string(), to_u16(f.depth, opt.depth_scale));
     if (f.mover_mask.width() > 0) {  // the movers' ground truth: masks first, then their list line
-      fs::create_directories(dir / "mask", ec);
+      if (!movers_txt.is_open()) fs::create_directories(dir / "mask", ec);  // with the list, once
       write_png_u8((dir / "mask" / name).string(), f.mover_mask);
       if (!movers_txt.is_open())
         movers_txt = open_list(dir / "movers.txt", "# movers (capsules) of the synthetic room, frame of groundtruth.txt\n" +

@@ -111,9 +111,13 @@ void SyntheticSource::render(const SE3& T, std::uint32_t frame_number, Image<flo
 
 void SyntheticSource::render(const SE3& T, std::uint32_t frame_number, Image<float>& depth, Image<uchar3>& rgb,
                              Image<std::uint8_t>& mask) {
+  render(T, frame_number, pose_movers(p_.movers, frame_number / p_.fps), depth, rgb, mask);
+}
+
+void SyntheticSource::render(const SE3& T, std::uint32_t frame_number, const kernels::movers::Scene& movers,
+                             Image<float>& depth, Image<uchar3>& rgb, Image<std::uint8_t>& mask) {
   kernels::DepthNoise noise = synthetic_noise_model(p_);
   std::uint32_t seed = static_cast<std::uint32_t>(p_.seed ^ (p_.seed >> 32));
-  const kernels::movers::Scene movers = pose_movers(p_.movers, frame_number / p_.fps);
   const bool with_mask = !p_.movers.empty();
   if (with_mask && mask_dev_.width() != K_.width) mask_dev_ = Image<std::uint8_t>(K_.width, K_.height, device_);
   with_exec(device_, [&](const auto& ex) {
@@ -137,8 +141,9 @@ bool SyntheticSource::next(RgbdFrame& frame) {
   double t = k / p_.fps;
   SE3 T = synthetic_camera_pose(p_, t);
   reserve_frame_images(frame, K_.width, K_.height, device_ == Device::CUDA);
-  render(T, static_cast<std::uint32_t>(k), frame.depth, frame.rgb, frame.mover_mask);
-  if (!p_.movers.empty()) frame.movers = pose_movers(p_.movers, t);
+  const kernels::movers::Scene movers = pose_movers(p_.movers, t);  // posed once: rendered and reported
+  render(T, static_cast<std::uint32_t>(k), movers, frame.depth, frame.rgb, frame.mover_mask);
+  if (!p_.movers.empty()) frame.movers = movers;
   frame.index = next_++;
   frame.timestamp = t;
   frame.intrinsics = K_;

@@ -36,6 +36,12 @@ class SyntheticSource : public FrameSource {
               Image<std::uint8_t>& mask);
 
  private:
+  void render(const SE3& world_T_camera, std::uint32_t frame_number, const kernels::movers::Scene& movers,
+              Image<float>& depth, Image<uchar3>& rgb, Image<std::uint8_t>& mask);
+
+ public:
+
+ private:
   SyntheticParams p_;
   Intrinsics K_;
   Device device_;

@@ -24,6 +24,9 @@ constexpr int kMaxProbe = 128;   // linear probing at <= 50% fill rarely probes 
 constexpr int kMaxGrowths = 40;
 constexpr std::int64_t kMaxSlots = std::int64_t{1} << 30;
 
+// Blocks of a pool of `pool` handed out, by the counters' free-list top.
+std::int64_t blocks_in_use(std::int64_t pool, const HashCounters& c) { return pool - std::max(c.free_top, 0); }
+
 std::int64_t next_pow2(std::int64_t n) {
   std::int64_t p = 1;
   while (p < n) p <<= 1;
@@ -164,7 +167,7 @@ void VoxelHashVolume::handle_failures(const HashCounters& c) {
     // tombstones in place is then the remedy; doubling is for a table that is really full (a
     // 10,000-frame run doubled 11 times with 65,536 blocks and overflowed 32-bit slot indices).
     const std::int64_t slots = keys_.size();
-    const std::int64_t live = free_list_.size() - std::max(c.free_top, 0);
+    const std::int64_t live = blocks_in_use(free_list_.size(), c);
     // (No tombstones left, as after an in-place rehash, and still failing: a real cluster; grow.)
     const bool crowded = 4 * live > slots || c.tombstones == 0;
     spdlog::debug("voxel hashing: {} insertions found no slot in a table of {} slots ({} blocks, {} tombstones); "
@@ -185,7 +188,7 @@ void VoxelHashVolume::handle_failures(const HashCounters& c) {
 // extra: keys about to be inserted besides allocation (streaming in).
 void VoxelHashVolume::maybe_rehash(const HashCounters& c, std::int64_t extra) {
   const std::int64_t slots = keys_.size();
-  const std::int64_t live = free_list_.size() - std::max(c.free_top, 0) + extra;
+  const std::int64_t live = blocks_in_use(free_list_.size(), c) + extra;
   if (2 * (live + c.tombstones) <= slots) return;
   if (4 * live > slots && params_.grow_when_full) return rehash(next_pow2(4 * live));
   if (4 * live > slots)
