@@ -66,8 +66,7 @@ int run_bench(BenchArgs a) {
     std::string names;
     for (auto& [n, info] : reg) names += "\n  " + n + ": " + info.description;
     names += std::string("\n  pipeline: ") + kPipelineDescription;
-    spdlog::error("no benchmark named '{}'; this build has:{}", a.name, names);
-    return 1;
+    throw UsageError("no benchmark named '" + a.name + "'; this build has:" + names);
   }
   BenchOptions o{resolve_device(a.device), a.data, a.filter, a.scale};
   if (it->second.custom) return it->second.custom(o, a.reps, a.json);

@@ -141,6 +141,16 @@ void add_eval_command(CLI::App& app, std::function<int()>& action) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--t_max_diff,--max-dt", a->opt.t_max_diff,
                   "largest timestamp difference of associated poses, seconds (TUM: 0.02, evo: 0.01)")
+      ->check(CLI::Validator(
+          [](const std::string& s) {
+            double v = -1;
+            try {
+              v = std::stod(s);
+            } catch (const std::exception&) {
+            }
+            return v >= 0 ? std::string() : "is " + s + "; a timestamp difference is 0 s or more";
+          },
+          "SECONDS >= 0"))
       ->capture_default_str();
   cmd->add_option("--offset", a->opt.offset, "seconds added to the estimate's timestamps before association")
       ->capture_default_str();
