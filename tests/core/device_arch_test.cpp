@@ -1,9 +1,9 @@
-// Which CUDA architectures of a build run on which GPU (core/device.hpp), by CUDA's compatibility
+// Which CUDA architectures of a build run on which GPU (core/cuda_arch.hpp), by CUDA's compatibility
 // rules (CUDA C++ Programming Guide, "Binary Compatibility" and "PTX Compatibility"): machine code
 // for sm_XY runs on X.Z, Z >= Y; PTX for compute_XY on any later compute capability.
 #include <gtest/gtest.h>
 
-#include "core/device.hpp"
+#include "core/cuda_arch.hpp"
 
 using namespace seamless;
 
