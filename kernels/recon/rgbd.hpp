@@ -98,7 +98,7 @@ SEAMLESS_HD inline void update_scale(const RgbdSums& s, IcpPose& p) {
 // the undistortion of freiburg1/2 images (kernels/io/undistort.hpp) writes it where the lens saw
 // nothing, a 6-25 pixel border. Used as colour, that border is a sharp black edge fixed in the
 // image: every photometric row that samples it pulls the estimate towards no motion (the 4-5 %
-// too small yaw of frame-to-model tracking on fr1_rpy, docs/TRACKING.md "Session 6").
+// too small yaw of frame-to-model tracking on fr1_rpy, docs/HISTORY.md, "Session 5", the rotation slope).
 constexpr float kNoIntensity = -1.f;
 
 // Bilinear sample into v; false when one of the four pixels has no reading (kNoIntensity). The

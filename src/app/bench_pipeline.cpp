@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "app/exit_codes.hpp"
+#include "app/json_file.hpp"
 #include "app/pipeline.hpp"
 #include "app/render_stage.hpp"
 #include "app/run_context.hpp"
@@ -21,7 +22,6 @@
 #include "core/buffer.hpp"
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
-#include "core/json.hpp"
 #include "seamless/build_config.hpp"
 #include "seamless/git_commit.hpp"
 
@@ -219,39 +219,33 @@ void print_table(const std::vector<std::string>& stages, const std::vector<RepRe
 void write_json(const std::string& path, const PipelineBenchOptions& o, const Experiment& e,
                 const std::vector<std::string>& stages, const std::vector<RepResult>& reps,
                 const std::string& render_note) {
-  JsonWriter w;
-  w.begin_object().field("benchmark", "pipeline").field("seamless_version", SEAMLESS_VERSION);
-  w.field("commit", SEAMLESS_GIT_COMMIT).field("device", device_name(o.device)).field("gpu", cuda_device_description());
-  w.field("mode", o.mode).field("config", o.config).field("data", e.input.path).field("tracker", e.tracker.kind);
-  w.field("tracker_mode", e.tracker.mode).field("voxel_size", e.volume.voxel_size).field("volume", e.volume.layout);
-  w.field("frames_requested", e.frames).field("reps", static_cast<int>(reps.size()));
-  w.field("render", render_note.empty() ? std::string(o.mode == "live" ? "measured" : "not in scan mode") : render_note);
-  w.key("stages").begin_array();
-  for (const std::string& s : stages) w.value(s);
-  w.end_array();
-  w.key("median_of_medians_ms").begin_object();
+  Json j = {{"benchmark", "pipeline"}, {"seamless_version", SEAMLESS_VERSION}, {"commit", SEAMLESS_GIT_COMMIT},
+            {"device", device_name(o.device)}, {"gpu", cuda_device_description()}, {"mode", o.mode},
+            {"config", o.config}, {"data", e.input.path}, {"tracker", e.tracker.kind},
+            {"tracker_mode", e.tracker.mode}, {"voxel_size", e.volume.voxel_size}, {"volume", e.volume.layout},
+            {"frames_requested", e.frames}, {"reps", static_cast<int>(reps.size())}};
+  j["render"] = render_note.empty() ? std::string(o.mode == "live" ? "measured" : "not in scan mode") : render_note;
+  j["stages"] = stages;
+  Json& medians = j["median_of_medians_ms"] = Json::object();
   for (const std::string& s : stages) {
     std::vector<double> med;
     for (const RepResult& r : reps) med.push_back(summarise(r.per_frame.at(s)).median);
-    w.field(s, quantile(med, 0.5));
+    medians[s] = quantile(med, 0.5);
   }
-  w.end_object();
-  w.key("replays").begin_array();
+  Json replays = Json::array();
   for (const RepResult& r : reps) {
-    w.begin_object().field("frames", r.frames).field("lost_frames", r.lost).field("wall_s", r.wall_s);
-    w.field("peak_buffer_bytes", r.peak_buffer_bytes).field("peak_rss_bytes", r.peak_rss_bytes);
-    w.field("exit_code", r.exit_code);
-    w.key("stages").begin_object();
+    Json per_stage = Json::object();
     for (const std::string& s : stages) {
       const Summary x = summarise(r.per_frame.at(s));
-      w.key(s).begin_object().field("median_ms", x.median).field("p90_ms", x.p90).field("max_ms", x.max);
-      w.key("per_frame_ms").begin_array();
-      for (double v : r.per_frame.at(s)) w.value(v);
-      w.end_array().end_object();
+      per_stage[s] = {{"median_ms", x.median}, {"p90_ms", x.p90}, {"max_ms", x.max},
+                      {"per_frame_ms", r.per_frame.at(s)}};
     }
-    w.end_object().end_object();
+    replays.push_back({{"frames", r.frames}, {"lost_frames", r.lost}, {"wall_s", r.wall_s},
+                       {"peak_buffer_bytes", r.peak_buffer_bytes}, {"peak_rss_bytes", r.peak_rss_bytes},
+                       {"exit_code", r.exit_code}, {"stages", std::move(per_stage)}});
   }
-  w.end_array().end_object().write_file(path);
+  j["replays"] = std::move(replays);
+  write_json_file(path, j);
 }
 
 // A folder of its own under the system's temporary folder (mkdtemp: no two runs share one).

@@ -2,7 +2,7 @@
 #include <cstdio>
 
 #include "app/bench_cases.hpp"
-#include "core/json.hpp"
+#include "app/json_file.hpp"
 #include "render/bench_render.hpp"
 #include "seamless/build_config.hpp"
 
@@ -24,14 +24,12 @@ RenderBenchResult run_one(const char* label, const RenderParams& settings, int r
 }
 
 void write_json(const std::string& path, const RenderBenchResult& r) {
-  JsonWriter w;
-  w.begin_object().field("benchmark", "render").field("seamless_version", SEAMLESS_VERSION);
-  w.field("gl", r.gl_renderer).field("median_gpu_ms", r.median_gpu_ms).field("median_frame_ms", r.median_frame_ms);
-  w.field("median_draw_ms", r.median_draw_ms).field("median_readback_ms", r.median_readback_ms);
-  w.field("median_interop_ms", r.median_interop_ms);
-  w.key("passes_ms").begin_object();
-  for (const RenderTiming& t : r.passes) w.field(t.pass, t.ms);
-  w.end_object().end_object().write_file(path);
+  Json passes = Json::object();
+  for (const RenderTiming& t : r.passes) passes[t.pass] = t.ms;
+  write_json_file(path, {{"benchmark", "render"}, {"seamless_version", SEAMLESS_VERSION}, {"gl", r.gl_renderer},
+                         {"median_gpu_ms", r.median_gpu_ms}, {"median_frame_ms", r.median_frame_ms},
+                         {"median_draw_ms", r.median_draw_ms}, {"median_readback_ms", r.median_readback_ms},
+                         {"median_interop_ms", r.median_interop_ms}, {"passes_ms", std::move(passes)}});
 }
 }  // namespace
 

@@ -7,8 +7,8 @@
 #include "app/bench.hpp"
 #include "app/bench_pipeline.hpp"
 #include "app/commands.hpp"
+#include "app/json_file.hpp"
 #include "core/error.hpp"
-#include "core/json.hpp"
 #include "core/timing.hpp"
 #include "seamless/build_config.hpp"
 
@@ -45,15 +45,12 @@ struct CaseResult {
 };
 
 void write_json(const std::string& path, const std::string& bench, Device dev, const std::vector<CaseResult>& rows) {
-  JsonWriter w;
-  w.begin_object().field("benchmark", bench).field("seamless_version", SEAMLESS_VERSION);
-  w.field("device", device_name(dev)).field("gpu", cuda_device_description());
-  w.key("cases").begin_array();
-  for (const CaseResult& c : rows) {
-    w.begin_object().field("name", c.name).field("reps", c.reps).field("min_ms", c.min_ms);
-    w.field("median_ms", c.median_ms).field("max_ms", c.max_ms).field("detail", c.detail).end_object();
-  }
-  w.end_array().end_object().write_file(path);
+  Json cases = Json::array();
+  for (const CaseResult& c : rows)
+    cases.push_back({{"name", c.name}, {"reps", c.reps}, {"min_ms", c.min_ms}, {"median_ms", c.median_ms},
+                     {"max_ms", c.max_ms}, {"detail", c.detail}});
+  write_json_file(path, {{"benchmark", bench}, {"seamless_version", SEAMLESS_VERSION}, {"device", device_name(dev)},
+                         {"gpu", cuda_device_description()}, {"cases", std::move(cases)}});
 }
 
 int run_bench(BenchArgs a) {
@@ -69,8 +66,7 @@ int run_bench(BenchArgs a) {
     std::string names;
     for (auto& [n, info] : reg) names += "\n  " + n + ": " + info.description;
     names += std::string("\n  pipeline: ") + kPipelineDescription;
-    spdlog::error("no benchmark named '{}'; this build has:{}", a.name, names);
-    return 1;
+    throw UsageError("no benchmark named '" + a.name + "'; this build has:" + names);
   }
   BenchOptions o{resolve_device(a.device), a.data, a.filter, a.scale};
   if (it->second.custom) return it->second.custom(o, a.reps, a.json);

@@ -8,12 +8,12 @@
 #include <optional>
 
 #include "app/commands.hpp"
+#include "app/json_file.hpp"
 #include "app/run_context.hpp"
 #include "config/config.hpp"
 #include "seamless/build_config.hpp"
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
-#include "core/json.hpp"
 #include "eval/trajectory_eval.hpp"
 #include "io/frame_source.hpp"
 #include "io/record.hpp"
@@ -63,10 +63,10 @@ void warn_if_swapped(const std::string& gt_path, const std::string& est_path, co
                why, est_path, gt_path);
 }
 
-void write_stats(JsonWriter& w, const std::string& prefix, const ErrorStats& s, const char* unit) {
-  w.field(prefix + "_rmse_" + unit, s.rmse).field(prefix + "_mean_" + unit, s.mean);
-  w.field(prefix + "_median_" + unit, s.median).field(prefix + "_std_" + unit, s.std);
-  w.field(prefix + "_min_" + unit, s.min).field(prefix + "_max_" + unit, s.max);
+void add_stats(Json& j, const std::string& prefix, const ErrorStats& s, const char* unit) {
+  j[prefix + "_rmse_" + unit] = s.rmse, j[prefix + "_mean_" + unit] = s.mean;
+  j[prefix + "_median_" + unit] = s.median, j[prefix + "_std_" + unit] = s.std;
+  j[prefix + "_min_" + unit] = s.min, j[prefix + "_max_" + unit] = s.max;
 }
 
 int run_eval(const EvalArgs& a) {
@@ -107,27 +107,25 @@ int run_eval(const EvalArgs& a) {
   if (!a.aligned.empty()) write_tum_trajectory(a.aligned, ate.aligned);
   if (!a.json.empty()) {
     // Schema: docs/TRACKING.md, "seamless eval".
-    JsonWriter w;
-    w.begin_object().field("schema", "seamless-eval/1").field("seamless_version", SEAMLESS_VERSION);
-    w.field("groundtruth", gt_path).field("estimate", est_path);
-    w.field("groundtruth_poses", gt.size()).field("estimate_poses", est.size());
-    w.field("t_max_diff_s", opt.t_max_diff).field("offset_s", opt.offset);
-    w.field("align", to_string(opt.align)).field("scale", ate.scale);
-    w.field("pairs", ate.trans.count);
-    write_stats(w, "ate", ate.trans, "m");
-    w.field("rpe_frame_pairs", rpe_f.trans.count);
-    write_stats(w, "rpe_frame_trans", rpe_f.trans, "m");
-    write_stats(w, "rpe_frame_rot", rpe_f.rot, "deg");
-    w.field("rpe_second_delta_s", 1.0);
+    Json j = {{"schema", "seamless-eval/1"}, {"seamless_version", SEAMLESS_VERSION},
+              {"groundtruth", gt_path}, {"estimate", est_path},
+              {"groundtruth_poses", gt.size()}, {"estimate_poses", est.size()},
+              {"t_max_diff_s", opt.t_max_diff}, {"offset_s", opt.offset},
+              {"align", to_string(opt.align)}, {"scale", ate.scale}, {"pairs", ate.trans.count}};
+    add_stats(j, "ate", ate.trans, "m");
+    j["rpe_frame_pairs"] = rpe_f.trans.count;
+    add_stats(j, "rpe_frame_trans", rpe_f.trans, "m");
+    add_stats(j, "rpe_frame_rot", rpe_f.rot, "deg");
+    j["rpe_second_delta_s"] = 1.0;
     if (rpe_s) {
-      w.field("rpe_second_pairs", rpe_s->trans.count);
-      write_stats(w, "rpe_second_trans", rpe_s->trans, "m");  // metres over 1 s: m/s
-      write_stats(w, "rpe_second_rot", rpe_s->rot, "deg");    // deg/s
+      j["rpe_second_pairs"] = rpe_s->trans.count;
+      add_stats(j, "rpe_second_trans", rpe_s->trans, "m");  // metres over 1 s: m/s
+      add_stats(j, "rpe_second_rot", rpe_s->rot, "deg");    // deg/s
     } else {
-      w.field("rpe_second_pairs", 0);
-      for (const char* k : {"rpe_second_trans_rmse_m", "rpe_second_rot_rmse_deg"}) w.key(k).null();
+      j["rpe_second_pairs"] = 0;
+      for (const char* k : {"rpe_second_trans_rmse_m", "rpe_second_rot_rmse_deg"}) j[k] = nullptr;
     }
-    w.end_object().write_file(a.json);
+    write_json_file(a.json, j);
   }
   return 0;
 }
@@ -143,6 +141,16 @@ void add_eval_command(CLI::App& app, std::function<int()>& action) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--t_max_diff,--max-dt", a->opt.t_max_diff,
                   "largest timestamp difference of associated poses, seconds (TUM: 0.02, evo: 0.01)")
+      ->check(CLI::Validator(
+          [](const std::string& s) {
+            double v = -1;
+            try {
+              v = std::stod(s);
+            } catch (const std::exception&) {
+            }
+            return v >= 0 ? std::string() : "is " + s + "; a timestamp difference is 0 s or more";
+          },
+          "SECONDS >= 0"))
       ->capture_default_str();
   cmd->add_option("--offset", a->opt.offset, "seconds added to the estimate's timestamps before association")
       ->capture_default_str();

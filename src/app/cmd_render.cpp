@@ -123,7 +123,8 @@ RenderCamera mesh_camera(Renderer& r, const RenderOptions& o, const RenderParams
 }
 
 int render_run(const RenderOptions& o) {
-  if (!fs::is_directory(o.run_dir)) throw Error("run folder '" + o.run_dir + "' does not exist");
+  // A command-line argument that names nothing: bad usage (exit 2), as a missing `eval` file is.
+  if (!fs::is_directory(o.run_dir)) throw UsageError("run folder '" + o.run_dir + "' does not exist");
   Experiment e = load_run_config(o);
   const RenderParams& p = e.render;
   const std::string out_dir = o.out.empty() ? o.run_dir + "/render" : o.out;

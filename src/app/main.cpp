@@ -9,6 +9,7 @@
 #include "core/interrupt.hpp"
 #include "core/log.hpp"
 #include "seamless/build_config.hpp"
+#include "seamless/git_commit.hpp"
 
 int main(int argc, char** argv) {
   using namespace seamless;
@@ -19,6 +20,9 @@ int main(int argc, char** argv) {
   bool quiet = false, verbose = false;
   app.add_flag("-q,--quiet", quiet, "warnings and errors only");
   app.add_flag("-v,--verbose", verbose, "debug output");
+  // `seamless run cfg.yaml -q` as well as `seamless -q run cfg.yaml`: what a subcommand does not
+  // know goes to these options (and is a usage error there when no one knows it).
+  app.fallthrough();
 
   std::function<int()> action;
   app::add_run_command(app, action);
@@ -36,6 +40,7 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? app::kExitOk : app::kExitUsage;  // --help and --version exit 0
   }
   init_logging(quiet ? Verbosity::Quiet : verbose ? Verbosity::Verbose : Verbosity::Normal);
+  spdlog::debug("seamless {} (commit {}), debug output on", SEAMLESS_VERSION, SEAMLESS_GIT_COMMIT);
   int code = app::kExitUsage;
   try {
     if (action) code = action();

@@ -214,7 +214,7 @@ class SimulationLoop : public FrameLoop {
         steps_(static_cast<std::int64_t>(std::ceil(e_.duration / e_.solver.dt))),
         render_every_(std::max<std::int64_t>(1, std::llround(1.0 / (e_.render.fps * e_.solver.dt)))),
         replay_(replay ? std::make_unique<ReplayFrames>(e_, ctx.device(), *replay) : nullptr),
-        progress_(replay_ ? "replay" : "simulate", replay_ ? replay_->frames() : steps_) {}
+        progress_(replay_ ? "replay" : "simulate", replay_ ? replay_->frames() : steps_, true, replay_ ? "fps" : "steps/s") {}
 
   std::int64_t steps() const { return steps_; }
   std::int64_t done_steps() const { return k_; }

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <set>
 
+#include "app/json_file.hpp"
 #include "core/error.hpp"
-#include "core/json.hpp"
 #include "core/output_file.hpp"
 #include "eval/trajectory_eval.hpp"
 #include "seamless/build_config.hpp"
@@ -61,61 +61,52 @@ void add_stage_medians(RunSummary& s, const StageTimer& t) {
 }
 
 namespace {
-void vec_value(JsonWriter& j, vec3 v) { j.begin_array().value(v.x).value(v.y).value(v.z).end_array(); }
+Json vec_json(vec3 v) { return Json::array({v.x, v.y, v.z}); }
 }  // namespace
 
 void write_summary(const std::string& path, const RunSummary& s) {
-  JsonWriter j;
-  j.begin_object();
-  j.field("seamless_version", SEAMLESS_VERSION).field("commit", SEAMLESS_GIT_COMMIT);
-  j.field("command", s.command).field("config", s.config).field("device", s.device);
+  Json j;
+  j["seamless_version"] = SEAMLESS_VERSION;
+  j["commit"] = SEAMLESS_GIT_COMMIT;
+  j["command"] = s.command, j["config"] = s.config, j["device"] = s.device;
   if (s.intrinsics) {
     const Intrinsics& K = *s.intrinsics;
-    j.key("intrinsics").begin_object().field("fx", K.fx).field("fy", K.fy).field("cx", K.cx).field("cy", K.cy);
-    j.field("width", K.width).field("height", K.height).end_object();
+    j["intrinsics"] = {{"fx", K.fx}, {"fy", K.fy}, {"cx", K.cx}, {"cy", K.cy}, {"width", K.width}, {"height", K.height}};
   }
-  j.key("frames").begin_object().field("read", s.frames_read).field("lost", s.frames_lost);
-  j.field("fused", s.frames_fused).field("unreadable", s.frames_unreadable).end_object();
-  if (s.ate_rmse_m) j.key("ate").begin_object().field("rmse_m", *s.ate_rmse_m).field("pairs", s.ate_pairs).end_object();
-  if (s.floor_height) j.field("floor_height", *s.floor_height);
-  j.key("surfaces").begin_array();
+  j["frames"] = {{"read", s.frames_read}, {"lost", s.frames_lost}, {"fused", s.frames_fused},
+                 {"unreadable", s.frames_unreadable}};
+  if (s.ate_rmse_m) j["ate"] = {{"rmse_m", *s.ate_rmse_m}, {"pairs", s.ate_pairs}};
+  if (s.floor_height) j["floor_height"] = *s.floor_height;
+  Json& surfaces = j["surfaces"] = Json::array();
   for (std::size_t i = 0; i < s.surfaces.size() && i < 10; ++i) {
     const HorizontalSurface& h = s.surfaces[i];
-    j.begin_object().field("area_m2", h.area).field("height", h.height).key("centre");
-    vec_value(j, h.centre);
-    j.field("open_radius", h.open_radius).field("floor", h.floor).end_object();
+    surfaces.push_back({{"area_m2", h.area}, {"height", h.height}, {"centre", vec_json(h.centre)},
+                        {"open_radius", h.open_radius}, {"floor", h.floor}});
   }
-  j.end_array();
-  j.key("spawns").begin_array();
+  Json& spawns = j["spawns"] = Json::array();
   for (std::size_t i = 0; i < s.spawns.size(); ++i) {
     const SpawnParams& sp = s.spawns[i];
-    j.begin_object().field("index", i).field("kind", sp.kind).field("time", sp.time).key("position");
-    vec_value(j, sp.position);
+    Json e = {{"index", i}, {"kind", sp.kind}, {"time", sp.time}, {"position", vec_json(sp.position)}};
     for (const ResolvedPlacement& r : s.placements)
-      if (r.spawn == static_cast<int>(i)) {
-        j.field("placed", r.how).key("surface_point");
-        vec_value(j, r.surface_point);
-      }
-    j.end_object();
+      if (r.spawn == static_cast<int>(i)) e["placed"] = r.how, e["surface_point"] = vec_json(r.surface_point);
+    spawns.push_back(std::move(e));
   }
-  j.end_array();
   if (s.physics) {
     const SolverStats& p = *s.physics;
-    j.key("particles").begin_object().field("dynamic", p.particles).field("fluid", p.fluid_particles);
-    j.field("cloth", p.cloth_particles).field("rigid", p.rigid_particles).field("rigid_bodies", p.rigid_bodies);
-    j.field("static", p.static_particles).field("simulated_s", p.time).field("steps", p.steps);
-    j.field("neighbour_overflow", p.neighbour_overflow).field("emitter_dropped", p.emitter_dropped);
+    Json ph = {{"dynamic", p.particles}, {"fluid", p.fluid_particles}, {"cloth", p.cloth_particles},
+               {"rigid", p.rigid_particles}, {"rigid_bodies", p.rigid_bodies}, {"static", p.static_particles},
+               {"simulated_s", p.time}, {"steps", p.steps}, {"neighbour_overflow", p.neighbour_overflow},
+               {"emitter_dropped", p.emitter_dropped}};
     if (s.escaped) {
-      j.field("escaped", s.escaped->total()).field("escaped_below_floor", s.escaped->below_floor);
-      j.field("escaped_outside", s.escaped->outside).field("escaped_falling", s.escaped->falling);
+      ph["escaped"] = s.escaped->total(), ph["escaped_below_floor"] = s.escaped->below_floor;
+      ph["escaped_outside"] = s.escaped->outside, ph["escaped_falling"] = s.escaped->falling;
     }
-    j.end_object();
+    j["particles"] = std::move(ph);
   }
-  j.key("stage_median_ms").begin_object();
-  for (const auto& [stage, ms] : s.stage_median_ms) j.field(stage, ms);
-  j.end_object().end_object();
+  Json& stages = j["stage_median_ms"] = Json::object();
+  for (const auto& [stage, ms] : s.stage_median_ms) stages[stage] = ms;
   // Written complete under a temporary name, then renamed: a reader never sees half a file.
-  j.write_file(partial_path(path));
+  write_json_file(partial_path(path), j);
   commit_partial(path);
 }
 

@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "core/cuda_arch.hpp"
 #include "core/cuda_check.hpp"
 #include "core/error.hpp"
 #include "seamless/build_config.hpp"
@@ -55,7 +56,7 @@ std::string unusable_gpu(cudaError_t e) {
   if (e == cudaErrorNoKernelImageForDevice || e == cudaErrorInvalidDeviceFunction)
     return m + "they were compiled for the CUDA architectures \"" SEAMLESS_CUDA_ARCHITECTURES
                "\": rebuild with -DSEAMLESS_CUDA_ARCH=" + (sm.empty() ? "<its sm number>" : sm) +
-           " (or -DSEAMLESS_CUDA_ARCH=native on this machine)";
+           " (or -DSEAMLESS_CUDA_ARCH=auto on this machine)";
   if (e == cudaErrorUnsupportedPtxVersion || e == cudaErrorInsufficientDriver)
     return m + "the NVIDIA driver is older than this build's CUDA toolkit needs: update the driver";
   return m + "CUDA's error above says why";
@@ -78,6 +79,11 @@ const CudaState& cuda_state() {
     const cudaError_t probe = detail::probe_kernel_launch();
     if (probe == cudaSuccess) {
       s.usable = true;
+      int dev = 0;
+      cudaDeviceProp p{};
+      if (cudaGetDevice(&dev) == cudaSuccess && cudaGetDeviceProperties(&p, dev) == cudaSuccess)
+        if (cuda_arch_match(SEAMLESS_CUDA_ARCHITECTURES, p.major, p.minor) == CudaArchMatch::ptx_only)
+          spdlog::info("{}", cuda_arch_advice(SEAMLESS_CUDA_ARCHITECTURES, p.major, p.minor, p.name));
     } else {
       cudaGetLastError();
       s.problem = unusable_gpu(probe);

@@ -168,7 +168,8 @@ FrameFolderSource::FrameFolderSource(const InputParams& params, bool pinned)
       spdlog::warn("'{}' gives gravity in the poses' world frame, but no frame has a pose: gravity unused", g);
   }
 
-  K_ = resolve_intrinsics(params.intrinsics, folder_);  // logged, with a warning for the generic set
+  const IntrinsicsChoice choice = resolve_intrinsics(params.intrinsics, folder_);  // logged (a warning for the generic set)
+  K_ = choice.K, flip_x_ = choice.flip_x, flip_y_ = choice.flip_y;
   spdlog::info("frame folder '{}': {} frames (numbers {}..{}), {} with a pose file{}{}, depth {} units per metre{}, "
                "timestamps number / {} fps",
                folder_, frames_.size(), frames_.front().number, frames_.back().number, with_pose,
@@ -187,6 +188,7 @@ void FrameFolderSource::load_frame(std::size_t i, RgbdFrame& frame) {
   const std::string depth_path = (dir / f.depth).string(), colour_path = (dir / f.colour).string();
   Image<std::uint16_t> raw = read_png_u16(depth_path);
   Image<uchar3> rgb = read_colour_image(colour_path);  // PNG or JPEG, by content
+  flip_image(raw, flip_x_, flip_y_), flip_image(rgb, flip_x_, flip_y_);  // a negative focal length
   if (raw.width() != K_.width || raw.height() != K_.height)
     throw InputError("depth image '" + depth_path + "' is " + std::to_string(raw.width()) + "x" + std::to_string(raw.height()) +
                 " but input.intrinsics says " + std::to_string(K_.width) + "x" + std::to_string(K_.height));

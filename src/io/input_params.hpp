@@ -10,9 +10,10 @@
 
 namespace seamless {
 
-// Camera intrinsics: a named preset, or `custom` with fx fy cx cy given here.
+// Camera intrinsics: a named preset, `custom` with fx fy cx cy given here, or a camera file.
 struct IntrinsicsParams {
   std::string preset = "auto";
+  std::string file;  // a camera file (io/camera_file.hpp); wins over preset auto
   float fx = 525.f, fy = 525.f, cx = 319.5f, cy = 239.5f;  // used when preset is custom
   int width = 640, height = 480;
 
@@ -24,8 +25,11 @@ struct IntrinsicsParams {
     // contains, else kinect_v1 (also for the synthetic room and a live Kinect).
     v("preset", preset, "intrinsics preset (fx fy cx cy below are used only for custom)",
       Choices{"auto", "freiburg1", "freiburg2", "freiburg3", "kinect_v1", "custom"});
-    v("fx", fx, "focal length x, pixels (custom only)", Range{1.0, 1e5});
-    v("fy", fy, "focal length y, pixels (custom only)", Range{1.0, 1e5});
+    v("file", file,
+      "camera file: ORB-SLAM/OpenCV YAML, ROS camera_info YAML or Open3D JSON (told by content); with preset auto");
+    // Negative focal lengths (ICL-NUIM's fy = -480) are taken as a flipped image axis.
+    v("fx", fx, "focal length x, pixels (custom only; negative: the image's x axis is flipped)", Range{-1e5, 1e5});
+    v("fy", fy, "focal length y, pixels (custom only; negative: the image's y axis is flipped)", Range{-1e5, 1e5});
     v("cx", cx, "principal point x, pixels (custom only)", Range{-1e4, 1e4});
     v("cy", cy, "principal point y, pixels (custom only)", Range{-1e4, 1e4});
     v("width", width, "image width, pixels", Range{1, 16384});

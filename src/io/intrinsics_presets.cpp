@@ -14,10 +14,12 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "io/camera_file.hpp"
 #include "io/number_file.hpp"
 #include "io/input_params.hpp"
 
 namespace seamless {
+namespace fs = std::filesystem;
 namespace {
 
 Intrinsics make(float fx, float fy, float cx, float cy, std::initializer_list<float> d = {}) {
@@ -29,6 +31,13 @@ Intrinsics make(float fx, float fy, float cx, float cy, std::initializer_list<fl
   int i = 0;
   for (float v : d) K.dist[i++] = v;
   return K;
+}
+
+// A negative focal length as a flip of that image axis (IntrinsicsChoice's comment derives it).
+void flip_negative_focal_lengths(IntrinsicsChoice& c) {
+  Intrinsics& K = c.K;
+  if (K.fx < 0) K.fx = -K.fx, K.cx = static_cast<float>(K.width - 1) - K.cx, c.flip_x = true;
+  if (K.fy < 0) K.fy = -K.fy, K.cy = static_cast<float>(K.height - 1) - K.cy, c.flip_y = true;
 }
 
 }  // namespace
@@ -78,9 +87,22 @@ std::string describe_intrinsics(const Intrinsics& K) {
 }
 
 IntrinsicsChoice choose_intrinsics(const IntrinsicsParams& p, const std::string& folder) {
-  namespace fs = std::filesystem;
   IntrinsicsChoice c;
+  if (!p.file.empty()) {
+    if (p.preset != "auto")
+      throw ConfigError("input.intrinsics.file '" + p.file + "' and input.intrinsics.preset " + p.preset +
+                        " both name the camera: keep one (preset auto with the file)");
+    const CameraFile f = read_camera_file(p.file);
+    c.K = f.K;
+    c.chosen = fs::path(p.file).filename().string();
+    c.reason = "input.intrinsics.file: " + p.file + " (" + f.format + ")";
+    if (!f.has_size) c.K.width = p.width, c.K.height = p.height;
+    flip_negative_focal_lengths(c);
+    return c;
+  }
   if (p.preset == "custom") {
+    if (!(std::abs(p.fx) >= 1 && std::abs(p.fy) >= 1))
+      throw ConfigError("input.intrinsics.fx and fy must be at least one pixel in size (negative: a flipped axis)");
     c.K = make(p.fx, p.fy, p.cx, p.cy);
     c.chosen = "custom";
     c.reason = "input.intrinsics.preset: custom (fx fy cx cy from the config)";
@@ -105,6 +127,7 @@ IntrinsicsChoice choose_intrinsics(const IntrinsicsParams& p, const std::string&
       c.K = read_calibration(calibration.string());
       c.chosen = "calibration.txt";
       c.reason = "preset auto: the folder has " + calibration.string();
+      flip_negative_focal_lengths(c);
       return c;  // its width and height are the recording's
     } else if (!matrix.empty()) {
       c.K = read_intrinsics_matrix(matrix);
@@ -125,19 +148,25 @@ IntrinsicsChoice choose_intrinsics(const IntrinsicsParams& p, const std::string&
   }
   c.K.width = p.width;
   c.K.height = p.height;
+  flip_negative_focal_lengths(c);
   return c;
 }
 
-Intrinsics resolve_intrinsics(const IntrinsicsParams& p, const std::string& folder) {
+IntrinsicsChoice resolve_intrinsics(const IntrinsicsParams& p, const std::string& folder) {
   IntrinsicsChoice c = choose_intrinsics(p, folder);
+  if (c.flip_x || c.flip_y)
+    spdlog::info("intrinsics: {} has a negative focal length {}: every image is read with its {} flipped, which "
+                 "makes it an ordinary pinhole seeing the same 3D points (fx fy cx cy below are the flipped image's)",
+                 c.chosen, c.flip_y ? "fy" : "fx",
+                 c.flip_x && c.flip_y ? "columns and rows" : (c.flip_y ? "rows" : "columns"));
   if (c.generic)
     spdlog::warn("intrinsics: {}: USING THE GENERIC KINECT v1 SET ({}), which can be off by several pixels for "
                  "this camera; set input.intrinsics.preset (freiburg1, freiburg2, freiburg3, kinect_v1 or custom "
                  "with fx fy cx cy) or put a calibration.txt in the folder",
                  c.reason, describe_intrinsics(c.K));
-  else if (!folder.empty() || p.preset != "auto")
+  else if (!folder.empty() || p.preset != "auto" || !p.file.empty())
     spdlog::info("intrinsics: {} ({}): {}", c.chosen, c.reason, describe_intrinsics(c.K));
-  return c.K;
+  return c;
 }
 
 std::string find_intrinsics_matrix(const std::string& folder) {
@@ -158,15 +187,9 @@ Intrinsics read_intrinsics_matrix(const std::string& path) {
   if (v.size() != 9)
     throw InputError("camera matrix file '" + path + "' holds " + std::to_string(v.size()) +
                 " numbers; expected a 3x3 matrix K = [fx 0 cx; 0 fy cy; 0 0 1], nine numbers");
-  auto bad = [&](const std::string& what) {
-    return Error("camera matrix file '" + path + "': " + what + "; expected K = [fx 0 cx; 0 fy cy; 0 0 1]");
-  };
-  if (v[6] != 0 || v[7] != 0 || v[8] != 1) throw bad("the bottom row is not 0 0 1 (a transposed or projection matrix?)");
-  if (v[3] != 0) throw bad("the second row starts with " + std::to_string(v[3]) + ", not 0");
-  if (!(v[0] > 0 && v[4] > 0)) throw bad("the focal lengths fx, fy must be positive");
-  // A skew below 1e-3 px changes no projection by a thousandth of a pixel across a 640-pixel image.
-  if (std::abs(v[1]) > 1e-3) throw bad("a skew of " + std::to_string(v[1]) + " px, which the pinhole model here lacks");
-  return make(static_cast<float>(v[0]), static_cast<float>(v[4]), static_cast<float>(v[2]), static_cast<float>(v[5]));
+  double k[9];
+  std::copy(v.begin(), v.end(), k);
+  return intrinsics_from_matrix(k, "camera matrix file '" + path + "'");
 }
 
 Intrinsics read_calibration(const std::string& path) {

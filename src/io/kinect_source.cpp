@@ -29,7 +29,11 @@ vec3 camera_accel(freenect_raw_tilt_state* s) {
 }  // namespace
 
 KinectSource::KinectSource(const InputParams& params, bool pinned) : params_(params), pinned_(pinned) {
-  K_ = resolve_intrinsics(params.intrinsics);
+  const IntrinsicsChoice choice = resolve_intrinsics(params.intrinsics);
+  if (choice.flip_x || choice.flip_y)
+    throw ConfigError("input.intrinsics for a live Kinect has a negative focal length (" + choice.chosen +
+                      "): a Kinect's images are not flipped; give its focal lengths as positive numbers");
+  K_ = choice.K;
   if (K_.width != kW || K_.height != kH)
     throw ConfigError("input.intrinsics width/height must be 640x480 for a Kinect v1 (got " + std::to_string(K_.width) + "x" +
                 std::to_string(K_.height) + ")");

@@ -95,7 +95,9 @@ kernels::DepthNoise synthetic_noise_model(const SyntheticParams& p) {
 
 SyntheticSource::SyntheticSource(const InputParams& params, Device device)
     : p_(params.synthetic), device_(device), first_(params.first_frame) {
-  K_ = resolve_intrinsics(params.intrinsics);
+  // A negative focal length gives the flipped (positive) camera: the room is rendered as the
+  // flipped images of a recorded folder would show it.
+  K_ = resolve_intrinsics(params.intrinsics).K;
   for (float& d : K_.dist) d = 0.f;  // an ideal pinhole: the room is rendered undistorted
   count_ = std::max<std::int64_t>(0, p_.frames - first_);
   if (params.max_frames > 0) count_ = std::min(count_, params.max_frames);

@@ -178,7 +178,8 @@ TumSource::TumSource(const InputParams& params, bool pinned) : params_(params), 
   if (folder_.empty()) throw InputError("input.path is empty: set it to a TUM RGB-D folder (source: tum)");
   if (!fs::is_directory(folder_))
     throw InputError("input.path '" + folder_ + "' is not a folder: download one with datasets/download_tum.sh");
-  K_ = resolve_intrinsics(params.intrinsics, folder_);
+  const IntrinsicsChoice choice = resolve_intrinsics(params.intrinsics, folder_);
+  K_ = choice.K, flip_x_ = choice.flip_x, flip_y_ = choice.flip_y;
   fs::path dir(folder_);
   pairs_ = tum_folder_pairs(folder_, params);
   if (pairs_.empty())
@@ -221,6 +222,7 @@ void TumSource::load_frame(const TumPair& pair, RgbdFrame& frame) {
   std::string depth_path = (dir / pair.depth.file).string(), rgb_path = (dir / pair.rgb.file).string();
   Image<std::uint16_t> raw = read_png_u16(depth_path);
   Image<uchar3> rgb = read_colour_image(rgb_path);  // PNG or JPEG, by content
+  flip_image(raw, flip_x_, flip_y_), flip_image(rgb, flip_x_, flip_y_);  // a negative focal length
   if (raw.width() != K_.width || raw.height() != K_.height)
     throw InputError("depth image '" + depth_path + "' is " + std::to_string(raw.width()) + "x" + std::to_string(raw.height()) +
                 " but input.intrinsics says " + std::to_string(K_.width) + "x" + std::to_string(K_.height));

@@ -57,6 +57,7 @@ class TumSource : public FrameSource {
   InputParams params_;
   std::string folder_;
   Intrinsics K_;  // as calibrated (with distortion)
+  bool flip_x_ = false, flip_y_ = false;  // images flipped on reading (a negative focal length)
   std::vector<TumPair> pairs_;
   Trajectory groundtruth_;
   std::vector<std::pair<double, vec3>> accel_;  // camera-frame specific force

@@ -23,7 +23,7 @@ DATA = os.environ.get("SEAMLESS_SHARED_DATA", DATA)
 SEQ = os.path.join(DATA, "tum_fr1_rpy_000-149")
 FRAMES = 5
 TRACKING = ["upload", "preprocess", "track", "allocate", "fuse", "raycast"]
-# Stage times are printed by JsonWriter in shortest round-trip form, so sums agree to double rounding;
+# Stage times are printed by nlohmann-json in shortest round-trip form, so sums agree to double rounding;
 # tracking_stats.csv prints milliseconds with 3 decimals (half a unit: 5e-4 ms).
 SUM_TOL = 1e-9
 CSV_TOL = 5e-4 + 1e-9

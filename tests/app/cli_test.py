@@ -82,6 +82,32 @@ class Cli(unittest.TestCase):
             self.assertIn("volume.voxel_sise", r.stderr)
             self.assertIn("did you mean 'voxel_size'", r.stderr)
 
+    def test_log_options_after_the_subcommand_and_usage_exit_codes(self):
+        # Issue 23: -q/--quiet and -v/--verbose work before or after the subcommand; usage errors
+        # exit 2 (README, "Exit codes and interrupted runs").
+        demo = os.path.join(SRC, "configs", "demo.yaml")
+        normal = seamless("run", demo, "--dry-run")
+        self.assertIn("valid", normal.stderr)  # the info line --quiet must silence
+        for args in (["--quiet", "run", demo, "--dry-run"], ["run", demo, "--dry-run", "--quiet"],
+                     ["run", demo, "-q", "--dry-run"]):
+            r = seamless(*args)
+            self.assertNotIn("valid", r.stderr, args)
+        for args in (["--verbose", "config", demo], ["config", demo, "-v"]):
+            self.assertIn("debug output on", seamless(*args).stderr, args)
+        with tempfile.TemporaryDirectory() as d:
+            gt = os.path.join(d, "gt.txt")
+            with open(gt, "w") as f:
+                f.write("".join(f"{i / 30:.6f} {0.01 * i} 0 0 0 0 0 1\n" for i in range(10)))
+            usage = [["run", demo, "--dry-run", "--no-such-option"], ["no-such-command"], ["run"],
+                     ["eval", gt], ["eval", gt, gt, "--t_max_diff", "-1"], ["eval", gt, gt, "--align", "affine"],
+                     ["eval", gt, os.path.join(d, "missing.txt")], ["bench", "no-such-benchmark"],
+                     ["run", demo, "--device", "gpu"]]
+            for args in usage:
+                r = seamless(*args, check=False)
+                self.assertEqual(r.returncode, 2, f"{args}: {r.stderr}")
+            self.assertIn("a timestamp difference is 0 s or more", seamless("eval", gt, gt, "--t_max_diff", "-1",
+                                                                            check=False).stderr)
+
     def test_set_reaches_effective_config(self):
         out = seamless("config", os.path.join(SRC, "configs", "demo.yaml"), "--set", "volume.voxel_size=0.0125").stdout
         self.assertIn("voxel_size: 0.0125", out)

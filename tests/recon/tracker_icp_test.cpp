@@ -314,7 +314,7 @@ TEST(Rgbd, MinGradientAboveEveryGradientLeavesTheGeometryAlone) {
   EXPECT_LT(dr, 1e-4);
 }
 
-// ---- The undistortion border (docs/TRACKING.md, "Session 6") -----------------------------------
+// ---- The undistortion border (docs/HISTORY.md, "Session 5") -------------------------------------
 
 TEST(Rgbd, BlackRgbIsNoIntensityReading) {
   // RGB (0, 0, 0) is what the undistortion writes where the lens saw nothing: no reading, like
