@@ -91,6 +91,11 @@ int run(const CommonOptions& o) {
   if (e.render.camera == "recorded" && e.input.source == "kinect" && e.mode != "live")
     throw ConfigError("render.camera: recorded replays the input after the scan, which a live Kinect cannot; use "
                 "mode: live (each frame drawn from its own pose) or record first (`seamless record`)");
+  if (!e.render.zoom_at.empty() && e.render.zoom_at.size() != 2)
+    throw ConfigError("render.zoom_at: expected [u, v] (two numbers), got " + std::to_string(e.render.zoom_at.size()));
+  if ((e.render.zoom != 1.f || !e.render.zoom_at.empty()) && (e.render.camera != "recorded" || e.render.view != "mesh"))
+    throw ConfigError("render.zoom and render.zoom_at magnify the recorded camera of the mesh view; they need "
+                      "render.camera: recorded and render.view: mesh (the mesh view's fixed camera has render.fov_y)");
   auto renderer = RunRenderer::make(ctx);
   RunSummary summary;
   summary.command = "run", summary.config = o.config, summary.device = device_name(ctx.device());
