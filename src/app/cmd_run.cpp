@@ -22,8 +22,20 @@ namespace seamless::app {
 
 namespace {
 
+// render.zoom / zoom_at crop the recorded camera of the mesh view (render_stage.cpp); elsewhere
+// they would be ignored silently.
+void check_render_zoom(const RenderParams& r) {
+  if (!r.zoom_at.empty() && r.zoom_at.size() != 2)
+    throw ConfigError("render.zoom_at: expected [u, v] (two numbers), got " + std::to_string(r.zoom_at.size()));
+  if ((r.zoom != 1.f || !r.zoom_at.empty()) && (r.camera != "recorded" || r.view != "mesh"))
+    throw ConfigError("render.zoom and render.zoom_at magnify the recorded camera of the mesh view; they need "
+                      "render.camera: recorded and render.view: mesh (the mesh view's fixed camera has render.fov_y)");
+}
+
 int dry_run(const CommonOptions& o) {
   Experiment e = load_experiment(o.config, overrides(o));
+  check_placements(e.spawn);
+  check_render_zoom(e.render);
   spdlog::info("{}: valid ({} spawn entries, input {}, device {})", o.config, e.spawn.size(), e.input.source,
                e.device);
   return 0;
@@ -88,6 +100,7 @@ int run(const CommonOptions& o) {
   RunContext ctx(o);
   Experiment& e = ctx.experiment();
   check_placements(e.spawn);  // before the scan: a malformed place costs no scan
+  check_render_zoom(e.render);
   if (e.render.camera == "recorded" && e.input.source == "kinect" && e.mode != "live")
     throw ConfigError("render.camera: recorded replays the input after the scan, which a live Kinect cannot; use "
                 "mode: live (each frame drawn from its own pose) or record first (`seamless record`)");

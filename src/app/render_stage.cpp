@@ -363,7 +363,7 @@ class GlRunRenderer : public RunRenderer {
       renderer_.set_kinect_view(frame.rgb, frame.depth, frame.intrinsics, world_T_camera);
       camera_ = renderer_.kinect_camera();
     } else if (p_.camera == "recorded") {  // the mesh seen through the recorded camera
-      camera_.K = scale_intrinsics(frame.intrinsics, p_.width, p_.height);
+      camera_.K = scale_intrinsics(zoom_intrinsics(frame.intrinsics, p_.zoom, p_.zoom_at), p_.width, p_.height);
       camera_.world_T_camera = world_T_camera;
       camera_.znear = p_.znear, camera_.zfar = p_.zfar;
       have_recorded_camera_ = true;

@@ -50,6 +50,17 @@ Intrinsics scale_intrinsics(const Intrinsics& K, int W, int H) {
   return s;
 }
 
+Intrinsics zoom_intrinsics(const Intrinsics& K, float zoom, const std::vector<float>& at) {
+  const float u = at.size() == 2 ? at[0] : 0.5f * static_cast<float>(K.width - 1);
+  const float v = at.size() == 2 ? at[1] : 0.5f * static_cast<float>(K.height - 1);
+  Intrinsics z = K;
+  z.fx *= zoom;
+  z.fy *= zoom;
+  z.cx = 0.5f * static_cast<float>(K.width - 1) - zoom * (u - K.cx);
+  z.cy = 0.5f * static_cast<float>(K.height - 1) - zoom * (v - K.cy);
+  return z;
+}
+
 Mat4 projection_matrix(const Intrinsics& K, float n, float f) {
   const float W = static_cast<float>(K.width), H = static_cast<float>(K.height);
   Mat4 P{};  // column-major: P[c * 4 + r]

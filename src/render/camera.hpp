@@ -2,6 +2,7 @@
 // z forward) with a pose, so that the Kinect view projects with the sensor's exact intrinsics
 // and any free camera is the same model with intrinsics made from a field of view.
 #pragma once
+#include <vector>
 #include <array>
 
 #include "core/camera.hpp"
@@ -26,6 +27,12 @@ struct RenderCamera {
 
 // Intrinsics of an image of w x h pixels resampled to W x H (pixel centres at integers).
 Intrinsics scale_intrinsics(const Intrinsics& K, int W, int H);
+
+// The same camera magnified `zoom` times about pixel `at` ([u, v] of K's image; empty: the image
+// centre), which lands on the image centre: a crop of the view, as a longer lens would see it.
+// Focal lengths times zoom; the principal point moves so that the ray through `at` projects to
+// the centre: u' = cx' + zoom (u - cx) = (w - 1) / 2.
+Intrinsics zoom_intrinsics(const Intrinsics& K, float zoom, const std::vector<float>& at);
 
 // OpenGL clip transform of a pinhole camera: pixel u = fx x/z + cx lands on window x = u + 0.5
 // and image row v on window y = H - (v + 0.5), so image row 0 is the top of the picture.

@@ -2,6 +2,7 @@
 // docs/RENDERING.md explains every key and the passes they tune.
 #pragma once
 #include <string>
+#include <vector>
 
 #include "core/math.hpp"
 #include "core/params.hpp"
@@ -18,6 +19,10 @@ struct RenderParams {
   // advancing by the recording's frame interval (scan_then_simulate replays the recording after the scan).
   std::string camera = "fixed";
   int replay_start = 0;               // recorded, scan_then_simulate: first input frame of the replay
+  // recorded, mesh view: magnify the recorded camera about pixel zoom_at (default the centre), so
+  // that a figure can frame an object that the recording saw from afar (a chair across the room).
+  float zoom = 1.f;
+  std::vector<float> zoom_at;
   std::string fluid = "ssfr";         // screen-space fluid rendering (van der Laan 2009) or raw particles
   bool write_frames = false;
   bool video = false;
@@ -81,6 +86,10 @@ struct RenderParams {
       Choices{"fixed", "recorded"});
     v("replay_start", replay_start, "camera recorded, scan_then_simulate: input frame the replay starts at",
       Range{0, 1e9});
+    v("zoom", zoom, "camera recorded, view mesh: magnify the recorded camera this many times about zoom_at",
+      Range{1.0, 20.0});
+    v("zoom_at", zoom_at, "[u, v]: input image pixel that zoom centres on (empty: the image centre)",
+      Range{-1e5, 1e5});
     v("fluid", fluid, "fluid drawing", Choices{"ssfr", "particles"});
     v("write_frames", write_frames, "write each rendered frame as PNG into the output folder");
     v("video", video, "encode the frames into a video (needs ffmpeg)");

@@ -12,7 +12,13 @@ Checks, against what the plan is meant to do rather than against printed numbers
 - every step leaves its .done marker, wall time and log, and a second call skips finished steps;
 - --from-runs reports the run's own commit (the plan's) and device (host.txt), writes a table
   5.1 row with a positive time for the fluid case and one figure 5.8 row per layout and size;
-- a broken binary makes the plan exit non-zero and name the failed steps.
+- a broken binary makes the plan exit non-zero and name the failed steps;
+- issue 18, with ../shared/data beside the source tree: the real set's smoke step (fig5_1 on the
+  first 8 frames of tum_fr1_rpy_000-149) reads DATA, finishes, and --from-runs lists its settings
+  as run: 8 frames (120-127), ground-truth poses and the config's 14 x 8 x 14 = 1568 water
+  particles (a 0.28 x 0.16 x 0.28 m block of 2 cm particles); its figure is there whenever the
+  synthetic one is (both need a GL renderer). Without DATA's recording the step is skipped, not
+  failed.
 """
 import csv
 import json
@@ -45,7 +51,10 @@ def main():
     plan, runs, out = os.path.join(work, "plan.sh"), os.path.join(work, "runs"), os.path.join(work, "out")
     r = run([sys.executable, reproduce, "--smoke", "--plan", plan, "--device", "cpu"], cwd=src)
     assert r.returncode == 0, r.stdout + r.stderr
-    steps = re.findall(r"^step (\S+) ", open(plan).read(), re.M)
+    steps = re.findall(r"^(?:step|data_step \S+) (\S+) ", open(plan).read(), re.M)
+    data = os.path.normpath(os.path.join(src, "..", "shared", "data"))
+    real = os.path.isdir(os.path.join(data, "tum_fr1_rpy_000-149"))
+    assert "real_fig5_1_fluid_desk" in steps, steps
     assert steps[0] == "fig5_1_fluid_desk" and "bench_physics" in steps, steps
     assert sum(s.startswith("recon_") for s in steps) == 4, steps
 
@@ -53,6 +62,10 @@ def main():
     r = run(["bash", plan], cwd=src, env=env)
     print(r.stdout, r.stderr)
     assert r.returncode == 0, "the plan failed with only bash, mkdir and rm on PATH"
+    if not real:
+        assert "real_fig5_1_fluid_desk: skipped, no recording" in r.stdout, r.stdout
+        print(f"no {data}/tum_fr1_rpy_000-149: the real step was skipped (as it should); not checked further")
+        steps.remove("real_fig5_1_fluid_desk")
     for s in steps:
         for ext in (".done", ".ms", ".log"):
             assert os.path.exists(os.path.join(runs, s + ext)), f"{s}{ext} missing"
@@ -78,6 +91,14 @@ def main():
                                                               ("hash", "64")], rows
     assert all(float(r["frame_ms"]) > 0 for r in rows), rows
     assert os.path.getsize(os.path.join(out, "figures", "fig5_8_recon.png")) > 0
+
+    if real:
+        settings = open(os.path.join(out, "real_settings.md")).read()
+        row = re.search(r"^\| 5\.1 \| tum_fr1_rpy_000-149 \| (\S+) \| (\S+) \| (\d+) fluid \|", settings, re.M)
+        assert row and row.groups() == ("120-127", "ground_truth", "1568"), settings
+        assert os.path.exists(os.path.join(out, "real_settings.tex"))
+        if os.path.exists(os.path.join(out, "figures", "fig5_1_fluid_desk.png")):
+            assert os.path.exists(os.path.join(out, "figures", "real_fig5_1_fluid_desk.png")), "real figure missing"
 
     # a binary that fails: the plan carries on, then exits 1 naming the steps
     bad = os.path.join(work, "false_seamless")

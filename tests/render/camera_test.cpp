@@ -53,5 +53,25 @@ TEST(RenderCamera, ScaledIntrinsicsKeepPixelCentres) {
   EXPECT_NEAR(b.y + 0.5f, (a.y + 0.5f) * 1.5f, 1e-3f);
 }
 
+// render.zoom: the picked pixel lands on the image centre and image distances from it grow by the
+// zoom factor (a longer lens about that ray); zoom 1 without a pixel leaves the camera unchanged.
+TEST(RenderCamera, ZoomCentresThePickedPixel) {
+  const Intrinsics K = intrinsics(517.3f, 318.6f, 255.3f, 640, 480);
+  const Intrinsics Z = zoom_intrinsics(K, 2.f, {126.f, 343.f});
+  for (vec3 p : {vec3{-0.7f, 0.3f, 2.7f}, vec3{0.1f, -0.2f, 1.f}, vec3{0.4f, 0.5f, 3.5f}}) {
+    const vec2 a = K.project(p), b = Z.project(p);
+    EXPECT_NEAR(b.x, 319.5f + 2.f * (a.x - 126.f), 1e-3f);
+    EXPECT_NEAR(b.y, 239.5f + 2.f * (a.y - 343.f), 1e-3f);
+  }
+  const Intrinsics C = zoom_intrinsics(K, 3.f, {});  // about the image centre
+  const vec2 c = C.project(K.unproject(319.5f, 239.5f, 2.f));
+  EXPECT_NEAR(c.x, 319.5f, 1e-3f);
+  EXPECT_NEAR(c.y, 239.5f, 1e-3f);
+  const Intrinsics U = zoom_intrinsics(K, 1.f, {});
+  EXPECT_EQ(U.fx, K.fx);
+  EXPECT_EQ(U.cx, K.cx);
+  EXPECT_EQ(U.cy, K.cy);
+}
+
 }  // namespace
 }  // namespace seamless::test
