@@ -98,7 +98,7 @@ class Cli(unittest.TestCase):
         # Everything spawns at once above the desk, apart from each other along x.
         cfg["spawn"] = [
             {"kind": "fluid_block", "position": [-0.35, -0.3, 1.55], "size": [0.12, 0.12, 0.12]},
-            {"kind": "cloth", "position": [0.0, -0.3, 1.5], "nx": 8, "ny": 8},
+            {"kind": "cloth", "position": [0.0, -0.3, 1.5], "nx": 16, "ny": 16},  # 0.3 m of the demo's 2 cm particles
             {"kind": "rigid", "shape": "box", "position": [0.35, -0.3, 1.5], "size": [0.16, 0.16, 0.16]}]
         cfg["render"] = {"mode": "none"}
         cfg["output"]["particles_every"] = 3
