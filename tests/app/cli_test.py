@@ -162,6 +162,17 @@ class Cli(unittest.TestCase):
             with open(os.path.join(out, "config.yaml")) as c:
                 self.assertIn("frames: 6", c.read())
 
+    def test_render_camera_keys_are_checked(self):
+        # render.eye / render.target take [x, y, z]: anything else stops the run before the scan,
+        # with exit code 4 (configuration) and the key named.
+        with tempfile.TemporaryDirectory() as d:
+            for key, value in [("render.eye", "[1, 2]"), ("render.target", "[0, 0, 0, 1]")]:
+                r = seamless("run", os.path.join(SRC, "configs", "demo.yaml"), "--device", "cpu", "--out",
+                             os.path.join(d, key), "--set", f"{key}={value}", check=False)
+                self.assertEqual(r.returncode, 4, r.stderr)
+                self.assertIn(key + ": expected [x, y, z]", r.stderr)
+                self.assertFalse(os.path.exists(os.path.join(d, key, "trajectory.txt")))
+
     def check_preview(self, out, last_frame):
         """preview.png (issue 18): the last frame at the demo config's own size (1280x720: the reduced
         run overrides no render key), not blank."""
