@@ -107,7 +107,7 @@ class KinectFrames {
   bool have_ = false;
 };
 
-RenderCamera mesh_camera(Renderer& r, const RenderOptions& o, const RenderParams& p) {
+SceneCamera mesh_camera(Renderer& r, const RenderOptions& o, const RenderParams& p) {
   const std::string mesh_path = o.run_dir + "/mesh.ply", traj_path = o.run_dir + "/trajectory.txt";
   Mesh mesh;
   if (fs::exists(mesh_path)) mesh = read_ply(mesh_path);
@@ -118,8 +118,7 @@ RenderCamera mesh_camera(Renderer& r, const RenderOptions& o, const RenderParams
     Trajectory t = read_tum_trajectory(traj_path);
     if (!t.empty()) first = t.front().se3();
   }
-  SceneCamera c = mesh_view_camera(mesh, first);
-  return RenderCamera::look_at(c.eye, c.target, {0.f, 1.f, 0.f}, p.fov_y, p.width, p.height, p.znear, p.zfar);
+  return mesh_view_camera(mesh, first, p);
 }
 
 int render_run(const RenderOptions& o) {
@@ -127,6 +126,7 @@ int render_run(const RenderOptions& o) {
   if (!fs::is_directory(o.run_dir)) throw UsageError("run folder '" + o.run_dir + "' does not exist");
   Experiment e = load_run_config(o);
   const RenderParams& p = e.render;
+  check_render_camera(p);
   const std::string out_dir = o.out.empty() ? o.run_dir + "/render" : o.out;
   fs::create_directories(out_dir);
   const auto states = snapshots(o.run_dir, o.last_only);
@@ -142,7 +142,7 @@ int render_run(const RenderOptions& o) {
   Renderer r(p, p.width, p.height);
   spdlog::info("re-rendering {} states of {} at {}x{}, {} view, with {}", states.size(), o.run_dir, p.width, p.height,
                p.view, r.gl_info().renderer);
-  RenderCamera cam = p.view == "mesh" ? mesh_camera(r, o, p) : RenderCamera{};
+  const SceneCamera scene_cam = p.view == "mesh" ? mesh_camera(r, o, p) : SceneCamera{};
   std::unique_ptr<KinectFrames> kinect;
   if (p.view == "kinect") kinect = std::make_unique<KinectFrames>(e, o.run_dir);
   HeadlessOutput out(out_dir, p);
@@ -151,6 +151,12 @@ int render_run(const RenderOptions& o) {
     if (kinect && !kinect->set(r, step)) throw Error("the run's input gives no frame for the Kinect view");
     ParticleState s = read_particles_ply(path);
     std::vector<RigidFrame> frames = match_rigid_frames(objects, s, warm);
+    RenderCamera cam{};  // the Kinect view uses its own
+    if (p.view == "mesh") {  // the orbit's progress as in the run: the state's time over the duration
+      const float progress = e.duration > 0.0 ? static_cast<float>(step * e.solver.dt / e.duration) : 0.f;
+      const SceneCamera c = orbit_camera(scene_cam, p, progress);
+      cam = RenderCamera::look_at(c.eye, c.target, {0.f, 1.f, 0.f}, p.fov_y, p.width, p.height, p.znear, p.zfar);
+    }
     r.draw(run_draw_list(s, frames, objects, meshes, 0.5f * e.solver.particle_diameter), cam);
     out.add(r);
   }

@@ -101,6 +101,7 @@ int run(const CommonOptions& o) {
   Experiment& e = ctx.experiment();
   check_placements(e.spawn);  // before the scan: a malformed place costs no scan
   check_render_zoom(e.render);
+  check_render_camera(e.render);
   if (e.render.camera == "recorded" && e.input.source == "kinect" && e.mode != "live")
     throw ConfigError("render.camera: recorded replays the input after the scan, which a live Kinect cannot; use "
                 "mode: live (each frame drawn from its own pose) or record first (`seamless record`)");

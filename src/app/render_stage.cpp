@@ -13,6 +13,7 @@
 #include "kernels/physics/particle_math.hpp"
 #include "seamless/build_config.hpp"
 #if SEAMLESS_HAS_GL
+#include "io/png_io.hpp"
 #include "render/headless_output.hpp"
 #include "render/renderer.hpp"
 #if SEAMLESS_HAS_CUDA
@@ -171,12 +172,33 @@ std::vector<RigidFrame> match_rigid_frames(const RunObjects& o, const ParticleSt
   return out;
 }
 
-SceneCamera mesh_view_camera(const Mesh& mesh, const SE3& scan_camera) {
+void check_render_camera(const RenderParams& p) {
+  for (const auto& [key, v] : {std::pair{"eye", &p.eye}, std::pair{"target", &p.target}})
+    if (!v->empty() && v->size() != 3)
+      throw ConfigError(std::string("render.") + key + ": expected [x, y, z] (three numbers, world metres), got " +
+                        std::to_string(v->size()));
+  if (p.eye.size() == 3 && p.target.size() == 3 && p.eye == p.target)
+    throw ConfigError("render.eye and render.target are the same point: the camera would look nowhere");
+}
+
+SceneCamera mesh_view_camera(const Mesh& mesh, const SE3& scan_camera, const RenderParams& p) {
   vec3 lo{1e9f, 1e9f, 1e9f}, hi{-1e9f, -1e9f, -1e9f};
-  for (vec3 p : mesh.positions) lo = vmin(lo, p), hi = vmax(hi, p);
+  for (vec3 q : mesh.positions) lo = vmin(lo, q), hi = vmax(hi, q);
   vec3 target = mesh.positions.empty() ? scan_camera.t + scan_camera.rotate({0, 0, 1}) : (lo + hi) * 0.5f;
-  vec3 back = normalize(scan_camera.t - target);
-  return {scan_camera.t + back * 0.5f + vec3{0.f, 0.4f, 0.f}, target};
+  if (p.target.size() == 3) target = {p.target[0], p.target[1], p.target[2]};
+  const vec3 back = normalize(scan_camera.t - target);
+  vec3 eye = scan_camera.t + back * 0.5f + vec3{0.f, 0.4f, 0.f};
+  if (p.eye.size() == 3) eye = {p.eye[0], p.eye[1], p.eye[2]};
+  return {eye, target};
+}
+
+SceneCamera orbit_camera(const SceneCamera& c, const RenderParams& p, float progress) {
+  const float a = p.orbit_deg * std::clamp(progress, 0.f, 1.f) * kernels::kPi / 180.f;
+  const vec3 r = c.eye - c.target;
+  const float cs = std::cos(a), sn = std::sin(a);
+  // A turn about +y by a: (x, z) -> (x cos a + z sin a, -x sin a + z cos a); a positive angle turns
+  // +z towards +x (from ahead of the first camera towards its right).
+  return {c.target + vec3{cs * r.x + sn * r.z, r.y, -sn * r.x + cs * r.z}, c.target};
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -354,8 +376,9 @@ class GlRunRenderer : public RunRenderer {
     if (p_.view != "mesh") return;
     renderer_.set_scene_mesh(mesh);
     if (have_recorded_camera_) return;  // the recorded frames set it
-    SceneCamera c = mesh_view_camera(mesh, scan_camera);
-    camera_ = RenderCamera::look_at(c.eye, c.target, {0.f, 1.f, 0.f}, p_.fov_y, p_.width, p_.height, p_.znear, p_.zfar);
+    mesh_camera_ = mesh_view_camera(mesh, scan_camera, p_);
+    have_mesh_camera_ = true;
+    set_mesh_camera(0.f);
   }
 
   void set_kinect_frame(const RgbdFrame& frame, const SE3& world_T_camera) override {
@@ -373,6 +396,10 @@ class GlRunRenderer : public RunRenderer {
   void draw(const ParticleSolver& solver) override {
     StageScope s(ctx_.timer(), "render");
     draw_state_.update(solver, ctx_.experiment().spawn);
+    // The orbit's progress: simulated time over the run's duration (0 at the first frame).
+    const double duration = ctx_.experiment().duration;
+    if (p_.orbit_deg != 0.f && have_mesh_camera_ && !have_recorded_camera_ && duration > 0.0)
+      set_mesh_camera(static_cast<float>(solver.stats().time / duration));
 #if SEAMLESS_HAS_CUDA
     if (interop_ && solver.device() == Device::CUDA) {
       interop_->copy_from_device(solver.device_positions(), solver.device_phases(), solver.size());
@@ -387,16 +414,26 @@ class GlRunRenderer : public RunRenderer {
 
   void finish() override {
     out_.finish();
-    spdlog::info("rendered {} frames{}", out_.frames(), out_.video_open() ? " and " + out_.video_path() : "");
+    // The last frame on its own: what a reader sees first of a run (scripts/demo prints it).
+    if (out_.frames() > 0) write_png_rgb(ctx_.out_path("preview.png"), renderer_.read_frame());
+    spdlog::info("rendered {} frames{}{}", out_.frames(), out_.video_open() ? " and " + out_.video_path() : "",
+                 out_.frames() > 0 ? ", the last as preview.png" : "");
   }
 
  private:
+  void set_mesh_camera(float progress) {
+    const SceneCamera c = orbit_camera(mesh_camera_, p_, progress);
+    camera_ = RenderCamera::look_at(c.eye, c.target, {0.f, 1.f, 0.f}, p_.fov_y, p_.width, p_.height, p_.znear, p_.zfar);
+  }
+
   RunContext& ctx_;
   RenderParams p_;
   Renderer renderer_;
   HeadlessOutput out_;
   RenderCamera camera_{};
   bool have_recorded_camera_ = false;
+  SceneCamera mesh_camera_{};  // render.eye/target or their defaults, before the orbit
+  bool have_mesh_camera_ = false;
   RunDrawState draw_state_;
 #if SEAMLESS_HAS_CUDA
   std::unique_ptr<CudaGlParticles> interop_;
@@ -456,7 +493,7 @@ class WindowRunRenderer : public RunRenderer {
     v.target = {0.f, 0.f, 1.5f};
     v.distance = 2.5f;
     if (!mesh_.positions.empty()) {
-      const SceneCamera c = mesh_view_camera(mesh_, mesh_camera_);
+      const SceneCamera c = mesh_view_camera(mesh_, mesh_camera_, ctx_.experiment().render);
       v.target = c.target, v.distance = std::max(0.5f, length(c.eye - c.target));
     }
     return v;

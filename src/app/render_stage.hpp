@@ -83,12 +83,19 @@ ParticleState read_particles_ply(const std::string& path);
 // which is updated; pass the previous snapshot's result). Bodies not in the state are skipped.
 std::vector<RigidFrame> match_rigid_frames(const RunObjects& o, const ParticleState& s, std::vector<vec4>& warm);
 
-// The camera of the mesh view: looking at the mesh's centre from behind and above the first
-// scanning camera (world up +y: the tracker's world has gravity along -y).
+// The camera of the mesh view: at render.eye looking at render.target where given, else looking
+// at the mesh's centre from behind and above the first scanning camera (world up +y: the
+// tracker's world has gravity along -y).
 struct SceneCamera {
   vec3 eye, target;
 };
-SceneCamera mesh_view_camera(const Mesh& mesh, const SE3& scan_camera);
+SceneCamera mesh_view_camera(const Mesh& mesh, const SE3& scan_camera, const RenderParams& p = {});
+// render.orbit_deg: the eye turned about the vertical through the target by orbit_deg * progress
+// (progress 0 at the run's first frame, 1 at its last; clamped); a positive angle turns +z towards +x.
+SceneCamera orbit_camera(const SceneCamera& c, const RenderParams& p, float progress);
+// Throws ConfigError when render.eye or render.target is given but not as three numbers, or both
+// are the same point.
+void check_render_camera(const RenderParams& p);
 
 #if SEAMLESS_HAS_GL
 // Each body's surface in its body frame, from its spawn entry: a sphere of diameter size.x, the

@@ -29,6 +29,13 @@ struct RenderParams {
   bool stage_images = false;
   // Camera of the mesh view (the Kinect view uses the sensor's intrinsics and tracked pose).
   float fov_y = 60.f;                 // degrees, vertical
+  // Where the fixed mesh-view camera stands and what it looks at (world metres, [x, y, z]); empty:
+  // behind and above the first scanning camera, looking at the scanned mesh's centre. A camera that
+  // sees only what the scan saw shows no empty background (the demo frames the desk this way).
+  std::vector<float> eye, target;
+  // The fixed mesh-view camera turns by this many degrees about the vertical through the target
+  // between the first and the last frame of a run (parallax that shows depth); 0: it stays.
+  float orbit_deg = 0.f;
   float znear = 0.05f, zfar = 30.f;   // metres
   int fps = 30;                       // video frame rate
   // What is drawn (the window toggles these with keys 1-5).
@@ -95,6 +102,12 @@ struct RenderParams {
     v("video", video, "encode the frames into a video (needs ffmpeg)");
     v("stage_images", stage_images, "also write the intermediate SSFR stages (depth, blur, thickness)");
     v("fov_y", fov_y, "vertical field of view of the mesh view camera, degrees", Range{5.0, 170.0});
+    v("eye", eye, "[x, y, z]: position of the fixed mesh view camera, world metres; empty: behind and above the "
+      "first scanning camera", Range{-1e4, 1e4});
+    v("target", target, "[x, y, z]: point the fixed mesh view camera looks at, world metres; empty: the scanned "
+      "mesh's centre", Range{-1e4, 1e4});
+    v("orbit_deg", orbit_deg, "the fixed mesh view camera turns this many degrees about the vertical through its "
+      "target from the first frame to the last; 0: it stays", Range{-360.0, 360.0});
     v("znear", znear, "near clipping distance, metres", Range{1e-4, 10.0});
     v("zfar", zfar, "far clipping distance, metres", Range{0.1, 1e5});
     v("fps", fps, "frame rate of the encoded video", Range{1, 240});

@@ -124,7 +124,7 @@ class Cli(unittest.TestCase):
         # Everything spawns at once above the desk, apart from each other along x.
         cfg["spawn"] = [
             {"kind": "fluid_block", "position": [-0.35, -0.3, 1.55], "size": [0.12, 0.12, 0.12]},
-            {"kind": "cloth", "position": [0.0, -0.3, 1.5], "nx": 8, "ny": 8},
+            {"kind": "cloth", "position": [0.0, -0.3, 1.5], "nx": 16, "ny": 16},  # 0.3 m of the demo's 2 cm particles
             {"kind": "rigid", "shape": "box", "position": [0.35, -0.3, 1.5], "size": [0.16, 0.16, 0.16]}]
         cfg["render"] = {"mode": "none"}
         cfg["output"]["particles_every"] = 3
@@ -178,14 +178,44 @@ class Cli(unittest.TestCase):
                 self.assertGreater(os.path.getsize(p), 0, f)
             # With the renderer built (it is in CI: Mesa's EGL), the demo's headless frames exist too.
             if "render" in seamless("bench", "--list").stdout:
-                frames = glob.glob(os.path.join(out, "frames", "*.png"))
+                frames = sorted(glob.glob(os.path.join(out, "frames", "*.png")))
                 self.assertGreater(len(frames), 0)
                 self.assertTrue(all(os.path.getsize(f) > 0 for f in frames))
+                self.check_preview(out, frames[-1])
             with open(os.path.join(out, "trajectory.txt")) as t:
                 poses = [l for l in t if l.strip() and not l.startswith("#")]
             self.assertEqual(len(poses), 6)
             with open(os.path.join(out, "config.yaml")) as c:
                 self.assertIn("frames: 6", c.read())
+
+    def test_render_camera_keys_are_checked(self):
+        # render.eye / render.target take [x, y, z]: anything else stops the run before the scan,
+        # with exit code 4 (configuration) and the key named.
+        with tempfile.TemporaryDirectory() as d:
+            for key, value in [("render.eye", "[1, 2]"), ("render.target", "[0, 0, 0, 1]")]:
+                r = seamless("run", os.path.join(SRC, "configs", "demo.yaml"), "--device", "cpu", "--out",
+                             os.path.join(d, key), "--set", f"{key}={value}", check=False)
+                self.assertEqual(r.returncode, 4, r.stderr)
+                self.assertIn(key + ": expected [x, y, z]", r.stderr)
+                self.assertFalse(os.path.exists(os.path.join(d, key, "trajectory.txt")))
+
+    def check_preview(self, out, last_frame):
+        """preview.png (issue 18): the last frame at the demo config's own size (1280x720: the reduced
+        run overrides no render key), not blank."""
+        img = read_png(os.path.join(out, "preview.png"))
+        self.assertEqual((len(img[0]), len(img)), (1280, 720))
+        self.assertEqual(img, read_png(last_frame))
+        # Not blank: a frame where nothing was drawn is the clear colour everywhere (render.background,
+        # the top-left pixel of a blank frame). The 6-frame scan covers a strip of the desk and the room
+        # behind it: at least a quarter of the frame is scan or objects, in many colours (the scan's
+        # textures and shading; a flat fill of one object colour would give a handful).
+        with open(os.path.join(out, "config.yaml")) as c:
+            bg = next(l for l in c if l.strip().startswith("background:"))
+        bg = [float(v) for v in bg.split("[")[1].split("]")[0].split(",")]
+        clear = [round(255 * v) for v in bg]  # the clear colour is written as given (31, 33, 38 by default)
+        drawn = [px for row in img for px in row if max(abs(px[k] - clear[k]) for k in range(3)) > 2]
+        self.assertGreater(len(drawn), 0.25 * 1280 * 720)
+        self.assertGreater(len(set(drawn)), 256)
 
     def test_record_then_track_then_eval(self):
         with tempfile.TemporaryDirectory() as d:
