@@ -307,7 +307,8 @@ class Limits(unittest.TestCase):
         with tempfile.TemporaryDirectory() as d:
             def simulate(name, spawn, *sets):
                 args = ["simulate", DEMO, "--device", "cpu", "--out", os.path.join(d, name), "--set", f"spawn=[{spawn}]",
-                        "--set", "duration=0.1", "--set", "output.particles_every=0", "--set", "render.mode=none"]
+                        "--set", "duration=0.1", "--set", "output.particles_every=0", "--set", "render.mode=none",
+                        "--set", "solver.particle_diameter=0.04"]  # the counts below are for 4 cm particles
                 for s in sets:
                     args += ["--set", s]
                 r = seamless(*args)
