@@ -14,6 +14,8 @@ import tempfile
 import time
 import unittest
 
+from tum_subset import tum_subset
+
 EXE, SRC, DATA = sys.argv[1], sys.argv[2], sys.argv[3]
 TUM = os.path.abspath(os.path.join(DATA, "tum_fr1_rpy_000-149"))
 DEMO = os.path.join(SRC, "configs", "demo.yaml")
@@ -70,23 +72,14 @@ def count_poses(path):
 
 
 def tum_copy(dest, frames, corrupt_depth_of=None):
-    """The first `frames` associated pairs of the real fr1_rpy folder, images linked, not copied;
-    frame `corrupt_depth_of`'s depth PNG replaced by its first 200 bytes (a truncated file)."""
-    pairs = list_lines(os.path.join(TUM, "associations.txt"))[:frames]
-    os.makedirs(os.path.join(dest, "rgb"))
-    os.makedirs(os.path.join(dest, "depth"))
-    with open(os.path.join(dest, "associations.txt"), "w") as f:
-        for p in pairs:
-            f.write(" ".join(p) + "\n")
-    for i, (_, rgb, _, depth) in enumerate(pairs):
-        os.symlink(os.path.join(TUM, rgb), os.path.join(dest, rgb))
+    """The first `frames` associated pairs of the real fr1_rpy folder; frame `corrupt_depth_of`'s
+    depth PNG replaced by its first 200 bytes (a truncated file)."""
+    def truncated(i, src, out):
         if i == corrupt_depth_of:
-            with open(os.path.join(TUM, depth), "rb") as src, open(os.path.join(dest, depth), "wb") as out:
-                out.write(src.read(200))
-        else:
-            os.symlink(os.path.join(TUM, depth), os.path.join(dest, depth))
-    for name in ["groundtruth.txt", "accelerometer.txt"]:
-        shutil.copy(os.path.join(TUM, name), dest)
+            with open(src, "rb") as f, open(out, "wb") as g:
+                g.write(f.read(200))
+        return i == corrupt_depth_of
+    tum_subset(TUM, dest, frames, truncated)
 
 
 def track_tum(path, out, *sets):

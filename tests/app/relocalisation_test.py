@@ -17,6 +17,8 @@ import tempfile
 import unittest
 import zlib
 
+from tum_subset import tum_subset
+
 EXE, SRC, DATA = sys.argv[1], sys.argv[2], sys.argv[3]
 TUM = os.path.abspath(os.path.join(DATA, "tum_fr1_rpy_000-149"))
 TUM_CFG = os.path.join(SRC, "configs", "tum_fr1.yaml")
@@ -40,22 +42,13 @@ def zero_depth_png(path, width=640, height=480):
 
 
 def tum_copy(dest, gap):
-    """The first FRAMES associated pairs of the real folder (images linked, not copied), the depth of
-    the frames in `gap` replaced by all-zero PNGs."""
-    pairs = list_lines(os.path.join(TUM, "associations.txt"))[:FRAMES]
-    os.makedirs(os.path.join(dest, "rgb"))
-    os.makedirs(os.path.join(dest, "depth"))
-    with open(os.path.join(dest, "associations.txt"), "w") as f:
-        for p in pairs:
-            f.write(" ".join(p) + "\n")
-    for i, (_, rgb, _, depth) in enumerate(pairs):
-        os.symlink(os.path.join(TUM, rgb), os.path.join(dest, rgb))
+    """The first FRAMES associated pairs of the real folder, the depth of the frames in `gap`
+    replaced by all-zero PNGs."""
+    def covered(i, _src, out):
         if i in gap:
-            zero_depth_png(os.path.join(dest, depth))
-        else:
-            os.symlink(os.path.join(TUM, depth), os.path.join(dest, depth))
-    for name in ["groundtruth.txt", "accelerometer.txt"]:
-        os.symlink(os.path.join(TUM, name), os.path.join(dest, name))
+            zero_depth_png(out)
+        return i in gap
+    tum_subset(TUM, dest, FRAMES, covered)
 
 
 def track(seq, out, kind):
