@@ -79,7 +79,22 @@ struct IcpLevel {
   // than stop_translation (metres); 0 and 0: it always takes all its steps (docs/TRACKING.md).
   float stop_rotation = 0.f;
   float stop_translation = 0.f;
+  // The reduction visits every stride-th pixel of every stride-th row (tracker.pixel_stride): a
+  // subsample at full resolution, which keeps the finest level's sharp intensity gradients and
+  // exact depths (unlike the next, averaged level) at 1/stride^2 of the cost. 1: every pixel.
+  int stride = 1;
 };
+
+// The number of pixels a level's reduction visits, and the i-th of them (row by row).
+SEAMLESS_HD inline std::int64_t level_pixel_count(const IcpLevel& L) {
+  const int s = L.stride;
+  return static_cast<std::int64_t>((L.cur_vertex.width + s - 1) / s) * ((L.cur_vertex.height + s - 1) / s);
+}
+SEAMLESS_HD inline void level_pixel(const IcpLevel& L, std::int64_t i, int& x, int& y) {
+  const int s = L.stride, ws = (L.cur_vertex.width + s - 1) / s;
+  x = s * static_cast<int>(i % ws);
+  y = s * static_cast<int>(i / ws);
+}
 
 // A projective correspondence (KinectFusion eq. 17): the current point moved into the reference
 // frame, the reference pixel it projects to, and the reference vertex and normal there.

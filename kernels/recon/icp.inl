@@ -10,8 +10,8 @@ SEAMLESS_HD inline IcpTerms icp_pixel_terms(const IcpLevel& level, const IcpPose
   IcpTerms s{};
   IcpLevel l = level;
   l.ref_T_cur = to_se3(p);
-  const int w = l.cur_vertex.width;
-  int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
+  int x, y;
+  level_pixel(l, i, x, y);
   if (valid_point(l.cur_vertex(x, y))) s.valid = 1.f;
   Correspondence c;
   if (find_correspondence(l, x, y, c)) add_point_to_plane(s, c, 1.f);
@@ -21,13 +21,13 @@ SEAMLESS_HD inline IcpTerms icp_pixel_terms(const IcpLevel& level, const IcpPose
 template <class Exec>
 void icp_reduce_into(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSums* out) {
   ex.transform_reduce_into(
-      L.cur_vertex.count(), [=] SEAMLESS_HD(std::int64_t i) { return icp_pixel_terms(L, *pose, i); }, out);
+      level_pixel_count(L), [=] SEAMLESS_HD(std::int64_t i) { return icp_pixel_terms(L, *pose, i); }, out);
 }
 
 template <class Exec>
 void icp_level_steps(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSums* out, int steps) {
   ex.transform_reduce_rounds(
-      L.cur_vertex.count(), steps, [=] SEAMLESS_HD(std::int64_t i) { return icp_pixel_terms(L, *pose, i); }, out,
+      level_pixel_count(L), steps, [=] SEAMLESS_HD(std::int64_t i) { return icp_pixel_terms(L, *pose, i); }, out,
       [=] SEAMLESS_HD(int step, const IcpSums& sum) {
         gauss_newton_update(sum, *pose, level_step(step), L);
         return level_done(*pose);

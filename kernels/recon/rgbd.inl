@@ -10,8 +10,8 @@ SEAMLESS_HD inline RgbdTerms rgbd_pixel_terms(const RgbdLevel& R, const IcpPose&
   RgbdTerms s{};
   RgbdLevel L = R;
   L.geo.ref_T_cur = to_se3(p);
-  const int w = L.geo.cur_vertex.width;
-  int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
+  int x, y;
+  level_pixel(L.geo, i, x, y);
   if (valid_point(L.geo.cur_vertex(x, y))) s.icp.valid = 1.f;
   Correspondence c;
   bool geometric;
@@ -31,14 +31,14 @@ SEAMLESS_HD inline void rgbd_update(const RgbdLevel& R, const RgbdSums& out, Icp
 template <class Exec>
 void rgbd_reduce_into(const Exec& ex, RgbdLevel R, IcpPose* pose, RgbdSums* out, IcpSums* level_sums) {
   ex.transform_reduce_into(
-      R.geo.cur_vertex.count(), [=] SEAMLESS_HD(std::int64_t i) { return rgbd_pixel_terms(R, *pose, i); }, out,
+      level_pixel_count(R.geo), [=] SEAMLESS_HD(std::int64_t i) { return rgbd_pixel_terms(R, *pose, i); }, out,
       [=] SEAMLESS_HD { rgbd_update(R, *out, *pose, *level_sums, IcpUpdate::none); });
 }
 
 template <class Exec>
 void rgbd_level_steps(const Exec& ex, RgbdLevel R, IcpPose* pose, RgbdSums* out, IcpSums* level_sums, int steps) {
   ex.transform_reduce_rounds(
-      R.geo.cur_vertex.count(), steps, [=] SEAMLESS_HD(std::int64_t i) { return rgbd_pixel_terms(R, *pose, i); },
+      level_pixel_count(R.geo), steps, [=] SEAMLESS_HD(std::int64_t i) { return rgbd_pixel_terms(R, *pose, i); },
       out, [=] SEAMLESS_HD(int step, const RgbdSums& sum) {
         rgbd_update(R, sum, *pose, *level_sums, level_step(step));
         return level_done(*pose);

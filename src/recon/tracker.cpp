@@ -173,6 +173,7 @@ void Tracker::reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, i
                       SE3::identity(), params_.dist_threshold,
                       static_cast<float>(std::cos(params_.angle_threshold_deg * kPi / 180.0)),
                       static_cast<float>(params_.stop_rotation_deg * kPi / 180.0), params_.stop_translation};
+  if (level < static_cast<int>(params_.pixel_stride.size())) L.stride = params_.pixel_stride[level];
   kernels::IcpState* st = state();
   kernels::IcpSums* out = sums_slot(level);
   with_exec(device_, [&](const auto& ex) {

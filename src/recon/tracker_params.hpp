@@ -13,6 +13,9 @@ struct TrackerParams {
   std::string kind = "icp";
   std::string mode = "frame_to_model";
   std::vector<int> iterations{10, 5, 4};  // finest level first (KinectFusion, sec. 3.5)
+  // Per level, finest first: the reduction visits every n-th pixel of every n-th row (levels not
+  // listed: every pixel). The CPU's cost is the finest level's pixels (docs/TRACKING.md, "Pixel stride").
+  std::vector<int> pixel_stride{1};
   // A level stops early once a Gauss-Newton step is below both: a tenth of a millimetre, and a
   // rotation that moves a point 1.7 m away by as much; an order of magnitude under the Kinect v1's
   // depth noise at 1 m (~1.4 mm, Khoshelham & Elberink 2012), so the pose it would still gain is far
@@ -61,6 +64,10 @@ struct TrackerParams {
     v("mode", mode, "align to the model raycast or to the previous frame",
       Choices{"frame_to_model", "frame_to_frame"});
     v("iterations", iterations, "ICP iterations per pyramid level, finest first", Range{0, 1000});
+    v("pixel_stride", pixel_stride,
+      "per pyramid level, finest first: track on every n-th pixel of every n-th row (a full-resolution "
+      "subsample); levels not listed use every pixel",
+      Range{1, 64});
     v("stop_translation", stop_translation,
       "a pyramid level stops iterating once a step translates less than this (metres) and rotates less than "
       "stop_rotation_deg; 0 and 0: always all iterations",

@@ -296,6 +296,30 @@ TEST(Rgbd, VisiblePixelsMatchGroundTruth) {
   expect_pair_within_tolerance(r.world_T_camera, *f[4].frame.ground_truth);
 }
 
+TEST(Rgbd, PixelStrideMatchesGroundTruth) {
+  // tracker.pixel_stride [2, 2] (configs/tum_fr1.yaml) on the noisy pair above: a quarter of the
+  // pixels of the two finest levels still over-determine 6 parameters ~10^4 times, so the pose
+  // stays within the same per-pair tolerance.
+  auto f = synthetic_frames(5, true, true);
+  TrackerParams tp = robust_rgbd();
+  tp.photometric_pixels = "visible";
+  tp.pixel_stride = {2, 2};
+  TrackResult r = track_rgbd_pair(tp, f);
+  ASSERT_TRUE(r.ok()) << to_string(r.status);
+  expect_pair_within_tolerance(r.world_T_camera, *f[4].frame.ground_truth);
+  // The finest level's system counts exactly the valid vertices on the even rows and columns.
+  const std::vector<vec3> v = f[4].pyr->level(0).vertices.to_host();
+  const int w = f[4].pyr->level(0).K.width, h = f[4].pyr->level(0).K.height;
+  double even_valid = 0;
+  for (int y = 0; y < h; y += 2)
+    for (int x = 0; x < w; x += 2) even_valid += v[static_cast<std::size_t>(y) * w + x].z > 0.f ? 1 : 0;
+  ReferenceMaps ref;
+  ref.set_from_frame(*f[0].pyr, *f[0].frame.ground_truth);
+  const kernels::IcpSums s = Tracker(tp, Device::CPU).reduce(*f[4].pyr, ref, 0, *f[4].frame.ground_truth);
+  EXPECT_EQ(s.valid, even_valid);
+  EXPECT_GT(even_valid, 0.2 * w * h / 4);  // the room fills most of the image
+}
+
 TEST(Rgbd, MinGradientAboveEveryGradientLeavesTheGeometryAlone) {
   // tracker.min_gradient: with a threshold no intensity gradient reaches (1 per pixel on [0, 1]
   // images), no pixel gets a photometric row, so the fixed-weight RGB-D estimate is the ICP's
