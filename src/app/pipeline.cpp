@@ -16,6 +16,7 @@
 #include "app/render_stage.hpp"
 #include "app/run_summary.hpp"
 #include "physics/builders.hpp"
+#include "physics/depth_colliders.hpp"
 #include "physics/particle_solver.hpp"
 #include "recon/ply.hpp"
 
@@ -343,6 +344,7 @@ class LiveLoop : public FrameLoop {
     poses_.push_back(TumPose::from_se3(frame_.timestamp, rec.result.world_T_camera));
     const bool reextract = rec.fused && (fused_++ % e_.reextract_every) == 0;
     if (reextract) extract_scene();
+    if (e_.solver.dynamic_colliders != "none" && rec.result.ok()) update_colliders(rec.result.world_T_camera);
     if (fused_ > 0) {
       StageScope s(ctx_.timer(), "physics");
       if (!t0_) t0_ = frame_.timestamp;
@@ -417,6 +419,19 @@ class LiveLoop : public FrameLoop {
     points_.resize(static_cast<std::size_t>(scene.count));
     solver_.clear_static_particles();
     solver_.add_static_particles(points_);
+  }
+
+  // solver.dynamic_colliders: this frame's depth points as the solver's kinematic colliders
+  // (physics/depth_colliders.hpp), spaced by the pyramid level's pixels, thickened by one particle
+  // diameter per layer.
+  void update_colliders(const SE3& world_T_camera) {
+    StageScope s(ctx_.timer(), "colliders");
+    const FramePyramid& pyr = session_.pyramid();
+    const PyramidLevel& lv = pyr.level(std::min(e_.solver.collider_level, pyr.levels() - 1));
+    std::vector<std::uint8_t> mask;  // empty: every pixel (dynamic_colliders: all)
+    solver_.set_collider_particles(depth_collider_points(lv.vertices.to_host(), lv.K.width, lv.K.height,
+                                                         world_T_camera, e_.solver.particle_diameter,
+                                                         e_.solver.collider_thickness, mask));
   }
 
   // summary.json of a live run: as scan_then_simulate's, with the scene as it was at the end.

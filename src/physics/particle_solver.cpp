@@ -81,8 +81,10 @@ struct ParticleSolver::Impl {
   Buffer<float> sw, lambda, density, h_rho, vort_len;
   Buffer<int> cell_start, counters;
   int bits = 4;
-  // static scene
-  std::vector<vec3> static_host;
+  // static scene; collider_host: this frame's kinematic colliders (set_collider_particles), kept
+  // after the scene's points in the same static grid
+  std::vector<vec3> static_host, collider_host;
+  std::int64_t static_count() const { return static_cast<std::int64_t>(static_host.size() + collider_host.size()); }
   Buffer<vec3> stat;
   Buffer<int> scell_start;
   K::GridSpec sgrid{};
@@ -228,7 +230,7 @@ struct ParticleSolver::Impl {
     if (dev == Device::CUDA && lanes < K::kRowMajorLanes) S.nbr_row = 1, S.nbr_col = n, S.snbr_row = 1, S.snbr_col = n;
     else S.nbr_row = P.max_neighbours + 1, S.nbr_col = 1, S.snbr_row = P.max_static_neighbours + 1, S.snbr_col = 1;
     S.counters = counters.data();
-    S.ns = static_cast<std::int64_t>(static_host.size());
+    S.ns = static_count();
     S.stat = stat.data(), S.sgrid = sgrid, S.scell_start = scell_start.data();
     S.sdf = sdf;
     S.nbodies = static_cast<int>(body_start.size());
@@ -255,7 +257,7 @@ struct ParticleSolver::Impl {
     std::int64_t cells = std::int64_t{1} << (3 * bits);
     const void* before[3] = {cell_start.data(), snbr.data(), nullptr};
     cell_start.reserve_discard(cells + 1, dev);
-    if (!static_host.empty()) snbr.reserve_discard(cap * (P.max_static_neighbours + 1), dev);
+    if (static_count() > 0) snbr.reserve_discard(cap * (P.max_static_neighbours + 1), dev);
 #if SEAMLESS_HAS_CUDA
     before[2] = sort_temp.data();
     if (dev == Device::CUDA && sort_temp_n != n) {
@@ -645,11 +647,14 @@ struct ParticleSolver::Impl {
 
   void rebuild_static() {
     ++generation;
-    const std::int64_t ns = static_cast<std::int64_t>(static_host.size());
+    const std::int64_t ns = static_count();
+    if (ns == 0) return;
     int sb = grid_bits(ns);
     sgrid = K::GridSpec::for_radius(std::max(P.fluid_smoothing * P.particle_diameter, 1.5f * P.particle_diameter), sb);
     std::int64_t cells = std::int64_t{1} << (3 * sb);
-    Buffer<vec3> raw = Buffer<vec3>::from_host(static_host, dev);
+    std::vector<vec3> all = static_host;
+    all.insert(all.end(), collider_host.begin(), collider_host.end());
+    Buffer<vec3> raw = Buffer<vec3>::from_host(all, dev);
     Buffer<std::uint32_t> keys(ns, dev);
     Buffer<int> idx(ns, dev);
     stat = Buffer<vec3>(ns, dev);
@@ -677,6 +682,14 @@ void ParticleSolver::add_static_particles(const std::vector<vec3>& points) {
 void ParticleSolver::clear_static_particles() {
   impl_->static_host.clear();
   ++impl_->generation;
+  if (!impl_->collider_host.empty()) impl_->rebuild_static();
+}
+
+void ParticleSolver::set_collider_particles(const std::vector<vec3>& points) {
+  if (points.empty() && impl_->collider_host.empty()) return;
+  impl_->collider_host = points;
+  ++impl_->generation;
+  impl_->rebuild_static();
 }
 
 void ParticleSolver::set_scene_sdf(const kernels::SceneSdf& sdf) {
@@ -730,6 +743,7 @@ SolverStats ParticleSolver::stats() const {
   s.particles = I.n, s.fluid_particles = I.n_fluid, s.cloth_particles = I.n_cloth, s.rigid_particles = I.n_rigid;
   s.rigid_bodies = static_cast<std::int64_t>(I.body_start.size());
   s.static_particles = static_cast<std::int64_t>(I.static_host.size());
+  s.collider_particles = static_cast<std::int64_t>(I.collider_host.size());
   s.substeps = substeps();
   s.time = I.time, s.steps = I.steps, s.emitter_dropped = I.emitter_dropped;
   // One small read: the counters the kernels keep on the device (overflow, longest lists, the

@@ -24,6 +24,7 @@ namespace seamless {
 struct SolverStats {
   std::int64_t particles = 0, fluid_particles = 0, cloth_particles = 0, rigid_particles = 0;
   std::int64_t rigid_bodies = 0, static_particles = 0;
+  std::int64_t collider_particles = 0;  // this frame's kinematic colliders (set_collider_particles)
   int substeps = 1;
   double time = 0.0;              // simulated seconds
   std::int64_t steps = 0;
@@ -45,6 +46,10 @@ class ParticleSolver {
   // Static scene particles (appended to those already there); they never move.
   void add_static_particles(const std::vector<vec3>& points);
   void clear_static_particles();
+  // This frame's kinematic colliders (solver.dynamic_colliders: points from the depth camera,
+  // physics/depth_colliders.hpp), replacing the last frame's: they collide as scene particles do,
+  // infinitely heavy, so whatever they move into is pushed out of them.
+  void set_collider_particles(const std::vector<vec3>& points);
   // Collide against an SDF as well (analytic primitives and/or the synthetic room).
   void set_scene_sdf(const kernels::SceneSdf& sdf);
   // Collide against a dense sampled SDF (x fastest), e.g. resampled from the TSDF.

@@ -52,6 +52,11 @@ struct SolverParams {
   float cloth_strain_omega = 1.5f;      // over-relaxation of strain limiting
   float cloth_strain_contact_weight = 0.3f;  // strain limiting: inverse-mass factor of particles on the scene
   bool cuda_graph = true;               // CUDA: replay a step as one captured graph (docs/PHYSICS.md)
+  // Issue 22: the live depth camera's points as kinematic colliders each frame (people and moving
+  // objects push the simulation): none, the dynamic pixels only (dynamic.enabled), or every pixel.
+  std::string dynamic_colliders = "none";
+  int collider_level = 2;               // pyramid level whose vertex map gives the points (2: 160x120)
+  float collider_thickness = 0.1f;      // metres of colliders behind each seen surface point, along its ray
 
   template <class V> void visit(V& v) {
     v("particle_diameter", particle_diameter, "particle diameter, metres", Range{0.001, 1.0});
@@ -100,6 +105,18 @@ struct SolverParams {
     v("cloth_strain_contact_weight", cloth_strain_contact_weight,
       "strain limiting: inverse-mass factor of cloth particles touching the scene (1 = none)", Range{0.01, 1.0});
     v("cuda_graph", cuda_graph, "CUDA: capture a step as a graph and replay it while the scene is unchanged");
+    v("dynamic_colliders", dynamic_colliders,
+      "live mode: each frame's depth points become kinematic collider particles: none, the dynamic pixels only "
+      "(depth; needs dynamic.enabled) or every pixel (all)",
+      Choices{"none", "depth", "all"});
+    v("collider_level", collider_level,
+      "dynamic_colliders: the depth pyramid level whose points are used (0 = full resolution; each level halves "
+      "both sides)",
+      Range{0, 3});
+    v("collider_thickness", collider_thickness,
+      "dynamic_colliders: metres of collider particles behind each seen point along its camera ray (the camera "
+      "sees only the front of a person; particles pushed past that shell would be inside them)",
+      Range{0.0, 2.0});
   }
 };
 
