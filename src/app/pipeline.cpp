@@ -332,6 +332,10 @@ class LiveLoop : public FrameLoop {
     if (e_.output.write_trajectory) traj_ = std::make_unique<TrajectoryWriter>(ctx.out_path("trajectory.txt"));
     sp_.spacing = e_.solver.particle_diameter;
     sp_.interior_depth = e_.scene_interior_depth;
+    if (e_.solver.dynamic_colliders == "depth")
+      throw ConfigError("solver.dynamic_colliders: depth (the dynamic pixels only) is not built yet; use all");
+    if (e_.solver.dynamic_colliders != "none")
+      colliders_.emplace(e_.solver.particle_diameter, e_.solver.collider_thickness, e_.solver.max_speed);
   }
 
   bool advance() override {
@@ -344,16 +348,19 @@ class LiveLoop : public FrameLoop {
     poses_.push_back(TumPose::from_se3(frame_.timestamp, rec.result.world_T_camera));
     const bool reextract = rec.fused && (fused_++ % e_.reextract_every) == 0;
     if (reextract) extract_scene();
-    if (e_.solver.dynamic_colliders != "none" && rec.result.ok()) update_colliders(rec.result.world_T_camera);
     if (fused_ > 0) {
       StageScope s(ctx_.timer(), "physics");
       if (!t0_) t0_ = frame_.timestamp;
       // camera recorded: the simulation keeps the recording's time (several steps a frame);
       // otherwise one step a frame, as the dissertation's live loop.
       const double target = e_.render.camera == "recorded" ? frame_.timestamp - *t0_ : time_ + 0.5 * e_.solver.dt;
-      while (time_ + 0.5 * e_.solver.dt <= target) {
+      int steps = 0;
+      while (time_ + (steps + 0.5) * e_.solver.dt <= target) ++steps;
+      if (colliders_ && rec.result.ok()) update_colliders(rec.result.world_T_camera, time_ + steps * e_.solver.dt);
+      for (int k = 0; k < steps; ++k) {
         queue_.due(solver_, time_,
                    [&](int i, SpawnParams& sp) { return place_live(i, sp, rec.result.world_T_camera); });
+        if (colliders_) solver_.set_collider_particles(colliders_->at(time_ + e_.solver.dt));
         solver_.step();
         time_ += e_.solver.dt;
       }
@@ -424,14 +431,16 @@ class LiveLoop : public FrameLoop {
   // solver.dynamic_colliders: this frame's depth points as the solver's kinematic colliders
   // (physics/depth_colliders.hpp), spaced by the pyramid level's pixels, thickened by one particle
   // diameter per layer.
-  void update_colliders(const SE3& world_T_camera) {
+  // frame_time: the simulation time this frame's steps end at; the steps between the last frame
+  // and this one move the colliders with their estimated velocities (MovingColliders).
+  void update_colliders(const SE3& world_T_camera, double frame_time) {
     StageScope s(ctx_.timer(), "colliders");
     const FramePyramid& pyr = session_.pyramid();
     const PyramidLevel& lv = pyr.level(std::min(e_.solver.collider_level, pyr.levels() - 1));
     std::vector<std::uint8_t> mask;  // empty: every pixel (dynamic_colliders: all)
-    solver_.set_collider_particles(depth_collider_points(lv.vertices.to_host(), lv.K.width, lv.K.height,
-                                                         world_T_camera, e_.solver.particle_diameter,
-                                                         e_.solver.collider_thickness, mask));
+    colliders_->update(depth_surface(lv.vertices.to_host(), lv.normals.to_host(), lv.K.width, lv.K.height,
+                                     world_T_camera, mask),
+                       frame_time);
   }
 
   // summary.json of a live run: as scan_then_simulate's, with the scene as it was at the end.
@@ -501,6 +510,7 @@ class LiveLoop : public FrameLoop {
   std::int64_t fused_ = 0, tried_at_ = -1;
   double time_ = 0.0;
   std::optional<double> t0_;  // timestamp of the first fused frame
+  std::optional<MovingColliders> colliders_;  // solver.dynamic_colliders
   std::vector<vec3> points_;  // the scene particles of the last extraction
   Trajectory poses_;          // tracked so far (pixel placements)
   std::vector<SpawnParams> spawns_ = e_.spawn;       // with the live placements resolved
