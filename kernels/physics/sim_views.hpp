@@ -5,8 +5,7 @@
 // "slot" hold the state between substeps in the last substep's sorted order (slot_id gives the
 // particle in each slot), so that the next sort starts from an almost sorted order: the gather of
 // the state into the new order reads nearly consecutive slots, and writing it back needs no
-// scatter by id (both lost coherence as a fluid mixes: 0.19 ms a step for 1M particles at the
-// bench's plateau, H200; fluid_1m 1.925 -> 1.843 ms with slots).
+// scatter by id (both lost coherence as a fluid mixes; docs/PERFORMANCE.md).
 #pragma once
 #include <cstdint>
 

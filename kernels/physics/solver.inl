@@ -78,8 +78,8 @@ inline constexpr bool kCachePairs = Exec::device == Device::CPU;
 // loads what the pair needs of neighbour j; use does the math. On CUDA the entries come in
 // batches of kPairBatch: their indices, then all their gathers, then the math. At 1M particles
 // CUDA runs one thread per particle, whose pair loop was a chain of dependent loads (index, then
-// the neighbour's data) per entry, and the passes were latency-bound (Nsight, H200: 45-55%
-// active warps, 10-20% of DRAM bandwidth); the math cannot be relied on to leave loads free
+// the neighbour's data) per entry, and the passes were latency-bound (Nsight showed few active
+// warps and little DRAM bandwidth used); the math cannot be relied on to leave loads free
 // to move (IEEE square roots and divisions have slow-path branches), so the batch is explicit.
 // On the CPU one entry at a time (kPairBatch 1), the plain loop.
 // Batch sizes (CUDA) of the passes that gather one packed word per pair (density, PBF) and two
@@ -98,9 +98,8 @@ constexpr int kPairBatch1 = 1, kPairBatch2 = 1;
 #endif
 // Blocks of the executor's threads that the heavy pair passes (prepare_constraints,
 // solve_contacts_fluid, velocity_effects) ask to keep resident per multiprocessor (a register cap
-// on CUDA, MinBlocks; 0: none). 5 (48 registers, a few spilled bytes in two passes) against none,
-// H200, one call at 08936fc, medians of 3: fluid_1m 2.226 against 2.256 ms a step, fluid_10k
-// 0.148 against 0.156, the other scenes within 0.4 %.
+// on CUDA, MinBlocks; 0: none). 5 (48 registers, a few spilled bytes in two passes) was faster
+// than none on fluid_1m and fluid_10k and no slower on the other scenes (docs/PERFORMANCE.md).
 #ifndef SEAMLESS_PAIR_MIN_BLOCKS
 #define SEAMLESS_PAIR_MIN_BLOCKS 5
 #endif
@@ -143,8 +142,8 @@ struct Gather2 {
 // The pair math of the fluid passes with one reciprocal square root on CUDA: SphKernel's
 // spiky gradient and the cohesion factor take |r| by an IEEE square root and divide by it, and
 // the symmetrising factor is a division; on CUDA each compiles to a multi-instruction sequence
-// with a slow-path branch, and at 1M particles the pair passes issue an instruction on ~60-70 %
-// of cycles (Nsight, H200: prepare_constraints, solve_contacts_fluid). rsqrtf and __fdividef are
+// with a slow-path branch, and at 1M particles the pair passes are bound by instruction issue
+// (Nsight: prepare_constraints, solve_contacts_fluid). rsqrtf and __fdividef are
 // the hardware approximations (2 ulp, CUDA programming guide, table of intrinsic functions),
 // far below the CPU/CUDA tolerance of PhysicsParity (FMA contraction and sum order differ
 // already). The CPU keeps the IEEE forms: its results are unchanged.
@@ -153,7 +152,7 @@ struct Gather2 {
 // On CUDA the reciprocal square root skips rsqrtf's denormal fix-up (four instructions a pair),
 // which an argument above 1e-24 never needs (PTX rsqrt.approx.ftz: the same hardware result for
 // normal arguments). The pair math keeps its early returns: selects instead (every pair's math
-// done, no branch) took 5 % longer at 1M particles (H200, A/B in one call).
+// done, no branch) were slower at 1M particles (docs/PERFORMANCE.md).
 #if defined(__CUDA_ARCH__)
 __device__ inline float rsqrt_normal(float x) {
   float r;
@@ -411,8 +410,8 @@ void cell_starts(const Exec& ex, const std::uint32_t* keys, std::int64_t n, int*
   // backends, no atomics, no host sync, and no task fills a long run of empty cells alone. Blocks
   // of 32 cells on the CPU, where a thread's binary search is shared by many cells; of 4 on CUDA,
   // where the walk is a chain of dependent loads and stores: with 32, 10k particles' 2^18 cells
-  // made 33 blocks of threads that each waited on 32 of them (19 us on an H200, 40 of 132
-  // multiprocessors busy), with 4 it is 256 blocks of 4 (the binary searches' upper levels are
+  // made 33 blocks of threads that each waited on 32 of them (most multiprocessors idle), with 4
+  // it is 256 blocks of 4 (the binary searches' upper levels are
   // shared in cache).
   //
   // The CPU instead gives each entry i the cells (keys[i - 1], keys[i]] (entry 0 those up to
@@ -502,13 +501,11 @@ SEAMLESS_HD inline int scan_candidates(const SimViews& S, vec3 p, float R2, std:
 // CUDA's candidate loop for a lane that walks its runs alone (find_neighbors): the candidates
 // [a, e) of s, 4 at a time, all 4 loaded before any is tested (lanes past the run load its last
 // entry and reject it): 4 loads in flight instead of one chain of load-test-store per candidate
-// (see for_each_entry; 2 or 8 at a time: fluid_1m 3 % and 5 % slower, H200). Only kept
-// candidates are stored: a store for every candidate (the CPU's
-// branch-free way) costs memory traffic that the diverging threads of a warp cannot coalesce
-// (H200: 0.57 ms storing kept entries only, 0.80 ms with every candidate stored; d76cd62). They
-// are stored through a pointer that moves one column per stored candidate: indexing the
-// column-major list by count x column took 64-bit multiplies and a branch per candidate
-// (Nsight, 1M fluid particles, H200: the store line was 17 % of the pass's instructions).
+// (see for_each_entry; 2 or 8 at a time were slower). Only kept candidates are stored: a store
+// for every candidate (the CPU's branch-free way) costs memory traffic that the diverging
+// threads of a warp cannot coalesce. They are stored through a pointer that moves one column per
+// stored candidate: indexing the column-major list by count x column took 64-bit multiplies and
+// a branch per candidate (docs/PERFORMANCE.md has the measurements).
 // General: the rigid/cloth pair test (may_interact), compiled only into the walk of rigid and
 // cloth particles (a runtime test per candidate left its loads if-converted into the fluid
 // walk, 7 % of the instructions). cnt counts every accepted candidate, solid those stored
@@ -801,8 +798,8 @@ SEAMLESS_HD inline F pbf_factor(const SimConstants& c, F wgt, F li, F lj) {
 // (eq. 13, n = 4), before the division by rho_0: lane g's share. With Cached, the pairs' kernel
 // values come from pair_w (prepare_constraints at these positions) instead of the positions.
 // Mixed: whether s has neighbours that are not fluid (nsolid); otherwise a loop of its own without
-// phase loads (a runtime test left predicated loads and byte moves in every pair; the two loops:
-// fluid_1m 2.017 -> 1.917 ms a step, H200, A/B in one call).
+// phase loads (a runtime test left predicated loads and byte moves in every pair; the two loops
+// are faster on fluid_1m, docs/PERFORMANCE.md).
 template <bool Cached, bool Mixed>
 SEAMLESS_HD inline vec3 pbf_part(const SimViews& S, int s, Lanes g) {
   const vec3 p = S.sp[s];
@@ -1393,8 +1390,8 @@ SEAMLESS_SIMD_INL void tile_add(simd::v3& acc, const simd::v3& d, simd::vm in) {
 
 // vorticity_part of the tile's 8 particles (velocity_effects). False where the tile needs the
 // scalar loops. The tiles keep nothing in pair_w: forces_tile recomputes the pairs' kernel values
-// (on 8 lanes that costs less time than storing and reloading them: 10.5 -> 9.6 ms a step of
-// fluid_10k on one thread; the scalar loops of tiles that decline keep using pair_w, and a tile
+// (on 8 lanes that costs less time than storing and reloading them, docs/PERFORMANCE.md; the
+// scalar loops of tiles that decline keep using pair_w, and a tile
 // declines in both passes or in neither).
 bool vorticity_tile(const SimViews& S, int s0) {
   Tile t;

@@ -97,8 +97,8 @@ struct Lanes {
   SEAMLESS_HD int rank(bool p, int* total) const {
 #if defined(__CUDA_ARCH__)
     // One lane: no ballot. Each thread of the warp would name a different one-lane mask, and
-    // such syncs run the warp's threads one after another (find_neighbors at 1M particles took
-    // 1.2-1.5 ms with them, 0.57 ms as a plain loop).
+    // such syncs run the warp's threads one after another (several times slower than a plain
+    // loop in find_neighbors, docs/PERFORMANCE.md).
     if (size == 1) {
       *total = p ? 1 : 0;
       return 0;

@@ -29,9 +29,8 @@ int CudaExec::lanes(std::int64_t n, int max_lanes) const {
   int g = 1;
   while (2 * g <= max_lanes && g < 32 && n * g < resident) g <<= 1;
   // Groups of 2 or 4 lanes cost more than they give: each group's ballots and shuffles name its
-  // own mask, and a warp of 8-16 such groups runs them group after group (on an H200,
-  // find_neighbors for 262,144 particles took 0.6 ms at 2 lanes). From 8 lanes on, the shorter
-  // chains win (10,000 fluid particles: 0.30 -> 0.16 ms a step at 16).
+  // own mask, and a warp of 8-16 such groups runs them group after group. From 8 lanes on, the
+  // shorter chains win (docs/PERFORMANCE.md).
   return g >= 8 ? g : 1;
 }
 

@@ -42,7 +42,7 @@ class ReferenceMaps {
   // photometric: when given (a frame seen from world_T_camera, normally the last tracked one), its
   // intensity pyramid is the photometric reference instead of the raycast's fused colour; see
   // TrackerParams::photometric_reference. with_intensity = false: no intensity at all (a geometric
-  // tracker reads none; its conversion and pyramid cost ~0.01 ms a frame on an H200).
+  // tracker reads none, and its conversion and pyramid would be wasted work).
   void set_from_raycast(const RaycastMaps& maps, const Intrinsics& K, const SE3& world_T_camera, int levels,
                         float max_diff = 0.09f, const FramePyramid* photometric = nullptr, bool with_intensity = true);
   const ReferenceLevel& level(int l) const { return levels_.at(l); }

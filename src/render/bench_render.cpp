@@ -37,7 +37,7 @@ Mesh floor_mesh() {
 
 // What draw_device_particles needs besides the buffers: the particle radius. (A default DrawList
 // has a radius of 0.02 m, four times the bench's: 16 times the fragments, which made the "draw
-// only" figure 227 ms on the H200 where the real frame was 32 ms.)
+// only" figure several times the real frame's.)
 DrawList device_list(float radius) {
   DrawList d;
   d.particle_radius = radius;
