@@ -332,8 +332,6 @@ class LiveLoop : public FrameLoop {
     if (e_.output.write_trajectory) traj_ = std::make_unique<TrajectoryWriter>(ctx.out_path("trajectory.txt"));
     sp_.spacing = e_.solver.particle_diameter;
     sp_.interior_depth = e_.scene_interior_depth;
-    if (e_.solver.dynamic_colliders == "depth")
-      throw ConfigError("solver.dynamic_colliders: depth (the dynamic pixels only) is not built yet; use all");
     if (e_.solver.dynamic_colliders != "none")
       colliders_.emplace(e_.solver.particle_diameter, e_.solver.collider_thickness, e_.solver.max_speed);
   }

@@ -37,7 +37,18 @@ Experiment parse_experiment(const std::string& yaml_text, const std::vector<std:
   }
   config::LoadContext ctx(source_name, std::move(applied), experiment_keys());
   for (const std::string& problem : unusable) ctx.problem(problem);
-  return config::load_params<Experiment>(root, ctx);
+  Experiment e = config::load_params<Experiment>(root, ctx);
+  e.validate();
+  return e;
+}
+
+void Experiment::validate() const {
+  volume.validate();
+  if (solver.dynamic_colliders != "none" && mode != "live")
+    throw ConfigError("solver.dynamic_colliders: " + solver.dynamic_colliders +
+                      " needs mode: live (the colliders are each frame's depth points while the camera runs)");
+  if (solver.dynamic_colliders == "depth")
+    throw ConfigError("solver.dynamic_colliders: depth (the dynamic pixels only) is not built yet; use all");
 }
 
 Experiment load_experiment(const std::string& path, const std::vector<std::string>& overrides) {

@@ -62,6 +62,10 @@ struct Experiment {
   RenderParams render;
   OutputParams output;
 
+  // Rules across keys and sections, checked once the whole file is read (parse_experiment), so a
+  // bad combination is a config error before any work starts (src/config/config.cpp).
+  void validate() const;
+
   template <class V> void visit(V& v) {
     v("name", name, "experiment name (used in logs and output names)");
     v("device", device, "compute backend (auto: CUDA when built and a GPU is present)",

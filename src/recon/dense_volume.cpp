@@ -11,9 +11,7 @@
 namespace seamless {
 
 DenseVolume::DenseVolume(const VolumeParams& p, Device d) : params_(p), device_(d) {
-  if (p.truncation < 2.f * p.voxel_size)
-    throw Error("volume.truncation (" + std::to_string(p.truncation) + " m) must be at least two voxels (2 * " +
-                "volume.voxel_size = " + std::to_string(2.f * p.voxel_size) + " m)");
+  p.validate();
   blocks_per_side_ = (p.dense_resolution + kernels::kBlockSide - 1) / kernels::kBlockSide;
   params_.dense_resolution = blocks_per_side_ * kernels::kBlockSide;
   geom_ = {p.dense_origin, p.voxel_size, p.truncation};

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <string>
 
+#include "core/error.hpp"
 #include "core/math.hpp"
 #include "core/params.hpp"
 
@@ -28,6 +29,16 @@ struct VolumeParams {
   int occlusion_tile = 8;            // pixels per side of the depth tiles that cull occluded blocks; 0: none
   float stream_radius = 0.f;         // blocks beyond this distance from the camera go to host memory; 0: off
   float stream_step = 0.25f;         // camera travel (metres) between two streaming passes
+
+  // Rules across keys, checked when a config is loaded (Experiment::validate) and by the volumes'
+  // constructors (for code that builds a volume without a config).
+  void validate() const {
+    if (truncation < 2.f * voxel_size)
+      throw ConfigError("volume.truncation (" + std::to_string(truncation) + " m) must be at least two voxels (2 * " +
+                        "volume.voxel_size = " + std::to_string(2.f * voxel_size) +
+                        " m): the truncation band must reach the voxels on both sides of the surface");
+    if (capacity > (std::int64_t{1} << 30)) throw ConfigError("volume.capacity must be below 2^30 blocks");
+  }
 
   template <class V> void visit(V& v) {
     v("layout", layout, "volume layout: voxel hashing or dense grid", Choices{"hash", "dense"});

@@ -43,11 +43,7 @@ void staged(StageTimer* timer, const char* stage, F&& fn) {
 }  // namespace
 
 VoxelHashVolume::VoxelHashVolume(const VolumeParams& p, Device d) : params_(p), device_(d) {
-  if (p.truncation < 2.f * p.voxel_size)
-    throw ConfigError("volume.truncation (" + std::to_string(p.truncation) + " m) must be at least two voxels (2 * " +
-                "volume.voxel_size = " + std::to_string(2.f * p.voxel_size) +
-                " m): the truncation band must reach the voxels on both sides of the surface");
-  if (p.capacity > (1ll << 30)) throw ConfigError("volume.capacity must be below 2^30 blocks");
+  p.validate();
   geom_ = {{0.f, 0.f, 0.f}, p.voxel_size, p.truncation};
   const std::int64_t slots = next_pow2(std::max<std::int64_t>(p.hash_buckets, 1024));
   keys_ = Buffer<kernels::HashKey>(slots, d);

@@ -127,6 +127,17 @@ TEST(ConfigErrors, BadChoice) {
   EXPECT_THAT(msg, HasSubstr("volume.layout: got 'hsah', expected one of hash, dense; did you mean 'hash'?"));
 }
 
+TEST(ConfigErrors, RulesAcrossKeysAreCheckedAtLoad) {
+  // Experiment::validate: combinations no single key's range can catch, as config errors before
+  // anything runs (each names the keys involved).
+  EXPECT_THAT(error_of("volume: {voxel_size: 0.01, truncation: 0.015}"),
+              HasSubstr("volume.truncation (0.015000 m) must be at least two voxels"));
+  EXPECT_EQ(error_of("volume: {voxel_size: 0.01, truncation: 0.02}"), "");  // exactly two voxels
+  EXPECT_THAT(error_of("mode: scan_then_simulate\nsolver: {dynamic_colliders: all}"),
+              HasSubstr("solver.dynamic_colliders: all needs mode: live"));
+  EXPECT_EQ(error_of("mode: live\nsolver: {dynamic_colliders: all}"), "");
+}
+
 TEST(ConfigErrors, ListElementsHaveIndexedPathsAndPositions) {
   std::string msg = error_of("spawn:\n  - kind: rigid\n  - kind: fluid_blok\n");
   EXPECT_THAT(msg, HasSubstr("test.yaml:3:11: spawn.1.kind"));

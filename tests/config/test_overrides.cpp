@@ -52,8 +52,8 @@ TEST(ConfigOverride, ValuesAreYamlFlowNodes) {
 }
 
 TEST(ConfigOverride, LaterOverridesWin) {
-  Experiment e = parse_experiment(kBase, {"volume.voxel_size=0.01", "volume.voxel_size=0.02"}, "base.yaml");
-  EXPECT_EQ(e.volume.voxel_size, 0.02f);
+  Experiment e = parse_experiment(kBase, {"volume.voxel_size=0.01", "volume.voxel_size=0.008"}, "base.yaml");
+  EXPECT_EQ(e.volume.voxel_size, 0.008f);  // (0.02 would break the truncation rule: 2 voxels)
 }
 
 TEST(ConfigOverride, ListElementsByIndex) {
