@@ -48,7 +48,9 @@ void classify_dynamic(const Exec& ex, DynamicInput in, View2D<std::uint8_t> cand
 // (2r+1)^2 candidates around it (itself included) are candidates, or when the previous frame's
 // mask had it (prev may be empty: data == nullptr); then the kept pixels are dilated by r into
 // neighbours whose depth is within max_step of theirs (the silhouette's mixed pixels, never the
-// background behind). The opening removes isolated speckles of noise; the previous mask keeps a
+// background behind) and into neighbours without a reading (the sensor drops a mover's silhouette
+// and scattered pixels on it: a fifth of a person's pixels in the synthetic Kinect model; they
+// carry no depth to fuse or track, but the mask is also what the physics and the view show). The opening removes isolated speckles of noise; the previous mask keeps a
 // mover's thin parts (arms) that flicker in and out of the support test.
 template <class Exec>
 void filter_dynamic(const Exec& ex, View2D<const std::uint8_t> candidates, View2D<const std::uint8_t> prev,

@@ -62,11 +62,11 @@ void filter_dynamic(const Exec& ex, View2D<const std::uint8_t> candidates, View2
     const int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
     std::uint8_t m = kept(x, y);
     const float d = depth(x, y);
-    if (!m && d > 0.f)
+    if (!m)
       for (int dy = -radius; dy <= radius && !m; ++dy)
         for (int dx = -radius; dx <= radius && !m; ++dx) {
           const int u = x + dx, v = y + dy;
-          if (kept.inside(u, v) && kept(u, v) && fabsf(depth(u, v) - d) <= max_step) m = 1;
+          if (kept.inside(u, v) && kept(u, v) && (!(d > 0.f) || fabsf(depth(u, v) - d) <= max_step)) m = 1;
         }
     mask(x, y) = m;
   });
