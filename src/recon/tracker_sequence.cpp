@@ -13,6 +13,7 @@
 #include "core/log.hpp"
 #include "core/output_file.hpp"
 #include "core/timing.hpp"
+#include "io/png_io.hpp"
 #include "kernels/recon/dynamic.hpp"
 #include "kernels/recon/rgbd.hpp"
 #include "seamless/build_config.hpp"
@@ -513,6 +514,23 @@ void log_lost(const FrameRecord& rec) {
 }
 }  // namespace
 
+namespace {
+// dynamic.write_masks: out_dir/dynamic_mask/<frame, 6 digits>.png, 255 where dynamic (an empty mask
+// before the first frame with a model).
+void write_dynamic_mask(const std::string& out_dir, std::int64_t index, const TrackingSession& session) {
+  const std::string dir = out_dir + "/dynamic_mask";
+  std::filesystem::create_directories(dir);
+  char name[32];
+  std::snprintf(name, sizeof name, "/%06lld.png", static_cast<long long>(index));
+  Image<std::uint8_t> png(session.pyramid().level(0).K.width, session.pyramid().level(0).K.height, Device::CPU);
+  std::vector<std::uint8_t> m(static_cast<std::size_t>(png.width()) * png.height(), 0);
+  if (session.dynamic_mask().width() == png.width()) m = session.dynamic_mask().to_host();
+  for (std::uint8_t& v : m) v = v ? 255 : 0;
+  png.buffer().copy_from_host(m.data(), static_cast<std::int64_t>(m.size()));
+  write_png_u8(dir + name, png);
+}
+}  // namespace
+
 TrackSequenceResult track_sequence(FrameSource& source, const TrackSequenceParams& params, Device device,
                                    const std::string& out_dir, Volume* volume,
                                    const std::function<void(const RgbdFrame&, const FrameRecord&)>& on_frame) {
@@ -554,6 +572,7 @@ TrackSequenceResult track_sequence(FrameSource& source, const TrackSequenceParam
                                                 "frame's ground truth is its pose there");
         if (gt_writer) gt_writer->write(out.ground_truth.back());
       }
+      if (params.write_files && params.dynamic.write_masks) write_dynamic_mask(out_dir, frame.index, session);
       if (out.frames.size() > 0) track_ms.push_back(rec.track_ms);
       frame_ms.push_back(rec.frame_ms);
       log_lost(rec);
