@@ -5,6 +5,7 @@ seamless_kernel_family(recon/tsdf_raycast)
 seamless_kernel_family(recon/icp)
 seamless_kernel_family(recon/rgbd)
 seamless_kernel_family(recon/tsdf_extract)
+seamless_kernel_family(recon/dynamic)
 
 # The raycast's march is latency-bound (docs/PERFORMANCE.md, docs/RECONSTRUCTION.md). Register
 # cap for this translation unit, measured on an H200 (frame medians of 3 invocations): 64 beat the

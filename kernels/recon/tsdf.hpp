@@ -70,6 +70,9 @@ struct FrameInput {
   Intrinsics K;
   SE3 world_T_camera;
   float min_depth = 0.3f, max_depth = 4.f;
+  // Free-space carving (dynamic.carve_truncations * truncation, metres; 0: off): fuse_voxel resets
+  // a voxel this far in front of the measurement to free space (docs/DYNAMIC.md).
+  float carve = 0.f;
 };
 
 // An image cut into tile x tile pixel tiles, row-major (the last row and column may be partial):

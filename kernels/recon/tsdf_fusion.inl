@@ -153,6 +153,22 @@ SEAMLESS_HD inline void set_keep(std::int32_t* flag) {
   if (atomic_load(flag) == 0) atomic_exch(flag, 1);
 }
 
+// Free-space carving (issue 22, after ReFusion, Palazzolo et al. 2019, section III-D): the voxel
+// lies more than in.carve in front of the reading at its pixel and of the 3x3 readings around it,
+// so the ray saw through it: whatever surface it held (a person who stood there) is gone. The
+// running average alone would need as many free observations as the voxel had weight (up to
+// max_weight frames); the reset takes one. The neighbours keep a voxel at an object's silhouette,
+// whose pixel may read the background behind, from being carved by its rounding.
+SEAMLESS_HD inline bool carved(const FrameInput& in, int u, int v, float z) {
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      if (!in.depth.inside(u + dx, v + dy)) return false;
+      const float d = in.depth(u + dx, v + dy);
+      if (!(d >= in.min_depth && d <= in.max_depth) || d - z <= in.carve) return false;
+    }
+  return true;
+}
+
 // Weighted running average of the truncated signed distance (Curless & Levoy 1996; KinectFusion
 // eq. 11-13) with the weight capped at max_weight so the model can follow change. The distance is
 // projective (along z), as in KinectFusion and Niessner; colour is averaged only near the surface.
@@ -167,6 +183,11 @@ SEAMLESS_HD inline void fuse_voxel(Voxel& v, vec3 p_world, const FrameInput& in,
   if (!(d >= in.min_depth && d <= in.max_depth)) return;
   float sdf = d - pc.z;
   if (sdf < -mu) return;  // occluded: behind the surface by more than the truncation
+  if (in.carve > 0.f && sdf > in.carve && carved(in, u, w, pc.z)) {
+    v.sdf = mu;  // what a voxel never seen before holds after this frame: free, weight 1
+    v.weight = 1.f;
+    return;
+  }
   float tsdf = fminf(sdf, mu);
   float wt = v.weight;
   v.sdf = (v.sdf * wt + tsdf) / (wt + 1.f);

@@ -41,6 +41,7 @@ TrackSequenceParams tracking_params(const Experiment& e, StageTimer* volume_stag
   p.tracker = e.tracker;
   p.preprocess = e.preprocess;
   p.volume = e.volume;
+  p.dynamic = e.dynamic;
   p.max_frames = e.frames;
   p.write_files = e.output.write_trajectory;
   return p;

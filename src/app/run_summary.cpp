@@ -47,6 +47,11 @@ void add_tracking(RunSummary& s, const TrackSequenceResult& r, std::int64_t unre
   s.frames_lost = r.lost_frames;
   s.frames_unreadable = unreadable;
   for (const FrameRecord& f : r.frames) s.frames_fused += f.fused;
+  double masked = 0;
+  std::int64_t with_mask = 0;
+  for (const FrameRecord& f : r.frames)
+    if (std::isfinite(f.dynamic_fraction)) masked += f.dynamic_fraction, ++with_mask;
+  if (with_mask > 0) s.dynamic_masked_fraction = masked / static_cast<double>(with_mask);
   if (groundtruth.empty() || r.trajectory.empty()) return;
   const AteResult ate = compute_ate(r.trajectory, read_tum_trajectory(groundtruth));
   if (ate.trans.count == 0) return;
@@ -76,6 +81,7 @@ void write_summary(const std::string& path, const RunSummary& s) {
   j["frames"] = {{"read", s.frames_read}, {"lost", s.frames_lost}, {"fused", s.frames_fused},
                  {"unreadable", s.frames_unreadable}};
   if (s.ate_rmse_m) j["ate"] = {{"rmse_m", *s.ate_rmse_m}, {"pairs", s.ate_pairs}};
+  if (s.dynamic_masked_fraction) j["dynamic"] = {{"mean_masked_fraction", *s.dynamic_masked_fraction}};
   if (s.floor_height) j["floor_height"] = *s.floor_height;
   Json& surfaces = j["surfaces"] = Json::array();
   for (std::size_t i = 0; i < s.surfaces.size() && i < 10; ++i) {

@@ -36,6 +36,7 @@ struct RunSummary {
   std::int64_t frames_read = 0, frames_lost = 0, frames_fused = 0, frames_unreadable = 0;
   std::optional<double> ate_rmse_m;    // against the input's ground truth, when it has one
   std::int64_t ate_pairs = 0;
+  std::optional<double> dynamic_masked_fraction;  // dynamic.enabled: mean over the tracked frames
   std::vector<ResolvedPlacement> placements;
   std::vector<SpawnParams> spawns;     // as resolved
   std::optional<SolverStats> physics;

@@ -8,6 +8,7 @@
 #include "core/params.hpp"
 #include "io/input_params.hpp"
 #include "physics/solver_params.hpp"
+#include "recon/dynamic_params.hpp"
 #include "recon/preprocess_params.hpp"
 #include "recon/refine/refine_params.hpp"
 #include "recon/tracker_params.hpp"
@@ -56,6 +57,7 @@ struct Experiment {
   PreprocessParams preprocess;
   VolumeParams volume;
   TrackerParams tracker;
+  DynamicParams dynamic;
   RefineParams refine;
   SolverParams solver;
   std::vector<SpawnParams> spawn;
@@ -86,6 +88,7 @@ struct Experiment {
     v("preprocess", preprocess, "depth filtering, pyramid, vertex and normal maps");
     v("volume", volume, "TSDF volume");
     v("tracker", tracker, "camera tracking");
+    v("dynamic", dynamic, "people and moving objects: kept out of tracking and fusion, free space carved (docs/DYNAMIC.md)");
     v("refine", refine, "offline keyframe pose-graph refinement of the tracked trajectory (Ceres)");
     v("solver", solver, "particle solver");
     v("spawn", spawn, "what to drop into the scene and when (list)");

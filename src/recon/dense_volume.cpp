@@ -34,6 +34,7 @@ void DenseVolume::integrate(const Image<float>& depth, const Image<uchar3>& rgb,
   const Image<uchar3>& col = detail::on_device(rgb, device_, ctmp);
   kernels::FrameInput in{dep.cview(), col.width() ? col.cview() : View2D<const uchar3>{}, K, world_T_camera,
                          params_.min_depth, params_.max_depth};
+  in.carve = carve_;
   if (timer) timer->begin("fuse");
   with_exec(device_, [&](const auto& ex) {
     kernels::fuse_dense_blocks(ex, device_view(), in, params_.max_weight, params_.integrate_color);

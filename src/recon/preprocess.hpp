@@ -23,6 +23,7 @@ class FramePyramid {
   // raw_depth and intensity (optional) are full-resolution images on this pyramid's device.
   void build(const Image<float>& raw_depth, const Image<float>* intensity, const PreprocessParams& p);
   const PyramidLevel& level(int l) const { return levels_[l]; }
+  PyramidLevel& mutable_level(int l) { return levels_[l]; }  // masking pixels out (dynamic pixels)
   int levels() const { return static_cast<int>(levels_.size()); }
   Device device() const { return device_; }
 

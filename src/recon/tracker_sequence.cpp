@@ -13,6 +13,8 @@
 #include "core/log.hpp"
 #include "core/output_file.hpp"
 #include "core/timing.hpp"
+#include "io/png_io.hpp"
+#include "kernels/recon/dynamic.hpp"
 #include "kernels/recon/rgbd.hpp"
 #include "seamless/build_config.hpp"
 
@@ -113,7 +115,69 @@ TrackingSession::TrackingSession(const TrackSequenceParams& params, Device devic
     own_volume_ = make_volume(p_.volume, device);
     volume_ = own_volume_.get();
   }
+  if (p_.dynamic.enabled) {
+    if (!volume_)
+      spdlog::warn("dynamic.enabled: no volume to compare frames with (tracker {} {}); no pixel is masked",
+                   p_.tracker.kind, p_.tracker.mode);
+    else if (p_.dynamic.carve_truncations > 0)
+      volume_->set_free_space_carving(p_.dynamic.carve_truncations * volume_->params().truncation);
+  }
 }
+
+// ---- dynamic pixels (issue 22, docs/DYNAMIC.md) -------------------------------------------------
+
+const ReferenceMaps* TrackingSession::dynamic_reference() {
+  if (tracker_ && p_.tracker.mode == "frame_to_model") return ref_.empty() ? nullptr : &ref_;
+  if (!volume_) return nullptr;
+  volume_->raycast(K_, last_good_, dyn_maps_);
+  dyn_ref_.set_from_raycast(dyn_maps_, K_, last_good_, 1, p_.preprocess.pyramid_max_diff, nullptr, false);
+  return &dyn_ref_;
+}
+
+// Before tracking, the mask at the pose the tracker starts from (our trackers; the ground-truth
+// one needs none) zeroes the dynamic pixels' vertices on every pyramid level: weight 0 in the ICP
+// and RGB-D reductions. Relocalising frames start from several poses and keep every pixel.
+const ReferenceMaps* TrackingSession::mask_before_tracking() {
+  const ReferenceMaps* model = dynamic_reference();
+  if (!model) return nullptr;
+  if (!tracker_ || odometry_ || lost_run_ > 0) return model;
+  find_dynamic(*model, p_.tracker.constant_velocity ? last_good_ * last_motion(1) : last_good_);
+  with_exec(device_, [&](const auto& ex) {
+    for (int l = 0; l < pyr_.levels(); ++l) {
+      PyramidLevel& lv = pyr_.mutable_level(l);
+      kernels::mask_vertices(ex, dyn_mask_.cview(), 1 << l, lv.vertices.view(), lv.normals.view());
+    }
+  });
+  return model;
+}
+
+void TrackingSession::find_dynamic(const ReferenceMaps& model, const SE3& world_T_camera) {
+  const DynamicParams& d = p_.dynamic;
+  if (dyn_mask_.width() != K_.width) {
+    for (Image<std::uint8_t>* im : {&dyn_candidates_, &dyn_kept_, &dyn_mask_, &dyn_prev_})
+      *im = Image<std::uint8_t>(K_.width, K_.height, device_);
+    dyn_prev_.buffer().zero();  // no previous frame: no temporal support
+  }
+  const PyramidLevel& l0 = pyr_.level(0);
+  const ReferenceLevel& m = model.level(0);
+  kernels::DynamicInput in;
+  in.depth = l0.depth.cview();
+  in.K = K_;
+  in.model_vertices = m.vertices.cview();
+  in.model_normals = m.normals.cview();
+  in.ref_T_cur = model.world_T_ref().inverse() * world_T_camera;
+  in.residual_min = d.residual_min;
+  in.noise_coeff = d.noise_coeff;
+  in.residual_sigmas = d.residual_sigmas;
+  in.free_space = d.free_space_truncations * (volume_ ? volume_->params().truncation : p_.volume.truncation);
+  in.search_radius = d.search_radius;
+  with_exec(device_, [&](const auto& ex) {
+    kernels::classify_dynamic(ex, in, dyn_candidates_.view());
+    kernels::filter_dynamic(ex, dyn_candidates_.cview(), dyn_prev_.cview(), l0.depth.cview(), d.support_radius,
+                            d.min_support, d.dilate_max_step, dyn_kept_.view(), dyn_mask_.view());
+  });
+}
+
 
 TrackingSession::~TrackingSession() = default;
 
@@ -356,10 +420,24 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
   if (pyramid) preprocess();
   marks_.mark(kPreprocessed);
   const bool tracked = started_;
+  const ReferenceMaps* dyn_model = nullptr;
   if (!started_) {
     first_frame(frame, rec);
   } else {
+    if (p_.dynamic.enabled) dyn_model = mask_before_tracking();
     rec.result = track_frame(frame);
+  }
+  if (dyn_model && rec.result.ok()) {
+    // The mask at the tracked pose is the frame's: fusion skips it, the next frame's filter reads it.
+    find_dynamic(*dyn_model, rec.result.world_T_camera);
+    with_exec(device_, [&](const auto& ex) {
+      kernels::mask_depth(ex, dyn_mask_.cview(), depth_.view());
+      rec.dynamic_fraction = static_cast<double>(kernels::count_dynamic(ex, dyn_mask_.cview())) /
+                             static_cast<double>(K_.width * K_.height);
+    });
+    dyn_prev_.buffer().copy_from(dyn_mask_.buffer());
+  } else if (p_.dynamic.enabled) {
+    rec.dynamic_fraction = 0;  // the first frame, or a lost one: nothing masked, nothing fused
   }
   marks_.mark(kTracked);
   if (rec.result.ok()) {
@@ -436,6 +514,23 @@ void log_lost(const FrameRecord& rec) {
 }
 }  // namespace
 
+namespace {
+// dynamic.write_masks: out_dir/dynamic_mask/<frame, 6 digits>.png, 255 where dynamic (an empty mask
+// before the first frame with a model).
+void write_dynamic_mask(const std::string& out_dir, std::int64_t index, const TrackingSession& session) {
+  const std::string dir = out_dir + "/dynamic_mask";
+  std::filesystem::create_directories(dir);
+  char name[32];
+  std::snprintf(name, sizeof name, "/%06lld.png", static_cast<long long>(index));
+  Image<std::uint8_t> png(session.pyramid().level(0).K.width, session.pyramid().level(0).K.height, Device::CPU);
+  std::vector<std::uint8_t> m(static_cast<std::size_t>(png.width()) * png.height(), 0);
+  if (session.dynamic_mask().width() == png.width()) m = session.dynamic_mask().to_host();
+  for (std::uint8_t& v : m) v = v ? 255 : 0;
+  png.buffer().copy_from_host(m.data(), static_cast<std::int64_t>(m.size()));
+  write_png_u8(dir + name, png);
+}
+}  // namespace
+
 TrackSequenceResult track_sequence(FrameSource& source, const TrackSequenceParams& params, Device device,
                                    const std::string& out_dir, Volume* volume,
                                    const std::function<void(const RgbdFrame&, const FrameRecord&)>& on_frame) {
@@ -477,6 +572,7 @@ TrackSequenceResult track_sequence(FrameSource& source, const TrackSequenceParam
                                                 "frame's ground truth is its pose there");
         if (gt_writer) gt_writer->write(out.ground_truth.back());
       }
+      if (params.write_files && params.dynamic.write_masks) write_dynamic_mask(out_dir, frame.index, session);
       if (out.frames.size() > 0) track_ms.push_back(rec.track_ms);
       frame_ms.push_back(rec.frame_ms);
       log_lost(rec);

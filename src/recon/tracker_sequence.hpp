@@ -14,6 +14,7 @@
 #include "core/timing.hpp"
 #include "io/frame_source.hpp"
 #include "io/trajectory.hpp"
+#include "recon/dynamic_params.hpp"
 #include "recon/external/odometry.hpp"
 #include "recon/preprocess.hpp"
 #include "recon/tracker.hpp"
@@ -28,6 +29,7 @@ struct TrackSequenceParams {
   TrackerParams tracker;
   PreprocessParams preprocess;
   VolumeParams volume;
+  DynamicParams dynamic;        // issue 22: dynamic pixels out of tracking and fusion (off by default)
   std::int64_t max_frames = 0;  // 0 = all the source has
   bool write_files = true;      // trajectory.txt and tracking_stats.csv into out_dir
   // When set, the volume's kernel steps (allocate, visible, fuse, remove_empty, raycast) are timed
@@ -49,6 +51,8 @@ struct FrameRecord {
   // fuse_ms (the next reference view: raycast and its pyramid), allocate_ms of fuse_ms (block
   // allocation and the visible-block list; NaN unless TrackSequenceParams::volume_stages is set).
   double upload_ms = 0, raycast_ms = 0, allocate_ms = std::numeric_limits<double>::quiet_NaN();
+  // dynamic.enabled: the fraction of the frame's pixels in its dynamic mask (NaN when off).
+  double dynamic_fraction = std::numeric_limits<double>::quiet_NaN();
 };
 
 // The per-frame state machine. World frame: the first camera, rotated so that gravity is world -y
@@ -72,6 +76,9 @@ class TrackingSession {
   std::int64_t lost_frames() const { return lost_; }
   const ReferenceMaps& reference() const { return ref_; }
   const FramePyramid& pyramid() const { return pyr_; }
+  // dynamic.enabled: the last processed frame's dynamic pixels (1) on the session's device, full
+  // resolution; empty before the first frame with a model to compare with (docs/DYNAMIC.md).
+  const Image<std::uint8_t>& dynamic_mask() const { return dyn_mask_; }
 
  private:
   bool uses_volume() const;
@@ -89,6 +96,12 @@ class TrackingSession {
   void accept(const RgbdFrame& frame, const SE3& pose, FrameRecord& rec);
   double volume_allocate_ms(std::size_t first_row) const;
   void update_reference(const SE3& pose);
+  // Dynamic pixels (issue 22): the model to compare with (ref_ when tracking frame to model, else
+  // a raycast of the volume from the last good pose; nullptr without a volume), and the mask of the
+  // current frame at pose world_T_camera into dyn_mask_.
+  const ReferenceMaps* dynamic_reference();
+  const ReferenceMaps* mask_before_tracking();  // dynamic_reference(), and the tracker's pixels masked
+  void find_dynamic(const ReferenceMaps& model, const SE3& world_T_camera);
 
   TrackSequenceParams p_;
   Device device_;
@@ -101,6 +114,9 @@ class TrackingSession {
   FramePyramid pyr_;
   ReferenceMaps ref_;
   RaycastMaps maps_;
+  ReferenceMaps dyn_ref_;  // frame-to-frame tracking: the model raycast the mask compares with
+  RaycastMaps dyn_maps_;
+  Image<std::uint8_t> dyn_candidates_, dyn_kept_, dyn_mask_, dyn_prev_;
   Image<float> depth_, intensity_;
   Image<uchar3> rgb_;
   GravityEstimate gravity_;

@@ -73,6 +73,12 @@ class Volume {
   virtual VolumeStats stats() = 0;
   virtual Device device() const = 0;
   virtual const VolumeParams& params() const = 0;
+  // Free-space carving in later integrate() calls (issue 22, docs/DYNAMIC.md): voxels more than
+  // `metres` in front of the measurement are reset to free space; 0 (the default) turns it off.
+  void set_free_space_carving(float metres) { carve_ = metres; }
+
+ protected:
+  float carve_ = 0.f;
 };
 
 // Builds the layout named by params.layout ("hash" or "dense") on device d.

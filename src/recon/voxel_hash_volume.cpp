@@ -82,6 +82,7 @@ void VoxelHashVolume::integrate(const Image<float>& depth, const Image<uchar3>& 
   const Image<uchar3>& col = detail::on_device(rgb, device_, ctmp);
   kernels::FrameInput in{dep.cview(), col.width() ? col.cview() : View2D<const uchar3>{}, K, world_T_camera,
                          params_.min_depth, params_.max_depth};
+  in.carve = carve_;
   if (params_.stream_radius > 0.f) staged(timer, "stream", [&] { maybe_stream(K, world_T_camera.t); });
   maybe_rehash(last_);
   allocate_and_list(in, timer);

@@ -1,0 +1,75 @@
+// Dynamic pixels from depth alone (issue 22; docs/DYNAMIC.md): which pixels of a frame see
+// something that moves (a person walking, a ball rolling), found by comparing the measurement with
+// the model raycast, after ReFusion (Palazzolo et al., "ReFusion: 3D Reconstruction in Dynamic
+// Environments for RGB-D Cameras Exploiting Residuals", IROS 2019, sections III-C and III-D):
+// a large residual against the model and a measurement well in front of a model surface along its
+// ray (free-space violation), then region and temporal consistency so that noise makes no speckles.
+// Masks are 0 (static) / 1 (dynamic), one byte a pixel.
+#pragma once
+#include <cstdint>
+
+#include "core/camera.hpp"
+#include "core/math.hpp"
+#include "core/view.hpp"
+
+namespace seamless::kernels {
+
+// What classify_dynamic compares: the frame's depth and the model raycast, both seen by the same
+// pinhole camera K; the model in the coordinates of the camera it was rendered from (ref), the
+// frame at ref_T_cur (the predicted pose before tracking, the tracked pose after).
+struct DynamicInput {
+  View2D<const float> depth;          // metres, 0 = no reading (the filtered level 0)
+  Intrinsics K;
+  View2D<const vec3> model_vertices;  // reference camera coordinates, zero = no surface
+  View2D<const vec3> model_normals;   // facing the reference camera, zero = none
+  SE3 ref_T_cur;
+  float residual_min = 0.03f;    // metres: the residual threshold's floor (tracking and raycast error)
+  float noise_coeff = 0.0015f;   // depth noise sigma(z) = noise_coeff * z^2 (Khoshelham & Elberink 2012)
+  float residual_sigmas = 3.f;   // the residual threshold in noise sigmas
+  float free_space = 0.12f;      // metres in front of the nearest model surface along the ray
+  int search_radius = 2;         // pixels around the projection searched for the best-fitting model point
+};
+
+// The residual threshold at depth z: the larger of residual_min and residual_sigmas * sigma(z).
+SEAMLESS_HD inline float dynamic_threshold(const DynamicInput& in, float z) {
+  return fmaxf(in.residual_min, in.residual_sigmas * in.noise_coeff * z * z);
+}
+
+// Candidates (1) per pixel: the measurement lies in front of the model, either (a) by more than the
+// residual threshold from every model plane near its projection (point-to-plane, signed: in front)
+// or (b) by more than free_space from the nearest model surface along the ray. Pixels without depth
+// or without any model surface near their projection are 0 (nothing to compare with: unknown space
+// is not evidence of motion). Only "in front" counts: a measurement behind the model is what an
+// object that left, or background it uncovered, gives, and fusing it carves the old surface away.
+template <class Exec>
+void classify_dynamic(const Exec& ex, DynamicInput in, View2D<std::uint8_t> candidates);
+
+// Region and temporal consistency: a candidate stays dynamic when at least min_support of the
+// (2r+1)^2 candidates around it (itself included) are candidates, or when the previous frame's
+// mask had it (prev may be empty: data == nullptr); then the kept pixels are dilated by r into
+// neighbours whose depth is within max_step of theirs (the silhouette's mixed pixels, never the
+// background behind) and into neighbours without a reading (the sensor drops a mover's silhouette
+// and scattered pixels on it: a fifth of a person's pixels in the synthetic Kinect model; they
+// carry no depth to fuse or track, but the mask is also what the physics and the view show). The opening removes isolated speckles of noise; the previous mask keeps a
+// mover's thin parts (arms) that flicker in and out of the support test.
+template <class Exec>
+void filter_dynamic(const Exec& ex, View2D<const std::uint8_t> candidates, View2D<const std::uint8_t> prev,
+                    View2D<const float> depth, int radius, int min_support, float max_step,
+                    View2D<std::uint8_t> kept, View2D<std::uint8_t> mask);
+
+// Zeroes the vertices and normals of pyramid level pixels whose 2^level x 2^level block of the
+// full-resolution mask holds a dynamic pixel: the trackers then give them weight 0 (a zero vertex
+// is no reading).
+template <class Exec>
+void mask_vertices(const Exec& ex, View2D<const std::uint8_t> mask, int scale, View2D<vec3> vertices,
+                   View2D<vec3> normals);
+
+// Zeroes the depth of dynamic pixels (fusion then skips them).
+template <class Exec>
+void mask_depth(const Exec& ex, View2D<const std::uint8_t> mask, View2D<float> depth);
+
+// Dynamic pixels in a mask (the frame's masked fraction for summary.json).
+template <class Exec>
+std::int64_t count_dynamic(const Exec& ex, View2D<const std::uint8_t> mask);
+
+}  // namespace seamless::kernels

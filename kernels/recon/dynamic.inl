@@ -1,0 +1,119 @@
+// Kernel bodies for recon/dynamic.hpp, compiled once per backend.
+#include <cmath>
+
+#include "kernels/recon/dynamic.hpp"
+
+namespace seamless::kernels {
+
+template <class Exec>
+void classify_dynamic(const Exec& ex, DynamicInput in, View2D<std::uint8_t> candidates) {
+  const int w = in.depth.width;
+  ex.for_each(in.depth.count(), [=] SEAMLESS_HD(std::int64_t i) {
+    const int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
+    candidates(x, y) = 0;
+    const float d = in.depth(x, y);
+    if (!(d > 0.f)) return;
+    const vec3 p = in.ref_T_cur * in.K.unproject(static_cast<float>(x), static_cast<float>(y), d);
+    if (p.z <= 0.f) return;
+    const vec2 uv = in.K.project(p);
+    const int u0 = static_cast<int>(floorf(uv.x + 0.5f)), v0 = static_cast<int>(floorf(uv.y + 0.5f));
+    // The best-fitting model plane and the nearest model surface in a small window: projective
+    // association is off by the pose error (a pixel or two), which at a depth edge would otherwise
+    // pair a measurement on the near side with model on the far side.
+    float best = 1e30f, nearest = 1e30f;
+    bool any = false;
+    for (int dy = -in.search_radius; dy <= in.search_radius; ++dy)
+      for (int dx = -in.search_radius; dx <= in.search_radius; ++dx) {
+        const int u = u0 + dx, v = v0 + dy;
+        if (!in.model_vertices.inside(u, v)) continue;
+        const vec3 m = in.model_vertices(u, v), n = in.model_normals(u, v);
+        if (!(m.z > 0.f) || length2(n) == 0.f) continue;
+        any = true;
+        // n faces the camera, so in front of the plane is dot(p - m, n) > 0.
+        best = fminf(best, dot(p - m, n));
+        nearest = fminf(nearest, m.z);
+      }
+    if (!any) return;
+    const bool residual = best > dynamic_threshold(in, d);          // (a)
+    const bool free_space = p.z < nearest - in.free_space;          // (b)
+    candidates(x, y) = residual || free_space ? 1 : 0;
+  });
+}
+
+template <class Exec>
+void filter_dynamic(const Exec& ex, View2D<const std::uint8_t> candidates, View2D<const std::uint8_t> prev,
+                    View2D<const float> depth, int radius, int min_support, float max_step,
+                    View2D<std::uint8_t> kept, View2D<std::uint8_t> mask) {
+  const int w = candidates.width;
+  const bool has_prev = prev.data != nullptr && prev.width == candidates.width && prev.height == candidates.height;
+  ex.for_each(candidates.count(), [=] SEAMLESS_HD(std::int64_t i) {
+    const int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
+    std::uint8_t k = 0;
+    if (candidates(x, y)) {
+      int support = 0;
+      for (int dy = -radius; dy <= radius; ++dy)
+        for (int dx = -radius; dx <= radius; ++dx)
+          if (candidates.inside(x + dx, y + dy) && candidates(x + dx, y + dy)) ++support;
+      k = support >= min_support || (has_prev && prev(x, y)) ? 1 : 0;
+    }
+    kept(x, y) = k;
+  });
+  ex.for_each(candidates.count(), [=] SEAMLESS_HD(std::int64_t i) {
+    const int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
+    std::uint8_t m = kept(x, y);
+    const float d = depth(x, y);
+    if (!m)
+      for (int dy = -radius; dy <= radius && !m; ++dy)
+        for (int dx = -radius; dx <= radius && !m; ++dx) {
+          const int u = x + dx, v = y + dy;
+          if (kept.inside(u, v) && kept(u, v) && (!(d > 0.f) || fabsf(depth(u, v) - d) <= max_step)) m = 1;
+        }
+    mask(x, y) = m;
+  });
+}
+
+template <class Exec>
+void mask_vertices(const Exec& ex, View2D<const std::uint8_t> mask, int scale, View2D<vec3> vertices,
+                   View2D<vec3> normals) {
+  const int w = vertices.width;
+  ex.for_each(vertices.count(), [=] SEAMLESS_HD(std::int64_t i) {
+    const int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
+    bool dynamic = false;
+    for (int dy = 0; dy < scale && !dynamic; ++dy)
+      for (int dx = 0; dx < scale && !dynamic; ++dx)
+        if (mask.inside(x * scale + dx, y * scale + dy) && mask(x * scale + dx, y * scale + dy)) dynamic = true;
+    if (!dynamic) return;
+    vertices(x, y) = vec3{0.f, 0.f, 0.f};
+    normals(x, y) = vec3{0.f, 0.f, 0.f};
+  });
+}
+
+template <class Exec>
+void mask_depth(const Exec& ex, View2D<const std::uint8_t> mask, View2D<float> depth) {
+  const int w = depth.width;
+  ex.for_each(depth.count(), [=] SEAMLESS_HD(std::int64_t i) {
+    const int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
+    if (mask(x, y)) depth(x, y) = 0.f;
+  });
+}
+
+template <class Exec>
+std::int64_t count_dynamic(const Exec& ex, View2D<const std::uint8_t> mask) {
+  const int w = mask.width;
+  return ex.transform_reduce(mask.count(), std::int64_t{0}, [=] SEAMLESS_HD(std::int64_t i) {
+    return static_cast<std::int64_t>(mask(static_cast<int>(i % w), static_cast<int>(i / w)) != 0);
+  });
+}
+
+}  // namespace seamless::kernels
+
+#define SEAMLESS_INSTANTIATE_DYNAMIC(EXEC)                                                                       \
+  namespace seamless::kernels {                                                                                  \
+  template void classify_dynamic<EXEC>(const EXEC&, DynamicInput, View2D<std::uint8_t>);                         \
+  template void filter_dynamic<EXEC>(const EXEC&, View2D<const std::uint8_t>, View2D<const std::uint8_t>,        \
+                                     View2D<const float>, int, int, float, View2D<std::uint8_t>,                 \
+                                     View2D<std::uint8_t>);                                                      \
+  template void mask_vertices<EXEC>(const EXEC&, View2D<const std::uint8_t>, int, View2D<vec3>, View2D<vec3>);   \
+  template void mask_depth<EXEC>(const EXEC&, View2D<const std::uint8_t>, View2D<float>);                        \
+  template std::int64_t count_dynamic<EXEC>(const EXEC&, View2D<const std::uint8_t>);                            \
+  }

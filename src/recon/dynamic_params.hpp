@@ -1,0 +1,63 @@
+// Dynamic section (`dynamic:`): people and moving objects kept out of tracking and fusion, and
+// free-space carving of what they left behind (issue 22, docs/DYNAMIC.md). Off by default: then
+// every run is bit for bit what it was without this section.
+#pragma once
+#include "core/params.hpp"
+
+namespace seamless {
+
+struct DynamicParams {
+  bool enabled = false;
+  // Residual threshold: max(residual_min, residual_sigmas * noise_coeff * z^2). Kinect v1 depth
+  // noise grows with the square of the distance (Khoshelham & Elberink 2012: about 1.5 mm at 1 m,
+  // 4 cm at 5 m, so sigma ~ 1.5e-3 z^2); 3 sigma keeps 99.7% of static noise out. The floor of
+  // 3 cm covers what the noise model does not: the pose error of the prediction and the raycast's
+  // trilinear surface (a voxel or two at the default sizes).
+  float residual_min = 0.03f;
+  float noise_coeff = 0.0015f;
+  float residual_sigmas = 3.f;
+  // Free-space violation: a measurement more than this many volume.truncation widths in front of
+  // the nearest model surface along its ray sees through space the model says is empty.
+  float free_space_truncations = 3.f;
+  int search_radius = 2;     // pixels: projective association is a pixel or two off at depth edges
+  int support_radius = 1;    // pixels: the consistency window is (2r+1)^2
+  int min_support = 5;       // of the window's 9 pixels (r = 1): a majority
+  float dilate_max_step = 0.05f;  // metres: the dilation never crosses a larger depth step
+  // Free-space carving: a voxel more than this many truncation widths in front of the measured depth
+  // (and of its 3x3 neighbours) is reset to free; 0: only the running average (KinectFusion).
+  float carve_truncations = 3.f;
+  bool write_masks = false;  // dynamic_mask/<frame>.png (255 = dynamic) into the run's folder
+
+  template <class V> void visit(V& v) {
+    v("enabled", enabled,
+      "find dynamic pixels (people, moving objects) from the depth and the model, keep them out of tracking and "
+      "fusion, and carve free space (docs/DYNAMIC.md); false: exactly the static pipeline");
+    v("residual_min", residual_min,
+      "smallest point-to-plane residual in front of the model that marks a pixel dynamic, metres", Range{0.0, 1.0});
+    v("noise_coeff", noise_coeff,
+      "depth noise model sigma(z) = noise_coeff * z^2 (Khoshelham & Elberink 2012), 1/metres", Range{0.0, 1.0});
+    v("residual_sigmas", residual_sigmas, "residual threshold in depth-noise sigmas at the pixel's depth",
+      Range{0.0, 100.0});
+    v("free_space_truncations", free_space_truncations,
+      "a measurement this many volume.truncation widths in front of the nearest model surface along its ray is "
+      "dynamic (free-space violation)",
+      Range{0.5, 100.0});
+    v("search_radius", search_radius, "pixels around a measurement's projection searched for the model surface",
+      Range{0, 8});
+    v("support_radius", support_radius, "radius of the consistency window, pixels", Range{1, 8});
+    v("min_support", min_support,
+      "candidates needed in the (2r+1)^2 consistency window for a pixel to stay dynamic (without the previous "
+      "frame's mask having it)",
+      Range{1, 289});
+    v("dilate_max_step", dilate_max_step,
+      "the mask grows by support_radius into neighbours whose depth differs by at most this, metres",
+      Range{0.0, 10.0});
+    v("carve_truncations", carve_truncations,
+      "free-space carving: voxels this many truncation widths in front of the measurement are reset to free "
+      "space; 0: off",
+      Range{0.0, 100.0});
+    v("write_masks", write_masks, "write each frame's mask as dynamic_mask/<frame>.png (255 = dynamic)");
+  }
+};
+
+}  // namespace seamless

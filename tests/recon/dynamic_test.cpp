@@ -1,0 +1,176 @@
+// Issue 22: a person walking through the synthetic room (configs/dynamic_person.yaml's movers) with
+// exact ground truth: the dynamic mask against the rendered mover masks, the ghost the person
+// leaves in the mesh, and the tracking error, each with dynamic.enabled off and on. Made small
+// (320x240 pixels, the person at 2.4 m/s so that the crossing takes 39 frames, not 117), yet
+// minutes on the CPU: label slow. (At 160x120 or with 2 cm voxels ICP loses this orbit.)
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/exec.hpp"
+#include "eval/trajectory_eval.hpp"
+#include "kernels/scene/synthetic_room.hpp"
+#include "io/movers.hpp"
+#include "io/synthetic_source.hpp"
+#include "kernels/recon/dynamic.hpp"
+#include "recon/tracker_sequence.hpp"
+#include "recon/volume.hpp"
+
+using namespace seamless;
+
+namespace {
+
+constexpr int kFrames = 64;  // person from frame 10 to 49 (3.1 m at 2.4 m/s), then 0.5 s of empty room
+constexpr double kFps = 30.0;
+constexpr float kPersonSpeed = 2.4f;
+
+// configs/dynamic_person.yaml's scene at a quarter of the Kinect's resolution.
+InputParams scene(bool with_movers) {
+  InputParams in;
+  in.source = "synthetic";
+  in.synthetic.frames = kFrames;
+  in.synthetic.fps = kFps;
+  in.synthetic.speed_deg = 15.f;
+  in.intrinsics.preset = "custom";
+  in.intrinsics.fx = in.intrinsics.fy = 262.5f;  // the Kinect's 525 px focal length / 2
+  in.intrinsics.cx = 159.5f, in.intrinsics.cy = 119.5f;
+  in.intrinsics.width = 320, in.intrinsics.height = 240;
+  if (with_movers) {
+    MoverParams person;
+    person.kind = "person", person.path = {{-1.3f, 1.15f, 0.f}, {1.8f, 1.15f, 0.f}}, person.speed = kPersonSpeed;
+    person.start = 10 / kFps;
+    MoverParams ball;
+    ball.kind = "ball", ball.path = {{1.5f, 1.7f, 0.f}, {-1.2f, 1.7f, 0.f}}, ball.speed = 0.4f, ball.start = 0.5;
+    ball.radius = 0.15f;
+    in.synthetic.movers = {person, ball};
+  }
+  return in;
+}
+
+TrackSequenceParams params(bool dynamic, const std::string& tracker) {
+  TrackSequenceParams p;
+  p.tracker.kind = tracker;
+  p.tracker.mode = "frame_to_model";
+  p.volume.voxel_size = 0.01f;  // configs/dynamic_person.yaml's volume
+  p.volume.truncation = 0.04f;
+  p.volume.hash_buckets = 1 << 16;
+  p.volume.capacity = 1 << 15;
+  p.dynamic.enabled = dynamic;
+  p.write_files = false;
+  return p;
+}
+
+struct Outcome {
+  double ate_m = 0;             // ATE RMSE after se3 alignment (seamless eval's)
+  double min_iou = 1, mean_iou = 0;
+  int iou_frames = 0;
+  std::int64_t ghost_vertices = 0;  // mesh vertices inside the person's swept volume
+  double mean_fraction = 0;
+};
+
+// A person's capsules over the run, in the room frame.
+std::vector<kernels::movers::Scene> person_track(const InputParams& in) {
+  std::vector<kernels::movers::Scene> out;
+  std::vector<MoverParams> person{in.synthetic.movers.at(0)};
+  for (int k = 0; k < kFrames; ++k) out.push_back(pose_movers(person, k / kFps));
+  return out;
+}
+
+// tracker ground_truth: the map is exactly in the room frame (up to the first pose), so the ghost
+// measures fusion and carving alone; icp: the tracking error.
+Outcome run(const InputParams& in, bool dynamic, const std::string& tracker = "icp") {
+  SyntheticSource src(in);
+  const TrackSequenceParams p = params(dynamic, tracker);
+  std::unique_ptr<Volume> volume = make_volume(p.volume, Device::CPU);  // ground_truth makes none itself
+  TrackingSession s(p, Device::CPU, src.intrinsics(), volume.get());
+  SE3 world_T_room = SE3::identity();
+  const std::vector<MoverParams> person{in.synthetic.movers.empty() ? MoverParams{} : in.synthetic.movers[0]};
+  Outcome o;
+  RgbdFrame f;
+  Trajectory est, gt;
+  double iou_sum = 0, fraction_sum = 0;
+  int n = 0;
+  while (src.next(f)) {
+    const FrameRecord r = s.process(f);
+    EXPECT_TRUE(r.result.ok()) << "frame " << f.index << (dynamic ? " dynamic on: " : " dynamic off: ")
+                               << to_string(r.result.status) << ", inliers " << r.result.inlier_ratio << ", masked "
+                               << r.dynamic_fraction;
+    if (n == 0) world_T_room = r.result.world_T_camera * f.ground_truth->inverse();
+    est.push_back(TumPose::from_se3(f.timestamp, r.result.world_T_camera));
+    gt.push_back(TumPose::from_se3(f.timestamp, *f.ground_truth));
+    ++n;
+    if (!dynamic || in.synthetic.movers.empty() || f.index == 0) continue;
+    fraction_sum += r.dynamic_fraction;
+    // Mask quality where the person is at least 0.5 m from the camera (the issue's condition) and
+    // covers at least 1% of the image: a sliver at the image border has a handful of pixels, where
+    // one pixel of silhouette is already 10% of the IoU.
+    const auto scene_now = pose_movers(person, f.timestamp);
+    if (scene_now.count == 0 || kernels::movers::distance(scene_now, f.ground_truth->t) < 0.5f) continue;
+    const std::vector<std::uint8_t> truth = f.mover_mask.to_host(), mine = s.dynamic_mask().to_host();
+    std::int64_t inter = 0, uni = 0, truth_n = 0;
+    for (std::size_t i = 0; i < truth.size(); ++i) {
+      inter += truth[i] && mine[i];
+      uni += truth[i] || mine[i];
+      truth_n += truth[i] != 0;
+    }
+    if (truth_n < static_cast<std::int64_t>(truth.size() / 100)) continue;
+    const double iou = static_cast<double>(inter) / static_cast<double>(uni);
+    o.min_iou = std::min(o.min_iou, iou);
+    iou_sum += iou;
+    ++o.iou_frames;
+  }
+  const AteResult ate = compute_ate(est, gt);
+  o.ate_m = ate.trans.rmse;
+  o.mean_iou = o.iou_frames ? iou_sum / o.iou_frames : 0;
+  o.mean_fraction = fraction_sum / std::max(1, n - 1);
+  // The ghost: mesh vertices inside the person's capsules of any frame, shrunk by 2 voxels so that
+  // the floor the feet stand on (a true surface within a voxel of the leg capsules' ends) does not
+  // count, nor the room's own surfaces that the swinging arms reach into (the far wall): a vertex
+  // within 2 voxels of the room's exact surface is the room.
+  const auto track = person_track(scene(true));
+  const SE3 room_T_world = world_T_room.inverse();
+  const Mesh mesh = s.volume()->extract_mesh();
+  const float margin = 2 * p.volume.voxel_size;
+  for (const vec3& v : mesh.positions) {
+    const vec3 q = room_T_world * v;
+    if (std::fabs(kernels::room::room_sdf(q)) < margin) continue;
+    for (const auto& sc : track)
+      if (sc.count > 0 && kernels::movers::distance(sc, q) < -margin) {
+        ++o.ghost_vertices;
+        break;
+      }
+  }
+  return o;
+}
+
+}  // namespace
+
+// One test for all five runs: the numbers compare them (the person-free run is the baseline). About
+// 8 minutes on 2 shared cores, hence "Slow" (label slow: not in scripts/test's CI run; run it with
+// `ctest --test-dir build -L slow -R Dynamic` or build/tests/recon/test_dynamic).
+TEST(Dynamic, SlowPersonWalkingThroughTheRoom) {
+  // Ghost and mask on ground-truth poses (the map in the room frame exactly); tracking with ICP.
+  const Outcome off = run(scene(true), false, "ground_truth"), on = run(scene(true), true, "ground_truth");
+  const Outcome tracked_off = run(scene(true), false), tracked_on = run(scene(true), true),
+                empty = run(scene(false), false);
+  std::printf("ground-truth poses, dynamic off: ghost %lld vertices\n", static_cast<long long>(off.ghost_vertices));
+  std::printf("ground-truth poses, dynamic on:  ghost %lld vertices, IoU min %.3f mean %.3f over %d frames, masked %.2f%%\n",
+              static_cast<long long>(on.ghost_vertices), on.min_iou, on.mean_iou, on.iou_frames, 100 * on.mean_fraction);
+  std::printf("icp, dynamic off: ATE %.2f cm\nicp, dynamic on:  ATE %.2f cm, IoU min %.3f mean %.3f\n",
+              100 * tracked_off.ate_m, 100 * tracked_on.ate_m, tracked_on.min_iou, tracked_on.mean_iou);
+  std::printf("icp, no person:   ATE %.2f cm\n", 100 * empty.ate_m);
+  // Mask quality (issue 22): IoU at least 0.8 on every frame with the person 0.5 m or more away.
+  EXPECT_GT(on.iou_frames, 10);
+  EXPECT_GE(on.min_iou, 0.8);
+  // Ghost: with dynamic handling off the person is fused into the model where they walked.
+  EXPECT_GT(off.ghost_vertices, 100);
+  EXPECT_LE(static_cast<double>(on.ghost_vertices), 0.02 * static_cast<double>(off.ghost_vertices));
+  // Tracking: at most 1 cm, and within 20% of the same path without the person.
+  EXPECT_LE(tracked_on.ate_m, 0.01);
+  EXPECT_LE(tracked_on.ate_m, 1.2 * empty.ate_m);
+}
