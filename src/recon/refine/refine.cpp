@@ -70,9 +70,10 @@ using namespace refine_detail;
 bool refine_available() { return SEAMLESS_HAS_CERES != 0; }
 
 void require_refine(const RefineParams& params) {
-  if (params.enabled && !refine_available())
-    throw ConfigError("refine.enabled is true but this build has no Ceres: install libceres-dev (scripts/packages.txt) "
-                "and reconfigure, or set refine.enabled=false");
+  if ((params.enabled || params.online) && !refine_available())
+    throw ConfigError(std::string("refine.") + (params.enabled ? "enabled" : "online") +
+                      " is true but this build has no Ceres: install libceres-dev (scripts/packages.txt) and "
+                      "reconfigure, or set it to false");
 }
 
 // ---- keyframes ----------------------------------------------------------------------------------
