@@ -118,6 +118,7 @@ int run(const CommonOptions& o) {
   const Trajectory& traj = scan_result.tracking.trajectory;
   summary.intrinsics = scan_result.intrinsics;
   add_tracking(summary, scan_result.tracking, scan_result.unreadable, groundtruth_path(ctx));
+  summary.online_refine = scan_result.online_refine;
   std::optional<SdfGrid> grid;
   if (e.solver.scene_collision == "sdf") grid = scene_sdf_grid(*scan_result.volume, scan_result.mesh, e);
   SceneParticleParams sp;

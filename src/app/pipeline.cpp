@@ -19,6 +19,7 @@
 #include "physics/depth_colliders.hpp"
 #include "physics/particle_solver.hpp"
 #include "recon/ply.hpp"
+#include "recon/refine/online_refine.hpp"
 
 namespace seamless::app {
 
@@ -91,8 +92,17 @@ ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
     if (n == 0) r.first_frame = host_copy(frame);
     progress.update(++n, to_string(f.result.status));
   };
-  r.tracking = track_sequence(*source, tracking_params(e, volume_stages), ctx.device(), ctx.out_dir(), r.volume.get(),
-                              on_frame);
+  TrackSequenceParams tp = tracking_params(e, volume_stages);
+  std::unique_ptr<OnlineCorrector> online;  // refine.online: the keyframe graph solved while tracking runs
+  if (e.refine.online) {
+    online = std::make_unique<OnlineCorrector>(e.refine, e.preprocess, source->intrinsics(), online_feedback(e.tracker));
+    tp.corrector = online.get();
+  }
+  r.tracking = track_sequence(*source, tp, ctx.device(), ctx.out_dir(), r.volume.get(), on_frame);
+  if (online) {
+    r.tracking.trajectory = online_refine_finish(*online, ctx.out_dir(), e.output.write_trajectory);
+    r.online_refine = online->stats();
+  }
   r.unreadable = source->skipped_frames();
   progress.finish();
   spdlog::info("{} frames from {} ({} unreadable, skipped); {} lost by tracking; median track {:.3f} ms, frame {:.3f} ms",
@@ -331,6 +341,9 @@ class LiveLoop : public FrameLoop {
         total_(e_.frames > 0 ? e_.frames : source_->size().value_or(0)), progress_("live", total_) {
     record_intrinsics(ctx, *source_);
     if (e_.output.write_trajectory) traj_ = std::make_unique<TrajectoryWriter>(ctx.out_path("trajectory.txt"));
+    if (e_.refine.online)
+      online_ = std::make_unique<OnlineCorrector>(e_.refine, e_.preprocess, source_->intrinsics(),
+                                                  online_feedback(e_.tracker));
     sp_.spacing = e_.solver.particle_diameter;
     sp_.interior_depth = e_.scene_interior_depth;
     if (e_.solver.dynamic_colliders != "none")
@@ -342,6 +355,8 @@ class LiveLoop : public FrameLoop {
         !source_->next(frame_))
       return !(finished_ = true);
     const FrameRecord rec = session_.process(frame_);
+    if (online_)
+      if (std::optional<SE3> delta = online_->after_frame(frame_, rec)) session_.correct(*delta);
     const auto k = static_cast<std::int64_t>(records_.size());
     if (traj_) traj_->write(frame_.timestamp, rec.result.world_T_camera);
     poses_.push_back(TumPose::from_se3(frame_.timestamp, rec.result.world_T_camera));
@@ -403,6 +418,10 @@ class LiveLoop : public FrameLoop {
       spdlog::warn("live: {} spawn entries were never spawned (their time or their placement's surface never "
                    "came)", queue_.pending());
     if (renderer_) finish_renderer(ctx_, *renderer_);
+    if (online_) {
+      traj_.reset();  // trajectory.txt complete under its name before it becomes trajectory_live.txt
+      poses_ = online_refine_finish(*online_, ctx_.out_dir(), e_.output.write_trajectory);
+    }
     if (e_.output.write_stats) write_tracking_stats(ctx_.out_path("tracking_stats.csv"), records_);
     ctx_.report_tracking(static_cast<std::int64_t>(records_.size()), session_.lost_frames());
     const ParticleState state = solver_.download_state();  // one download for the file and the summary
@@ -460,6 +479,7 @@ class LiveLoop : public FrameLoop {
     sum.placements = placements_;
     sum.spawns = spawns_;
     sum.physics = solver_.stats();
+    if (online_) sum.online_refine = online_->stats();
     sum.escaped = count_escaped(state, b, e_.solver.particle_diameter);
     add_stage_medians(sum, ctx_.timer());
     write_summary(ctx_.out_path("summary.json"), sum);
@@ -503,6 +523,7 @@ class LiveLoop : public FrameLoop {
   const std::int64_t total_;
   Progress progress_;
   std::unique_ptr<TrajectoryWriter> traj_;
+  std::unique_ptr<OnlineCorrector> online_;  // refine.online
   SceneParticleParams sp_;
   std::vector<FrameRecord> records_;
   RgbdFrame frame_;

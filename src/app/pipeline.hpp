@@ -1,10 +1,12 @@
 // The pipeline's stages as the subcommands run them, shared by run, reconstruct and track.
 #pragma once
 #include <memory>
+#include <optional>
 
 #include "app/run_context.hpp"
 #include "io/frame_source.hpp"
 #include "physics/particle_solver.hpp"
+#include "recon/refine/online_refine.hpp"
 #include "recon/tracker_sequence.hpp"
 #include "recon/volume.hpp"
 #include "kernels/physics/scene_sdf.hpp"
@@ -18,6 +20,7 @@ struct ScanResult {
   Intrinsics intrinsics{};         // of the frames (undistorted)
   RgbdFrame first_frame;           // host copy of the first frame (the Kinect view's fixed camera)
   std::int64_t unreadable = 0;     // frames the source skipped as unreadable
+  std::optional<OnlineRefineStats> online_refine;  // refine.online; tracking.trajectory is then the final graph's
 };
 
 class RunRenderer;

@@ -67,6 +67,21 @@ void add_stage_medians(RunSummary& s, const StageTimer& t) {
 
 namespace {
 Json vec_json(vec3 v) { return Json::array({v.x, v.y, v.z}); }
+
+Json median_max(const std::vector<double>& v) {
+  if (v.empty()) return {{"median", 0.0}, {"max", 0.0}, {"count", 0}};
+  return {{"median", median(v)}, {"max", *std::max_element(v.begin(), v.end())}, {"count", v.size()}};
+}
+
+// refine.online: the tracking thread's time per frame (handover_ms) and the background's per
+// keyframe and per Ceres solve (docs/OUTPUTS.md).
+Json online_json(const OnlineRefineStats& o) {
+  return {{"keyframes", o.keyframes}, {"solves", o.solves}, {"corrections", o.corrections},
+          {"pair_edges", o.pair_edges}, {"rejected_pairs", o.rejected_pairs}, {"candidate_pairs", o.candidate_pairs},
+          {"max_correction_m", o.max_correction_m}, {"max_correction_deg", o.max_correction_deg},
+          {"handover_ms", median_max(o.handover_ms)}, {"keyframe_s", median_max(o.keyframe_s)},
+          {"solve_s", median_max(o.solve_s)}, {"final_wait_s", o.final_wait_s}};
+}
 }  // namespace
 
 void write_summary(const std::string& path, const RunSummary& s) {
@@ -111,6 +126,7 @@ void write_summary(const std::string& path, const RunSummary& s) {
   }
   Json& stages = j["stage_median_ms"] = Json::object();
   for (const auto& [stage, ms] : s.stage_median_ms) stages[stage] = ms;
+  if (s.online_refine) j["online_refine"] = online_json(*s.online_refine);
   // Written complete under a temporary name, then renamed: a reader never sees half a file.
   write_json_file(partial_path(path), j);
   commit_partial(path);

@@ -8,6 +8,7 @@
 #include "app/placement.hpp"
 #include "core/camera.hpp"
 #include "physics/particle_solver.hpp"
+#include "recon/refine/online_refine.hpp"
 #include "recon/tracker_sequence.hpp"
 
 namespace seamless::app {
@@ -44,6 +45,7 @@ struct RunSummary {
   std::optional<float> floor_height;   // of the floor found in the scan (along up), when one was seen
   std::vector<HorizontalSurface> surfaces;  // the scan's horizontal surfaces, largest first
   std::vector<std::pair<std::string, double>> stage_median_ms;
+  std::optional<OnlineRefineStats> online_refine;  // refine.online: its cost and what it did
 };
 
 // Frames, loss and ATE (when `groundtruth` is not empty) of a tracked sequence.

@@ -50,6 +50,8 @@ class ReferenceMaps {
   bool empty() const { return levels_.empty(); }
   bool has_intensity() const { return !levels_.empty() && levels_[0].intensity.width() > 0; }
   const SE3& world_T_ref() const { return world_T_ref_; }
+  // The same maps seen from a corrected world (world' = delta * world): their own frame is unchanged.
+  void move_world(const SE3& delta) { world_T_ref_ = delta * world_T_ref_; }
 
  private:
   void resize(const Intrinsics& K, int levels, Device d, bool intensity);

@@ -477,6 +477,12 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
   return rec;
 }
 
+void TrackingSession::correct(const SE3& delta) {
+  last_good_ = delta * last_good_;
+  prev_good_ = delta * prev_good_;
+  ref_.move_world(delta);
+}
+
 // Allocation as Niessner et al. (2013, section 4) count it: inserting the frame's blocks and listing
 // the visible ones (every pass, when a full table or pool made the volume grow and repeat them).
 double TrackingSession::volume_allocate_ms(std::size_t first_row) const {
@@ -559,6 +565,8 @@ TrackSequenceResult track_sequence(FrameSource& source, const TrackSequenceParam
   try {
     while (wanted() && source.next(frame)) {
       FrameRecord rec = session.process(frame);
+      if (params.corrector)
+        if (std::optional<SE3> delta = params.corrector->after_frame(frame, rec)) session.correct(*delta);
       out.trajectory.push_back(TumPose::from_se3(frame.timestamp, rec.result.world_T_camera));
       if (writer) writer->write(out.trajectory.back());
       if (out.frames.empty() && frame.ground_truth)

@@ -8,6 +8,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,17 @@
 
 namespace seamless {
 
+struct FrameRecord;
+
+// A hook after every processed frame (refine.online, src/recon/refine/online_refine.hpp): it may
+// return a correction delta (corrected world = delta * world) that the caller applies with
+// TrackingSession::correct before the next frame.
+class PoseCorrector {
+ public:
+  virtual ~PoseCorrector() = default;
+  virtual std::optional<SE3> after_frame(const RgbdFrame& frame, const FrameRecord& rec) = 0;
+};
+
 // The sections of an experiment that tracking reads (from Experiment: tracker, preprocess, volume,
 // frames).
 struct TrackSequenceParams {
@@ -36,6 +48,8 @@ struct TrackSequenceParams {
   // into it, one end_frame(frame index) a processed frame, and FrameRecord::allocate_ms is filled
   // (`seamless bench pipeline`). Off in ordinary runs: on CUDA each step costs two more events.
   StageTimer* volume_stages = nullptr;
+  // refine.online: sees every frame; its corrections move the session's pose (track_sequence).
+  PoseCorrector* corrector = nullptr;
 };
 
 // One frame's outcome, one row of tracking_stats.csv.
@@ -70,6 +84,9 @@ class TrackingSession {
   TrackingSession(const TrackSequenceParams& params, Device device, const Intrinsics& K, Volume* volume = nullptr);
   ~TrackingSession();
   FrameRecord process(const RgbdFrame& frame);
+  // Moves the session's pose, its motion model and its reference view by `delta` (world' = delta *
+  // world): the next frames are tracked and fused in the corrected frame (refine.online).
+  void correct(const SE3& delta);
 
   Volume* volume() const { return volume_; }
   const GravityEstimate& gravity() const { return gravity_; }

@@ -15,16 +15,17 @@
 #include "kernels/recon/rgbd.hpp"
 #include "recon/preprocess.hpp"
 #include "recon/refine/refine_graph.hpp"
+#include "recon/refine/refine_steps.hpp"
 #include "recon/tracker.hpp"
 #include "seamless/build_config.hpp"
 
 namespace seamless {
 
-using refine_detail::Edge;
-using refine_detail::Pose;
-
+// The steps are shared with the online refinement (online_refine.cpp): refine_steps.hpp.
+namespace refine_detail {
 namespace {
 constexpr double kRadToDeg = 57.29577951308232;
+}  // namespace
 
 Pose to_pose(const TumPose& p) {
   Pose o;
@@ -55,14 +56,24 @@ std::pair<double, double> distance(const Pose& a, const Pose& b) {
 }
 
 bool is_tracked(const std::vector<bool>& tracked, std::size_t i) { return tracked.empty() || tracked[i]; }
-}  // namespace
+
+bool keyframe_due(const Pose& last_keyframe, std::int64_t last_index, const Pose& pose, std::int64_t index,
+                  const RefineParams& p) {
+  if (p.keyframes == "every") return index - last_index >= p.keyframe_every;
+  auto [deg, m] = distance(last_keyframe, pose);
+  return m > p.keyframe_translation || deg > p.keyframe_rotation_deg;
+}
+}  // namespace refine_detail
+
+using namespace refine_detail;
 
 bool refine_available() { return SEAMLESS_HAS_CERES != 0; }
 
 void require_refine(const RefineParams& params) {
-  if (params.enabled && !refine_available())
-    throw ConfigError("refine.enabled is true but this build has no Ceres: install libceres-dev (scripts/packages.txt) "
-                "and reconfigure, or set refine.enabled=false");
+  if ((params.enabled || params.online) && !refine_available())
+    throw ConfigError(std::string("refine.") + (params.enabled ? "enabled" : "online") +
+                      " is true but this build has no Ceres: install libceres-dev (scripts/packages.txt) and "
+                      "reconfigure, or set it to false");
 }
 
 // ---- keyframes ----------------------------------------------------------------------------------
@@ -80,14 +91,8 @@ std::vector<std::int64_t> select_keyframes(const Trajectory& odometry, const Ref
       continue;
     }
     const std::int64_t last = kf.back();
-    bool take = false;
-    if (p.keyframes == "every") {
-      take = static_cast<std::int64_t>(i) - last >= p.keyframe_every;
-    } else {
-      auto [deg, m] = distance(to_pose(odometry[last]), to_pose(odometry[i]));
-      take = m > p.keyframe_translation || deg > p.keyframe_rotation_deg;
-    }
-    if (take) kf.push_back(static_cast<std::int64_t>(i));
+    if (keyframe_due(to_pose(odometry[last]), last, to_pose(odometry[i]), static_cast<std::int64_t>(i), p))
+      kf.push_back(static_cast<std::int64_t>(i));
   }
   // The sequence's end is anchored by a keyframe, so no frame is left to extrapolation only.
   for (std::size_t i = odometry.size(); i-- > 0;) {
@@ -102,15 +107,7 @@ std::vector<std::int64_t> select_keyframes(const Trajectory& odometry, const Ref
 
 // ---- keyframe images ----------------------------------------------------------------------------
 
-namespace {
-
-// One keyframe's pyramid on the device (kept for the whole stage: a 640x480 pyramid is ~13 MB).
-struct KeyframeData {
-  std::int64_t frame = 0;
-  double timestamp = 0;
-  Pose odometry;
-  std::unique_ptr<FramePyramid> pyr;
-};
+namespace refine_detail {
 
 std::unique_ptr<FramePyramid> build_pyramid(const RgbdFrame& f, const Intrinsics& K, const PreprocessParams& pre,
                                             bool colour, Device d) {
@@ -127,6 +124,7 @@ std::unique_ptr<FramePyramid> build_pyramid(const RgbdFrame& f, const Intrinsics
   return pyr;
 }
 
+namespace {
 // Reads the whole source (its frames are the trajectory's, in order) and keeps the keyframes.
 std::vector<KeyframeData> load_keyframes(FrameSource& source, const Trajectory& odometry,
                                          const std::vector<std::int64_t>& kf, const PreprocessParams& pre,
@@ -150,6 +148,8 @@ std::vector<KeyframeData> load_keyframes(FrameSource& source, const Trajectory& 
                 " poses; refine the trajectory of exactly these frames (same input, same frames setting)");
   return out;
 }
+
+}  // namespace
 
 // ---- pairwise alignment -------------------------------------------------------------------------
 
@@ -179,6 +179,7 @@ int finest_level(const RefineParams& p, int levels) {
   throw ConfigError("refine.iterations has no level with iterations > 0: the pairwise alignment would do nothing");
 }
 
+namespace {
 struct PairResult {
   bool ok = false;
   Pose z;  // i_T_j
@@ -223,6 +224,7 @@ PairResult align_pair(const Tracker& tracker, const KeyframeData& a, const Keyfr
   if (out.ok) out.info = information(s, p);
   return out;
 }
+}  // namespace
 
 // Overlap of b with a at the odometry's relative pose: the share of b's pixels (coarsest level)
 // that find a correspondence on a's surface.
@@ -231,11 +233,6 @@ double overlap(const Tracker& tracker, const KeyframeData& a, const KeyframeData
   kernels::IcpSums s = tracker.reduce(*b.pyr, ref_a, ref_a.levels() - 1, to_se3(z_odo));
   return s.valid > 0 ? s.inliers / s.valid : 0.0;
 }
-
-struct Graph {
-  std::vector<Edge> edges;
-  RefineStats stats;
-};
 
 // Odometry edge (consecutive keyframes a, b): the tracker's relative pose. It is a chain of n =
 // b - a per-frame alignments, so (errors of a random walk) its covariance is about n times that of
@@ -282,6 +279,10 @@ std::vector<int> partners(const Tracker& tracker, const std::vector<KeyframeData
     double ov = overlap(tracker, kf[i], kf[j], ref_i);
     if (ov >= p.min_overlap) cand.push_back({ov, j});
   }
+  return best_partners(std::move(cand), p);
+}
+
+std::vector<int> best_partners(std::vector<std::pair<double, int>> cand, const RefineParams& p) {
   std::sort(cand.begin(), cand.end(), [](auto& x, auto& y) { return x.first > y.first; });
   if (static_cast<int>(cand.size()) > p.max_pairs_per_keyframe) cand.resize(p.max_pairs_per_keyframe);
   std::vector<int> out;
@@ -335,6 +336,9 @@ Trajectory apply_corrections(const Trajectory& odometry, const std::vector<Keyfr
   return out;
 }
 
+}  // namespace refine_detail
+
+namespace {
 RefineResult no_op(const Trajectory& odometry, RefineResult r, const std::string& why) {
   r.trajectory = odometry;
   r.stats.message = why;

@@ -42,7 +42,7 @@ struct RefineResult {
   RefineStats stats;
 };
 
-// Throws seamless::Error naming libceres-dev when params.enabled and this build has no Ceres.
+// Throws seamless::Error naming libceres-dev when params.enabled or params.online and this build has no Ceres.
 void require_refine(const RefineParams& params);
 bool refine_available();
 

@@ -11,6 +11,7 @@ namespace seamless {
 
 struct RefineParams {
   bool enabled = false;
+  bool online = false;                     // the graph grown and solved while tracking runs (online_refine.hpp)
   std::string keyframes = "every";         // every keyframe_every frames, or by motion
   int keyframe_every = 10;                 // frames
   float keyframe_translation = 0.1f;       // motion mode: metres since the last keyframe
@@ -36,6 +37,9 @@ struct RefineParams {
 
   template <class V> void visit(V& v) {
     v("enabled", enabled, "refine the tracked trajectory with a keyframe pose graph (needs Ceres, libceres-dev)");
+    v("online", online, "refine while tracking runs: keyframes handed to a background thread that aligns them and "
+      "re-solves the graph; the tracker's pose follows the newest solution (needs Ceres; docs/TRACKING.md, "
+      "'Online refinement')");
     v("keyframes", keyframes, "keyframe selection: every keyframe_every frames, or when the motion since the last "
       "keyframe exceeds keyframe_translation / keyframe_rotation_deg", Choices{"every", "motion"});
     v("keyframe_every", keyframe_every, "frames between keyframes (keyframes: every)", Range{1, 1e6});
