@@ -43,6 +43,7 @@ TrackSequenceParams tracking_params(const Experiment& e, StageTimer* volume_stag
   p.preprocess = e.preprocess;
   p.volume = e.volume;
   p.dynamic = e.dynamic;
+  if (e.solver.dynamic_colliders != "none") p.keep_unmasked_level = e.solver.collider_level;
   p.max_frames = e.frames;
   p.write_files = e.output.write_trajectory;
   return p;
@@ -346,6 +347,9 @@ class LiveLoop : public FrameLoop {
                                                   online_feedback(e_.tracker));
     sp_.spacing = e_.solver.particle_diameter;
     sp_.interior_depth = e_.scene_interior_depth;
+    if (e_.solver.dynamic_colliders == "depth" && !e_.dynamic.enabled)
+      spdlog::warn("solver.dynamic_colliders: depth with dynamic.enabled false: no pixel is dynamic, so nothing "
+                   "from the camera collides");
     if (e_.solver.dynamic_colliders != "none")
       colliders_.emplace(e_.solver.particle_diameter, e_.solver.collider_thickness, e_.solver.max_speed);
   }
@@ -453,12 +457,26 @@ class LiveLoop : public FrameLoop {
   // and this one move the colliders with their estimated velocities (MovingColliders).
   void update_colliders(const SE3& world_T_camera, double frame_time) {
     StageScope s(ctx_.timer(), "colliders");
-    const FramePyramid& pyr = session_.pyramid();
-    const PyramidLevel& lv = pyr.level(std::min(e_.solver.collider_level, pyr.levels() - 1));
+    const auto [vertices, normals] = session_.unmasked_level();
+    const int w = vertices->width(), h = vertices->height();
     std::vector<std::uint8_t> mask;  // empty: every pixel (dynamic_colliders: all)
-    colliders_->update(depth_surface(lv.vertices.to_host(), lv.normals.to_host(), lv.K.width, lv.K.height,
-                                     world_T_camera, mask),
+    if (e_.solver.dynamic_colliders == "depth") mask = block_any(session_.dynamic_mask(), w, h);
+    colliders_->update(depth_surface(vertices->to_host(), normals->to_host(), w, h, world_T_camera, mask),
                        frame_time);
+  }
+
+  // The full-resolution dynamic mask at a pyramid level's w x h: a level pixel is dynamic when
+  // any of the full-resolution pixels it averages is.
+  static std::vector<std::uint8_t> block_any(const Image<std::uint8_t>& full, int w, int h) {
+    std::vector<std::uint8_t> out(static_cast<std::size_t>(w) * h, 0);
+    if (full.width() == 0) return out;  // no mask yet (the first frame): nothing is dynamic
+    const std::vector<std::uint8_t> m = full.to_host();
+    const int W = full.width(), H = full.height(), sx = W / w, sy = H / h;
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x)
+        if (m[static_cast<std::size_t>(y) * W + x] && x / sx < w && y / sy < h)
+          out[static_cast<std::size_t>(y / sy) * w + x / sx] = 1;
+    return out;
   }
 
   // summary.json of a live run: as scan_then_simulate's, with the scene as it was at the end.

@@ -47,8 +47,7 @@ void Experiment::validate() const {
   if (solver.dynamic_colliders != "none" && mode != "live")
     throw ConfigError("solver.dynamic_colliders: " + solver.dynamic_colliders +
                       " needs mode: live (the colliders are each frame's depth points while the camera runs)");
-  if (solver.dynamic_colliders == "depth")
-    throw ConfigError("solver.dynamic_colliders: depth (the dynamic pixels only) is not built yet; use all");
+
 }
 
 Experiment load_experiment(const std::string& path, const std::vector<std::string>& overrides) {

@@ -134,6 +134,12 @@ const ReferenceMaps* TrackingSession::dynamic_reference() {
   return &dyn_ref_;
 }
 
+std::pair<const Image<vec3>*, const Image<vec3>*> TrackingSession::unmasked_level() const {
+  if (kept_) return {&kept_vertices_, &kept_normals_};
+  const PyramidLevel& lv = pyr_.level(std::min(std::max(p_.keep_unmasked_level, 0), pyr_.levels() - 1));
+  return {&lv.vertices, &lv.normals};
+}
+
 // Before tracking, the mask at the pose the tracker starts from (our trackers; the ground-truth
 // one needs none) zeroes the dynamic pixels' vertices on every pyramid level: weight 0 in the ICP
 // and RGB-D reductions. Relocalising frames start from several poses and keep every pixel.
@@ -142,6 +148,11 @@ const ReferenceMaps* TrackingSession::mask_before_tracking() {
   if (!model) return nullptr;
   if (!tracker_ || odometry_ || lost_run_ > 0) return model;
   find_dynamic(*model, p_.tracker.constant_velocity ? last_good_ * last_motion(1) : last_good_);
+  if (p_.keep_unmasked_level >= 0 && p_.keep_unmasked_level < pyr_.levels()) {
+    const PyramidLevel& lv = pyr_.level(p_.keep_unmasked_level);
+    kept_vertices_ = lv.vertices.clone(device_), kept_normals_ = lv.normals.clone(device_);
+    kept_ = true;
+  }
   with_exec(device_, [&](const auto& ex) {
     for (int l = 0; l < pyr_.levels(); ++l) {
       PyramidLevel& lv = pyr_.mutable_level(l);
@@ -411,6 +422,7 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
   FrameRecord rec;
   rec.frame = frame.index;
   rec.timestamp = frame.timestamp;
+  kept_ = false;
   marks_.mark(kStart);
   // External trackers read the host frame; our pyramid is needed only for the floor-plane gravity
   // of the first frame and for a volume to fuse into.

@@ -50,6 +50,9 @@ struct TrackSequenceParams {
   StageTimer* volume_stages = nullptr;
   // refine.online: sees every frame; its corrections move the session's pose (track_sequence).
   PoseCorrector* corrector = nullptr;
+  // >= 0: this pyramid level's vertex and normal maps are also kept as they were before the
+  // dynamic mask zeroed them (TrackingSession::unmasked_level; the live colliders of issue 22).
+  int keep_unmasked_level = -1;
 };
 
 // One frame's outcome, one row of tracking_stats.csv.
@@ -96,6 +99,9 @@ class TrackingSession {
   // dynamic.enabled: the last processed frame's dynamic pixels (1) on the session's device, full
   // resolution; empty before the first frame with a model to compare with (docs/DYNAMIC.md).
   const Image<std::uint8_t>& dynamic_mask() const { return dyn_mask_; }
+  // The last frame's pyramid level params.keep_unmasked_level (vertices, then normals) with its
+  // dynamic pixels still in it; the pyramid's own level when nothing was masked.
+  std::pair<const Image<vec3>*, const Image<vec3>*> unmasked_level() const;
 
  private:
   bool uses_volume() const;
@@ -134,6 +140,8 @@ class TrackingSession {
   ReferenceMaps dyn_ref_;  // frame-to-frame tracking: the model raycast the mask compares with
   RaycastMaps dyn_maps_;
   Image<std::uint8_t> dyn_candidates_, dyn_kept_, dyn_mask_, dyn_prev_;
+  Image<vec3> kept_vertices_, kept_normals_;  // params.keep_unmasked_level before masking
+  bool kept_ = false;                         // they hold this frame's level
   Image<float> depth_, intensity_;
   Image<uchar3> rgb_;
   GravityEstimate gravity_;

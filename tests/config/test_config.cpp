@@ -136,6 +136,9 @@ TEST(ConfigErrors, RulesAcrossKeysAreCheckedAtLoad) {
   EXPECT_THAT(error_of("mode: scan_then_simulate\nsolver: {dynamic_colliders: all}"),
               HasSubstr("solver.dynamic_colliders: all needs mode: live"));
   EXPECT_EQ(error_of("mode: live\nsolver: {dynamic_colliders: all}"), "");
+  // depth without dynamic.enabled is allowed (no pixel is dynamic, so nothing collides: the live
+  // loop says so), so that `--set dynamic.enabled=false` compares a run with and without.
+  EXPECT_EQ(error_of("mode: live\nsolver: {dynamic_colliders: depth}"), "");
 }
 
 TEST(ConfigErrors, ListElementsHaveIndexedPathsAndPositions) {
