@@ -16,6 +16,8 @@
 #include "config/config.hpp"
 #include "core/error.hpp"
 #include "io/trajectory.hpp"
+#include "physics/objects.hpp"
+#include "physics/particle_io.hpp"
 #include "recon/ply.hpp"
 #include "seamless/build_config.hpp"
 #if SEAMLESS_HAS_GL
@@ -130,15 +132,15 @@ int render_run(const RenderOptions& o) {
   const std::string out_dir = o.out.empty() ? o.run_dir + "/render" : o.out;
   fs::create_directories(out_dir);
   const auto states = snapshots(o.run_dir, o.last_only);
-  RunObjects objects;
+  SceneObjects objects;
   if (fs::exists(o.run_dir + "/objects.txt")) {
-    objects = read_run_objects(o.run_dir + "/objects.txt");
+    objects = read_objects(o.run_dir + "/objects.txt");
   } else {
     spdlog::warn("{}/objects.txt is missing (a run older than `seamless render`): cloth and rigid bodies are drawn "
                  "as particles", o.run_dir);
     e.render.show_particles = true;
   }
-  const auto meshes = body_meshes(objects, e.spawn, e.solver);
+  attach_body_meshes(objects, e.spawn, e.solver);
   Renderer r(p, p.width, p.height);
   spdlog::info("re-rendering {} states of {} at {}x{}, {} view, with {}", states.size(), o.run_dir, p.width, p.height,
                p.view, r.gl_info().renderer);
@@ -150,14 +152,14 @@ int render_run(const RenderOptions& o) {
   for (const auto& [step, path] : states) {
     if (kinect && !kinect->set(r, step)) throw Error("the run's input gives no frame for the Kinect view");
     ParticleState s = read_particles_ply(path);
-    std::vector<RigidFrame> frames = match_rigid_frames(objects, s, warm);
+    std::vector<RigidFrame> frames = rigid_frames_of_state(objects, s, warm);
     RenderCamera cam{};  // the Kinect view uses its own
     if (p.view == "mesh") {  // the orbit's progress as in the run: the state's time over the duration
       const float progress = e.duration > 0.0 ? static_cast<float>(step * e.solver.dt / e.duration) : 0.f;
       const SceneCamera c = orbit_camera(scene_cam, p, progress);
       cam = RenderCamera::look_at(c.eye, c.target, {0.f, 1.f, 0.f}, p.fov_y, p.width, p.height, p.znear, p.zfar);
     }
-    r.draw(run_draw_list(s, frames, objects, meshes, 0.5f * e.solver.particle_diameter), cam);
+    r.draw(make_draw_list(s, objects, frames, 0.5f * e.solver.particle_diameter), cam);
     out.add(r);
   }
   out.finish();

@@ -16,6 +16,7 @@
 #include "app/run_summary.hpp"
 #include "config/config.hpp"
 #include "core/error.hpp"
+#include "physics/particle_io.hpp"
 #include "physics/particle_solver.hpp"
 
 namespace seamless::app {

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <optional>
 
 #include "core/error.hpp"
@@ -17,6 +16,7 @@
 #include "app/run_summary.hpp"
 #include "physics/builders.hpp"
 #include "physics/depth_colliders.hpp"
+#include "physics/particle_io.hpp"
 #include "physics/particle_solver.hpp"
 #include "recon/ply.hpp"
 #include "recon/refine/online_refine.hpp"
@@ -123,40 +123,6 @@ ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
 
 namespace {
 
-// Spawn entries in the solver's own schedule order (ParticleSolver::schedule: at the start of the
-// first step whose start time reaches their time, in list order), kept here so that the window's
-// key G can take the next one early without it being spawned twice.
-class SpawnQueue {
- public:
-  SpawnQueue(const std::vector<SpawnParams>& spawns, const SolverParams& p) {
-    check_spawn_capacity(spawns, p);  // the whole list fits, or an Error naming the entry
-    for (int i = 0; i < static_cast<int>(spawns.size()); ++i) pending_.push_back({i, spawns[i]});
-  }
-  // Before the step that starts at `time` (seconds). `ready`, if given, may hold an entry back
-  // (live mode: its placement needs a surface not scanned yet); it is tried again next time.
-  void due(ParticleSolver& solver, double time, const std::function<bool(int, SpawnParams&)>& ready = {}) {
-    for (auto it = pending_.begin(); it != pending_.end();)
-      if (it->s.time <= time + 1e-9 && (!ready || ready(it->index, it->s))) solver.spawn(it->s), it = pending_.erase(it);
-      else ++it;
-  }
-  std::size_t pending() const { return pending_.size(); }
-  void next_now(ParticleSolver& solver) {
-    if (pending_.empty()) return spdlog::info("spawn: every configured object is spawned already");
-    auto it = std::min_element(pending_.begin(), pending_.end(),
-                               [](const Pending& a, const Pending& b) { return a.s.time < b.s.time; });
-    spdlog::info("spawn: {} (configured for t = {:.2f} s) now", it->s.kind, it->s.time);
-    solver.spawn(it->s);
-    pending_.erase(it);
-  }
-
- private:
-  struct Pending {
-    int index;  // in the experiment's spawn list
-    SpawnParams s;
-  };
-  std::vector<Pending> pending_;
-};
-
 // The input frames of a replay in output order, each with its tracked pose and its time since the
 // replay began: forward from replay.start; when the simulation must last longer than that and the
 // recording is short enough to keep in memory, backward and forward again.
@@ -223,7 +189,7 @@ class ReplayFrames {
 class SimulationLoop : public FrameLoop {
  public:
   SimulationLoop(RunContext& ctx, ParticleSolver& solver, RunRenderer* renderer, const Replay* replay)
-      : ctx_(ctx), e_(ctx.experiment()), solver_(solver), renderer_(renderer), queue_(e_.spawn, e_.solver),
+      : ctx_(ctx), e_(ctx.experiment()), solver_(solver), renderer_(renderer),
         steps_(static_cast<std::int64_t>(std::ceil(e_.duration / e_.solver.dt))),
         render_every_(std::max<std::int64_t>(1, std::llround(1.0 / (e_.render.fps * e_.solver.dt)))),
         replay_(replay ? std::make_unique<ReplayFrames>(e_, ctx.device(), *replay) : nullptr),
@@ -237,7 +203,7 @@ class SimulationLoop : public FrameLoop {
     for (std::int64_t i = 0; i < render_every_ && k_ < steps_ && !interrupted(); ++i) step();
     return k_ < steps_ && !interrupted();
   }
-  void spawn_next() override { queue_.next_now(solver_); }
+  void spawn_next() override { solver_.spawn_next(); }
   const ParticleSolver& solver() const override { return solver_; }
   void finish() { progress_.finish(); }
 
@@ -259,8 +225,7 @@ class SimulationLoop : public FrameLoop {
   void step() {
     {
       StageScope s(ctx_.timer(), "physics");
-      queue_.due(solver_, time_);
-      solver_.step();
+      solver_.step();  // spawns what is due first
       time_ += e_.solver.dt;
     }
     ctx_.timer().end_frame(k_);
@@ -276,13 +241,12 @@ class SimulationLoop : public FrameLoop {
   const Experiment& e_;
   ParticleSolver& solver_;
   RunRenderer* renderer_;
-  SpawnQueue queue_;
   const std::int64_t steps_, render_every_;
   std::unique_ptr<ReplayFrames> replay_;
   Progress progress_;
   std::int64_t k_ = 0, replayed_ = 0;
   bool replay_done_ = false;
-  double time_ = 0.0;  // accumulated like the solver's clock, so spawns fall on the same steps
+  double time_ = 0.0;  // accumulated like the solver's clock (the replay's steps follow it)
 };
 
 }  // namespace
@@ -294,7 +258,8 @@ SimulationResult simulate(RunContext& ctx, const std::vector<vec3>& scene_partic
   if (!scene_particles.empty()) solver.add_static_particles(scene_particles);
   if (sdf) solver.set_scene_sdf(*sdf);
   if (grid) solver.set_scene_sdf_grid(grid->values, grid->dims, grid->origin, grid->voxel);
-  SimulationLoop loop(ctx, solver, renderer, replay);  // checks the particle budget up front
+  solver.schedule(e.spawn);  // checks the particle budget up front
+  SimulationLoop loop(ctx, solver, renderer, replay);
   if (replay)
     spdlog::info("replaying input frames {}..{} from their tracked poses, simulating in the recording's time "
                  "(at least {:.2f} s) in steps of {} s on {} scene particles{}{}",
@@ -318,7 +283,7 @@ SimulationResult simulate(RunContext& ctx, const std::vector<vec3>& scene_partic
   if (renderer) finish_renderer(ctx, *renderer);
   SimulationResult result{solver.download_state(), solver.stats()};
   write_particles_ply(ctx.out_path("particles.ply"), result.state);
-  write_run_objects(ctx.out_path("objects.txt"), collect_run_objects(solver, e.spawn));  // for `seamless render`
+  write_objects(ctx.out_path("objects.txt"), solver.objects());  // for `seamless render`
   SolverStats st = solver.stats();
   spdlog::info("physics: {} particles ({} fluid, {} cloth, {} rigid in {} bodies), {} substeps/step, median {:.3f} ms "
                "per step; neighbour overflow {} / {}",
@@ -338,8 +303,11 @@ class LiveLoop : public FrameLoop {
       : ctx_(ctx), e_(ctx.experiment()), renderer_(renderer), source_(make_source(e_.input, ctx.device())),
         volume_(make_volume(e_.volume, ctx.device())),
         session_(tracking_params(e_, volume_stages), ctx.device(), source_->intrinsics(), volume_.get()),
-        solver_(e_.solver, ctx.device()), queue_(e_.spawn, e_.solver),
+        solver_(e_.solver, ctx.device()),
         total_(e_.frames > 0 ? e_.frames : source_->size().value_or(0)), progress_("live", total_) {
+    solver_.schedule(e_.spawn);
+    // An entry due with `place:` waits for the surface it is placed on (place_live).
+    solver_.set_spawn_gate([this](int i, SpawnParams& sp) { return place_live(i, sp, pose_); });
     record_intrinsics(ctx, *source_);
     if (e_.output.write_trajectory) traj_ = std::make_unique<TrajectoryWriter>(ctx.out_path("trajectory.txt"));
     if (e_.refine.online)
@@ -372,14 +340,13 @@ class LiveLoop : public FrameLoop {
       // camera recorded: the simulation keeps the recording's time (several steps a frame);
       // otherwise one step a frame, as the dissertation's live loop.
       const double target = e_.render.camera == "recorded" ? frame_.timestamp - *t0_ : time_ + 0.5 * e_.solver.dt;
+      pose_ = rec.result.world_T_camera;
       int steps = 0;
       while (time_ + (steps + 0.5) * e_.solver.dt <= target) ++steps;
       if (colliders_ && rec.result.ok()) update_colliders(rec.result.world_T_camera, time_ + steps * e_.solver.dt);
       for (int k = 0; k < steps; ++k) {
-        queue_.due(solver_, time_,
-                   [&](int i, SpawnParams& sp) { return place_live(i, sp, rec.result.world_T_camera); });
         if (colliders_) solver_.set_collider_particles(colliders_->at(time_ + e_.solver.dt));
-        solver_.step();
+        solver_.step();  // spawns what is due first
         time_ += e_.solver.dt;
       }
     }
@@ -400,7 +367,7 @@ class LiveLoop : public FrameLoop {
     progress_.update(k + 1, to_string(rec.result.status));
     return true;
   }
-  void spawn_next() override { queue_.next_now(solver_); }
+  void spawn_next() override { solver_.spawn_next(); }
   const ParticleSolver& solver() const override { return solver_; }
   const std::vector<FrameRecord>& records() const { return records_; }
 
@@ -418,9 +385,9 @@ class LiveLoop : public FrameLoop {
 
   void finish() {
     progress_.finish();
-    if (queue_.pending())
+    if (solver_.pending_spawns())
       spdlog::warn("live: {} spawn entries were never spawned (their time or their placement's surface never "
-                   "came)", queue_.pending());
+                   "came)", solver_.pending_spawns());
     if (renderer_) finish_renderer(ctx_, *renderer_);
     if (online_) {
       traj_.reset();  // trajectory.txt complete under its name before it becomes trajectory_live.txt
@@ -430,7 +397,7 @@ class LiveLoop : public FrameLoop {
     ctx_.report_tracking(static_cast<std::int64_t>(records_.size()), session_.lost_frames());
     const ParticleState state = solver_.download_state();  // one download for the file and the summary
     write_particles_ply(ctx_.out_path("particles.ply"), state);
-    write_run_objects(ctx_.out_path("objects.txt"), collect_run_objects(solver_, e_.spawn));  // for `seamless render`
+    write_objects(ctx_.out_path("objects.txt"), solver_.objects());  // for `seamless render`
     spdlog::info("live: {} frames ({} lost), median track {:.3f} ms, physics {:.3f} ms, extraction {:.3f} ms",
                  records_.size(), session_.lost_frames(), ctx_.timer().median_ms("track"),
                  ctx_.timer().median_ms("physics"), ctx_.timer().median_ms("extract"));
@@ -537,7 +504,6 @@ class LiveLoop : public FrameLoop {
   std::unique_ptr<Volume> volume_;
   TrackingSession session_;
   ParticleSolver solver_;
-  SpawnQueue queue_;
   const std::int64_t total_;
   Progress progress_;
   std::unique_ptr<TrajectoryWriter> traj_;
@@ -547,6 +513,7 @@ class LiveLoop : public FrameLoop {
   RgbdFrame frame_;
   std::int64_t fused_ = 0, tried_at_ = -1;
   double time_ = 0.0;
+  SE3 pose_ = SE3::identity();  // this frame's tracked pose (placements made while it steps)
   std::optional<double> t0_;  // timestamp of the first fused frame
   std::optional<MovingColliders> colliders_;  // solver.dynamic_colliders
   std::vector<vec3> points_;  // the scene particles of the last extraction

@@ -5,9 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <cstring>
-#include <fstream>
-#include <sstream>
 
 #include "core/error.hpp"
 #include "kernels/physics/particle_math.hpp"
@@ -28,149 +25,6 @@
 #endif
 
 namespace seamless::app {
-
-// ---------------------------------------------------------------------------------------------
-// objects.txt and particle states
-
-namespace {
-
-// Rigid spawn entries in the order the solver creates their bodies: by the step whose start time
-// first reaches the entry's time (ParticleSolver spawns pending entries at the start of a step,
-// in list order), then by list order.
-std::vector<int> rigid_spawn_order(const std::vector<SpawnParams>& spawns, float dt) {
-  std::vector<int> idx;
-  for (int i = 0; i < static_cast<int>(spawns.size()); ++i)
-    if (spawns[i].kind == "rigid") idx.push_back(i);
-  auto step_of = [&](int i) { return std::max(0.0, std::ceil((spawns[i].time - 1e-9) / dt)); };
-  std::stable_sort(idx.begin(), idx.end(), [&](int a, int b) { return step_of(a) < step_of(b); });
-  return idx;
-}
-
-}  // namespace
-
-RunObjects collect_run_objects(const ParticleSolver& solver, const std::vector<SpawnParams>& spawns) {
-  RunObjects o;
-  o.cloth_triangles = solver.cloth_triangles();
-  const ParticleState s = solver.download_state();
-  const std::vector<RigidFrame> frames = solver.rigid_frames();
-  const std::vector<int> order = rigid_spawn_order(spawns, solver.params().dt);
-  for (std::size_t b = 0; b < frames.size(); ++b) {
-    const RigidFrame& f = frames[b];
-    RunObjects::Body body;
-    body.first = f.first, body.count = f.count;
-    const mat3 Rt = transpose(kernels::quat_to_mat(f.rotation));
-    for (std::int64_t i = f.first; i < f.first + f.count; ++i) body.rest.push_back(Rt * (s.x[i] - f.centre));
-    if (b < order.size() && make_rigid(spawns[order[b]], solver.params()).size() == f.count) body.spawn = order[b];
-    o.bodies.push_back(std::move(body));
-  }
-  return o;
-}
-
-// Format (text, one record a line):
-//   # comment
-//   cloth_triangles <n>      followed by n lines "a b c" (particle ids)
-//   body <first> <count> <spawn>   followed by count lines "qx qy qz" (rest offsets, metres)
-void write_run_objects(const std::string& path, const RunObjects& o) {
-  std::ofstream out(path);
-  if (!out) throw Error("cannot write '" + path + "'; check that the folder exists and is writable");
-  out << "# seamless run objects: cloth triangles and rigid bodies in particle ids (docs/RENDERING.md)\n";
-  out << "cloth_triangles " << o.cloth_triangles.size() << "\n";
-  for (const int3& t : o.cloth_triangles) out << t.x << ' ' << t.y << ' ' << t.z << '\n';
-  out.precision(9);
-  for (const RunObjects::Body& b : o.bodies) {
-    out << "body " << b.first << ' ' << b.count << ' ' << b.spawn << '\n';
-    for (const vec3& q : b.rest) out << q.x << ' ' << q.y << ' ' << q.z << '\n';
-  }
-  if (!out) throw Error("writing '" + path + "' failed (disk full?)");
-}
-
-RunObjects read_run_objects(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw Error("cannot open '" + path + "' (written by `seamless run` since the renderer's issue 7)");
-  RunObjects o;
-  std::string line;
-  int lineno = 0;
-  auto next = [&](const char* what) -> std::istringstream {
-    while (std::getline(in, line)) {
-      ++lineno;
-      if (!line.empty() && line[0] != '#') return std::istringstream(line);
-    }
-    throw Error(path + ": ends early, expected " + what);
-  };
-  auto bad = [&](const char* what) { return Error(path + ":" + std::to_string(lineno) + ": expected " + what); };
-  while (true) {
-    std::string tag;
-    std::istringstream ls;
-    try { ls = next("a record"); } catch (const Error&) { break; }
-    ls >> tag;
-    if (tag == "cloth_triangles") {
-      std::int64_t n = -1;
-      if (!(ls >> n) || n < 0) throw bad("cloth_triangles <count>");
-      for (std::int64_t i = 0; i < n; ++i) {
-        int3 t{};
-        if (!(next("a triangle") >> t.x >> t.y >> t.z)) throw bad("three particle ids");
-        o.cloth_triangles.push_back(t);
-      }
-    } else if (tag == "body") {
-      RunObjects::Body b;
-      if (!(ls >> b.first >> b.count >> b.spawn) || b.first < 0 || b.count < 1) throw bad("body <first> <count> <spawn>");
-      for (std::int64_t i = 0; i < b.count; ++i) {
-        vec3 q{};
-        if (!(next("a rest offset") >> q.x >> q.y >> q.z)) throw bad("three rest offset coordinates");
-        b.rest.push_back(q);
-      }
-      o.bodies.push_back(std::move(b));
-    } else {
-      throw bad("'cloth_triangles' or 'body'");
-    }
-  }
-  return o;
-}
-
-ParticleState read_particles_ply(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error("cannot open particle file '" + path + "'");
-  std::string line, header;
-  std::int64_t n = -1;
-  while (std::getline(in, line) && line != "end_header") {
-    header += line + "\n";
-    if (line.rfind("element vertex ", 0) == 0) n = std::stoll(line.substr(15));
-  }
-  const char* expected = "property float x\nproperty float y\nproperty float z\nproperty float vx\nproperty float vy\n"
-                         "property float vz\nproperty uint phase\n";
-  if (n < 0 || header.find("format binary_little_endian") == std::string::npos || header.find(expected) == std::string::npos)
-    throw Error("'" + path + "' is not a particle file of `seamless run` (binary PLY with x y z vx vy vz phase)");
-  std::vector<char> buf(static_cast<std::size_t>(n) * 28);
-  if (!in.read(buf.data(), static_cast<std::streamsize>(buf.size())))
-    throw Error("'" + path + "' is cut short: its header promises " + std::to_string(n) + " particles");
-  ParticleState s;
-  s.x.resize(n), s.v.resize(n), s.phase.resize(n), s.inv_mass.assign(n, 1.f);
-  for (std::int64_t i = 0; i < n; ++i) {
-    float f[6];
-    std::memcpy(f, &buf[i * 28], 24);
-    std::memcpy(&s.phase[i], &buf[i * 28 + 24], 4);
-    s.x[i] = {f[0], f[1], f[2]}, s.v[i] = {f[3], f[4], f[5]};
-  }
-  return s;
-}
-
-std::vector<RigidFrame> match_rigid_frames(const RunObjects& o, const ParticleState& s, std::vector<vec4>& warm) {
-  warm.resize(o.bodies.size(), vec4{0.f, 0.f, 0.f, 1.f});
-  std::vector<RigidFrame> out;
-  for (std::size_t b = 0; b < o.bodies.size(); ++b) {
-    const RunObjects::Body& body = o.bodies[b];
-    if (body.first + body.count > static_cast<std::int64_t>(s.x.size())) continue;  // not spawned yet
-    vec3 c{0.f, 0.f, 0.f};
-    for (std::int64_t i = 0; i < body.count; ++i) c += s.x[body.first + i];
-    c = c / static_cast<float>(body.count);
-    mat3 A = mat3::zero();
-    for (std::int64_t i = 0; i < body.count; ++i) A = A + outer(s.x[body.first + i] - c, body.rest[i]);
-    // 64 iterations: enough from identity for any rotation (each turns by the full residual angle).
-    warm[b] = kernels::extract_rotation(A, warm[b], 64);
-    out.push_back({c, warm[b], body.first, body.count});
-  }
-  return out;
-}
 
 void check_render_camera(const RenderParams& p) {
   for (const auto& [key, v] : {std::pair{"eye", &p.eye}, std::pair{"target", &p.target}})
@@ -207,145 +61,21 @@ SceneCamera orbit_camera(const SceneCamera& c, const RenderParams& p, float prog
 #if SEAMLESS_HAS_GL
 namespace {
 
-// UV sphere with outward normals, 16 rings of 32 segments (smooth at the frame sizes used).
-std::shared_ptr<const BodyMesh> sphere_mesh(float r) {
-  auto m = std::make_shared<BodyMesh>();
-  const int rings = 16, segs = 32;
-  for (int i = 0; i <= rings; ++i)
-    for (int j = 0; j <= segs; ++j) {
-      const float th = kernels::kPi * i / rings, ph = 2.f * kernels::kPi * j / segs;
-      const vec3 n{std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph)};
-      m->positions.push_back(n * r), m->normals.push_back(n);
-    }
-  for (int i = 0; i < rings; ++i)
-    for (int j = 0; j < segs; ++j) {
-      const int a = i * (segs + 1) + j, b = a + segs + 1;
-      m->triangles.push_back({a, a + 1, b}), m->triangles.push_back({a + 1, b + 1, b});
-    }
-  return m;
-}
-
-// The OBJ of a `shape: mesh` body in its body frame. The builder centres the OBJ on its bounding
-// box, scales it to fit s.size and voxelises it (voxelize_obj); the rest offsets are the voxel
-// centres minus their mean, so the body frame's origin is that mean in the scaled OBJ's frame.
-std::shared_ptr<const BodyMesh> obj_body_mesh(const SpawnParams& s, const SolverParams& p) {
-  std::ifstream in(s.mesh);
-  if (!in) return nullptr;
-  auto m = std::make_shared<BodyMesh>();
-  std::string line;
-  while (std::getline(in, line)) {
-    std::istringstream ls(line);
-    std::string tag, tok;
-    ls >> tag;
-    if (tag == "v") {
-      vec3 v{};
-      ls >> v.x >> v.y >> v.z;
-      m->positions.push_back(v);
-    } else if (tag == "f") {
-      std::vector<int> f;
-      const int nv = static_cast<int>(m->positions.size());
-      while (ls >> tok) f.push_back(std::stoi(tok.substr(0, tok.find('/'))));
-      for (int& i : f) i = i < 0 ? nv + i : i - 1;
-      for (std::size_t k = 2; k < f.size(); ++k) m->triangles.push_back({f[0], f[k - 1], f[k]});
-    }
-  }
-  if (m->positions.empty() || m->triangles.empty()) return nullptr;
-  vec3 lo = m->positions[0], hi = lo;
-  for (vec3 v : m->positions) lo = vmin(lo, v), hi = vmax(hi, v);
-  const vec3 ext = hi - lo, mid = (lo + hi) * 0.5f;
-  const float scale = std::min({s.size.x / std::max(ext.x, 1e-9f), s.size.y / std::max(ext.y, 1e-9f),
-                                s.size.z / std::max(ext.z, 1e-9f)});
-  vec3 mean{0.f, 0.f, 0.f};
-  const std::vector<vec3> cells = voxelize_obj(s.mesh, p.particle_diameter, s.size);
-  for (vec3 c : cells) mean += c;
-  if (!cells.empty()) mean = mean / static_cast<float>(cells.size());
-  for (vec3& v : m->positions) v = (v - mid) * scale - mean;
-  m->normals = vertex_normals(m->positions, m->triangles);
-  return m;
-}
-
-}  // namespace
-
-std::vector<std::shared_ptr<const BodyMesh>> body_meshes(const RunObjects& o, const std::vector<SpawnParams>& spawns,
-                                                         const SolverParams& p) {
-  std::vector<std::shared_ptr<const BodyMesh>> out;
-  for (const RunObjects::Body& b : o.bodies) {
-    std::shared_ptr<const BodyMesh> m;
-    if (b.spawn >= 0 && b.spawn < static_cast<int>(spawns.size())) {
-      const SpawnParams& s = spawns[b.spawn];
-      if (s.shape == "sphere") m = sphere_mesh(0.5f * s.size.x);
-      if (s.shape == "mesh") {
-        m = obj_body_mesh(s, p);
-        if (!m) spdlog::warn("rigid body mesh '{}' cannot be read here: drawing that body as a box", s.mesh);
-      }
-    }
-    out.push_back(std::move(m));
-  }
-  return out;
-}
-
-std::vector<RigidDraw> rigid_draws(const std::vector<RigidFrame>& frames, const RunObjects& o,
-                                   const std::vector<std::shared_ptr<const BodyMesh>>& meshes, float radius) {
-  std::vector<RigidDraw> out;
-  for (const RigidFrame& f : frames)
-    for (std::size_t b = 0; b < o.bodies.size(); ++b) {
-      if (o.bodies[b].first != f.first) continue;
-      RigidDraw r;
-      r.world_T_body = {kernels::quat_to_mat(f.rotation), f.centre};
-      vec3 hi{0.f, 0.f, 0.f};  // the box around the rest offsets, plus the particles' radius
-      for (vec3 q : o.bodies[b].rest) hi = vmax(hi, vec3{std::fabs(q.x), std::fabs(q.y), std::fabs(q.z)});
-      r.half_extents = hi + vec3{radius, radius, radius};
-      if (b < meshes.size()) r.mesh = meshes[b];
-      out.push_back(std::move(r));
-    }
-  return out;
-}
-
-DrawList run_draw_list(const ParticleState& s, const std::vector<RigidFrame>& frames, const RunObjects& o,
-                       const std::vector<std::shared_ptr<const BodyMesh>>& meshes, float radius) {
-  DrawList d;
-  d.positions = s.x, d.phases = s.phase, d.particle_radius = radius;
-  d.rigids = rigid_draws(frames, o, meshes, radius);
-  ClothDraw cloth;
-  const auto n = static_cast<int>(s.x.size());
-  for (const int3& t : o.cloth_triangles)
-    if (t.x < n && t.y < n && t.z < n) cloth.triangles.push_back(t);  // sheets spawned by now
-  if (!cloth.triangles.empty()) d.cloths.push_back(std::move(cloth));
-  return d;
-}
-
-namespace {
-
-// The solver's objects as drawn: re-collected only when something was spawned (rest shapes,
-// spawn entries, body meshes).
+// One frame's DrawList from the solver: its objects and its rigid frames (render's make_draw_list).
 class RunDrawState {
  public:
-  void update(const ParticleSolver& solver, const std::vector<SpawnParams>& spawns) {
-    frames_ = solver.rigid_frames();
-    if (frames_.size() == objects_.bodies.size() && solver.cloth_triangles().size() == objects_.cloth_triangles.size())
-      return;
-    objects_ = collect_run_objects(solver, spawns);
-    meshes_ = body_meshes(objects_, spawns, solver.params());
-  }
   // Host path: the state is downloaded and kept here (the DrawList's spans point into it).
   DrawList host_list(const ParticleSolver& solver) {
     state_ = solver.download_state();
-    return run_draw_list(state_, frames_, objects_, meshes_, radius(solver));
+    return make_draw_list(state_, solver.objects(), solver.rigid_frames(), radius(solver));
   }
   // Device path: everything but the particles, which the interop buffer holds.
-  DrawList device_list(const ParticleSolver& solver) const {
-    DrawList list;
-    list.particle_radius = radius(solver);
-    list.rigids = rigid_draws(frames_, objects_, meshes_, list.particle_radius);
-    if (!objects_.cloth_triangles.empty()) list.cloths.push_back({objects_.cloth_triangles});
-    return list;
+  static DrawList device_list(const ParticleSolver& solver) {
+    return make_draw_list({}, {}, solver.size(), solver.objects(), solver.rigid_frames(), radius(solver));
   }
 
  private:
   static float radius(const ParticleSolver& s) { return 0.5f * s.params().particle_diameter; }
-  std::vector<RigidFrame> frames_;
-  RunObjects objects_;
-  std::vector<std::shared_ptr<const BodyMesh>> meshes_;
   ParticleState state_;
 };
 
@@ -395,7 +125,6 @@ class GlRunRenderer : public RunRenderer {
 
   void draw(const ParticleSolver& solver) override {
     StageScope s(ctx_.timer(), "render");
-    draw_state_.update(solver, ctx_.experiment().spawn);
     // The orbit's progress: simulated time over the run's duration (0 at the first frame).
     const double duration = ctx_.experiment().duration;
     if (p_.orbit_deg != 0.f && have_mesh_camera_ && !have_recorded_camera_ && duration > 0.0)
@@ -473,7 +202,6 @@ class WindowRunRenderer : public RunRenderer {
     cb.draw_list = [&] {
       StageScope s(ctx_.timer(), "render");
       ++shown;
-      draw_state_.update(loop.solver(), e.spawn);
       return draw_state_.host_list(loop.solver());
     };
     if (const int n = ctx_.window_frames(); n > 0)  // Esc before frame n-1: n frames are shown

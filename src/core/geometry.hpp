@@ -1,8 +1,9 @@
 // Geometry that several layers hand each other: the reconstructed mesh (recon makes it, render and
-// physics read it) and the particle state and rigid-body frames (physics makes them, render and the
-// app read them). Kept in core so that render depends on core and kernels only.
+// physics read it) and the particle state, the objects and the rigid-body frames (physics makes
+// them, render and the app read them). Kept in core so that render depends on core and kernels only.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "core/math.hpp"
@@ -30,5 +31,34 @@ struct RigidFrame {
   vec4 rotation;  // quaternion (x, y, z, w)
   std::int64_t first = 0, count = 0;  // particle ids
 };
+
+// A rigid body's surface in its body frame (the frame of its rest offsets q), shaded smooth or
+// flat as its normals say. The renderer uploads each one once (keyed by the object).
+struct BodyMesh {
+  std::vector<vec3> positions, normals;
+  std::vector<int3> triangles;
+};
+
+// The objects the particle solver has created (physics makes them: ParticleSolver::objects(), or
+// read_objects for a finished run). Particle ids are given in spawn order and never change.
+struct RigidBody {
+  std::int64_t first = 0, count = 0;     // particle ids
+  int spawn = -1;                        // index into the experiment's spawn list; -1: none (a batch added directly)
+  std::vector<vec3> rest;                // body-frame offsets q, x = R q + c (Mueller et al. 2005)
+  std::shared_ptr<const BodyMesh> mesh;  // the surface in the body frame; null: drawn as the box around `rest`
+};
+struct ClothSheet {
+  std::int64_t first = 0, count = 0;  // particle ids (count 0: not known, a sheet read from objects.txt)
+  int spawn = -1;                     // as RigidBody::spawn
+  std::vector<int3> triangles;        // particle ids
+};
+struct SceneObjects {
+  std::vector<RigidBody> bodies;   // in the order the solver created them (its body index)
+  std::vector<ClothSheet> cloths;  // likewise
+};
+
+// Area-weighted vertex normals of a triangle mesh (smooth shading; zero-area or unused vertices
+// get (0, 0, 0)).
+std::vector<vec3> vertex_normals(const std::vector<vec3>& positions, const std::vector<int3>& triangles);
 
 }  // namespace seamless

@@ -255,11 +255,6 @@ void check_spawn_capacity(const std::vector<SpawnParams>& spawns, const SolverPa
 
 namespace {
 
-struct ObjMesh {
-  std::vector<vec3> v;
-  std::vector<int3> f;
-};
-
 // One vertex reference of an OBJ face ("7", "7/1", "-2//3") as a 0-based index: 1-based, or
 // negative, counted back from the last vertex defined so far (`defined`). A positive index is
 // checked against all the file's vertices once they are read.
@@ -275,6 +270,8 @@ long long obj_index(const std::string& tok, std::size_t defined, const std::stri
                      " vertices defined before it");
   return static_cast<long long>(defined) + i;
 }
+
+}  // namespace
 
 ObjMesh read_obj(const std::string& path) {
   std::ifstream in(path);
@@ -314,8 +311,6 @@ ObjMesh read_obj(const std::string& path) {
                          std::to_string(m.v.size()) + " vertices)");
   return m;
 }
-
-}  // namespace
 
 std::vector<vec3> voxelize_obj(const std::string& path, float spacing, vec3 fit_size) {
   ObjMesh m = read_obj(path);

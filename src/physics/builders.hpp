@@ -54,6 +54,18 @@ std::int64_t spawn_particle_count(const SpawnParams& s, const SolverParams& p);
 // Throws seamless::Error naming the entry when the spawn list needs more than max_particles.
 void check_spawn_capacity(const std::vector<SpawnParams>& spawns, const SolverParams& p);
 
+// A triangle mesh read from an OBJ file: its vertices and its faces as triangles (polygons as fans
+// around their first vertex), 0-based.
+struct ObjMesh {
+  std::vector<vec3> v;
+  std::vector<int3> f;
+};
+// The OBJ reader of the project (rigid bodies' `shape: mesh`): 'v' and 'f' lines, the rest
+// ignored. Throws seamless::InputError naming the file and line of what it cannot read (a missing
+// file, a vertex without three finite numbers, a face vertex that is not a vertex number or does
+// not exist) or when there are no triangles.
+ObjMesh read_obj(const std::string& path);
+
 // Voxelises a closed triangle mesh (OBJ) on a grid of the given spacing: the centres inside by
 // ray parity, in the mesh's own coordinates. Throws seamless::Error if the file cannot be read.
 std::vector<vec3> voxelize_obj(const std::string& path, float spacing, vec3 fit_size);

@@ -5,12 +5,11 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
-#include <fstream>
+#include <optional>
 #include <utility>
 
 #include "core/buffer.hpp"
 #include "core/error.hpp"
-#include "core/output_file.hpp"
 #include "core/exec.hpp"
 #include "core/log.hpp"
 #include "kernels/physics/solver.hpp"
@@ -107,7 +106,7 @@ struct ParticleSolver::Impl {
   std::vector<float> edge_len, edge_k0, edge_limit0;
   std::vector<K::Quad> bends;
   std::vector<float> bend_rest, bend_k0;
-  std::vector<int3> tris;
+  std::vector<int3> tris;  // every sheet's, for the self-collision lists
   std::vector<std::int64_t> colour_off;  // stretch edges of colour c: [colour_off[c], colour_off[c + 1])
   bool strain_limited = false;
   Buffer<int> d_edge_a, d_edge_b, bend_off, bend_list, tri_off, tri_list;
@@ -118,7 +117,9 @@ struct ParticleSolver::Impl {
   int cloth_groups = 0;
   // bookkeeping
   std::int64_t n_fluid = 0, n_cloth = 0, n_rigid = 0, emitter_dropped = 0;
-  std::vector<SpawnParams> pending;
+  SpawnSchedule schedule;
+  SpawnSchedule::Gate gate;
+  SceneObjects objects;  // what add_batch created, as the app and the renderer see it
   std::vector<Emitter> emitters;
   double time = 0.0;
   std::int64_t steps = 0;
@@ -497,7 +498,9 @@ struct ParticleSolver::Impl {
     off = Buffer<int>::from_host(o, dev), items = Buffer<int>::from_host(it, dev);
   }
 
-  std::int64_t add_batch(const ParticleBatch& b) {
+  // `spawn`, `entry`: the spawn entry the batch comes from (index -1 and null: none), recorded
+  // with the object; a rigid body's mesh is made from the entry.
+  std::int64_t add_batch(const ParticleBatch& b, int spawn = -1, const SpawnParams* entry = nullptr) {
     const std::int64_t m = b.size(), first = n;
     if (m == 0) return first;
     ++generation;
@@ -523,6 +526,7 @@ struct ParticleSolver::Impl {
     if (b.kind == ParticleBatch::kRigid) {
       n_rigid += m;
       add_body(b, first);
+      objects.bodies.push_back({first, m, spawn, b.rest, entry ? body_mesh(*entry, P) : nullptr});
     }
     if (b.kind == ParticleBatch::kCloth) {
       n_cloth += m;
@@ -536,7 +540,10 @@ struct ParticleSolver::Impl {
         bends.push_back({q.a + o, q.b + o, q.c + o, q.d + o});
         bend_rest.push_back(b.bend_rest[i]), bend_k0.push_back(b.bend_k);
       }
-      for (const int3& t : b.tris) tris.push_back({t.x + o, t.y + o, t.z + o});
+      ClothSheet sheet{first, m, spawn, {}};
+      for (const int3& t : b.tris) sheet.triangles.push_back({t.x + o, t.y + o, t.z + o});
+      tris.insert(tris.end(), sheet.triangles.begin(), sheet.triangles.end());
+      objects.cloths.push_back(std::move(sheet));
       rebuild_cloth();
     }
     return first;
@@ -621,17 +628,14 @@ struct ParticleSolver::Impl {
   }
 
   void spawn_due() {
-    std::vector<SpawnParams> later;
-    for (const SpawnParams& s : pending)
-      if (s.time <= time + 1e-9) spawn(s);
-      else later.push_back(s);
-    pending = std::move(later);
+    schedule.spawn_due(time, gate, [&](const SpawnSchedule::Entry& e) { spawn(e.s, e.index); });
   }
 
-  std::int64_t spawn(const SpawnParams& s) {
+  // `index`: the entry's place in the scheduled list (-1: spawned directly), kept with its object.
+  std::int64_t spawn(const SpawnParams& s, int index) {
     auto placed = [&](ParticleBatch b) {
       report_placement(s, b.x);
-      return add_batch(b);
+      return add_batch(b, index, &s);
     };
     if (s.kind == "fluid_block") return placed(make_fluid_block(s, P));
     if (s.kind == "cloth") return placed(make_cloth(s, P));
@@ -712,12 +716,23 @@ void ParticleSolver::set_scene_sdf_grid(const std::vector<float>& values, int3 d
   impl_->sdf.grid = impl_->sdf_grid.data(), impl_->sdf.dims = dims, impl_->sdf.origin = origin, impl_->sdf.voxel = voxel;
 }
 
-std::int64_t ParticleSolver::spawn(const SpawnParams& s) { return impl_->spawn(s); }
+std::int64_t ParticleSolver::spawn(const SpawnParams& s) { return impl_->spawn(s, -1); }
 
 void ParticleSolver::schedule(const std::vector<SpawnParams>& spawns) {
   check_spawn_capacity(spawns, impl_->P);
-  impl_->pending.insert(impl_->pending.end(), spawns.begin(), spawns.end());
+  impl_->schedule.add(spawns);
 }
+
+void ParticleSolver::set_spawn_gate(SpawnSchedule::Gate gate) { impl_->gate = std::move(gate); }
+
+void ParticleSolver::spawn_next() {
+  std::optional<SpawnSchedule::Entry> e = impl_->schedule.take_next();
+  if (!e) return spdlog::info("spawn: every configured object is spawned already");
+  spdlog::info("spawn: {} (configured for t = {:.2f} s) now", e->s.kind, e->s.time);
+  impl_->spawn(e->s, e->index);
+}
+
+std::size_t ParticleSolver::pending_spawns() const { return impl_->schedule.pending(); }
 
 std::int64_t ParticleSolver::add_batch(const ParticleBatch& b) { return impl_->add_batch(b); }
 
@@ -792,7 +807,7 @@ std::vector<RigidFrame> ParticleSolver::rigid_frames() const {
   return out;
 }
 
-const std::vector<int3>& ParticleSolver::cloth_triangles() const { return impl_->tris; }
+const SceneObjects& ParticleSolver::objects() const { return impl_->objects; }
 const vec3* ParticleSolver::device_positions() const {
   impl_->copy_to_id_order();
   return impl_->x_id.data();
@@ -822,24 +837,6 @@ std::vector<float> ParticleSolver::fluid_density_ratio() const {
   std::vector<float> out(static_cast<std::size_t>(I.n));
   for (std::int64_t s = 0; s < I.n; ++s) out[order[s]] = rho[s] / I.rho0;
   return out;
-}
-
-void write_particles_ply(const std::string& path, const ParticleState& s) {
-  std::ofstream out(partial_path(path), std::ios::binary);
-  if (!out) throw Error("cannot write particle file '" + path + "'; check that the folder exists and is writable");
-  out << "ply\nformat binary_little_endian 1.0\nelement vertex " << s.x.size()
-      << "\nproperty float x\nproperty float y\nproperty float z\nproperty float vx\nproperty float vy\n"
-         "property float vz\nproperty uint phase\nend_header\n";
-  std::vector<char> buf(s.x.size() * 28);
-  for (std::size_t i = 0; i < s.x.size(); ++i) {
-    float f[6] = {s.x[i].x, s.x[i].y, s.x[i].z, s.v[i].x, s.v[i].y, s.v[i].z};
-    std::memcpy(&buf[i * 28], f, 24);
-    std::memcpy(&buf[i * 28 + 24], &s.phase[i], 4);
-  }
-  out.write(buf.data(), static_cast<std::streamsize>(buf.size()));
-  out.close();
-  if (!out) throw Error("writing particle file '" + path + "' failed (disk full?)");
-  commit_partial(path);
 }
 
 }  // namespace seamless

@@ -6,6 +6,11 @@
 //   s.add_static_particles(scene_points);      // and/or s.set_scene_sdf(...)
 //   s.schedule(experiment.spawn);              // spawned when their time comes
 //   for (...) { s.step(); write_particles_ply(path, s.download_state()); }
+//   write_objects(path, s.objects());          // which particles are which body and sheet
+//
+// The solver owns its object model: each rigid body and cloth sheet it created (spawn entry,
+// particle range, rest offsets, body mesh: objects()), each body's frame from its own shape
+// matching (rigid_frames()) and the schedule of what spawns when (schedule(), SpawnSchedule).
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -17,6 +22,7 @@
 #include "core/math.hpp"
 #include "kernels/physics/scene_sdf.hpp"
 #include "physics/builders.hpp"
+#include "physics/objects.hpp"
 #include "physics/solver_params.hpp"
 
 namespace seamless {
@@ -55,11 +61,20 @@ class ParticleSolver {
   // Collide against a dense sampled SDF (x fastest), e.g. resampled from the TSDF.
   void set_scene_sdf_grid(const std::vector<float>& values, int3 dims, vec3 origin, float voxel);
 
-  // Creates the entry's particles now (an emitter starts emitting now). Returns the first id.
+  // Creates the entry's particles now (an emitter starts emitting now), as an object of no spawn
+  // index (RigidBody::spawn -1). Returns the first id.
   std::int64_t spawn(const SpawnParams& s);
-  // Entries are spawned at the first step whose start time reaches their `time`. Checks the
-  // capacity of the whole list first (seamless::Error naming the entry).
+  // Entries are spawned at the start of each step by SpawnSchedule's rule, their objects carrying
+  // their index in `spawns` (counted over every call). Checks the capacity of the whole list first
+  // (seamless::Error naming the entry).
   void schedule(const std::vector<SpawnParams>& spawns);
+  // A gate that may hold a due entry back until a later step (SpawnSchedule::Gate; live mode).
+  void set_spawn_gate(SpawnSchedule::Gate gate);
+  // The scheduled entry with the earliest time, spawned now (the window's key G); says so in the
+  // log, or that every entry is spawned already.
+  void spawn_next();
+  // Scheduled entries not spawned yet.
+  std::size_t pending_spawns() const;
   // Adds a prepared batch (builders.hpp); returns the first id.
   std::int64_t add_batch(const ParticleBatch& b);
 
@@ -71,9 +86,10 @@ class ParticleSolver {
 
   SolverStats stats() const;
   ParticleState download_state() const;
+  // Each rigid body's frame now, from the solver's own shape matching (in objects().bodies order).
   std::vector<RigidFrame> rigid_frames() const;
-  // Triangles of every cloth sheet spawned so far, in particle ids (read-only; for rendering).
-  const std::vector<int3>& cloth_triangles() const;
+  // The rigid bodies and cloth sheets created so far (read-only; valid until the next spawn).
+  const SceneObjects& objects() const;
   // Positions and phases of the size() particles in id order on device(), read-only, valid until
   // the next step or spawn (for CUDA-OpenGL interop: the renderer copies them device to device).
   // The solver keeps its state in sorted order; the first call after a step copies it into id
@@ -92,8 +108,5 @@ class ParticleSolver {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
-
-// Writes particles as a binary little-endian PLY (x y z float, vx vy vz float, phase uint).
-void write_particles_ply(const std::string& path, const ParticleState& s);
 
 }  // namespace seamless

@@ -11,13 +11,6 @@
 
 namespace seamless {
 
-// A rigid body's surface in its body frame (the frame of its rest offsets q), shaded smooth or
-// flat as its normals say. The renderer uploads each one once (keyed by the object).
-struct BodyMesh {
-  std::vector<vec3> positions, normals;
-  std::vector<int3> triangles;
-};
-
 // A rigid body in its shape-matching frame (Mueller 2005: x = R q + c): its mesh, or without one
 // a box of the given half extents.
 struct RigidDraw {
@@ -39,12 +32,18 @@ struct DrawList {
   std::vector<ClothDraw> cloths;
 };
 
-// Rigid boxes from the solver's shape-matching frames: each box bounds its body's particles in
-// the body frame (plus one radius, the particles' extent). `state` must outlive the DrawList.
-// Area-weighted vertex normals of a triangle mesh (smooth shading; zero-area or unused vertices
-// get (0, 0, 0)).
-std::vector<vec3> vertex_normals(const std::vector<vec3>& positions, const std::vector<int3>& triangles);
-
-DrawList make_draw_list(const ParticleState& state, const std::vector<RigidFrame>& frames, float particle_radius);
+// One frame's DrawList from the solver's objects (physics: ParticleSolver::objects(), or
+// read_objects for a finished run) and its rigid frames:
+// - the particles as spans into `positions` and `phases` (which must outlive the list; empty when
+//   the renderer takes them from the device, Renderer::draw_device_particles);
+// - the cloth sheets as one triangle mesh, the triangles of the first `particles` ids (sheets
+//   spawned by then);
+// - each body in `frames` (matched to `objects` by its first particle id) with its mesh, or without
+//   one the box around its rest offsets plus one particle radius (the particles' extent).
+DrawList make_draw_list(std::span<const vec3> positions, std::span<const std::uint32_t> phases, std::int64_t particles,
+                        const SceneObjects& objects, const std::vector<RigidFrame>& frames, float particle_radius);
+// The same for a state in host memory (`state` must outlive the list).
+DrawList make_draw_list(const ParticleState& state, const SceneObjects& objects, const std::vector<RigidFrame>& frames,
+                        float particle_radius);
 
 }  // namespace seamless

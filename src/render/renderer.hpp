@@ -3,7 +3,7 @@
 //
 //   Renderer r(params, 640, 480);                 // creates a headless EGL context
 //   r.set_scene_mesh(mesh);                       // or r.set_kinect_view(rgb, depth, K, pose)
-//   r.draw(make_draw_list(state, frames, radius), camera);
+//   r.draw(make_draw_list(state, solver.objects(), solver.rigid_frames(), radius), camera);
 //   Image<uchar3> img = r.read_frame();
 //
 // Passes: scene (mesh or Kinect image + depth), rigid boxes, cloth, debug particle spheres,

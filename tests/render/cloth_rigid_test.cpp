@@ -135,26 +135,49 @@ TEST(RenderRigid, BodyMeshMovesWithItsFrame) {
   }
 }
 
-// make_draw_list: a body's box is its particles' extent in the body frame plus one radius.
-TEST(RenderRigid, DrawListBoxesFromShapeMatchingFrames) {
+// make_draw_list: each body in the frames (found by its first particle id) is posed by its frame,
+// with its mesh or the box around its rest offsets plus one radius; cloth triangles of particles
+// not in the state (sheets spawned later) are left out. Exact arithmetic on the given numbers: the
+// 1e-6 tolerance is float rounding of 0.3 + 0.02.
+TEST(RenderRigid, DrawListFromTheSolversObjects) {
   ParticleState st;
   const mat3 R = rotation({0.f, 0.f, 1.f}, 0.5f);
   const vec3 c{1.f, 2.f, 3.f};
+  SceneObjects objects;
+  RigidBody box{0, 3, 2, {}, nullptr};
   for (vec3 q : {vec3{-0.3f, -0.1f, -0.05f}, vec3{0.3f, 0.1f, 0.05f}, vec3{0.3f, -0.1f, 0.f}}) {
     st.x.push_back(R * q + c);
     st.phase.push_back(kernels::phase::kRigid);
+    box.rest.push_back(q);
   }
+  st.x.push_back({0.f, 0.f, 0.f}), st.phase.push_back(kernels::phase::kCloth);
+  auto mesh = std::make_shared<BodyMesh>();
+  objects.bodies = {{10, 1, 0, {vec3{0.f, 0.f, 0.f}}, mesh}, box};  // the first is not in the frames
+  objects.cloths.push_back({0, 0, 1, {int3{0, 1, 3}, int3{0, 1, 4}}});  // id 4: not spawned yet
   RigidFrame f;
   f.centre = c;
   const float s = std::sin(0.25f);
   f.rotation = {0.f, 0.f, s, std::cos(0.25f)};  // 0.5 rad about z
   f.first = 0, f.count = 3;
-  const DrawList d = make_draw_list(st, {f}, 0.02f);
+  const DrawList d = make_draw_list(st, objects, {f}, 0.02f);
   ASSERT_EQ(d.rigids.size(), 1u);
-  EXPECT_NEAR(d.rigids[0].half_extents.x, 0.32f, 1e-5f);
-  EXPECT_NEAR(d.rigids[0].half_extents.y, 0.12f, 1e-5f);
-  EXPECT_NEAR(d.rigids[0].half_extents.z, 0.07f, 1e-5f);
-  EXPECT_EQ(d.positions.size(), 3u);
+  EXPECT_NEAR(d.rigids[0].half_extents.x, 0.32f, 1e-6f);
+  EXPECT_NEAR(d.rigids[0].half_extents.y, 0.12f, 1e-6f);
+  EXPECT_NEAR(d.rigids[0].half_extents.z, 0.07f, 1e-6f);
+  EXPECT_EQ(d.rigids[0].mesh, nullptr);
+  EXPECT_NEAR(length(d.rigids[0].world_T_body.t - c), 0.f, 1e-6f);
+  EXPECT_NEAR(d.rigids[0].world_T_body.R.m[0][1], R.m[0][1], 1e-6f);
+  EXPECT_EQ(d.positions.size(), 4u);
+  ASSERT_EQ(d.cloths.size(), 1u);
+  ASSERT_EQ(d.cloths[0].triangles.size(), 1u);
+  EXPECT_EQ(d.cloths[0].triangles[0].z, 3);
+  // The mesh body, once its frame is there, is drawn with its mesh.
+  st.x.resize(11, vec3{0.f, 0.f, 0.f}), st.phase.resize(11, kernels::phase::kRigid);
+  RigidFrame g{vec3{0.f, 1.f, 0.f}, vec4{0.f, 0.f, 0.f, 1.f}, 10, 1};
+  const DrawList e = make_draw_list(st, objects, {f, g}, 0.02f);
+  ASSERT_EQ(e.rigids.size(), 2u);
+  EXPECT_EQ(e.rigids[1].mesh, mesh);
+  EXPECT_EQ(e.cloths[0].triangles.size(), 2u);
 }
 
 }  // namespace
