@@ -464,6 +464,7 @@ class LiveLoop : public FrameLoop {
     sum.placements = placements_;
     sum.spawns = spawns_;
     sum.physics = solver_.stats();
+    sum.dynamic_masked_fraction = mean_dynamic_fraction(records_);
     if (online_) sum.online_refine = online_->stats();
     sum.escaped = count_escaped(state, b, e_.solver.particle_diameter);
     add_stage_medians(sum, ctx_.timer());

@@ -41,17 +41,22 @@ EscapedParticles count_escaped(const ParticleState& s, const SceneBounds& b, flo
   return e;
 }
 
+std::optional<double> mean_dynamic_fraction(const std::vector<FrameRecord>& frames) {
+  double masked = 0;
+  std::int64_t with_mask = 0;
+  for (const FrameRecord& f : frames)
+    if (std::isfinite(f.dynamic_fraction)) masked += f.dynamic_fraction, ++with_mask;
+  if (with_mask == 0) return std::nullopt;
+  return masked / static_cast<double>(with_mask);
+}
+
 void add_tracking(RunSummary& s, const TrackSequenceResult& r, std::int64_t unreadable,
                   const std::string& groundtruth) {
   s.frames_read = static_cast<std::int64_t>(r.frames.size());
   s.frames_lost = r.lost_frames;
   s.frames_unreadable = unreadable;
   for (const FrameRecord& f : r.frames) s.frames_fused += f.fused;
-  double masked = 0;
-  std::int64_t with_mask = 0;
-  for (const FrameRecord& f : r.frames)
-    if (std::isfinite(f.dynamic_fraction)) masked += f.dynamic_fraction, ++with_mask;
-  if (with_mask > 0) s.dynamic_masked_fraction = masked / static_cast<double>(with_mask);
+  s.dynamic_masked_fraction = mean_dynamic_fraction(r.frames);
   if (groundtruth.empty() || r.trajectory.empty()) return;
   const AteResult ate = compute_ate(r.trajectory, read_tum_trajectory(groundtruth));
   if (ate.trans.count == 0) return;

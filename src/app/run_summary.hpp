@@ -49,6 +49,9 @@ struct RunSummary {
 };
 
 // Frames, loss and ATE (when `groundtruth` is not empty) of a tracked sequence.
+// dynamic.enabled: the mean fraction of pixels masked as dynamic over the frames that have a mask.
+std::optional<double> mean_dynamic_fraction(const std::vector<FrameRecord>& frames);
+
 void add_tracking(RunSummary& s, const TrackSequenceResult& r, std::int64_t unreadable,
                   const std::string& groundtruth);
 // The medians of every stage in the run's timer.
