@@ -8,28 +8,6 @@
 
 namespace seamless::kernels {
 
-// e^x for x <= 0, inlined (the bilateral filter's range weight: 49 per pixel at radius 3, where a call to libm's expf
-// was a fifth of a CPU frame). e^x = 2^k 2^f with k = round(x log2 e), |f| <= 1/2; 2^f = e^(f ln 2)
-// by its Taylor series to degree 6, whose remainder (0.347^7 / 7! ~ 1.2e-7) is float precision.
-// Below -87 (e^-87 ~ 1.6e-38, the smallest normal float) it returns 0, as expf's underflow does.
-SEAMLESS_HD inline float exp_nonpositive(float x) {
-  if (!(x >= -87.f)) return 0.f;
-  // Round to nearest by adding 1.5 * 2^23: the float's spacing there is 1, so the sum's low
-  // mantissa bits hold k (|k| <= 126); two additions instead of floorf (a libm call or a
-  // dozen instructions without SSE4.1's roundss).
-  const float shifted = x * 1.44269504f + 12582912.f;
-  const float kf = shifted - 12582912.f;
-  const float r = x - kf * 0.693147181f;  // e^r with |r| <= ln 2 / 2
-  float p = 1.f / 720.f;
-  p = p * r + 1.f / 120.f;
-  p = p * r + 1.f / 24.f;
-  p = p * r + 1.f / 6.f;
-  p = p * r + 0.5f;
-  p = p * r + 1.f;
-  p = p * r + 1.f;
-  return p * bits_float((float_bits(shifted) - float_bits(12582912.f) + 127) << 23);  // 2^k, k in [-126, 0]
-}
-
 // Edge-preserving smoothing of depth (KinectFusion eq. 2): Gaussian weights in pixel distance
 // (sigma_space, pixels) and in depth difference (sigma_depth, metres) over a (2r+1)^2 window.
 template <class Exec>

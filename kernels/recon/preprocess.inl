@@ -5,18 +5,10 @@
 
 namespace seamless::kernels {
 
-// The spatial Gaussian exp(-d^2 / (2 sigma_space^2)) of each offset d = 0..radius (the 2D weight
-// is the product of one per axis), computed once per frame instead of once per tap.
-struct SpatialWeights {
-  float w[16];
-};
-
 template <class Exec>
 void bilateral_filter(const Exec& ex, View2D<const float> depth, View2D<float> out, float sigma_space,
                       float sigma_depth, int radius) {
-  SpatialWeights ws{};
-  radius = radius < 15 ? radius : 15;  // preprocess.radius is at most 15 (its Range)
-  for (int d = 0; d <= radius; ++d) ws.w[d] = expf(-0.5f * static_cast<float>(d * d) / (sigma_space * sigma_space));
+  const float inv_s2 = 0.5f / (sigma_space * sigma_space);
   const float inv_d2 = 0.5f / (sigma_depth * sigma_depth);
   const int w = depth.width;
   ex.for_each(depth.count(), [=] SEAMLESS_HD(std::int64_t i) {
@@ -27,20 +19,16 @@ void bilateral_filter(const Exec& ex, View2D<const float> depth, View2D<float> o
       return;
     }
     float sum = 0.f, wsum = 0.f;
-    for (int dy = -radius; dy <= radius; ++dy) {
-      const int yy = y + dy;
-      if (yy < 0 || yy >= depth.height) continue;
-      const float wy = ws.w[dy < 0 ? -dy : dy];
+    for (int dy = -radius; dy <= radius; ++dy)
       for (int dx = -radius; dx <= radius; ++dx) {
-        const int xx = x + dx;
-        if (xx < 0 || xx >= w) continue;
+        int xx = x + dx, yy = y + dy;
+        if (!depth.inside(xx, yy)) continue;
         float d = depth(xx, yy);
         if (!(d > 0.f)) continue;
-        float wgt = wy * ws.w[dx < 0 ? -dx : dx] * exp_nonpositive(-(d - d0) * (d - d0) * inv_d2);
+        float wgt = expf(-(dx * dx + dy * dy) * inv_s2 - (d - d0) * (d - d0) * inv_d2);
         sum += wgt * d;
         wsum += wgt;
       }
-    }
     out(x, y) = sum / wsum;
   });
 }
