@@ -26,13 +26,14 @@ DepthSurface depth_surface(const std::vector<vec3>& camera_vertices, const std::
   return s;
 }
 
-std::vector<vec3> thicken(const DepthSurface& s, float spacing, float thickness) {
+std::vector<vec3> thicken(const std::vector<vec3>& points, const std::vector<vec3>& rays, float spacing,
+                          float thickness) {
   if (!(spacing > 0.f)) throw Error("depth colliders: the spacing must be positive");
   const int layers = thickness > 0.f ? static_cast<int>(std::floor(thickness / spacing)) : 0;
   std::vector<vec3> out;
-  out.reserve(s.points.size() * static_cast<std::size_t>(layers + 1));
-  for (std::size_t i = 0; i < s.points.size(); ++i)
-    for (int k = 0; k <= layers; ++k) out.push_back(s.points[i] + s.rays[i] * (spacing * static_cast<float>(k)));
+  out.reserve(points.size() * static_cast<std::size_t>(layers + 1));
+  for (std::size_t i = 0; i < points.size(); ++i)
+    for (int k = 0; k <= layers; ++k) out.push_back(points[i] + rays[i] * (spacing * static_cast<float>(k)));
   return out;
 }
 
@@ -97,10 +98,10 @@ void MovingColliders::update(DepthSurface surface, double t) {
 }
 
 std::vector<vec3> MovingColliders::at(double t) const {
-  DepthSurface moved = last_;
+  std::vector<vec3> moved = last_.points;  // the points only: rays and normals are not copied
   const float back = static_cast<float>(time_ - t);
-  for (std::size_t i = 0; i < moved.points.size(); ++i) moved.points[i] -= velocity_[i] * back;
-  return thicken(moved, spacing_, thickness_);
+  for (std::size_t i = 0; i < moved.size(); ++i) moved[i] -= velocity_[i] * back;
+  return thicken(moved, last_.rays, spacing_, thickness_);
 }
 
 }  // namespace seamless

@@ -27,7 +27,8 @@ DepthSurface depth_surface(const std::vector<vec3>& camera_vertices, const std::
                            const std::vector<std::uint8_t>& mask = {});
 
 // Each surface point and, behind it along its ray, one more every `spacing` metres up to `thickness`.
-std::vector<vec3> thicken(const DepthSurface& s, float spacing, float thickness);
+std::vector<vec3> thicken(const std::vector<vec3>& points, const std::vector<vec3>& rays, float spacing,
+                          float thickness);
 
 // The colliders between two frames. A depth camera gives no correspondences, so each point's
 // velocity is its displacement along the surface normal from the previous frame's nearest point

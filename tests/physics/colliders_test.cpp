@@ -68,7 +68,7 @@ TEST(DepthColliders, PointsLieOnTheSeenSurfaceAndBehindIt) {
   const float spacing = 0.04f;
   const DepthSurface surf = surface_of(s);
   ASSERT_EQ(surf.points.size(), seen);
-  const std::vector<vec3> pts = thicken(surf, spacing, 0.3f);
+  const std::vector<vec3> pts = thicken(surf.points, surf.rays, spacing, 0.3f);
   ASSERT_EQ(pts.size(), seen * 8);  // floor(0.3 / 0.04) = 7 layers behind each point
   for (std::size_t i = 0; i < pts.size(); i += 8) {
     EXPECT_NEAR(mv::distance(s, pts[i]), 0.f, 1e-4f);
