@@ -32,10 +32,12 @@ namespace fs = std::filesystem;
 namespace {
 
 // The stages a frame is split into, in pipeline order. The tracking stages partition the session's
-// frame time (TrackingSession::process marks): upload + preprocess + track + allocate + fuse +
-// raycast = frame. Live mode adds the run's own stages of the frame.
-const std::vector<std::string> kTrackingStages = {"upload", "preprocess", "track", "allocate", "fuse", "raycast"};
-const std::vector<std::string> kLiveStages = {"physics", "extract", "render"};
+// frame time (TrackingSession::process marks): upload + preprocess + dynamic + track + allocate +
+// fuse + raycast = frame (dynamic: the dynamic pixels, with dynamic.enabled only). Live mode adds
+// the run's own stages of the frame (colliders: solver.dynamic_colliders only).
+const std::vector<std::string> kTrackingStages = {"upload", "preprocess", "dynamic", "track", "allocate", "fuse",
+                                                  "raycast"};
+const std::vector<std::string> kLiveStages = {"colliders", "physics", "extract", "render"};
 
 // Linear interpolation between order statistics (numpy's default): q = 0.5 is the usual median,
 // and the result never decreases with q, so median <= p90 <= max holds.
@@ -118,10 +120,12 @@ Experiment load(const PipelineBenchOptions& o) {
   return e;
 }
 
-// frame k's value of each stage the run's timer recorded (physics, extract, render), summed.
-std::map<std::string, std::vector<double>> timer_stages(const StageTimer& t, std::int64_t frames) {
+// frame k's value of each stage the run's timer recorded (physics, extract, render), summed. The
+// colliders are a stage only in runs that have them (solver.dynamic_colliders).
+std::map<std::string, std::vector<double>> timer_stages(const StageTimer& t, std::int64_t frames, bool colliders) {
   std::map<std::string, std::vector<double>> out;
-  for (const std::string& s : kLiveStages) out[s].assign(static_cast<std::size_t>(frames), 0.0);
+  for (const std::string& s : kLiveStages)
+    if (s != "colliders" || colliders) out[s].assign(static_cast<std::size_t>(frames), 0.0);
   for (const StageTimer::Row& r : t.rows()) {
     auto it = out.find(r.stage);
     if (it != out.end() && r.frame >= 0 && r.frame < frames) it->second[static_cast<std::size_t>(r.frame)] += r.ms;
@@ -130,12 +134,13 @@ std::map<std::string, std::vector<double>> timer_stages(const StageTimer& t, std
 }
 
 // The tracking stages of each frame from its record (see kTrackingStages).
-void add_tracking_stages(const std::vector<FrameRecord>& records, bool split_allocate, RepResult& r) {
+void add_tracking_stages(const std::vector<FrameRecord>& records, bool split_allocate, bool dynamic, RepResult& r) {
   for (const FrameRecord& f : records) {
     const double allocate = split_allocate && f.fused ? f.allocate_ms : 0.0;
     r.per_frame["upload"].push_back(f.upload_ms);
     r.per_frame["preprocess"].push_back(f.preprocess_ms - f.upload_ms);
-    r.per_frame["track"].push_back(f.track_ms);  // 0 for the first frame, which defines the world
+    if (dynamic) r.per_frame["dynamic"].push_back(f.dynamic_ms);
+    r.per_frame["track"].push_back(f.track_ms - f.dynamic_ms);  // 0 for the first frame, which defines the world
     if (split_allocate) r.per_frame["allocate"].push_back(allocate);
     r.per_frame["fuse"].push_back(f.fuse_ms - f.raycast_ms - allocate);  // 0 for a lost frame
     r.per_frame["raycast"].push_back(f.raycast_ms);
@@ -161,7 +166,7 @@ RepResult replay(const PipelineBenchOptions& o, const Experiment& e, const std::
     StageTimer* vs = o.volume_stages ? &volume_stages : nullptr;
     if (o.mode == "scan") {
       const ScanResult s = scan(ctx, false, vs);  // what `seamless track` runs (its refinement comes after)
-      add_tracking_stages(s.tracking.frames, o.volume_stages, r);
+      add_tracking_stages(s.tracking.frames, o.volume_stages, e.dynamic.enabled, r);
     } else {
       std::unique_ptr<RunRenderer> renderer;
       try {
@@ -172,8 +177,8 @@ RepResult replay(const PipelineBenchOptions& o, const Experiment& e, const std::
         spdlog::warn("bench pipeline: render stage {}", render_note);
       }
       const std::vector<FrameRecord> records = live(ctx, renderer.get(), vs);
-      add_tracking_stages(records, o.volume_stages, r);
-      for (auto& [stage, v] : timer_stages(ctx.timer(), r.frames)) {
+      add_tracking_stages(records, o.volume_stages, e.dynamic.enabled, r);
+      for (auto& [stage, v] : timer_stages(ctx.timer(), r.frames, e.solver.dynamic_colliders != "none")) {
         if (stage == "render" && !renderer) continue;
         for (std::size_t k = 0; k < v.size(); ++k) r.per_frame["frame"][k] += v[k];
         r.per_frame[stage] = std::move(v);

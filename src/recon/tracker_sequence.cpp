@@ -22,7 +22,9 @@ namespace seamless {
 
 // Where a frame's stages end on the device's timeline (TrackingSession::marks_).
 namespace {
-enum Mark { kStart, kUploaded, kPreprocessed, kTracked, kFused, kEnd, kMarks };
+// kMasked and kPosed (dynamic.enabled only) split the track stage: the mask before tracking, the
+// pose, the mask at the pose.
+enum Mark { kStart, kUploaded, kPreprocessed, kMasked, kPosed, kTracked, kFused, kEnd, kMarks };
 }  // namespace
 
 // The colour image goes up on a stream of its own: only fusion (and the RGB-D tracker's intensity)
@@ -437,7 +439,9 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
     first_frame(frame, rec);
   } else {
     if (p_.dynamic.enabled) dyn_model = mask_before_tracking();
+    if (p_.dynamic.enabled) marks_.mark(kMasked);
     rec.result = track_frame(frame);
+    if (p_.dynamic.enabled) marks_.mark(kPosed);
   }
   if (dyn_model && rec.result.ok()) {
     // The mask at the tracked pose is the frame's: fusion skips it, the next frame's filter reads it.
@@ -476,6 +480,7 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
   rec.preprocess_ms = marks_.ms(kStart, kPreprocessed);
   rec.upload_ms = marks_.ms(kStart, kUploaded);
   if (tracked) rec.track_ms = marks_.ms(kPreprocessed, kTracked);
+  if (tracked && p_.dynamic.enabled) rec.dynamic_ms = marks_.ms(kPreprocessed, kMasked) + marks_.ms(kPosed, kTracked);
   if (rec.result.ok()) {  // accept() ran: fusion and the next reference
     rec.fuse_ms = marks_.ms(kTracked, kEnd);
     rec.raycast_ms = marks_.ms(kFused, kEnd);

@@ -68,6 +68,9 @@ struct FrameRecord {
   // fuse_ms (the next reference view: raycast and its pyramid), allocate_ms of fuse_ms (block
   // allocation and the visible-block list; NaN unless TrackSequenceParams::volume_stages is set).
   double upload_ms = 0, raycast_ms = 0, allocate_ms = std::numeric_limits<double>::quiet_NaN();
+  // dynamic_ms of track_ms: the dynamic pixels (dynamic.enabled; the mask before tracking and the
+  // mask at the tracked pose, docs/DYNAMIC.md), 0 otherwise.
+  double dynamic_ms = 0;
   // dynamic.enabled: the fraction of the frame's pixels in its dynamic mask (NaN when off).
   double dynamic_fraction = std::numeric_limits<double>::quiet_NaN();
 };

@@ -159,6 +159,44 @@ class BenchPipeline(unittest.TestCase):
         self.assertEqual(summary["particles"]["fluid"], 10000)  # Table 5.1's fluid scene
         self.assertEqual(summary["particles"]["steps"], frames)
 
+    def test_dynamic_stages(self):
+        """Issue 22's cost is its own stage: with dynamic.enabled the dynamic pixels' time is split off
+        the track stage ("dynamic", before it), the stages still partition the frame, and dynamic +
+        track is the session's track_ms of tracking_stats.csv. In live mode with
+        solver.dynamic_colliders the colliders are a stage of their own."""
+        out = os.path.join(OUT, "dynamic")
+        shutil.rmtree(out, ignore_errors=True)
+        cfg = os.path.join(SRC, "configs", "tum_fr1.yaml")
+        js = os.path.join(out, "scan.json")
+        frames = 3
+        seamless("bench", "pipeline", "--config", cfg, "--data", SEQ, "--frames", str(frames), "--tracker", "icp",
+                 "--set", "dynamic.enabled=true", "--device", "cpu", "--out", os.path.join(out, "scan"), "--json", js)
+        with open(js) as f:
+            doc = json.load(f)
+        self.assertEqual(doc["stages"], ["upload", "preprocess", "dynamic"] + TRACKING[2:] + ["frame"])
+        self.check_statistics(doc, frames)
+        st = {n: doc["replays"][0]["stages"][n]["per_frame_ms"] for n in doc["stages"]}
+        with open(os.path.join(out, "scan", "rep_0", "tracking_stats.csv")) as f:
+            rows = list(csv.DictReader(f))
+        for i, row in enumerate(rows):
+            self.check_sum(st, [n for n in doc["stages"] if n != "frame"], i)
+            self.assertAlmostEqual(st["dynamic"][i] + st["track"][i], float(row["track_ms"]), delta=CSV_TOL)
+            if i > 0:  # tracked frames compare the frame with the model (the first defines it)
+                self.assertGreater(st["dynamic"][i], 0)
+        self.assertEqual(st["dynamic"][0], 0)
+
+        js = os.path.join(out, "live.json")
+        seamless("bench", "pipeline", "--mode", "live", "--data", SEQ, "--frames", str(frames), "--set",
+                 "solver.dynamic_colliders=all", "--device", "cpu", "--out", os.path.join(out, "live"), "--json", js)
+        with open(js) as f:
+            doc = json.load(f)
+        self.assertIn("colliders", doc["stages"])
+        self.assertLess(doc["stages"].index("colliders"), doc["stages"].index("physics"))
+        st = {n: doc["replays"][0]["stages"][n]["per_frame_ms"] for n in doc["stages"]}
+        for i in range(frames):
+            self.check_sum(st, [n for n in doc["stages"] if n != "frame"], i)
+        self.assertGreater(st["colliders"][frames - 1], 0)  # a tracked frame's depth points became colliders
+
 
 if __name__ == "__main__":
     if not os.path.isdir(SEQ):
