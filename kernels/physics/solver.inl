@@ -286,14 +286,22 @@ SEAMLESS_HD inline int count_contacts(const SimViews& S, int s, const vec3* P, L
   return count > 0 ? count : 1;
 }
 
-// Weight of s's scene contacts: omega / n_s, and for a rigid particle times (body particles / body
-// particles touching the scene): shape matching spreads a particle's correction over the whole
-// body, and without this a flat face resting on the scene would resolve only a fraction of its
-// contact (and of its static friction) per iteration, so that resting bodies creep.
-SEAMLESS_HD inline float scene_contact_weight(const SimViews& S, int s) {
+// The two passes that project contacts: pre-stabilisation on the start positions (Macklin 2014,
+// section 4.4: no friction, and no shape matching after it) and the solver iterations.
+enum class ContactPass { kStabilize, kSolve };
+
+// Weight of s's scene contacts: omega / n_s, and in the solver iterations for a rigid particle
+// times (body particles / body particles touching the scene): shape matching spreads a particle's
+// correction over the whole body, and without this a flat face resting on the scene would resolve
+// only a fraction of its contact (and of its static friction) per iteration, so that resting
+// bodies creep. Not in pre-stabilisation: no shape matching follows it there, so the factor (up to
+// N for a body of N particles resting on one) would leave the body deformed by that many times its
+// penetration, on x and p alike, and the next iteration's shape matching would turn the
+// deformation into velocity: a cube resting on a real scan's bumps was kicked at up to 9.6 m/s.
+SEAMLESS_HD inline float scene_contact_weight(const SimViews& S, int s, ContactPass pass) {
   const std::uint32_t ph = S.sphase[s];
   float self = S.c.omega / static_cast<float>(S.ncontacts[s]);
-  if (phase::is(ph, phase::kRigid)) {
+  if (pass == ContactPass::kSolve && phase::is(ph, phase::kRigid)) {
     int b = static_cast<int>(phase::group(ph));
     self *= static_cast<float>(S.body_count[b]) / static_cast<float>(max(S.body_contacts[b], 1));
   }
@@ -305,7 +313,8 @@ SEAMLESS_HD inline float scene_contact_weight(const SimViews& S, int s) {
 // after count_contacts at the same positions. Each pair's correction is scaled by
 // omega / max(n_s, n_j): averaging as in Macklin 2014 (eq. 11) that keeps every pair's two
 // corrections equal and opposite, so momentum is conserved.
-SEAMLESS_HD inline vec3 contact_part(const SimViews& S, int s, const vec3* P, const vec3* X, bool friction, Lanes g) {
+SEAMLESS_HD inline vec3 contact_part(const SimViews& S, int s, const vec3* P, const vec3* X, ContactPass pass, Lanes g) {
+  const bool friction = pass == ContactPass::kSolve;
   const float D = S.c.diameter, wi = S.sw[s];
   const bool fl = phase::is(S.sphase[s], phase::kFluid);
   const vec3 p = P[s], dx = p - X[s];
@@ -327,7 +336,7 @@ SEAMLESS_HD inline vec3 contact_part(const SimViews& S, int s, const vec3* P, co
   }
   const int ms = S.nsnbr[s];
   if (ms == 0) return acc;
-  const float self = scene_contact_weight(S, s);
+  const float self = scene_contact_weight(S, s, pass);
   const float smu_s = fl ? fmu : mus, smu_k = fl ? fmu : muk;
   for (int k = g.lane; k < ms; k += g.size) {
     vec3 r = p - S.stat[S.snbrs(s)[k * S.snbr_col]];
@@ -342,14 +351,16 @@ SEAMLESS_HD inline vec3 contact_part(const SimViews& S, int s, const vec3* P, co
 
 // Adds the scene SDF's contact correction of s (sampled by count_contacts at the same positions)
 // to acc, where the SDF touches s.
-SEAMLESS_HD inline void add_sdf_contact(const SimViews& S, int s, const vec3* P, const vec3* X, bool friction, vec3& acc) {
+SEAMLESS_HD inline void add_sdf_contact(const SimViews& S, int s, const vec3* P, const vec3* X, ContactPass pass,
+                                        vec3& acc) {
+  const bool friction = pass == ContactPass::kSolve;
   if (!S.sdf.active()) return;
   const vec4 q = S.sdf_at[s];  // scene_sdf(S.sdf, p), stored by count_contacts
   if (!(q.w < S.c.radius)) return;
   const bool fl = phase::is(S.sphase[s], phase::kFluid);
   const float mu_s = !friction ? 0.f : fl ? S.c.fluid_friction : S.c.static_friction;
   const float mu_k = !friction ? 0.f : fl ? S.c.fluid_friction : S.c.kinetic_friction;
-  acc += contact_delta(xyz(q), S.c.radius - q.w, P[s] - X[s], S.sw[s], 0.f, mu_s, mu_k) * scene_contact_weight(S, s);
+  acc += contact_delta(xyz(q), S.c.radius - q.w, P[s] - X[s], S.sw[s], 0.f, mu_s, mu_k) * scene_contact_weight(S, s, pass);
 }
 
 // Whether s has list entries that contact_part visits (otherwise its lanes need no sum).
@@ -660,10 +671,10 @@ void stabilize(const Exec& ex, const SimViews& S) {
       if (g.lane == 0) S.tmp[s] = {0.f, 0.f, 0.f};
       return;
     }
-    vec3 acc = detail::contact_part(S, s, S.sx, S.sx, false, g);
+    vec3 acc = detail::contact_part(S, s, S.sx, S.sx, detail::ContactPass::kStabilize, g);
     if (detail::has_contact_lists(S, s)) acc = g.sum(acc);
     if (g.lane != 0) return;
-    detail::add_sdf_contact(S, s, S.sx, S.sx, false, acc);
+    detail::add_sdf_contact(S, s, S.sx, S.sx, detail::ContactPass::kStabilize, acc);
     S.tmp[s] = acc;
   });
   ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
@@ -832,7 +843,7 @@ SEAMLESS_HD inline vec3 pbf_part(const SimViews& S, int s, Lanes g) {
 // s's new position from its sums (the contacts' part.acc, the PBF or coupling sum part.f).
 SEAMLESS_HD inline void finish_solve(const SimViews& S, int s, const SolveSum& part, bool fluid, bool coupled) {
   vec3 acc = part.acc;
-  add_sdf_contact(S, s, S.sp, S.sx, true, acc);
+  add_sdf_contact(S, s, S.sp, S.sx, ContactPass::kSolve, acc);
   if (fluid) acc += part.f * (1.f / S.c.rest_density);
   if (coupled) acc += part.f * (S.c.solid_density_scale / S.c.rest_density);
   S.tmp[s] = S.sp[s] + acc;
@@ -864,7 +875,7 @@ void solve_contacts_fluid(const Exec& ex, const SimViews& S) {
       return;
     }
     const bool fluid = phase::is(S.sphase[s], phase::kFluid), coupled = !fluid && S.c.solid_density_scale > 0.f;
-    detail::SolveSum part{detail::contact_part(S, s, S.sp, S.sx, true, g), {0.f, 0.f, 0.f}};
+    detail::SolveSum part{detail::contact_part(S, s, S.sp, S.sx, detail::ContactPass::kSolve, g), {0.f, 0.f, 0.f}};
     if (fluid) {
       constexpr bool kCache = detail::kCachePairs<Exec>;
       part.f = S.nsolid[s] != 0 ? detail::pbf_part<kCache, true>(S, s, g) : detail::pbf_part<kCache, false>(S, s, g);
@@ -1499,7 +1510,7 @@ bool solve_tile(const SimViews& S, int s0) {
   for (int l = 0; l < simd::kWidth; ++l) {
     const int s = s0 + l;
     if (!(S.sw[s] > 0.f)) S.tmp[s] = S.sp[s];
-    else finish_solve(S, s, SolveSum{contact_part(S, s, S.sp, S.sx, true, Lanes{}), simd::lane(f, l)}, true, false);
+    else finish_solve(S, s, SolveSum{contact_part(S, s, S.sp, S.sx, ContactPass::kSolve, Lanes{}), simd::lane(f, l)}, true, false);
   }
   return true;
 }

@@ -44,7 +44,7 @@ double rigid_fit_error(const std::vector<vec3>& x, const std::vector<vec3>& q) {
 // projection of each iteration, so only float rounding remains: ~1e-7 m against 4e-5 m) and the
 // cube must have stopped (below 1e-3 m/s: pre-stabilisation removes the remaining overlap
 // without adding velocity). On a one-particle scene layer the same cube keeps rocking on the
-// bumps at ~1 cm/s; that figure is printed, not asserted (docs/PHYSICS.md, known limitations).
+// bumps at ~0.4 cm/s; that figure is printed, not asserted (docs/PHYSICS.md, known limitations).
 void resting_cube(bool particle_floor, double& err, float& vmax, float& centre_y) {
   SolverParams p;
   const float d = p.particle_diameter;
@@ -76,6 +76,58 @@ TEST(PhysicsRigid, RestingCubeKeepsShapeAndComesToRest) {
   std::printf("resting cube on scene particles: shape error %.3g diameters, max speed %.3g m/s\n", err / d, vmax);
   EXPECT_LE(err, 1e-3 * d);
   EXPECT_GT(cy, d);
+}
+
+// A 4x4x4 cube of 2 cm particles (configs/real/tum_desk.yaml's) dropped 1 cm onto a rough scan: two
+// layers of scene particles (a surface and one beneath, as scene_interior_depth gives) whose
+// heights scatter by up to +-3 mm (a Kinect's depth noise at 1-1.5 m). Returns the fastest particle
+// after the landing (from 0.2 s to 3 s) and how far the centre moved from where it first settled.
+struct RoughRun {
+  float vmax_after_landing = 0.f, drift = 0.f;
+};
+RoughRun cube_on_rough_scan() {
+  SolverParams p;
+  p.particle_diameter = 0.02f;
+  const float d = p.particle_diameter;
+  ParticleSolver s(p, Device::CPU);
+  std::vector<vec3> scan;
+  std::uint32_t h = 12345u;
+  auto jitter = [&] {  // a fixed LCG: the same scan on every machine
+    h = h * 1664525u + 1013904223u;
+    return (static_cast<float>(h >> 8) / 16777216.f * 2.f - 1.f) * 0.003f;
+  };
+  for (const vec3& q : test::static_layer(0.f, -0.2f, 0.2f, -0.2f, 0.2f, d)) {
+    scan.push_back({q.x, q.y + jitter(), q.z});
+    scan.push_back({q.x, q.y - d + jitter(), q.z});
+  }
+  s.add_static_particles(scan);
+  SpawnParams c;
+  c.kind = "rigid", c.size = {4 * d, 4 * d, 4 * d}, c.position = {0.003f, d + 1.5f * d + 0.013f, -0.002f};
+  s.add_batch(make_rigid(c, p));
+  RoughRun r;
+  vec3 settled{0.f, 0.f, 0.f};
+  for (int i = 1; i <= 300; ++i) {
+    s.step();
+    if (i == 20) settled = s.rigid_frames()[0].centre;
+    if (i <= 20) continue;
+    for (const vec3& v : s.download_state().v) r.vmax_after_landing = std::max(r.vmax_after_landing, length(v));
+    r.drift = std::max(r.drift, length(s.rigid_frames()[0].centre - settled));
+  }
+  return r;
+}
+
+TEST(PhysicsRigid, CubeRestingOnARoughScanIsNotThrown) {
+  // A body resting on a few bumps must not be kicked: on the real tum_desk scan a lone cube was
+  // thrown off the desk at up to 9.6 m/s when pre-stabilisation still spread a rigid particle's
+  // correction over its body (docs/PHYSICS.md). Landing from 1 cm gives 0.44 m/s, gone within the
+  // first 0.2 s; after it the cube may rock on the bumps at ~0.4 cm/s (the regular layer's figure
+  // above) but must neither reach 0.1 m/s (a tenth of the drop speed's order) nor wander off:
+  // less than a quarter particle (5 mm) from where it settled.
+  const RoughRun r = cube_on_rough_scan();
+  std::printf("cube on a rough scan: fastest particle after landing %.3f m/s, drift %.4f m\n", r.vmax_after_landing,
+              r.drift);
+  EXPECT_LT(r.vmax_after_landing, 0.1f);
+  EXPECT_LT(r.drift, 0.005f);
 }
 
 struct InclineRun {
