@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "app/commands.hpp"
+#include "app/ghost.hpp"
 #include "app/pipeline.hpp"
 #include "app/render_stage.hpp"
 #include "app/placement.hpp"
@@ -16,6 +17,7 @@
 #include "app/run_summary.hpp"
 #include "config/config.hpp"
 #include "core/error.hpp"
+#include "io/trajectory.hpp"
 #include "physics/particle_io.hpp"
 #include "physics/particle_solver.hpp"
 
@@ -119,6 +121,9 @@ int run(const CommonOptions& o) {
   const Trajectory& traj = scan_result.tracking.trajectory;
   summary.intrinsics = scan_result.intrinsics;
   add_tracking(summary, scan_result.tracking, scan_result.unreadable, groundtruth_path(ctx));
+  if (const std::string gt = groundtruth_path(ctx); !gt.empty())
+    summary.ghost_vertices = ghost_vertices(scan_result.mesh, e.input, traj, read_tum_trajectory(gt),
+                                            2 * e.volume.voxel_size);
   summary.online_refine = scan_result.online_refine;
   std::optional<SdfGrid> grid;
   if (e.solver.scene_collision == "sdf") grid = scene_sdf_grid(*scan_result.volume, scan_result.mesh, e);

@@ -4,14 +4,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <optional>
 
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
 #include "core/progress.hpp"
 #include "io/frame_source.hpp"
+#include "app/ghost.hpp"
 #include "app/placement.hpp"
 #include "io/intrinsics_presets.hpp"
+#include "io/trajectory.hpp"
 #include "app/render_stage.hpp"
 #include "app/run_summary.hpp"
 #include "physics/builders.hpp"
@@ -465,6 +468,9 @@ class LiveLoop : public FrameLoop {
     sum.spawns = spawns_;
     sum.physics = solver_.stats();
     sum.dynamic_masked_fraction = mean_dynamic_fraction(records_);
+    if (std::filesystem::exists(ctx_.out_path("groundtruth.txt")))
+      sum.ghost_vertices = ghost_vertices(mesh, e_.input, poses_, read_tum_trajectory(ctx_.out_path("groundtruth.txt")),
+                                          2 * e_.volume.voxel_size);
     if (online_) sum.online_refine = online_->stats();
     sum.escaped = count_escaped(state, b, e_.solver.particle_diameter);
     add_stage_medians(sum, ctx_.timer());

@@ -101,7 +101,11 @@ void write_summary(const std::string& path, const RunSummary& s) {
   j["frames"] = {{"read", s.frames_read}, {"lost", s.frames_lost}, {"fused", s.frames_fused},
                  {"unreadable", s.frames_unreadable}};
   if (s.ate_rmse_m) j["ate"] = {{"rmse_m", *s.ate_rmse_m}, {"pairs", s.ate_pairs}};
-  if (s.dynamic_masked_fraction) j["dynamic"] = {{"mean_masked_fraction", *s.dynamic_masked_fraction}};
+  if (s.dynamic_masked_fraction || s.ghost_vertices) {
+    Json& d = j["dynamic"] = Json::object();
+    if (s.dynamic_masked_fraction) d["mean_masked_fraction"] = *s.dynamic_masked_fraction;
+    if (s.ghost_vertices) d["ghost_vertices"] = *s.ghost_vertices;
+  }
   if (s.floor_height) j["floor_height"] = *s.floor_height;
   Json& surfaces = j["surfaces"] = Json::array();
   for (std::size_t i = 0; i < s.surfaces.size() && i < 10; ++i) {

@@ -38,6 +38,7 @@ struct RunSummary {
   std::optional<double> ate_rmse_m;    // against the input's ground truth, when it has one
   std::int64_t ate_pairs = 0;
   std::optional<double> dynamic_masked_fraction;  // dynamic.enabled: mean over the tracked frames
+  std::optional<std::int64_t> ghost_vertices;    // synthetic movers: what they left in the map (app/ghost.hpp)
   std::vector<ResolvedPlacement> placements;
   std::vector<SpawnParams> spawns;     // as resolved
   std::optional<SolverStats> physics;

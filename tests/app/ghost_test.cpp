@@ -1,0 +1,68 @@
+// Issue 22's ghost measure (src/app/ghost.cpp, summary.json dynamic.ghost_vertices) against mesh
+// vertices placed by hand in and around a person's exact capsules (kernels/scene/movers.hpp).
+#include <gtest/gtest.h>
+
+#include "app/ghost.hpp"
+#include "io/movers.hpp"
+#include "kernels/scene/synthetic_room.hpp"
+
+namespace seamless {
+namespace {
+
+InputParams person_walking() {
+  InputParams in;
+  in.source = "synthetic";
+  MoverParams person;
+  person.kind = "person", person.path = {{-1.f, 1.2f, 0.f}, {1.f, 1.2f, 0.f}}, person.speed = 1.f;
+  in.synthetic.movers = {person};
+  return in;
+}
+
+// 30 poses at 30 Hz: the ground truth (room_T_camera), and the estimate in a world frame that is
+// the room turned and moved by world_T_room (as a tracked run's first-camera world would be).
+Trajectory poses(const SE3& world_T_room) {
+  Trajectory t;
+  for (int k = 0; k < 30; ++k) {
+    SE3 room_T_camera = SE3::identity();
+    room_T_camera.t = {0.1f * k, -1.f, 1.2f};
+    t.push_back(TumPose::from_se3(k / 30.0, world_T_room * room_T_camera));
+  }
+  return t;
+}
+
+TEST(Ghost, CountsVerticesInsideTheMoversButNotTheRoomsOwnSurfaces) {
+  const InputParams in = person_walking();
+  SE3 world_T_room = SE3::identity();
+  world_T_room.R = {{{0.f, -1.f, 0.f}, {1.f, 0.f, 0.f}, {0.f, 0.f, 1.f}}};  // 90 degrees about z
+  world_T_room.t = {0.3f, -0.2f, 0.1f};
+  const Trajectory gt = poses(SE3::identity()), est = poses(world_T_room);
+  // Inside the torso at t = 0.5 s (its axis runs up through the walking point, about 1 m up), the
+  // room's floor under the person (within the margin of the room's surface: the room), empty
+  // space next to the path (nothing), and a point inside the person only at 5 s (after the last
+  // ground-truth time: not in the swept volume).
+  const kernels::movers::Scene at_half = pose_movers(in.synthetic.movers, 0.5);
+  ASSERT_GT(at_half.count, 0);
+  vec3 torso = (at_half.c[0].a + at_half.c[0].b) * 0.5f;
+  ASSERT_LT(kernels::movers::distance(at_half, torso), -0.05f);
+  const vec3 floor{torso.x, torso.y, 0.f};
+  ASSERT_LT(std::fabs(kernels::room::room_sdf(floor)), 0.02f);
+  const vec3 beside{torso.x, torso.y + 0.8f, torso.z};
+  const kernels::movers::Scene late = pose_movers(in.synthetic.movers, 1.8);
+  ASSERT_GT(late.count, 0);
+  const vec3 later = (late.c[0].a + late.c[0].b) * 0.5f;
+  Mesh m;
+  for (vec3 q : {torso, floor, beside, later}) m.positions.push_back(world_T_room * q);
+  const auto g = ghost_vertices(m, in, est, gt, 0.02f);
+  ASSERT_TRUE(g.has_value());
+  EXPECT_EQ(*g, 1);
+  // Without movers, or with no common timestamp, there is no measure.
+  InputParams none = in;
+  none.synthetic.movers.clear();
+  EXPECT_FALSE(ghost_vertices(m, none, est, gt, 0.02f).has_value());
+  Trajectory shifted = est;
+  for (TumPose& p : shifted) p.timestamp += 100.0;
+  EXPECT_FALSE(ghost_vertices(m, in, shifted, gt, 0.02f).has_value());
+}
+
+}  // namespace
+}  // namespace seamless
