@@ -185,7 +185,7 @@ struct ParticleSolver::Impl {
     if (id_copy_version == state_version) return;
     x_id.reserve_discard(cap, dev), phase_id.reserve_discard(cap, dev);
     K::SimViews S = views(P.dt);
-    with_exec(dev, [&](const auto& ex) { K::slots_to_ids(ex, S, x_id.data(), phase_id.data()); });
+    with_exec(dev, [&]<class E>(const E& ex) { K::Integration<E>::slots_to_ids(ex, S, x_id.data(), phase_id.data()); });
     id_copy_version = state_version;
   }
 
@@ -262,7 +262,7 @@ struct ParticleSolver::Impl {
 #if SEAMLESS_HAS_CUDA
     before[2] = sort_temp.data();
     if (dev == Device::CUDA && sort_temp_n != n) {
-      std::size_t need = K::sort_cells_temp_bytes(CudaExec{}, n, 3 * bits);
+      std::size_t need = K::NeighbourGrid<CudaExec>::sort_cells_temp_bytes(CudaExec{}, n, 3 * bits);
       if (static_cast<std::size_t>(sort_temp.size()) < need)
         sort_temp.reserve_discard(static_cast<std::int64_t>(need + need / 4), dev);
       sort_temp_n = n;
@@ -339,10 +339,11 @@ struct ParticleSolver::Impl {
   // Sort, grid and neighbour lists of the predicted positions (S.pred must be filled).
   template <class Ex>
   void build_neighbours(const Ex& ex, const K::SimViews& S) {
-    K::sort_cells(ex, S.key, S.order, n, 3 * bits);
-    K::reorder(ex, S);
-    K::cell_starts(ex, S.key, n, S.cell_start, std::int64_t{1} << (3 * bits));
-    K::find_neighbors(ex, S);
+    using Grid = K::NeighbourGrid<Ex>;
+    Grid::sort_cells(ex, S.key, S.order, n, 3 * bits);
+    Grid::reorder(ex, S);
+    Grid::cell_starts(ex, S.key, n, S.cell_start, std::int64_t{1} << (3 * bits));
+    Grid::find_neighbors(ex, S);
   }
 
   // One substep of Algorithm 1 (dissertation section 4.2.2) with Macklin 2014's additions.
@@ -350,32 +351,34 @@ struct ParticleSolver::Impl {
     K::SimViews S = views(dt);
     const bool has_fluid = n_fluid > 0, has_cloth = !edge_a.empty() || !bends.empty();
     const bool effects = has_fluid || (n_cloth > 0 && (P.drag > 0.f || P.lift > 0.f));
-    run([&](const auto& ex) {
-      K::predict(ex, S);
+    run([&]<class E>(const E& ex) {
+      using Fluid = K::Fluid<E>;
+      using Integration = K::Integration<E>;
+      K::NeighbourGrid<E>::predict(ex, S);
       build_neighbours(ex, S);
-      for (int i = 0; i < P.stabilization_iterations; ++i) K::stabilize(ex, S);
+      for (int i = 0; i < P.stabilization_iterations; ++i) K::Contacts<E>::stabilize(ex, S);
       for (int it = 0; it < P.iterations; ++it) {
-        K::prepare_constraints(ex, S);
-        K::solve_contacts_fluid(ex, S);
+        Fluid::prepare_constraints(ex, S);
+        Fluid::solve_contacts_fluid(ex, S);
         std::swap(S.sp, S.tmp);
-        K::shape_match(ex, S);
+        K::Solids<E>::shape_match(ex, S);
         if (has_cloth) solve_cloth(ex, S);
       }
       if (strain_limited) limit_strain(ex, S);
-      K::update_velocity(ex, S);
+      Integration::update_velocity(ex, S);
       if (effects) {
-        K::velocity_effects(ex, S, has_fluid);
+        Fluid::velocity_effects(ex, S, has_fluid);
         std::swap(S.sv, S.vtmp);
       }
-      K::write_back(ex, S);
+      Integration::write_back(ex, S);
     });
   }
 
   template <class Ex>
   void solve_cloth(const Ex& ex, K::SimViews& S) {
-    if (colour_off.size() > 1) K::cloth_stretch(ex, S, colour_off.data(), colours());
+    if (colour_off.size() > 1) K::Solids<Ex>::cloth_stretch(ex, S, colour_off.data(), colours());
     if (!bends.empty()) {
-      K::cloth_bend(ex, S);
+      K::Solids<Ex>::cloth_bend(ex, S);
       std::swap(S.sp, S.tmp);
     }
   }
@@ -385,7 +388,7 @@ struct ParticleSolver::Impl {
   // Strain limiting after the iterations (Provot 1995): Gauss-Seidel over the edge colours.
   template <class Ex>
   void limit_strain(const Ex& ex, const K::SimViews& S) {
-    if (colour_off.size() > 1) K::cloth_strain_limit(ex, S, colour_off.data(), colours(), P.cloth_strain_passes);
+    if (colour_off.size() > 1) K::Solids<Ex>::cloth_strain_limit(ex, S, colour_off.data(), colours(), P.cloth_strain_passes);
   }
 
   void upload_bodies(const std::vector<vec3>& c, const std::vector<vec4>& q) {
@@ -663,11 +666,12 @@ struct ParticleSolver::Impl {
     Buffer<int> idx(ns, dev);
     stat = Buffer<vec3>(ns, dev);
     scell_start = Buffer<int>(cells + 1, dev);
-    with_exec(dev, [&](const auto& ex) {
-      K::cell_keys(ex, raw.data(), ns, sgrid, keys.data(), idx.data());
-      K::sort_cells(ex, keys.data(), idx.data(), ns, 3 * sb);
-      K::gather_vec3(ex, raw.data(), idx.data(), ns, stat.data());
-      K::cell_starts(ex, keys.data(), ns, scell_start.data(), cells);
+    with_exec(dev, [&]<class E>(const E& ex) {
+      using Grid = K::NeighbourGrid<E>;
+      Grid::cell_keys(ex, raw.data(), ns, sgrid, keys.data(), idx.data());
+      Grid::sort_cells(ex, keys.data(), idx.data(), ns, 3 * sb);
+      Grid::gather_vec3(ex, raw.data(), idx.data(), ns, stat.data());
+      Grid::cell_starts(ex, keys.data(), ns, scell_start.data(), cells);
     });
     snbr.reserve_discard(std::max<std::int64_t>(cap, 1) * (P.max_static_neighbours + 1), dev);
   }
@@ -827,10 +831,10 @@ std::vector<float> ParticleSolver::fluid_density_ratio() const {
   I.prepare_grid();
   K::SimViews S = I.views(I.P.dt);
   S.c.dt = 0.f, S.c.max_speed = 1e30f;  // predicted = current positions, velocities untouched
-  with_exec(I.dev, [&](const auto& ex) {
-    K::predict(ex, S);
+  with_exec(I.dev, [&]<class E>(const E& ex) {
+    K::NeighbourGrid<E>::predict(ex, S);
     I.build_neighbours(ex, S);
-    K::prepare_constraints(ex, S);
+    K::Fluid<E>::prepare_constraints(ex, S);
   });
   std::vector<float> rho = I.density.to_host();
   std::vector<int> order = I.order.to_host();
