@@ -63,6 +63,22 @@ SEAMLESS_SIMD_INL void tile_add(simd::v3& acc, const simd::v3& d, simd::vm in) {
   else acc += d;
 }
 
+// The pair loop that every tile runs: pair(j, in, masked) for the entries k of the lanes' lists,
+// j[l] = entry k of lane l, with masked = std::false_type while every lane has an entry k (k
+// below the shortest list: no mask needed) and std::true_type after (in: the lanes that have one,
+// tile_entries). What a tile gathers and sums is all in its pair function.
+template <class Pair>
+SEAMLESS_SIMD_INL void tile_pairs(const SimViews& S, const Tile& t, Pair&& pair) {
+  auto step = [&](int k, auto masked) __attribute__((always_inline)) {
+    int j[simd::kWidth];
+    simd::vm in;
+    tile_entries<decltype(masked)::value>(S, t, k, j, in);
+    pair(j, in, masked);
+  };
+  for (int k = 0; k < t.kmin; ++k) step(k, std::false_type{});
+  for (int k = t.kmin; k < t.kmax; ++k) step(k, std::true_type{});
+}
+
 // vorticity_part of the tile's 8 particles (velocity_effects). False where the tile needs the
 // scalar loops. The tiles keep nothing in pair_w: forces_tile recomputes the pairs' kernel values
 // (on 8 lanes that costs less time than storing and reloading them, docs/PERFORMANCE.md; the
@@ -76,11 +92,8 @@ bool vorticity_tile(const SimViews& S, int s0) {
   const SphKernel W = S.c.W;
   const v3 p = simd::load_v3(S.sp + s0), vi = simd::load_v3(S.sv + s0);
   v3 tw{}, tn{}, tdv{};
-  auto step = [&](int k, auto masked) {
+  tile_pairs(S, t, [&](const int* j, simd::vm in, auto masked) __attribute__((always_inline)) {
     constexpr bool kMasked = decltype(masked)::value;
-    int j[simd::kWidth];
-    simd::vm in;
-    tile_entries<kMasked>(S, t, k, j, in);
     v3 q, vj;
     simd::vf rho, hj;
     gather_packed(S.spd, j, q, rho);
@@ -89,9 +102,7 @@ bool vorticity_tile(const SimViews& S, int s0) {
     tile_add<kMasked>(tw, d.w, in);
     tile_add<kMasked>(tn, d.n, in);
     tile_add<kMasked>(tdv, d.dv, in);
-  };
-  for (int k = 0; k < t.kmin; ++k) step(k, std::false_type{});
-  for (int k = t.kmin; k < t.kmax; ++k) step(k, std::true_type{});
+  });
   for (int l = 0; l < simd::kWidth; ++l) {
     const int s = s0 + l;
     S.vort[s] = simd::lane(tw, l);
@@ -118,11 +129,8 @@ bool density_tile(const SimViews& S, int s0) {
   const v3 p = simd::load_v3(S.sp + s0);
   vf rho(W.poly6(0.f)), sum2(0.f);
   v3 gi{};
-  auto step = [&](int k, auto masked) {
+  tile_pairs(S, t, [&](const int* j, simd::vm in, auto masked) __attribute__((always_inline)) {
     constexpr bool kMasked = decltype(masked)::value;
-    int j[simd::kWidth];
-    simd::vm in;
-    tile_entries<kMasked>(S, t, k, j, in);
     v3 q;
     vf ph;
     gather_packed(S.spk, j, q, ph);
@@ -135,9 +143,7 @@ bool density_tile(const SimViews& S, int s0) {
       sum2 = sum2 + length2(d.grad);
     }
     tile_add<kMasked>(gi, d.grad, in);
-  };
-  for (int k = 0; k < t.kmin; ++k) step(k, std::false_type{});
-  for (int k = t.kmin; k < t.kmax; ++k) step(k, std::true_type{});
+  });
   for (int l = 0; l < simd::kWidth; ++l) finish_density(S, s0 + l, nc[l], DensitySum{rho[l], sum2[l], simd::lane(gi, l)});
   return true;
 }
@@ -156,11 +162,8 @@ bool solve_tile(const SimViews& S, int s0) {
   vf li;
   for (int l = 0; l < simd::kWidth; ++l) li.v[l] = S.lambda[s0 + l];
   v3 f{};
-  auto step = [&](int k, auto masked) {
+  tile_pairs(S, t, [&](const int* j, simd::vm in, auto masked) __attribute__((always_inline)) {
     constexpr bool kMasked = decltype(masked)::value;
-    int j[simd::kWidth];
-    simd::vm in;
-    tile_entries<kMasked>(S, t, k, j, in);
     v3 q;
     vf lj;
     gather_packed(S.spl, j, q, lj);
@@ -168,9 +171,7 @@ bool solve_tile(const SimViews& S, int s0) {
     const v3 grad = pair_grad(W, r);
     const vf wgt = W.poly6(length2(r));  // (s_corr off: unused, see pbf_factor)
     tile_add<kMasked>(f, grad * pbf_factor(S.c, wgt, li, lj), in);
-  };
-  for (int k = 0; k < t.kmin; ++k) step(k, std::false_type{});
-  for (int k = t.kmin; k < t.kmax; ++k) step(k, std::true_type{});
+  });
   for (int l = 0; l < simd::kWidth; ++l) {
     const int s = s0 + l;
     if (!(S.sw[s] > 0.f)) S.tmp[s] = S.sp[s];
@@ -193,11 +194,8 @@ bool forces_tile(const SimViews& S, int s0) {
   vf rho_i;
   for (int l = 0; l < simd::kWidth; ++l) rho_i.v[l] = S.density[s0 + l];
   v3 eta{}, acc{};
-  auto step = [&](int k, auto masked) {
+  tile_pairs(S, t, [&](const int* j, simd::vm in, auto masked) __attribute__((always_inline)) {
     constexpr bool kMasked = decltype(masked)::value;
-    int j[simd::kWidth];
-    simd::vm in;
-    tile_entries<kMasked>(S, t, k, j, in);
     v3 q, nj;
     vf rho_j, wj;
     gather_packed(S.spd, j, q, rho_j);
@@ -209,9 +207,7 @@ bool forces_tile(const SimViews& S, int s0) {
     force_pair(inv_rho0, two_rho0, st, r, grad, cf, ni, nj, wj, rho_i, rho_j, e, a);
     tile_add<kMasked>(eta, e, in);
     tile_add<kMasked>(acc, a, in);
-  };
-  for (int k = 0; k < t.kmin; ++k) step(k, std::false_type{});
-  for (int k = t.kmin; k < t.kmax; ++k) step(k, std::true_type{});
+  });
   for (int l = 0; l < simd::kWidth; ++l) {
     const int s = s0 + l;
     S.vtmp[s] = fluid_velocity(S, s, finish_forces(S, s, ForceSum{simd::lane(eta, l), simd::lane(acc, l)}));
