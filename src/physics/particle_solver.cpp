@@ -12,6 +12,7 @@
 #include "core/error.hpp"
 #include "core/exec.hpp"
 #include "core/log.hpp"
+#include "core/step_graph.hpp"
 #include "kernels/physics/solver.hpp"
 
 namespace seamless {
@@ -128,18 +129,9 @@ struct ParticleSolver::Impl {
   // bumps the generation; a CUDA graph is captured for a generation that one step has already
   // run with, and replayed while the generation, dt and the substeps stay the same.
   std::uint64_t generation = 0, stepped_generation = ~std::uint64_t{0};
-#if SEAMLESS_HAS_CUDA
-  std::unique_ptr<CudaStream> stream;
-  CudaGraph graph;
-  Buffer<unsigned char> sort_temp;  // the sort's own temp storage (the graph keeps pointing at it)
-  std::int64_t sort_temp_n = -1;    // particle count sort_temp was sized for
-  std::uint64_t graph_generation = ~std::uint64_t{0};
-  float graph_dt = 0.f;
-  int graph_substeps = 0;
-  bool graph_failed = false;
-#endif
+  StepGraph graph;  // the solver's stream, sort storage and CUDA graph (core/step_graph.hpp)
 
-  Impl(const SolverParams& p, Device d) : P(p), dev(d), counters(5, d) {
+  Impl(const SolverParams& p, Device d) : P(p), dev(d), counters(5, d), graph(d, "particle solver") {
     counters.zero();
     compute_fluid_constants();
   }
@@ -256,19 +248,13 @@ struct ParticleSolver::Impl {
   void prepare_grid() {
     bits = grid_bits(n);
     std::int64_t cells = std::int64_t{1} << (3 * bits);
-    const void* before[3] = {cell_start.data(), snbr.data(), nullptr};
+    const void* before[2] = {cell_start.data(), snbr.data()};
     cell_start.reserve_discard(cells + 1, dev);
     if (static_count() > 0) snbr.reserve_discard(cap * (P.max_static_neighbours + 1), dev);
-#if SEAMLESS_HAS_CUDA
-    before[2] = sort_temp.data();
-    if (dev == Device::CUDA && sort_temp_n != n) {
-      std::size_t need = K::NeighbourGrid<CudaExec>::sort_cells_temp_bytes(CudaExec{}, n, 3 * bits);
-      if (static_cast<std::size_t>(sort_temp.size()) < need)
-        sort_temp.reserve_discard(static_cast<std::int64_t>(need + need / 4), dev);
-      sort_temp_n = n;
-    }
-    if (before[2] != sort_temp.data()) ++generation;
-#endif
+    const bool temp_moved = graph.reserve_temp(n, [&]<class E>(const E& ex) {
+      return K::NeighbourGrid<E>::sort_cells_temp_bytes(ex, n, 3 * bits);
+    });
+    if (temp_moved) ++generation;
     if (before[0] != cell_start.data() || before[1] != snbr.data()) ++generation;
   }
 
@@ -276,65 +262,22 @@ struct ParticleSolver::Impl {
   // own temp storage (so that a step can be captured as a graph).
   template <class F>
   void run(F&& fn) {
-#if SEAMLESS_HAS_CUDA
-    if (dev == Device::CUDA) {
-      if (!stream) stream = std::make_unique<CudaStream>();
-      CudaExec ex;
-      ex.stream = stream->get(), ex.temp = sort_temp.data(), ex.temp_bytes = static_cast<std::size_t>(sort_temp.size());
-      fn(ex);
-      return;
-    }
-#endif
-    with_exec(dev, fn);
+    graph.run(std::forward<F>(fn));
   }
 
   // k substeps of dt / k. On CUDA they run on the solver's stream, ordered after what the default
   // stream holds and before what it gets next (no host synchronisation), as one graph launch
-  // when solver.cuda_graph is set and the scene did not change since the last step.
+  // when solver.cuda_graph is set and the scene did not change since the last step (a graph is
+  // recorded for a generation that one step has already run with: StepGraph::step).
   void advance(float dt, int k) {
     if (n == 0) return;
     ++state_version;
     prepare_grid();
-#if SEAMLESS_HAS_CUDA
-    if (dev == Device::CUDA) {
-      if (!stream) stream = std::make_unique<CudaStream>();
-      stream->after_default();
-      if (!replay_graph(dt, k))
-        for (int i = 0; i < k; ++i) substep(dt / static_cast<float>(k));
-      stream->before_default();
-      stepped_generation = generation;
-      return;
-    }
-#endif
-    for (int i = 0; i < k; ++i) substep(dt / static_cast<float>(k));
+    graph.step(P.cuda_graph && generation == stepped_generation, StepGraph::Key{generation, dt, k}, [&] {
+      for (int i = 0; i < k; ++i) substep(dt / static_cast<float>(k));
+    });
     stepped_generation = generation;
   }
-
-#if SEAMLESS_HAS_CUDA
-  // Captures the step (if the graph held is not for this generation, dt and substeps) and
-  // launches it. A scene that changed since the last step is stepped directly: a capture pays
-  // only when it is replayed (an emitter adding particles every step never captures). If the
-  // capture fails, the step runs directly and graphs stay off (nothing recorded was run).
-  bool replay_graph(float dt, int k) {
-    if (!P.cuda_graph || graph_failed || generation != stepped_generation) return false;
-    if (!graph.ready() || graph_generation != generation || graph_dt != dt || graph_substeps != k) {
-      try {
-        graph.begin_capture(*stream);
-        for (int i = 0; i < k; ++i) substep(dt / static_cast<float>(k));
-        graph.end_capture();
-      } catch (const std::exception& e) {
-        graph.abort_capture();
-        graph.reset();
-        graph_failed = true;
-        spdlog::warn("particle solver: capturing the step as a CUDA graph failed ({}); stepping without graphs", e.what());
-        return false;
-      }
-      graph_generation = generation, graph_dt = dt, graph_substeps = k;
-    }
-    graph.launch(*stream);
-    return true;
-  }
-#endif
 
   // Sort, grid and neighbour lists of the predicted positions (S.pred must be filled).
   template <class Ex>
