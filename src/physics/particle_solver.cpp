@@ -57,12 +57,14 @@ struct Emitter {
 
 }  // namespace
 
-struct ParticleSolver::Impl {
-  SolverParams P;
-  Device dev;
-  std::int64_t n = 0, cap = 0;
-  // slot order (the state between steps in the last substep's sorted order; SimViews): slot_id
-  // holds the particle id of each slot
+// The solver's state by concern; ParticleSolver::Impl derives from them, so the code names each
+// member directly. Buffers on the solver's device; "slot order" is the state between steps in the
+// last substep's sorted order (kernels/physics/sim_views.hpp).
+namespace solver_state {
+
+// Per-particle state: slot order (slot_id holds the particle id of each slot), the per-particle
+// constants and the id-order copies, and the sorted scratch of a substep.
+struct ParticleState {
   Buffer<vec3> x, v, pred;
   Buffer<float> w;
   Buffer<std::uint32_t> phase;
@@ -70,19 +72,35 @@ struct ParticleSolver::Impl {
   // id order: per-particle constants; positions and phases copied out for device_positions()
   Buffer<vec3> rest, x_id;
   Buffer<std::uint32_t> phase_id;
-  std::uint64_t state_version = 0, id_copy_version = ~std::uint64_t{0};  // x_id, phase_id of this version
   Buffer<vec4> rsdf, sdf_at;
   Buffer<K::Packed> spk, spl, spd, svh, cnv;  // packed copies for the neighbour loops (sim_views.hpp)
   Buffer<K::Packed> pair_w;              // CPU: kernel values per list entry (SimViews::pair_w)
   // sort and sorted scratch
   Buffer<std::uint32_t> key, sphase;
-  Buffer<int> order, rank, ncontacts, nnbr, nsnbr, nsolid, nbr, snbr;
-  Buffer<vec3> sx, sp, sp0, sv, tmp, vtmp, vort, cnormal, scene_n;
-  Buffer<float> sw, lambda, density, h_rho, vort_len;
-  Buffer<int> cell_start, counters;
+  Buffer<int> order, rank, ncontacts;
+  Buffer<vec3> sx, sp, sp0, sv, tmp, vtmp, scene_n;
+  Buffer<float> sw;
+  Buffer<int> counters;  // overflow, longest lists, largest speed (kernels/physics/sim_views.hpp)
+};
+
+// The neighbour grid of the dynamic particles and their lists (kernels/physics/grid.hpp).
+struct GridState {
+  Buffer<int> nnbr, nsnbr, nsolid, nbr, snbr;
+  Buffer<int> cell_start;
   int bits = 4;
-  // static scene; collider_host: this frame's kinematic colliders (set_collider_particles), kept
-  // after the scene's points in the same static grid
+};
+
+// The fluid's per-particle quantities and its constants (kernels/physics/fluid.hpp).
+struct FluidState {
+  Buffer<vec3> vort, cnormal;
+  Buffer<float> lambda, density, h_rho, vort_len;
+  float rho0 = 1.f, eps = 0.f;
+};
+
+// The static scene the contacts meet: scene particles in their own grid, the scene SDF.
+// collider_host: this frame's kinematic colliders (set_collider_particles), kept after the
+// scene's points in the same static grid.
+struct StaticScene {
   std::vector<vec3> static_host, collider_host;
   std::int64_t static_count() const { return static_cast<std::int64_t>(static_host.size() + collider_host.size()); }
   Buffer<vec3> stat;
@@ -90,7 +108,10 @@ struct ParticleSolver::Impl {
   K::GridSpec sgrid{};
   K::SceneSdf sdf{};
   Buffer<float> sdf_grid;
-  // rigid bodies
+};
+
+// Rigid bodies (shape matching, kernels/physics/solids.hpp): host copies and device buffers.
+struct RigidState {
   std::vector<int> body_start, body_count, body_chunk_start, body_chunk_count, chunk_start, chunk_count, chunk_body;
   std::vector<float> body_stiffness;
   Buffer<int> d_body_start, d_body_count, d_body_chunk_start, d_body_chunk_count, d_chunk_start, d_chunk_count,
@@ -102,7 +123,10 @@ struct ParticleSolver::Impl {
   Buffer<mat3> body_R;
   Buffer<K::RigidSum> chunk_sum;
   Buffer<K::SlipSum> chunk_slip;
-  // cloth (global ids)
+};
+
+// Cloth constraints (global ids; kernels/physics/solids.hpp).
+struct ClothState {
   std::vector<int> edge_a, edge_b;
   std::vector<float> edge_len, edge_k0, edge_limit0;
   std::vector<K::Quad> bends;
@@ -116,6 +140,20 @@ struct ParticleSolver::Impl {
   Buffer<vec3> bend_delta;
   Buffer<int3> d_tris;
   int cloth_groups = 0;
+};
+
+}  // namespace solver_state
+
+struct ParticleSolver::Impl : solver_state::ParticleState,
+                              solver_state::GridState,
+                              solver_state::FluidState,
+                              solver_state::StaticScene,
+                              solver_state::RigidState,
+                              solver_state::ClothState {
+  SolverParams P;
+  Device dev;
+  std::int64_t n = 0, cap = 0;
+  std::uint64_t state_version = 0, id_copy_version = ~std::uint64_t{0};  // x_id, phase_id of this version
   // bookkeeping
   std::int64_t n_fluid = 0, n_cloth = 0, n_rigid = 0, emitter_dropped = 0;
   SpawnSchedule schedule;
@@ -124,14 +162,14 @@ struct ParticleSolver::Impl {
   std::vector<Emitter> emitters;
   double time = 0.0;
   std::int64_t steps = 0;
-  float rho0 = 1.f, eps = 0.f;
   // Anything a captured step points to or depends on (particle count, buffers, constraints, scene)
   // bumps the generation; a CUDA graph is captured for a generation that one step has already
   // run with, and replayed while the generation, dt and the substeps stay the same.
   std::uint64_t generation = 0, stepped_generation = ~std::uint64_t{0};
   StepGraph graph;  // the solver's stream, sort storage and CUDA graph (core/step_graph.hpp)
 
-  Impl(const SolverParams& p, Device d) : P(p), dev(d), counters(5, d), graph(d, "particle solver") {
+  Impl(const SolverParams& p, Device d) : P(p), dev(d), graph(d, "particle solver") {
+    counters = Buffer<int>(5, d);
     counters.zero();
     compute_fluid_constants();
   }
