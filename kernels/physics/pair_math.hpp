@@ -1,5 +1,5 @@
 // Inline helpers shared by the physics kernel families (their .inl files only): the pair loops'
-// driver (for_pairs) and batching, the SPH pair math of the fluid passes, the packed position
+// driver (for_each_entry) and batching, the SPH pair math of the fluid passes, the packed position
 // copy and the rule for which pairs are listed at all. Compiled once per backend with the family
 // that includes it.
 #pragma once

@@ -1,3 +1,6 @@
+// ParticleSolver's host side. Over ~600 lines: the state (grouped by concern in solver_state),
+// the views the kernels read, the substep and spawning (add_batch, emitters, the spawn schedule)
+// are still one file; spawning is the part to move out next.
 #include "physics/particle_solver.hpp"
 
 #include <algorithm>
