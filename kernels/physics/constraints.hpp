@@ -1,5 +1,5 @@
 // Per-constraint math of the unified solver (host and device). Each function returns the
-// position correction of one particle; the kernels in solver.inl gather these per particle
+// position correction of one particle; the kernels of the physics families gather these per particle
 // (Jacobi, Macklin 2014 section 4.2), so that no two threads write the same particle.
 #pragma once
 #include "core/hd.hpp"

@@ -1,18 +1,28 @@
-# kernels/physics: the unified particle solver (Macklin et al. 2014), see docs/PHYSICS.md.
-seamless_kernel_family(physics/solver)
-# The CPU instantiation without errno for sqrt: the same results (sqrt of a negative is NaN either
+# kernels/physics: the unified particle solver (Macklin et al. 2014), see docs/PHYSICS.md and
+# kernels/physics/solver.hpp (the passes in order).
+foreach(family grid contacts fluid solids integration)
+  seamless_kernel_family(physics/${family})
+endforeach()
+# The CPU's SIMD tiles (never compiled by nvcc).
+target_sources(seamless_kernels PRIVATE physics/cpu_tiles.cpp)
+# The CPU instantiations without errno for sqrt: the same results (sqrt of a negative is NaN either
 # way), but GCC may then share and vectorise square roots instead of guarding each libm call
 # (the SIMD tiles' lane-by-lane square roots become one vector instruction). -Wno-psabi: the tiles
-# pass 32-byte vectors between always_inline functions, whose ABI note does not apply.
-set_source_files_properties(${CMAKE_CURRENT_SOURCE_DIR}/physics/solver_cpu.cpp
+# pass 32-byte vectors between always_inline functions, whose ABI note does not apply. On every
+# physics CPU file, as when they were one file (solver_cpu.cpp), so the scalar loops compile as
+# they did.
+set(SEAMLESS_PHYSICS_CPU_SOURCES physics/cpu_tiles.cpp physics/grid_cpu.cpp physics/contacts_cpu.cpp
+  physics/fluid_cpu.cpp physics/solids_cpu.cpp physics/integration_cpu.cpp)
+list(TRANSFORM SEAMLESS_PHYSICS_CPU_SOURCES PREPEND ${CMAKE_CURRENT_SOURCE_DIR}/)
+set_source_files_properties(${SEAMLESS_PHYSICS_CPU_SOURCES}
   PROPERTIES COMPILE_OPTIONS "$<$<CXX_COMPILER_ID:GNU,Clang>:-fno-math-errno;-Wno-psabi;--param=inline-unit-growth=200>")
 # The sanitizer build (scripts/sanitize): GCC 12's use-after-scope instrumentation changes what the
 # AVX2 tiles compute (a falling fluid block loses momentum conservation from its first step, and the
 # tiles no longer match the scalar loops bit for bit), while the same build without that one check,
 # the uninstrumented -O2 build, UBSan alone and valgrind's memcheck of the tiles all agree and report
-# nothing. So this file keeps AddressSanitizer's heap, global and stack bounds checks but not
+# nothing. So these files keep AddressSanitizer's heap, global and stack bounds checks but not
 # use-after-scope (docs/ARCHITECTURE.md, "Checks").
 if(SEAMLESS_SANITIZE MATCHES "address")
-  set_property(SOURCE ${CMAKE_CURRENT_SOURCE_DIR}/physics/solver_cpu.cpp APPEND PROPERTY COMPILE_OPTIONS
+  set_property(SOURCE ${SEAMLESS_PHYSICS_CPU_SOURCES} APPEND PROPERTY COMPILE_OPTIONS
     $<$<CXX_COMPILER_ID:GNU>:-fno-sanitize-address-use-after-scope>)
 endif()

@@ -1,6 +1,6 @@
-// SIMD lanes for the CPU's pair loops (kernels/physics/solver.inl): a vector of 8 floats (vf), a
+// SIMD lanes for the CPU's pair loops (kernels/physics/cpu_tiles.cpp): a vector of 8 floats (vf), a
 // lane mask (vm) and a vec3 of vectors (v3), with the operators that the SPH kernels of
-// particle_math.hpp (templates over the float type) and the pair terms of solver.inl use, so that
+// particle_math.hpp (templates over the float type) and the pair terms of the families use, so that
 // one expression serves the scalar code (CUDA, and the CPU where a tile of particles cannot take
 // the vector path) and 8 particles at once on the CPU.
 //
@@ -11,10 +11,10 @@
 // roundings as in the scalar code).
 //
 // GCC vector extensions (generic code, GCC 12 or Clang): the tile functions that use them are
-// compiled for AVX2 on x86-64 (a `#pragma GCC target` region in solver.inl, taken where
+// compiled for AVX2 on x86-64 (a `#pragma GCC target` region in cpu_tiles.cpp, taken where
 // cpu_simd() finds AVX2 at run time; the scalar loops otherwise), for the baseline elsewhere;
 // everything here is always_inline, so it takes the caller's instruction set (the compiler turns
-// the lane loops into vector instructions: solver_cpu.cpp has -fno-math-errno). Never seen by
+// the lane loops into vector instructions: the physics CPU files have -fno-math-errno). Never seen by
 // nvcc.
 #pragma once
 #if !defined(__CUDACC__)
@@ -79,7 +79,7 @@ SEAMLESS_SIMD_INL vi floor_int(vf x) {
   const i8 i = __builtin_convertvector(x.v, i8);
   return select(vm{__builtin_convertvector(i, f8) > x.v}, vi(i - 1), vi(i));
 }
-// Lane by lane (the compiler makes it one vector square root; solver_cpu.cpp has no errno).
+// Lane by lane (the compiler makes it one vector square root; the physics CPU files have no errno).
 SEAMLESS_SIMD_INL vf sqrt(vf a) {
   vf r;
   for (int l = 0; l < kWidth; ++l) r.v[l] = __builtin_sqrtf(a.v[l]);

@@ -1,3 +1,6 @@
+// ParticleSolver's host side. Over ~600 lines: the state (grouped by concern in solver_state),
+// the views the kernels read, the substep and spawning (add_batch, emitters, the spawn schedule)
+// are still one file; spawning is the part to move out next.
 #include "physics/particle_solver.hpp"
 
 #include <algorithm>
@@ -12,6 +15,7 @@
 #include "core/error.hpp"
 #include "core/exec.hpp"
 #include "core/log.hpp"
+#include "core/step_graph.hpp"
 #include "kernels/physics/solver.hpp"
 
 namespace seamless {
@@ -56,12 +60,14 @@ struct Emitter {
 
 }  // namespace
 
-struct ParticleSolver::Impl {
-  SolverParams P;
-  Device dev;
-  std::int64_t n = 0, cap = 0;
-  // slot order (the state between steps in the last substep's sorted order; SimViews): slot_id
-  // holds the particle id of each slot
+// The solver's state by concern; ParticleSolver::Impl derives from them, so the code names each
+// member directly. Buffers on the solver's device; "slot order" is the state between steps in the
+// last substep's sorted order (kernels/physics/sim_views.hpp).
+namespace solver_state {
+
+// Per-particle state: slot order (slot_id holds the particle id of each slot), the per-particle
+// constants and the id-order copies, and the sorted scratch of a substep.
+struct ParticleState {
   Buffer<vec3> x, v, pred;
   Buffer<float> w;
   Buffer<std::uint32_t> phase;
@@ -69,19 +75,35 @@ struct ParticleSolver::Impl {
   // id order: per-particle constants; positions and phases copied out for device_positions()
   Buffer<vec3> rest, x_id;
   Buffer<std::uint32_t> phase_id;
-  std::uint64_t state_version = 0, id_copy_version = ~std::uint64_t{0};  // x_id, phase_id of this version
   Buffer<vec4> rsdf, sdf_at;
   Buffer<K::Packed> spk, spl, spd, svh, cnv;  // packed copies for the neighbour loops (sim_views.hpp)
   Buffer<K::Packed> pair_w;              // CPU: kernel values per list entry (SimViews::pair_w)
   // sort and sorted scratch
   Buffer<std::uint32_t> key, sphase;
-  Buffer<int> order, rank, ncontacts, nnbr, nsnbr, nsolid, nbr, snbr;
-  Buffer<vec3> sx, sp, sp0, sv, tmp, vtmp, vort, cnormal, scene_n;
-  Buffer<float> sw, lambda, density, h_rho, vort_len;
-  Buffer<int> cell_start, counters;
+  Buffer<int> order, rank, ncontacts;
+  Buffer<vec3> sx, sp, sp0, sv, tmp, vtmp, scene_n;
+  Buffer<float> sw;
+  Buffer<int> counters;  // overflow, longest lists, largest speed (kernels/physics/sim_views.hpp)
+};
+
+// The neighbour grid of the dynamic particles and their lists (kernels/physics/grid.hpp).
+struct GridState {
+  Buffer<int> nnbr, nsnbr, nsolid, nbr, snbr;
+  Buffer<int> cell_start;
   int bits = 4;
-  // static scene; collider_host: this frame's kinematic colliders (set_collider_particles), kept
-  // after the scene's points in the same static grid
+};
+
+// The fluid's per-particle quantities and its constants (kernels/physics/fluid.hpp).
+struct FluidState {
+  Buffer<vec3> vort, cnormal;
+  Buffer<float> lambda, density, h_rho, vort_len;
+  float rho0 = 1.f, eps = 0.f;
+};
+
+// The static scene the contacts meet: scene particles in their own grid, the scene SDF.
+// collider_host: this frame's kinematic colliders (set_collider_particles), kept after the
+// scene's points in the same static grid.
+struct StaticScene {
   std::vector<vec3> static_host, collider_host;
   std::int64_t static_count() const { return static_cast<std::int64_t>(static_host.size() + collider_host.size()); }
   Buffer<vec3> stat;
@@ -89,7 +111,10 @@ struct ParticleSolver::Impl {
   K::GridSpec sgrid{};
   K::SceneSdf sdf{};
   Buffer<float> sdf_grid;
-  // rigid bodies
+};
+
+// Rigid bodies (shape matching, kernels/physics/solids.hpp): host copies and device buffers.
+struct RigidState {
   std::vector<int> body_start, body_count, body_chunk_start, body_chunk_count, chunk_start, chunk_count, chunk_body;
   std::vector<float> body_stiffness;
   Buffer<int> d_body_start, d_body_count, d_body_chunk_start, d_body_chunk_count, d_chunk_start, d_chunk_count,
@@ -101,7 +126,10 @@ struct ParticleSolver::Impl {
   Buffer<mat3> body_R;
   Buffer<K::RigidSum> chunk_sum;
   Buffer<K::SlipSum> chunk_slip;
-  // cloth (global ids)
+};
+
+// Cloth constraints (global ids; kernels/physics/solids.hpp).
+struct ClothState {
   std::vector<int> edge_a, edge_b;
   std::vector<float> edge_len, edge_k0, edge_limit0;
   std::vector<K::Quad> bends;
@@ -115,6 +143,20 @@ struct ParticleSolver::Impl {
   Buffer<vec3> bend_delta;
   Buffer<int3> d_tris;
   int cloth_groups = 0;
+};
+
+}  // namespace solver_state
+
+struct ParticleSolver::Impl : solver_state::ParticleState,
+                              solver_state::GridState,
+                              solver_state::FluidState,
+                              solver_state::StaticScene,
+                              solver_state::RigidState,
+                              solver_state::ClothState {
+  SolverParams P;
+  Device dev;
+  std::int64_t n = 0, cap = 0;
+  std::uint64_t state_version = 0, id_copy_version = ~std::uint64_t{0};  // x_id, phase_id of this version
   // bookkeeping
   std::int64_t n_fluid = 0, n_cloth = 0, n_rigid = 0, emitter_dropped = 0;
   SpawnSchedule schedule;
@@ -123,23 +165,14 @@ struct ParticleSolver::Impl {
   std::vector<Emitter> emitters;
   double time = 0.0;
   std::int64_t steps = 0;
-  float rho0 = 1.f, eps = 0.f;
   // Anything a captured step points to or depends on (particle count, buffers, constraints, scene)
   // bumps the generation; a CUDA graph is captured for a generation that one step has already
   // run with, and replayed while the generation, dt and the substeps stay the same.
   std::uint64_t generation = 0, stepped_generation = ~std::uint64_t{0};
-#if SEAMLESS_HAS_CUDA
-  std::unique_ptr<CudaStream> stream;
-  CudaGraph graph;
-  Buffer<unsigned char> sort_temp;  // the sort's own temp storage (the graph keeps pointing at it)
-  std::int64_t sort_temp_n = -1;    // particle count sort_temp was sized for
-  std::uint64_t graph_generation = ~std::uint64_t{0};
-  float graph_dt = 0.f;
-  int graph_substeps = 0;
-  bool graph_failed = false;
-#endif
+  StepGraph graph;  // the solver's stream, sort storage and CUDA graph (core/step_graph.hpp)
 
-  Impl(const SolverParams& p, Device d) : P(p), dev(d), counters(5, d) {
+  Impl(const SolverParams& p, Device d) : P(p), dev(d), graph(d, "particle solver") {
+    counters = Buffer<int>(5, d);
     counters.zero();
     compute_fluid_constants();
   }
@@ -185,7 +218,7 @@ struct ParticleSolver::Impl {
     if (id_copy_version == state_version) return;
     x_id.reserve_discard(cap, dev), phase_id.reserve_discard(cap, dev);
     K::SimViews S = views(P.dt);
-    with_exec(dev, [&](const auto& ex) { K::slots_to_ids(ex, S, x_id.data(), phase_id.data()); });
+    with_exec(dev, [&]<class E>(const E& ex) { K::Integration<E>::slots_to_ids(ex, S, x_id.data(), phase_id.data()); });
     id_copy_version = state_version;
   }
 
@@ -256,19 +289,13 @@ struct ParticleSolver::Impl {
   void prepare_grid() {
     bits = grid_bits(n);
     std::int64_t cells = std::int64_t{1} << (3 * bits);
-    const void* before[3] = {cell_start.data(), snbr.data(), nullptr};
+    const void* before[2] = {cell_start.data(), snbr.data()};
     cell_start.reserve_discard(cells + 1, dev);
     if (static_count() > 0) snbr.reserve_discard(cap * (P.max_static_neighbours + 1), dev);
-#if SEAMLESS_HAS_CUDA
-    before[2] = sort_temp.data();
-    if (dev == Device::CUDA && sort_temp_n != n) {
-      std::size_t need = K::sort_cells_temp_bytes(CudaExec{}, n, 3 * bits);
-      if (static_cast<std::size_t>(sort_temp.size()) < need)
-        sort_temp.reserve_discard(static_cast<std::int64_t>(need + need / 4), dev);
-      sort_temp_n = n;
-    }
-    if (before[2] != sort_temp.data()) ++generation;
-#endif
+    const bool temp_moved = graph.reserve_temp(n, [&]<class E>(const E& ex) {
+      return K::NeighbourGrid<E>::sort_cells_temp_bytes(ex, n, 3 * bits);
+    });
+    if (temp_moved) ++generation;
     if (before[0] != cell_start.data() || before[1] != snbr.data()) ++generation;
   }
 
@@ -276,73 +303,31 @@ struct ParticleSolver::Impl {
   // own temp storage (so that a step can be captured as a graph).
   template <class F>
   void run(F&& fn) {
-#if SEAMLESS_HAS_CUDA
-    if (dev == Device::CUDA) {
-      if (!stream) stream = std::make_unique<CudaStream>();
-      CudaExec ex;
-      ex.stream = stream->get(), ex.temp = sort_temp.data(), ex.temp_bytes = static_cast<std::size_t>(sort_temp.size());
-      fn(ex);
-      return;
-    }
-#endif
-    with_exec(dev, fn);
+    graph.run(std::forward<F>(fn));
   }
 
   // k substeps of dt / k. On CUDA they run on the solver's stream, ordered after what the default
   // stream holds and before what it gets next (no host synchronisation), as one graph launch
-  // when solver.cuda_graph is set and the scene did not change since the last step.
+  // when solver.cuda_graph is set and the scene did not change since the last step (a graph is
+  // recorded for a generation that one step has already run with: StepGraph::step).
   void advance(float dt, int k) {
     if (n == 0) return;
     ++state_version;
     prepare_grid();
-#if SEAMLESS_HAS_CUDA
-    if (dev == Device::CUDA) {
-      if (!stream) stream = std::make_unique<CudaStream>();
-      stream->after_default();
-      if (!replay_graph(dt, k))
-        for (int i = 0; i < k; ++i) substep(dt / static_cast<float>(k));
-      stream->before_default();
-      stepped_generation = generation;
-      return;
-    }
-#endif
-    for (int i = 0; i < k; ++i) substep(dt / static_cast<float>(k));
+    graph.step(P.cuda_graph && generation == stepped_generation, StepGraph::Key{generation, dt, k}, [&] {
+      for (int i = 0; i < k; ++i) substep(dt / static_cast<float>(k));
+    });
     stepped_generation = generation;
   }
-
-#if SEAMLESS_HAS_CUDA
-  // Captures the step (if the graph held is not for this generation, dt and substeps) and
-  // launches it. A scene that changed since the last step is stepped directly: a capture pays
-  // only when it is replayed (an emitter adding particles every step never captures). If the
-  // capture fails, the step runs directly and graphs stay off (nothing recorded was run).
-  bool replay_graph(float dt, int k) {
-    if (!P.cuda_graph || graph_failed || generation != stepped_generation) return false;
-    if (!graph.ready() || graph_generation != generation || graph_dt != dt || graph_substeps != k) {
-      try {
-        graph.begin_capture(*stream);
-        for (int i = 0; i < k; ++i) substep(dt / static_cast<float>(k));
-        graph.end_capture();
-      } catch (const std::exception& e) {
-        graph.abort_capture();
-        graph.reset();
-        graph_failed = true;
-        spdlog::warn("particle solver: capturing the step as a CUDA graph failed ({}); stepping without graphs", e.what());
-        return false;
-      }
-      graph_generation = generation, graph_dt = dt, graph_substeps = k;
-    }
-    graph.launch(*stream);
-    return true;
-  }
-#endif
 
   // Sort, grid and neighbour lists of the predicted positions (S.pred must be filled).
   template <class Ex>
   void build_neighbours(const Ex& ex, const K::SimViews& S) {
-    K::sort_cells(ex, S.key, S.order, n, 3 * bits);
-    K::reorder(ex, S);
-    K::cell_starts(ex, S.key, n, S.cell_start, std::int64_t{1} << (3 * bits));
-    K::find_neighbors(ex, S);
+    using Grid = K::NeighbourGrid<Ex>;
+    Grid::sort_cells(ex, S.key, S.order, n, 3 * bits);
+    Grid::reorder(ex, S);
+    Grid::cell_starts(ex, S.key, n, S.cell_start, std::int64_t{1} << (3 * bits));
+    Grid::find_neighbors(ex, S);
   }
 
   // One substep of Algorithm 1 (dissertation section 4.2.2) with Macklin 2014's additions.
@@ -350,32 +335,34 @@ struct ParticleSolver::Impl {
     K::SimViews S = views(dt);
     const bool has_fluid = n_fluid > 0, has_cloth = !edge_a.empty() || !bends.empty();
     const bool effects = has_fluid || (n_cloth > 0 && (P.drag > 0.f || P.lift > 0.f));
-    run([&](const auto& ex) {
-      K::predict(ex, S);
+    run([&]<class E>(const E& ex) {
+      using Fluid = K::Fluid<E>;
+      using Integration = K::Integration<E>;
+      K::NeighbourGrid<E>::predict(ex, S);
       build_neighbours(ex, S);
-      for (int i = 0; i < P.stabilization_iterations; ++i) K::stabilize(ex, S);
+      for (int i = 0; i < P.stabilization_iterations; ++i) K::Contacts<E>::stabilize(ex, S);
       for (int it = 0; it < P.iterations; ++it) {
-        K::prepare_constraints(ex, S);
-        K::solve_contacts_fluid(ex, S);
+        Fluid::prepare_constraints(ex, S);
+        Fluid::solve_contacts_fluid(ex, S);
         std::swap(S.sp, S.tmp);
-        K::shape_match(ex, S);
+        K::Solids<E>::shape_match(ex, S);
         if (has_cloth) solve_cloth(ex, S);
       }
       if (strain_limited) limit_strain(ex, S);
-      K::update_velocity(ex, S);
+      Integration::update_velocity(ex, S);
       if (effects) {
-        K::velocity_effects(ex, S, has_fluid);
+        Fluid::velocity_effects(ex, S, has_fluid);
         std::swap(S.sv, S.vtmp);
       }
-      K::write_back(ex, S);
+      Integration::write_back(ex, S);
     });
   }
 
   template <class Ex>
   void solve_cloth(const Ex& ex, K::SimViews& S) {
-    if (colour_off.size() > 1) K::cloth_stretch(ex, S, colour_off.data(), colours());
+    if (colour_off.size() > 1) K::Solids<Ex>::cloth_stretch(ex, S, colour_off.data(), colours());
     if (!bends.empty()) {
-      K::cloth_bend(ex, S);
+      K::Solids<Ex>::cloth_bend(ex, S);
       std::swap(S.sp, S.tmp);
     }
   }
@@ -385,7 +372,7 @@ struct ParticleSolver::Impl {
   // Strain limiting after the iterations (Provot 1995): Gauss-Seidel over the edge colours.
   template <class Ex>
   void limit_strain(const Ex& ex, const K::SimViews& S) {
-    if (colour_off.size() > 1) K::cloth_strain_limit(ex, S, colour_off.data(), colours(), P.cloth_strain_passes);
+    if (colour_off.size() > 1) K::Solids<Ex>::cloth_strain_limit(ex, S, colour_off.data(), colours(), P.cloth_strain_passes);
   }
 
   void upload_bodies(const std::vector<vec3>& c, const std::vector<vec4>& q) {
@@ -663,11 +650,12 @@ struct ParticleSolver::Impl {
     Buffer<int> idx(ns, dev);
     stat = Buffer<vec3>(ns, dev);
     scell_start = Buffer<int>(cells + 1, dev);
-    with_exec(dev, [&](const auto& ex) {
-      K::cell_keys(ex, raw.data(), ns, sgrid, keys.data(), idx.data());
-      K::sort_cells(ex, keys.data(), idx.data(), ns, 3 * sb);
-      K::gather_vec3(ex, raw.data(), idx.data(), ns, stat.data());
-      K::cell_starts(ex, keys.data(), ns, scell_start.data(), cells);
+    with_exec(dev, [&]<class E>(const E& ex) {
+      using Grid = K::NeighbourGrid<E>;
+      Grid::cell_keys(ex, raw.data(), ns, sgrid, keys.data(), idx.data());
+      Grid::sort_cells(ex, keys.data(), idx.data(), ns, 3 * sb);
+      Grid::gather_vec3(ex, raw.data(), idx.data(), ns, stat.data());
+      Grid::cell_starts(ex, keys.data(), ns, scell_start.data(), cells);
     });
     snbr.reserve_discard(std::max<std::int64_t>(cap, 1) * (P.max_static_neighbours + 1), dev);
   }
@@ -827,10 +815,10 @@ std::vector<float> ParticleSolver::fluid_density_ratio() const {
   I.prepare_grid();
   K::SimViews S = I.views(I.P.dt);
   S.c.dt = 0.f, S.c.max_speed = 1e30f;  // predicted = current positions, velocities untouched
-  with_exec(I.dev, [&](const auto& ex) {
-    K::predict(ex, S);
+  with_exec(I.dev, [&]<class E>(const E& ex) {
+    K::NeighbourGrid<E>::predict(ex, S);
     I.build_neighbours(ex, S);
-    K::prepare_constraints(ex, S);
+    K::Fluid<E>::prepare_constraints(ex, S);
   });
   std::vector<float> rho = I.density.to_host();
   std::vector<int> order = I.order.to_host();

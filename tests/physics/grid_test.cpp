@@ -29,10 +29,11 @@ Mismatch compare_with_brute_force(const std::vector<vec3>& pts, float R, int bit
   std::vector<vec3> sorted(pts.size());
   std::vector<int> start(static_cast<std::size_t>(g.cells() + 1));
   CpuExec ex;
-  kernels::cell_keys(ex, pts.data(), n, g, keys.data(), idx.data());
-  kernels::sort_cells(ex, keys.data(), idx.data(), n, 3 * bits);
-  kernels::gather_vec3(ex, pts.data(), idx.data(), n, sorted.data());
-  kernels::cell_starts(ex, keys.data(), n, start.data(), g.cells());
+  using Grid = kernels::NeighbourGrid<CpuExec>;
+  Grid::cell_keys(ex, pts.data(), n, g, keys.data(), idx.data());
+  Grid::sort_cells(ex, keys.data(), idx.data(), n, 3 * bits);
+  Grid::gather_vec3(ex, pts.data(), idx.data(), n, sorted.data());
+  Grid::cell_starts(ex, keys.data(), n, start.data(), g.cells());
   Mismatch m;
   std::vector<int> seen(pts.size(), -1);
   for (int s = 0; s < n; ++s) {
@@ -73,12 +74,12 @@ TEST(PhysicsGrid, RowSearchFindsExactlyThePointsWithinTheRadius) {
 }
 
 // Cell offsets: start[k] is the number of keys below k for every k in [0, cells], also for empty
-// cells and long empty runs (the merge walk of kernels::cell_starts).
+// cells and long empty runs (the merge walk of kernels::NeighbourGrid::cell_starts).
 TEST(PhysicsGrid, CellStartsCountKeysBelowEachCell) {
   std::vector<std::uint32_t> keys = {0, 0, 3, 40, 40, 41, 100, 511, 511};
   const std::int64_t cells = 512;
   std::vector<int> start(cells + 1, -1);
-  kernels::cell_starts(CpuExec{}, keys.data(), static_cast<std::int64_t>(keys.size()), start.data(), cells);
+  kernels::NeighbourGrid<CpuExec>::cell_starts(CpuExec{}, keys.data(), static_cast<std::int64_t>(keys.size()), start.data(), cells);
   for (std::int64_t k = 0; k <= cells; ++k) {
     auto below = std::lower_bound(keys.begin(), keys.end(), static_cast<std::uint32_t>(k)) - keys.begin();
     ASSERT_EQ(start[k], below) << "cell " << k;

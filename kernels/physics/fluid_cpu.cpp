@@ -1,0 +1,3 @@
+#include "core/exec_cpu.hpp"
+#include "kernels/physics/fluid.inl"
+template struct seamless::kernels::Fluid<seamless::CpuExec>;

@@ -1,0 +1,3 @@
+#include "core/exec_cpu.hpp"
+#include "kernels/physics/solids.inl"
+template struct seamless::kernels::Solids<seamless::CpuExec>;
