@@ -159,6 +159,7 @@ struct RayIntervals : TileGrid {
 };
 constexpr std::int32_t kEmptyNear = 0x7f800000;  // +infinity
 constexpr std::int32_t kEmptyFar = 0;            // +0: no block splatted
+
 template <Executor Exec, class Acc = HashAccess>
 struct TsdfRaycast {
   // Empties every tile (near = +inf, far = 0), and window w when given (every entry -1).
@@ -213,6 +214,7 @@ namespace seamless::kernels {
 SEAMLESS_HD inline int lattice_per_block(float voxel_size, float spacing) {
   return static_cast<int>(ceilf(kBlockSide * voxel_size / spacing)) + 1;
 }
+
 template <Executor Exec, class Acc = HashAccess>
 struct TsdfExtract {
   // counts[i] = triangles of cell i (block i / 512, voxel i % 512); returns the total and turns
@@ -229,6 +231,7 @@ struct TsdfExtract {
   // Block coordinates of the given hash slots.
   static void slot_block_coords(const Exec& ex, HashTableView t, View<const std::int32_t> slots, View<int3> out);
 
+  // The candidates' counts of the lattice points (see lattice_per_block above).
   static std::int64_t scene_particle_count(const Exec& ex, Acc a, View<const int3> blocks, float spacing, float interior_depth,
                                            View<std::int32_t> counts);
 
