@@ -5,8 +5,8 @@
 
 namespace seamless::kernels {
 
-template <class Exec>
-void fill_depth_gaps(const Exec& ex, View2D<const float> in, View2D<float> out, float max_rel_diff) {
+template <Executor Exec>
+void FillGaps<Exec>::fill_depth_gaps(const Exec& ex, View2D<const float> in, View2D<float> out, float max_rel_diff) {
   const int w = out.width;
   ex.for_each(out.count(), [=] SEAMLESS_HD(std::int64_t i) {
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
@@ -15,8 +15,3 @@ void fill_depth_gaps(const Exec& ex, View2D<const float> in, View2D<float> out, 
 }
 
 }  // namespace seamless::kernels
-
-#define SEAMLESS_INSTANTIATE_FILL_GAPS(EXEC)                                                          \
-  namespace seamless::kernels {                                                                      \
-  template void fill_depth_gaps<EXEC>(const EXEC&, View2D<const float>, View2D<float>, float);         \
-  }

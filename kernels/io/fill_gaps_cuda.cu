@@ -1,3 +1,3 @@
 #include "core/exec_cuda.cuh"
 #include "kernels/io/fill_gaps.inl"
-SEAMLESS_INSTANTIATE_FILL_GAPS(seamless::CudaExec)
+template struct seamless::kernels::FillGaps<seamless::CudaExec>;

@@ -16,6 +16,7 @@
 #include <cstdint>
 
 #include "core/camera.hpp"
+#include "core/exec.hpp"
 #include "core/math.hpp"
 #include "core/view.hpp"
 #include "kernels/scene/movers.hpp"
@@ -65,14 +66,16 @@ SEAMLESS_HD inline float kinect_quantise(float z, float f, const DepthNoise& n, 
   return dq > 0.f ? fb / dq : 0.f;
 }
 
-// depth (metres, 0 = none) and rgb of the room seen from world_T_camera through the pinhole K,
-// with the frame's movers (people, balls) in it. scratch is a float image of the same size (holds
-// the noise-free depth between the two passes). mask (optional: an empty view skips it) gets the
-// id of the mover each pixel sees (0: the static room or nothing): the ground truth of dynamic
-// pixels. The noise is a pure function of (seed, frame, pixel): deterministic on both backends.
-template <class Exec>
-void render_room(const Exec& ex, Intrinsics K, SE3 world_T_camera, DepthNoise noise, std::uint32_t seed,
-                 std::uint32_t frame, const movers::Scene& movers, View2D<float> scratch, View2D<float> depth,
-                 View2D<uchar3> rgb, View2D<std::uint8_t> mask);
+template <Executor Exec>
+struct RenderRoom {
+  // depth (metres, 0 = none) and rgb of the room seen from world_T_camera through the pinhole K,
+  // with the frame's movers (people, balls) in it. scratch is a float image of the same size (holds
+  // the noise-free depth between the two passes). mask (optional: an empty view skips it) gets the
+  // id of the mover each pixel sees (0: the static room or nothing): the ground truth of dynamic
+  // pixels. The noise is a pure function of (seed, frame, pixel): deterministic on both backends.
+  static void render_room(const Exec& ex, Intrinsics K, SE3 world_T_camera, DepthNoise noise, std::uint32_t seed,
+                          std::uint32_t frame, const movers::Scene& movers, View2D<float> scratch, View2D<float> depth,
+                          View2D<uchar3> rgb, View2D<std::uint8_t> mask);
+};
 
 }  // namespace seamless::kernels

@@ -29,8 +29,8 @@ SEAMLESS_HD inline bool in_projector_shadow(vec3 p, vec3 n, vec3 projector, cons
 
 }  // namespace render_detail
 
-template <class Exec>
-void render_room(const Exec& ex, Intrinsics K, SE3 world_T_camera, DepthNoise noise, std::uint32_t seed,
+template <Executor Exec>
+void RenderRoom<Exec>::render_room(const Exec& ex, Intrinsics K, SE3 world_T_camera, DepthNoise noise, std::uint32_t seed,
                  std::uint32_t frame, const movers::Scene& movers, View2D<float> scratch, View2D<float> depth,
                  View2D<uchar3> rgb, View2D<std::uint8_t> mask) {
   const int w = depth.width;
@@ -85,10 +85,3 @@ void render_room(const Exec& ex, Intrinsics K, SE3 world_T_camera, DepthNoise no
 }
 
 }  // namespace seamless::kernels
-
-#define SEAMLESS_INSTANTIATE_RENDER_ROOM(EXEC)                                                        \
-  namespace seamless::kernels {                                                                      \
-  template void render_room<EXEC>(const EXEC&, Intrinsics, SE3, DepthNoise, std::uint32_t, std::uint32_t, \
-                                  const movers::Scene&, View2D<float>, View2D<float>, View2D<uchar3>,  \
-                                  View2D<std::uint8_t>);                                             \
-  }

@@ -1,3 +1,3 @@
 #include "core/exec_cpu.hpp"
 #include "kernels/io/render_room.inl"
-SEAMLESS_INSTANTIATE_RENDER_ROOM(seamless::CpuExec)
+template struct seamless::kernels::RenderRoom<seamless::CpuExec>;

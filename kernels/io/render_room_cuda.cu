@@ -1,3 +1,3 @@
 #include "core/exec_cuda.cuh"
 #include "kernels/io/render_room.inl"
-SEAMLESS_INSTANTIATE_RENDER_ROOM(seamless::CudaExec)
+template struct seamless::kernels::RenderRoom<seamless::CudaExec>;

@@ -3,6 +3,7 @@
 // same fx fy cx cy: each output pixel looks up where the lens put it.
 #pragma once
 #include "core/camera.hpp"
+#include "core/exec.hpp"
 #include "core/math.hpp"
 #include "core/view.hpp"
 
@@ -19,16 +20,16 @@ SEAMLESS_HD inline vec2 distort_pixel(const Intrinsics& K, float x, float y) {
   return {K.fx * xd + K.cx, K.fy * yd + K.cy};
 }
 
-// map(x, y) = distort_pixel(K, x, y) for every output pixel: computed once per camera.
-template <class Exec>
-void undistort_map(const Exec& ex, Intrinsics K, View2D<vec2> map);
+template <Executor Exec>
+struct Undistort {
+  // map(x, y) = distort_pixel(K, x, y) for every output pixel: computed once per camera.
+  static void undistort_map(const Exec& ex, Intrinsics K, View2D<vec2> map);
 
-// Depth: nearest neighbour (interpolating would invent depths across discontinuities).
-template <class Exec>
-void remap_depth(const Exec& ex, View2D<const vec2> map, View2D<const float> in, View2D<float> out);
+  // Depth: nearest neighbour (interpolating would invent depths across discontinuities).
+  static void remap_depth(const Exec& ex, View2D<const vec2> map, View2D<const float> in, View2D<float> out);
 
-// Colour: bilinear.
-template <class Exec>
-void remap_rgb(const Exec& ex, View2D<const vec2> map, View2D<const uchar3> in, View2D<uchar3> out);
+  // Colour: bilinear.
+  static void remap_rgb(const Exec& ex, View2D<const vec2> map, View2D<const uchar3> in, View2D<uchar3> out);
+};
 
 }  // namespace seamless::kernels

@@ -5,8 +5,8 @@
 
 namespace seamless::kernels {
 
-template <class Exec>
-void undistort_map(const Exec& ex, Intrinsics K, View2D<vec2> map) {
+template <Executor Exec>
+void Undistort<Exec>::undistort_map(const Exec& ex, Intrinsics K, View2D<vec2> map) {
   const int w = map.width;
   ex.for_each(map.count(), [=] SEAMLESS_HD(std::int64_t i) {
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
@@ -14,8 +14,8 @@ void undistort_map(const Exec& ex, Intrinsics K, View2D<vec2> map) {
   });
 }
 
-template <class Exec>
-void remap_depth(const Exec& ex, View2D<const vec2> map, View2D<const float> in, View2D<float> out) {
+template <Executor Exec>
+void Undistort<Exec>::remap_depth(const Exec& ex, View2D<const vec2> map, View2D<const float> in, View2D<float> out) {
   const int w = out.width;
   ex.for_each(out.count(), [=] SEAMLESS_HD(std::int64_t i) {
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
@@ -25,8 +25,8 @@ void remap_depth(const Exec& ex, View2D<const vec2> map, View2D<const float> in,
   });
 }
 
-template <class Exec>
-void remap_rgb(const Exec& ex, View2D<const vec2> map, View2D<const uchar3> in, View2D<uchar3> out) {
+template <Executor Exec>
+void Undistort<Exec>::remap_rgb(const Exec& ex, View2D<const vec2> map, View2D<const uchar3> in, View2D<uchar3> out) {
   const int w = out.width;
   ex.for_each(out.count(), [=] SEAMLESS_HD(std::int64_t i) {
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
@@ -47,10 +47,3 @@ void remap_rgb(const Exec& ex, View2D<const vec2> map, View2D<const uchar3> in, 
 }
 
 }  // namespace seamless::kernels
-
-#define SEAMLESS_INSTANTIATE_UNDISTORT(EXEC)                                                                \
-  namespace seamless::kernels {                                                                            \
-  template void undistort_map<EXEC>(const EXEC&, Intrinsics, View2D<vec2>);                                 \
-  template void remap_depth<EXEC>(const EXEC&, View2D<const vec2>, View2D<const float>, View2D<float>);     \
-  template void remap_rgb<EXEC>(const EXEC&, View2D<const vec2>, View2D<const uchar3>, View2D<uchar3>);    \
-  }

@@ -1,3 +1,3 @@
 #include "core/exec_cpu.hpp"
 #include "kernels/io/undistort.inl"
-SEAMLESS_INSTANTIATE_UNDISTORT(seamless::CpuExec)
+template struct seamless::kernels::Undistort<seamless::CpuExec>;

@@ -1,3 +1,3 @@
 #include "core/exec_cuda.cuh"
 #include "kernels/io/undistort.inl"
-SEAMLESS_INSTANTIATE_UNDISTORT(seamless::CudaExec)
+template struct seamless::kernels::Undistort<seamless::CudaExec>;

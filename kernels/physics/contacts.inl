@@ -180,7 +180,7 @@ SEAMLESS_HD inline bool has_contact_lists(const SimViews& S, int s) {
 
 // Macklin 2014, section 4.4: contacts that already exist at the start positions are resolved on
 // x and p together, so that they are removed without adding velocity.
-template <class Exec>
+template <Executor Exec>
 void Contacts<Exec>::stabilize(const Exec& ex, const SimViews& S) {
   ex.for_each(S.nbodies, [=] SEAMLESS_HD(std::int64_t b) { S.body_contacts[b] = 0; });
   ex.for_each_grouped(S.n, kPairLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {

@@ -1,11 +1,12 @@
 // Kernel family of the fluid (position based fluids, Macklin & Mueller 2013) and the velocity
 // effects (solver.hpp lists the passes in order).
 #pragma once
+#include "core/exec.hpp"
 #include "kernels/physics/sim_views.hpp"
 
 namespace seamless::kernels {
 
-template <class Exec>
+template <Executor Exec>
 struct Fluid {
   // Fluid density and lambda (PBF eqs. 1-11); number of active contacts of every particle.
   static void prepare_constraints(const Exec& ex, const SimViews& S);

@@ -85,7 +85,7 @@ SEAMLESS_HD inline void finish_density(const SimViews& S, int s, int nc, const D
 }
 }  // namespace detail
 
-template <class Exec>
+template <Executor Exec>
 void Fluid<Exec>::prepare_constraints(const Exec& ex, const SimViews& S) {
   ex.for_each(S.nbodies, [=] SEAMLESS_HD(std::int64_t b) { S.body_contacts[b] = 0; });
   detail::pack_positions(ex, S);
@@ -188,7 +188,7 @@ SEAMLESS_HD inline vec3 coupling_part(const SimViews& S, int s, Lanes g) {
 }
 }  // namespace detail
 
-template <class Exec>
+template <Executor Exec>
 void Fluid<Exec>::solve_contacts_fluid(const Exec& ex, const SimViews& S) {
   auto one = [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
     const int s = static_cast<int>(i);
@@ -383,7 +383,7 @@ SEAMLESS_HD inline VortSum vorticity_part(const SimViews& S, int s, Lanes g) {
 }
 }  // namespace detail
 
-template <class Exec>
+template <Executor Exec>
 void Fluid<Exec>::velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
   if (has_fluid) {
     // Vorticity omega_i = sum_j v_ij x grad_j W_ij (PBF eq. 15), Akinci's colour-field normal

@@ -4,11 +4,12 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "core/exec.hpp"
 #include "kernels/physics/sim_views.hpp"
 
 namespace seamless::kernels {
 
-template <class Exec>
+template <Executor Exec>
 struct NeighbourGrid {
   // External forces, speed limit, prediction p = x + v dt; cell keys of p; order = identity.
   static void predict(const Exec& ex, const SimViews& S);

@@ -6,7 +6,7 @@
 
 namespace seamless::kernels {
 
-template <class Exec>
+template <Executor Exec>
 void NeighbourGrid<Exec>::predict(const Exec& ex, const SimViews& S) {
   ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t i) {
     vec3 v = S.v[i];
@@ -22,19 +22,19 @@ void NeighbourGrid<Exec>::predict(const Exec& ex, const SimViews& S) {
   });
 }
 
-template <class Exec>
+template <Executor Exec>
 void NeighbourGrid<Exec>::sort_cells(const Exec& ex, std::uint32_t* keys, int* values, std::int64_t n, int bits) {
   ex.sort_by_key(keys, values, n, bits);
 }
 
-template <class Exec>
+template <Executor Exec>
 std::size_t NeighbourGrid<Exec>::sort_cells_temp_bytes(const Exec& ex, std::int64_t n, int bits) {
   return ex.template sort_by_key_temp_bytes<std::uint32_t, int>(n, bits);
 }
 
 // Gathers the slot state into the sorted order; order[s] becomes the particle id of sorted index
 // s (each thread rewrites only its own entry) and rank its inverse.
-template <class Exec>
+template <Executor Exec>
 void NeighbourGrid<Exec>::reorder(const Exec& ex, const SimViews& S) {
   ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
     const int slot = S.order[s], id = S.slot_id[slot];
@@ -50,7 +50,7 @@ void NeighbourGrid<Exec>::reorder(const Exec& ex, const SimViews& S) {
   });
 }
 
-template <class Exec>
+template <Executor Exec>
 void NeighbourGrid<Exec>::cell_starts(const Exec& ex, const std::uint32_t* keys, std::int64_t n, int* start, std::int64_t cells) {
   // Each task fills a block of cells: one binary search for the first, then a merge walk along
   // the sorted keys (work per task: the block's cells plus the entries in them). Parallel on both
@@ -87,7 +87,7 @@ void NeighbourGrid<Exec>::cell_starts(const Exec& ex, const std::uint32_t* keys,
   });
 }
 
-template <class Exec>
+template <Executor Exec>
 void NeighbourGrid<Exec>::cell_keys(const Exec& ex, const vec3* p, std::int64_t n, GridSpec g, std::uint32_t* keys, int* idx) {
   ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) {
     keys[i] = g.key(g.cell_of(p[i]));
@@ -95,7 +95,7 @@ void NeighbourGrid<Exec>::cell_keys(const Exec& ex, const vec3* p, std::int64_t 
   });
 }
 
-template <class Exec>
+template <Executor Exec>
 void NeighbourGrid<Exec>::gather_vec3(const Exec& ex, const vec3* src, const int* idx, std::int64_t n, vec3* dst) {
   ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) { dst[i] = src[idx[i]]; });
 }
@@ -199,7 +199,7 @@ SEAMLESS_HD inline void finish_neighbors(const SimViews& S, int s, int cnt, int 
 }
 }  // namespace detail
 
-template <class Exec>
+template <Executor Exec>
 void NeighbourGrid<Exec>::find_neighbors(const Exec& ex, const SimViews& S) {
   auto one = [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
     // A CPU thread walks a particle's runs alone (Lanes{}); CUDA does from about 270k particles.

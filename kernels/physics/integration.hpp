@@ -3,11 +3,12 @@
 #pragma once
 #include <cstdint>
 
+#include "core/exec.hpp"
 #include "kernels/physics/sim_views.hpp"
 
 namespace seamless::kernels {
 
-template <class Exec>
+template <Executor Exec>
 struct Integration {
   // v = v_pred + (p - p0) / dt (exactly symplectic Euler when nothing acted), restitution, sleeping.
   static void update_velocity(const Exec& ex, const SimViews& S);

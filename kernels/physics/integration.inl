@@ -6,7 +6,7 @@
 
 namespace seamless::kernels {
 
-template <class Exec>
+template <Executor Exec>
 void Integration<Exec>::update_velocity(const Exec& ex, const SimViews& S) {
   ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
     // v_pred + (p - p0)/dt equals (p - x)/dt, but is exactly v_pred when no constraint acted.
@@ -31,7 +31,7 @@ void Integration<Exec>::update_velocity(const Exec& ex, const SimViews& S) {
 
 
 // The sorted state becomes the slot state (slot s = sorted index s: coalesced, no scatter by id).
-template <class Exec>
+template <Executor Exec>
 void Integration<Exec>::write_back(const Exec& ex, const SimViews& S) {
   ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
     S.x[s] = S.sp[s];
@@ -49,7 +49,7 @@ void Integration<Exec>::write_back(const Exec& ex, const SimViews& S) {
 
 // The slot state's positions and phases in id order (for what reads particles by id: the
 // renderer's cloth triangles, downloads).
-template <class Exec>
+template <Executor Exec>
 void Integration<Exec>::slots_to_ids(const Exec& ex, const SimViews& S, vec3* x_id, std::uint32_t* phase_id) {
   ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
     const int id = S.slot_id[s];

@@ -4,11 +4,12 @@
 #pragma once
 #include <cstdint>
 
+#include "core/exec.hpp"
 #include "kernels/physics/sim_views.hpp"
 
 namespace seamless::kernels {
 
-template <class Exec>
+template <Executor Exec>
 struct Solids {
   // Shape matching of every rigid body (Mueller 2005): per-body sums, rotation, goal positions.
   static void shape_match(const Exec& ex, const SimViews& S);

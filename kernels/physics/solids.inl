@@ -17,7 +17,7 @@ namespace seamless::kernels {
 // mean normal correction in the step (eq. 24's condition, for the body's contact patch). The
 // contact points then stay put on average, without a torque (the body may still turn about them).
 // Otherwise the particles' kinetic friction acts alone.
-template <class Exec>
+template <Executor Exec>
 void Solids<Exec>::body_static_friction(const Exec& ex, const SimViews& S) {
   ex.for_each(S.nchunks, [=] SEAMLESS_HD(std::int64_t c) {
     SlipSum sum{{0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}, 0.f, 0.f};
@@ -48,7 +48,7 @@ void Solids<Exec>::body_static_friction(const Exec& ex, const SimViews& S) {
   });
 }
 
-template <class Exec>
+template <Executor Exec>
 void Solids<Exec>::shape_match(const Exec& ex, const SimViews& S) {
   if (S.nbodies == 0) return;
   // Partial sums over fixed-size chunks of each body's particles, then per-body totals: a
@@ -98,7 +98,7 @@ void Solids<Exec>::shape_match(const Exec& ex, const SimViews& S) {
 // particle and 2 iterations left hanging cloth stretched by 20 %. One task per edge writes both
 // of its particles, which no other task of the colour touches. The colours are the phases of one
 // for_each_phases sweep (one launch for a small cloth on CUDA, the same order as a launch each).
-template <class Exec>
+template <Executor Exec>
 void Solids<Exec>::cloth_stretch(const Exec& ex, const SimViews& S, const std::int64_t* colour_off, int colours) {
   // What the sweep reads, staged for it (in fast memory where the executor can, most valuable
   // first: the positions it writes, then the per-particle and per-edge constants).
@@ -127,7 +127,7 @@ void Solids<Exec>::cloth_stretch(const Exec& ex, const SimViews& S, const std::i
 // scene holds it, and the free part of the cloth takes more of the correction instead of the
 // limiter pulling the particle into the scene (mass scaling in the spirit of Macklin 2014's
 // stacking heuristic).
-template <class Exec>
+template <Executor Exec>
 void Solids<Exec>::cloth_strain_limit(const Exec& ex, const SimViews& S, const std::int64_t* colour_off, int colours, int passes) {
   std::vector<std::int64_t> begin, end;
   for (int pass = 0; pass < passes; ++pass)
@@ -158,7 +158,7 @@ void Solids<Exec>::cloth_strain_limit(const Exec& ex, const SimViews& S, const s
 // four corrections once (bend_delta[4 b + vertex]), then every particle gathers its own, in the
 // order of its incidence list (no float atomics), which names the slots directly (one dependent
 // load less than looking the vertex up in the constraint's Quad).
-template <class Exec>
+template <Executor Exec>
 void Solids<Exec>::cloth_bend(const Exec& ex, const SimViews& S) {
   ex.for_each(S.nbends, [=] SEAMLESS_HD(std::int64_t b) {
     Quad q = S.bend_ids[b];

@@ -9,6 +9,7 @@
 #include <cstdint>
 
 #include "core/camera.hpp"
+#include "core/exec.hpp"
 #include "core/math.hpp"
 #include "core/view.hpp"
 
@@ -35,41 +36,39 @@ SEAMLESS_HD inline float dynamic_threshold(const DynamicInput& in, float z) {
   return fmaxf(in.residual_min, in.residual_sigmas * in.noise_coeff * z * z);
 }
 
-// Candidates (1) per pixel: the measurement lies in front of the model, either (a) by more than the
-// residual threshold from every model plane near its projection (point-to-plane, signed: in front)
-// or (b) by more than free_space from the nearest model surface along the ray. Pixels without depth
-// or without any model surface near their projection are 0 (nothing to compare with: unknown space
-// is not evidence of motion). Only "in front" counts: a measurement behind the model is what an
-// object that left, or background it uncovered, gives, and fusing it carves the old surface away.
-template <class Exec>
-void classify_dynamic(const Exec& ex, DynamicInput in, View2D<std::uint8_t> candidates);
+template <Executor Exec>
+struct Dynamic {
+  // Candidates (1) per pixel: the measurement lies in front of the model, either (a) by more than the
+  // residual threshold from every model plane near its projection (point-to-plane, signed: in front)
+  // or (b) by more than free_space from the nearest model surface along the ray. Pixels without depth
+  // or without any model surface near their projection are 0 (nothing to compare with: unknown space
+  // is not evidence of motion). Only "in front" counts: a measurement behind the model is what an
+  // object that left, or background it uncovered, gives, and fusing it carves the old surface away.
+  static void classify_dynamic(const Exec& ex, DynamicInput in, View2D<std::uint8_t> candidates);
 
-// Region and temporal consistency: a candidate stays dynamic when at least min_support of the
-// (2r+1)^2 candidates around it (itself included) are candidates, or when the previous frame's
-// mask had it (prev may be empty: data == nullptr); then the kept pixels are dilated by r into
-// neighbours whose depth is within max_step of theirs (the silhouette's mixed pixels, never the
-// background behind) and into neighbours without a reading (the sensor drops a mover's silhouette
-// and scattered pixels on it: a fifth of a person's pixels in the synthetic Kinect model; they
-// carry no depth to fuse or track, but the mask is also what the physics and the view show). The opening removes isolated speckles of noise; the previous mask keeps a
-// mover's thin parts (arms) that flicker in and out of the support test.
-template <class Exec>
-void filter_dynamic(const Exec& ex, View2D<const std::uint8_t> candidates, View2D<const std::uint8_t> prev,
-                    View2D<const float> depth, int radius, int min_support, float max_step,
-                    View2D<std::uint8_t> kept, View2D<std::uint8_t> mask);
+  // Region and temporal consistency: a candidate stays dynamic when at least min_support of the
+  // (2r+1)^2 candidates around it (itself included) are candidates, or when the previous frame's
+  // mask had it (prev may be empty: data == nullptr); then the kept pixels are dilated by r into
+  // neighbours whose depth is within max_step of theirs (the silhouette's mixed pixels, never the
+  // background behind) and into neighbours without a reading (the sensor drops a mover's silhouette
+  // and scattered pixels on it: a fifth of a person's pixels in the synthetic Kinect model; they
+  // carry no depth to fuse or track, but the mask is also what the physics and the view show). The opening removes isolated speckles of noise; the previous mask keeps a
+  // mover's thin parts (arms) that flicker in and out of the support test.
+  static void filter_dynamic(const Exec& ex, View2D<const std::uint8_t> candidates, View2D<const std::uint8_t> prev,
+                             View2D<const float> depth, int radius, int min_support, float max_step,
+                             View2D<std::uint8_t> kept, View2D<std::uint8_t> mask);
 
-// Zeroes the vertices and normals of pyramid level pixels whose 2^level x 2^level block of the
-// full-resolution mask holds a dynamic pixel: the trackers then give them weight 0 (a zero vertex
-// is no reading).
-template <class Exec>
-void mask_vertices(const Exec& ex, View2D<const std::uint8_t> mask, int scale, View2D<vec3> vertices,
-                   View2D<vec3> normals);
+  // Zeroes the vertices and normals of pyramid level pixels whose 2^level x 2^level block of the
+  // full-resolution mask holds a dynamic pixel: the trackers then give them weight 0 (a zero vertex
+  // is no reading).
+  static void mask_vertices(const Exec& ex, View2D<const std::uint8_t> mask, int scale, View2D<vec3> vertices,
+                            View2D<vec3> normals);
 
-// Zeroes the depth of dynamic pixels (fusion then skips them).
-template <class Exec>
-void mask_depth(const Exec& ex, View2D<const std::uint8_t> mask, View2D<float> depth);
+  // Zeroes the depth of dynamic pixels (fusion then skips them).
+  static void mask_depth(const Exec& ex, View2D<const std::uint8_t> mask, View2D<float> depth);
 
-// Dynamic pixels in a mask (the frame's masked fraction for summary.json).
-template <class Exec>
-std::int64_t count_dynamic(const Exec& ex, View2D<const std::uint8_t> mask);
+  // Dynamic pixels in a mask (the frame's masked fraction for summary.json).
+  static std::int64_t count_dynamic(const Exec& ex, View2D<const std::uint8_t> mask);
+};
 
 }  // namespace seamless::kernels

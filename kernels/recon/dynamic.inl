@@ -5,8 +5,8 @@
 
 namespace seamless::kernels {
 
-template <class Exec>
-void classify_dynamic(const Exec& ex, DynamicInput in, View2D<std::uint8_t> candidates) {
+template <Executor Exec>
+void Dynamic<Exec>::classify_dynamic(const Exec& ex, DynamicInput in, View2D<std::uint8_t> candidates) {
   const int w = in.depth.width;
   ex.for_each(in.depth.count(), [=] SEAMLESS_HD(std::int64_t i) {
     const int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
@@ -40,8 +40,8 @@ void classify_dynamic(const Exec& ex, DynamicInput in, View2D<std::uint8_t> cand
   });
 }
 
-template <class Exec>
-void filter_dynamic(const Exec& ex, View2D<const std::uint8_t> candidates, View2D<const std::uint8_t> prev,
+template <Executor Exec>
+void Dynamic<Exec>::filter_dynamic(const Exec& ex, View2D<const std::uint8_t> candidates, View2D<const std::uint8_t> prev,
                     View2D<const float> depth, int radius, int min_support, float max_step,
                     View2D<std::uint8_t> kept, View2D<std::uint8_t> mask) {
   const int w = candidates.width;
@@ -72,8 +72,8 @@ void filter_dynamic(const Exec& ex, View2D<const std::uint8_t> candidates, View2
   });
 }
 
-template <class Exec>
-void mask_vertices(const Exec& ex, View2D<const std::uint8_t> mask, int scale, View2D<vec3> vertices,
+template <Executor Exec>
+void Dynamic<Exec>::mask_vertices(const Exec& ex, View2D<const std::uint8_t> mask, int scale, View2D<vec3> vertices,
                    View2D<vec3> normals) {
   const int w = vertices.width;
   ex.for_each(vertices.count(), [=] SEAMLESS_HD(std::int64_t i) {
@@ -88,8 +88,8 @@ void mask_vertices(const Exec& ex, View2D<const std::uint8_t> mask, int scale, V
   });
 }
 
-template <class Exec>
-void mask_depth(const Exec& ex, View2D<const std::uint8_t> mask, View2D<float> depth) {
+template <Executor Exec>
+void Dynamic<Exec>::mask_depth(const Exec& ex, View2D<const std::uint8_t> mask, View2D<float> depth) {
   const int w = depth.width;
   ex.for_each(depth.count(), [=] SEAMLESS_HD(std::int64_t i) {
     const int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
@@ -97,8 +97,8 @@ void mask_depth(const Exec& ex, View2D<const std::uint8_t> mask, View2D<float> d
   });
 }
 
-template <class Exec>
-std::int64_t count_dynamic(const Exec& ex, View2D<const std::uint8_t> mask) {
+template <Executor Exec>
+std::int64_t Dynamic<Exec>::count_dynamic(const Exec& ex, View2D<const std::uint8_t> mask) {
   const int w = mask.width;
   return ex.transform_reduce(mask.count(), std::int64_t{0}, [=] SEAMLESS_HD(std::int64_t i) {
     return static_cast<std::int64_t>(mask(static_cast<int>(i % w), static_cast<int>(i / w)) != 0);
@@ -106,14 +106,3 @@ std::int64_t count_dynamic(const Exec& ex, View2D<const std::uint8_t> mask) {
 }
 
 }  // namespace seamless::kernels
-
-#define SEAMLESS_INSTANTIATE_DYNAMIC(EXEC)                                                                       \
-  namespace seamless::kernels {                                                                                  \
-  template void classify_dynamic<EXEC>(const EXEC&, DynamicInput, View2D<std::uint8_t>);                         \
-  template void filter_dynamic<EXEC>(const EXEC&, View2D<const std::uint8_t>, View2D<const std::uint8_t>,        \
-                                     View2D<const float>, int, int, float, View2D<std::uint8_t>,                 \
-                                     View2D<std::uint8_t>);                                                      \
-  template void mask_vertices<EXEC>(const EXEC&, View2D<const std::uint8_t>, int, View2D<vec3>, View2D<vec3>);   \
-  template void mask_depth<EXEC>(const EXEC&, View2D<const std::uint8_t>, View2D<float>);                        \
-  template std::int64_t count_dynamic<EXEC>(const EXEC&, View2D<const std::uint8_t>);                            \
-  }

@@ -1,3 +1,3 @@
 #include "core/exec_cpu.hpp"
 #include "kernels/recon/dynamic.inl"
-SEAMLESS_INSTANTIATE_DYNAMIC(seamless::CpuExec)
+template struct seamless::kernels::Dynamic<seamless::CpuExec>;

@@ -1,3 +1,3 @@
 #include "core/exec_cuda.cuh"
 #include "kernels/recon/dynamic.inl"
-SEAMLESS_INSTANTIATE_DYNAMIC(seamless::CudaExec)
+template struct seamless::kernels::Dynamic<seamless::CudaExec>;

@@ -13,6 +13,7 @@
 #include <cstdint>
 
 #include "core/camera.hpp"
+#include "core/exec.hpp"
 #include "core/math.hpp"
 #include "core/view.hpp"
 
@@ -266,30 +267,29 @@ SEAMLESS_HD inline void gauss_newton_update(const IcpSums& s, IcpPose& p, IcpUpd
 // The step of round `step` of a level's loop: its first clears the previous level's flags.
 SEAMLESS_HD inline IcpUpdate level_step(int step) { return step == 0 ? IcpUpdate::first_step : IcpUpdate::step; }
 
-// Sums the point-to-plane normal equations over every pixel of the current level (one pass) at the
-// estimate *pose (level.ref_T_cur is ignored) into *out on the device, without a step (tests,
-// statistics).
-template <class Exec>
-void icp_reduce_into(const Exec& ex, IcpLevel level, IcpPose* pose, IcpSums* out);
+template <Executor Exec>
+struct Icp {
+  // Sums the point-to-plane normal equations over every pixel of the current level (one pass) at the
+  // estimate *pose (level.ref_T_cur is ignored) into *out on the device, without a step (tests,
+  // statistics).
+  static void icp_reduce_into(const Exec& ex, IcpLevel level, IcpPose* pose, IcpSums* out);
 
-// Up to `steps` Gauss-Newton steps of one level in one device launch (transform_reduce_rounds):
-// each sums the system at *pose into *out and applies it (gauss_newton_update), and the steps end
-// once the level is done, so a converged level's remaining steps cost nothing. *out then holds the
-// last system summed. The host queues the whole coarse-to-fine loop, a launch per level.
-template <class Exec>
-void icp_level_steps(const Exec& ex, IcpLevel level, IcpPose* pose, IcpSums* out, int steps);
+  // Up to `steps` Gauss-Newton steps of one level in one device launch (transform_reduce_rounds):
+  // each sums the system at *pose into *out and applies it (gauss_newton_update), and the steps end
+  // once the level is done, so a converged level's remaining steps cost nothing. *out then holds the
+  // last system summed. The host queues the whole coarse-to-fine loop, a launch per level.
+  static void icp_level_steps(const Exec& ex, IcpLevel level, IcpPose* pose, IcpSums* out, int steps);
 
-// Moves vertex and normal maps into another frame (x -> T x, n -> R n); invalid pixels stay zero.
-// Used to express a world-space raycast in the coordinates of the camera it was rendered from.
-template <class Exec>
-void transform_maps(const Exec& ex, View2D<const vec3> vin, View2D<const vec3> nin, SE3 T, View2D<vec3> vout,
-                    View2D<vec3> nout);
+  // Moves vertex and normal maps into another frame (x -> T x, n -> R n); invalid pixels stay zero.
+  // Used to express a world-space raycast in the coordinates of the camera it was rendered from.
+  static void transform_maps(const Exec& ex, View2D<const vec3> vin, View2D<const vec3> nin, SE3 T, View2D<vec3> vout,
+                             View2D<vec3> nout);
 
-// Half-resolution vertex and normal maps of a model prediction (KinectFusion builds the model
-// pyramid by subsampling the raycast): mean of the 2x2 block's valid pixels whose depth is within
-// max_diff of the block's first valid pixel; the normal is the renormalised mean normal.
-template <class Exec>
-void pyr_down_maps(const Exec& ex, View2D<const vec3> vin, View2D<const vec3> nin, View2D<vec3> vout,
-                   View2D<vec3> nout, float max_diff);
+  // Half-resolution vertex and normal maps of a model prediction (KinectFusion builds the model
+  // pyramid by subsampling the raycast): mean of the 2x2 block's valid pixels whose depth is within
+  // max_diff of the block's first valid pixel; the normal is the renormalised mean normal.
+  static void pyr_down_maps(const Exec& ex, View2D<const vec3> vin, View2D<const vec3> nin, View2D<vec3> vout,
+                            View2D<vec3> nout, float max_diff);
+};
 
 }  // namespace seamless::kernels

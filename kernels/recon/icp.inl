@@ -18,14 +18,14 @@ SEAMLESS_HD inline IcpTerms icp_pixel_terms(const IcpLevel& level, const IcpPose
   return s;
 }
 
-template <class Exec>
-void icp_reduce_into(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSums* out) {
+template <Executor Exec>
+void Icp<Exec>::icp_reduce_into(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSums* out) {
   ex.transform_reduce_into(
       level_pixel_count(L), [=] SEAMLESS_HD(std::int64_t i) { return icp_pixel_terms(L, *pose, i); }, out);
 }
 
-template <class Exec>
-void icp_level_steps(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSums* out, int steps) {
+template <Executor Exec>
+void Icp<Exec>::icp_level_steps(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSums* out, int steps) {
   ex.transform_reduce_rounds(
       level_pixel_count(L), steps, [=] SEAMLESS_HD(std::int64_t i) { return icp_pixel_terms(L, *pose, i); }, out,
       [=] SEAMLESS_HD(int step, const IcpSums& sum) {
@@ -34,8 +34,8 @@ void icp_level_steps(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSums* out, in
       });
 }
 
-template <class Exec>
-void transform_maps(const Exec& ex, View2D<const vec3> vin, View2D<const vec3> nin, SE3 T, View2D<vec3> vout,
+template <Executor Exec>
+void Icp<Exec>::transform_maps(const Exec& ex, View2D<const vec3> vin, View2D<const vec3> nin, SE3 T, View2D<vec3> vout,
                     View2D<vec3> nout) {
   const int w = vin.width;
   ex.for_each(vin.count(), [=] SEAMLESS_HD(std::int64_t i) {
@@ -50,8 +50,8 @@ void transform_maps(const Exec& ex, View2D<const vec3> vin, View2D<const vec3> n
   });
 }
 
-template <class Exec>
-void pyr_down_maps(const Exec& ex, View2D<const vec3> vin, View2D<const vec3> nin, View2D<vec3> vout,
+template <Executor Exec>
+void Icp<Exec>::pyr_down_maps(const Exec& ex, View2D<const vec3> vin, View2D<const vec3> nin, View2D<vec3> vout,
                    View2D<vec3> nout, float max_diff) {
   const int w = vout.width;
   ex.for_each(vout.count(), [=] SEAMLESS_HD(std::int64_t i) {
@@ -79,13 +79,3 @@ void pyr_down_maps(const Exec& ex, View2D<const vec3> vin, View2D<const vec3> ni
 }
 
 }  // namespace seamless::kernels
-
-#define SEAMLESS_INSTANTIATE_ICP(EXEC)                                                                             \
-  namespace seamless::kernels {                                                                                    \
-  template void icp_reduce_into<EXEC>(const EXEC&, IcpLevel, IcpPose*, IcpSums*);                                 \
-  template void icp_level_steps<EXEC>(const EXEC&, IcpLevel, IcpPose*, IcpSums*, int);                            \
-  template void transform_maps<EXEC>(const EXEC&, View2D<const vec3>, View2D<const vec3>, SE3, View2D<vec3>,      \
-                                     View2D<vec3>);                                                                \
-  template void pyr_down_maps<EXEC>(const EXEC&, View2D<const vec3>, View2D<const vec3>, View2D<vec3>,             \
-                                    View2D<vec3>, float);                                                          \
-  }

@@ -1,3 +1,3 @@
 #include "core/exec_cpu.hpp"
 #include "kernels/recon/icp.inl"
-SEAMLESS_INSTANTIATE_ICP(seamless::CpuExec)
+template struct seamless::kernels::Icp<seamless::CpuExec>;

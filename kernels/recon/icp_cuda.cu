@@ -1,3 +1,3 @@
 #include "core/exec_cuda.cuh"
 #include "kernels/recon/icp.inl"
-SEAMLESS_INSTANTIATE_ICP(seamless::CudaExec)
+template struct seamless::kernels::Icp<seamless::CudaExec>;

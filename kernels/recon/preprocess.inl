@@ -5,8 +5,8 @@
 
 namespace seamless::kernels {
 
-template <class Exec>
-void bilateral_filter(const Exec& ex, View2D<const float> depth, View2D<float> out, float sigma_space,
+template <Executor Exec>
+void Preprocess<Exec>::bilateral_filter(const Exec& ex, View2D<const float> depth, View2D<float> out, float sigma_space,
                       float sigma_depth, int radius) {
   const float inv_s2 = 0.5f / (sigma_space * sigma_space);
   const float inv_d2 = 0.5f / (sigma_depth * sigma_depth);
@@ -33,8 +33,8 @@ void bilateral_filter(const Exec& ex, View2D<const float> depth, View2D<float> o
   });
 }
 
-template <class Exec>
-void pyr_down_depth(const Exec& ex, View2D<const float> in, View2D<float> out, float max_diff) {
+template <Executor Exec>
+void Preprocess<Exec>::pyr_down_depth(const Exec& ex, View2D<const float> in, View2D<float> out, float max_diff) {
   const int w = out.width;
   ex.for_each(out.count(), [=] SEAMLESS_HD(std::int64_t i) {
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
@@ -55,8 +55,8 @@ void pyr_down_depth(const Exec& ex, View2D<const float> in, View2D<float> out, f
   });
 }
 
-template <class Exec>
-void pyr_down_intensity(const Exec& ex, View2D<const float> in, View2D<float> out) {
+template <Executor Exec>
+void Preprocess<Exec>::pyr_down_intensity(const Exec& ex, View2D<const float> in, View2D<float> out) {
   const int w = out.width;
   ex.for_each(out.count(), [=] SEAMLESS_HD(std::int64_t i) {
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
@@ -65,8 +65,8 @@ void pyr_down_intensity(const Exec& ex, View2D<const float> in, View2D<float> ou
   });
 }
 
-template <class Exec>
-void depth_to_vertices(const Exec& ex, View2D<const float> depth, Intrinsics K, View2D<vec3> vertices) {
+template <Executor Exec>
+void Preprocess<Exec>::depth_to_vertices(const Exec& ex, View2D<const float> depth, Intrinsics K, View2D<vec3> vertices) {
   const int w = depth.width;
   ex.for_each(depth.count(), [=] SEAMLESS_HD(std::int64_t i) {
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
@@ -75,8 +75,8 @@ void depth_to_vertices(const Exec& ex, View2D<const float> depth, Intrinsics K, 
   });
 }
 
-template <class Exec>
-void vertices_to_normals(const Exec& ex, View2D<const vec3> vertices, View2D<vec3> normals, float max_edge) {
+template <Executor Exec>
+void Preprocess<Exec>::vertices_to_normals(const Exec& ex, View2D<const vec3> vertices, View2D<vec3> normals, float max_edge) {
   const int w = vertices.width;
   const float max_edge2 = max_edge * max_edge;
   ex.for_each(vertices.count(), [=] SEAMLESS_HD(std::int64_t i) {
@@ -97,12 +97,3 @@ void vertices_to_normals(const Exec& ex, View2D<const vec3> vertices, View2D<vec
 }
 
 }  // namespace seamless::kernels
-
-#define SEAMLESS_INSTANTIATE_PREPROCESS(EXEC)                                                               \
-  namespace seamless::kernels {                                                                             \
-  template void bilateral_filter<EXEC>(const EXEC&, View2D<const float>, View2D<float>, float, float, int); \
-  template void pyr_down_depth<EXEC>(const EXEC&, View2D<const float>, View2D<float>, float);               \
-  template void pyr_down_intensity<EXEC>(const EXEC&, View2D<const float>, View2D<float>);                  \
-  template void depth_to_vertices<EXEC>(const EXEC&, View2D<const float>, Intrinsics, View2D<vec3>);        \
-  template void vertices_to_normals<EXEC>(const EXEC&, View2D<const vec3>, View2D<vec3>, float);            \
-  }

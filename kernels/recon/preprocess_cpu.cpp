@@ -1,3 +1,3 @@
 #include "core/exec_cpu.hpp"
 #include "kernels/recon/preprocess.inl"
-SEAMLESS_INSTANTIATE_PREPROCESS(seamless::CpuExec)
+template struct seamless::kernels::Preprocess<seamless::CpuExec>;

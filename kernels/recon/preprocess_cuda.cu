@@ -1,3 +1,3 @@
 #include "core/exec_cuda.cuh"
 #include "kernels/recon/preprocess.inl"
-SEAMLESS_INSTANTIATE_PREPROCESS(seamless::CudaExec)
+template struct seamless::kernels::Preprocess<seamless::CudaExec>;

@@ -5,6 +5,7 @@
 // and with g = dI_ref/dq = grad I . d pi/dq (chain rule through the pinhole projection) the same
 // left-update parametrisation as the ICP gives J_I = [ (q x g)^T, g^T ].
 #pragma once
+#include "core/exec.hpp"
 #include "kernels/recon/icp.hpp"
 
 namespace seamless::kernels {
@@ -188,22 +189,22 @@ SEAMLESS_HD inline bool find_rgbd_correspondence(const RgbdLevel& L, int x, int 
   return true;
 }
 
-// Sums the combined geometric + photometric normal equations over the current level (one pass) at
-// the estimate *pose into *out on the device; then, in the same launch, copies the system into
-// *level_sums (where the tracker reads each level's last system) and, with robust weighting,
-// re-estimates the variances in *pose. error holds the weighted sum of both terms; inliers counts
-// geometric correspondences.
-template <class Exec>
-void rgbd_reduce_into(const Exec& ex, RgbdLevel level, IcpPose* pose, RgbdSums* out, IcpSums* level_sums);
+template <Executor Exec>
+struct Rgbd {
+  // Sums the combined geometric + photometric normal equations over the current level (one pass) at
+  // the estimate *pose into *out on the device; then, in the same launch, copies the system into
+  // *level_sums (where the tracker reads each level's last system) and, with robust weighting,
+  // re-estimates the variances in *pose. error holds the weighted sum of both terms; inliers counts
+  // geometric correspondences.
+  static void rgbd_reduce_into(const Exec& ex, RgbdLevel level, IcpPose* pose, RgbdSums* out, IcpSums* level_sums);
 
-// Up to `steps` Gauss-Newton steps of one level in one device launch, like icp_level_steps: each
-// sums at *pose, keeps the system in *level_sums, steps, and re-estimates the variances.
-template <class Exec>
-void rgbd_level_steps(const Exec& ex, RgbdLevel level, IcpPose* pose, RgbdSums* out, IcpSums* level_sums, int steps);
+  // Up to `steps` Gauss-Newton steps of one level in one device launch, like icp_level_steps: each
+  // sums at *pose, keeps the system in *level_sums, steps, and re-estimates the variances.
+  static void rgbd_level_steps(const Exec& ex, RgbdLevel level, IcpPose* pose, RgbdSums* out, IcpSums* level_sums, int steps);
 
-// Intensity in [0, 1] from 8-bit RGB (ITU-R BT.601 luma weights); kNoIntensity where RGB is
-// (0, 0, 0), no colour reading (see kNoIntensity).
-template <class Exec>
-void rgb_to_intensity(const Exec& ex, View2D<const uchar3> rgb, View2D<float> out);
+  // Intensity in [0, 1] from 8-bit RGB (ITU-R BT.601 luma weights); kNoIntensity where RGB is
+  // (0, 0, 0), no colour reading (see kNoIntensity).
+  static void rgb_to_intensity(const Exec& ex, View2D<const uchar3> rgb, View2D<float> out);
+};
 
 }  // namespace seamless::kernels

@@ -28,15 +28,15 @@ SEAMLESS_HD inline void rgbd_update(const RgbdLevel& R, const RgbdSums& out, Icp
   if (R.dof > 0.f) update_scale(out, pose);
 }
 
-template <class Exec>
-void rgbd_reduce_into(const Exec& ex, RgbdLevel R, IcpPose* pose, RgbdSums* out, IcpSums* level_sums) {
+template <Executor Exec>
+void Rgbd<Exec>::rgbd_reduce_into(const Exec& ex, RgbdLevel R, IcpPose* pose, RgbdSums* out, IcpSums* level_sums) {
   ex.transform_reduce_into(
       level_pixel_count(R.geo), [=] SEAMLESS_HD(std::int64_t i) { return rgbd_pixel_terms(R, *pose, i); }, out,
       [=] SEAMLESS_HD { rgbd_update(R, *out, *pose, *level_sums, IcpUpdate::none); });
 }
 
-template <class Exec>
-void rgbd_level_steps(const Exec& ex, RgbdLevel R, IcpPose* pose, RgbdSums* out, IcpSums* level_sums, int steps) {
+template <Executor Exec>
+void Rgbd<Exec>::rgbd_level_steps(const Exec& ex, RgbdLevel R, IcpPose* pose, RgbdSums* out, IcpSums* level_sums, int steps) {
   ex.transform_reduce_rounds(
       level_pixel_count(R.geo), steps, [=] SEAMLESS_HD(std::int64_t i) { return rgbd_pixel_terms(R, *pose, i); },
       out, [=] SEAMLESS_HD(int step, const RgbdSums& sum) {
@@ -45,8 +45,8 @@ void rgbd_level_steps(const Exec& ex, RgbdLevel R, IcpPose* pose, RgbdSums* out,
       });
 }
 
-template <class Exec>
-void rgb_to_intensity(const Exec& ex, View2D<const uchar3> rgb, View2D<float> out) {
+template <Executor Exec>
+void Rgbd<Exec>::rgb_to_intensity(const Exec& ex, View2D<const uchar3> rgb, View2D<float> out) {
   const int w = rgb.width;
   ex.for_each(rgb.count(), [=] SEAMLESS_HD(std::int64_t i) {
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
@@ -57,10 +57,3 @@ void rgb_to_intensity(const Exec& ex, View2D<const uchar3> rgb, View2D<float> ou
 }
 
 }  // namespace seamless::kernels
-
-#define SEAMLESS_INSTANTIATE_RGBD(EXEC)                                                   \
-  namespace seamless::kernels {                                                           \
-  template void rgbd_reduce_into<EXEC>(const EXEC&, RgbdLevel, IcpPose*, RgbdSums*, IcpSums*);                     \
-  template void rgbd_level_steps<EXEC>(const EXEC&, RgbdLevel, IcpPose*, RgbdSums*, IcpSums*, int);                \
-  template void rgb_to_intensity<EXEC>(const EXEC&, View2D<const uchar3>, View2D<float>); \
-  }

@@ -1,3 +1,3 @@
 #include "core/exec_cpu.hpp"
 #include "kernels/recon/rgbd.inl"
-SEAMLESS_INSTANTIATE_RGBD(seamless::CpuExec)
+template struct seamless::kernels::Rgbd<seamless::CpuExec>;

@@ -1,3 +1,3 @@
 #include "core/exec_cuda.cuh"
 #include "kernels/recon/rgbd.inl"
-SEAMLESS_INSTANTIATE_RGBD(seamless::CudaExec)
+template struct seamless::kernels::Rgbd<seamless::CudaExec>;

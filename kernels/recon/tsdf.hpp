@@ -6,62 +6,65 @@
 #include <cstring>
 
 #include "core/camera.hpp"
+#include "core/exec.hpp"
 #include "core/math.hpp"
 #include "core/view.hpp"
 #include "kernels/recon/voxel_hash.hpp"
 
 namespace seamless::kernels {
 
-// --- hash table maintenance (family recon/voxel_hash) ------------------------------------------
-// Empties every slot (keys -> empty, values -> -1).
-template <class Exec>
-void hash_clear(const Exec& ex, HashTableView t);
-// Free list = 0..n-1, all counters zero, free_top = n.
-template <class Exec>
-void pool_reset(const Exec& ex, View<std::int32_t> free_list, HashCounters* counters);
-// Puts blocks first..first+n-1 on the free list (after the pool grew); free_top += n.
-template <class Exec>
-void pool_append(const Exec& ex, View<std::int32_t> free_list, HashCounters* counters, std::int32_t first, std::int32_t n);
-// Zeroes the per-frame fields of the counters (inserted, collisions, failures, visible, removed).
-template <class Exec>
-void reset_frame_counters(const Exec& ex, HashCounters* counters);
-// Concurrent insert of keys (duplicates allowed); slot_out[i] = slot, result_out[i] = InsertResult.
-// A newly inserted key gets values[slot] = value_in[i] (or -1 when value_in is empty).
-template <class Exec>
-void hash_insert(const Exec& ex, HashTableView t, View<const HashKey> keys, View<const std::int32_t> value_in,
-                 View<std::int32_t> slot_out, View<std::int32_t> result_out, HashCounters* counters);
-// slot_out[i] = slot of keys[i] or -1.
-template <class Exec>
-void hash_find(const Exec& ex, HashTableView t, View<const HashKey> keys, View<std::int32_t> slot_out);
-// Tombstones every key present; slot_out[i] = freed slot or -1 (absent, or erased by a duplicate).
-template <class Exec>
-void hash_erase(const Exec& ex, HashTableView t, View<const HashKey> keys, View<std::int32_t> slot_out,
-                HashCounters* counters);
-// Slots holding a live key with a block, in slot order (deterministic); returns how many. flags
-// must hold one int per slot (scratch).
-template <class Exec>
-std::int64_t hash_live_slots(const Exec& ex, HashTableView t, View<std::int32_t> flags, View<std::int32_t> slots_out);
-// Slots of the live blocks whose centre lies farther than radius from center (both in voxel
-// units), in slot order; returns how many (streaming out, Niessner section 5). flags as above.
-template <class Exec>
-std::int64_t hash_slots_beyond(const Exec& ex, HashTableView t, vec3 center, float radius, View<std::int32_t> flags,
-                               View<std::int32_t> slots_out);
-// Inserts each key (distinct, absent) with a block popped from the pool: blocks_out[i] = the block,
-// or -1 when the key was already present or no slot (probe_failures) or block (pool_failures)
-// was left; a key left without a block is tombstoned again, so it can be inserted later.
-template <class Exec>
-void insert_with_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list, HashCounters* counters,
-                        View<const HashKey> keys, View<std::int32_t> blocks_out);
-// Copies (key, value) of the given slots out (for rehashing and host inspection).
-template <class Exec>
-void hash_gather(const Exec& ex, HashTableView t, View<const std::int32_t> slots, View<HashKey> keys_out,
-                 View<std::int32_t> values_out);
-// Copies whole blocks out of / into the pool: out[i*512 + k] = pool[blocks[i]*512 + k] and back
-// (host download, streaming, dense <-> hash conversion); scatter skips blocks[i] < 0.
-template <class Exec>
-void gather_blocks(const Exec& ex, const Voxel* pool, View<const std::int32_t> blocks, View<Voxel> out);
-template <class Exec>
-void scatter_blocks(const Exec& ex, Voxel* pool, View<const std::int32_t> blocks, View<const Voxel> in);
+template <Executor Exec>
+struct VoxelHash {
+  // --- hash table maintenance (family recon/voxel_hash) ------------------------------------------
+  // Empties every slot (keys -> empty, values -> -1).
+  static void hash_clear(const Exec& ex, HashTableView t);
+
+  // Free list = 0..n-1, all counters zero, free_top = n.
+  static void pool_reset(const Exec& ex, View<std::int32_t> free_list, HashCounters* counters);
+
+  // Puts blocks first..first+n-1 on the free list (after the pool grew); free_top += n.
+  static void pool_append(const Exec& ex, View<std::int32_t> free_list, HashCounters* counters, std::int32_t first, std::int32_t n);
+
+  // Zeroes the per-frame fields of the counters (inserted, collisions, failures, visible, removed).
+  static void reset_frame_counters(const Exec& ex, HashCounters* counters);
+
+  // Concurrent insert of keys (duplicates allowed); slot_out[i] = slot, result_out[i] = InsertResult.
+  // A newly inserted key gets values[slot] = value_in[i] (or -1 when value_in is empty).
+  static void hash_insert(const Exec& ex, HashTableView t, View<const HashKey> keys, View<const std::int32_t> value_in,
+                          View<std::int32_t> slot_out, View<std::int32_t> result_out, HashCounters* counters);
+
+  // slot_out[i] = slot of keys[i] or -1.
+  static void hash_find(const Exec& ex, HashTableView t, View<const HashKey> keys, View<std::int32_t> slot_out);
+
+  // Tombstones every key present; slot_out[i] = freed slot or -1 (absent, or erased by a duplicate).
+  static void hash_erase(const Exec& ex, HashTableView t, View<const HashKey> keys, View<std::int32_t> slot_out,
+                         HashCounters* counters);
+
+  // Slots holding a live key with a block, in slot order (deterministic); returns how many. flags
+  // must hold one int per slot (scratch).
+  static std::int64_t hash_live_slots(const Exec& ex, HashTableView t, View<std::int32_t> flags, View<std::int32_t> slots_out);
+
+  // Slots of the live blocks whose centre lies farther than radius from center (both in voxel
+  // units), in slot order; returns how many (streaming out, Niessner section 5). flags as above.
+  static std::int64_t hash_slots_beyond(const Exec& ex, HashTableView t, vec3 center, float radius, View<std::int32_t> flags,
+                                        View<std::int32_t> slots_out);
+
+  // Inserts each key (distinct, absent) with a block popped from the pool: blocks_out[i] = the block,
+  // or -1 when the key was already present or no slot (probe_failures) or block (pool_failures)
+  // was left; a key left without a block is tombstoned again, so it can be inserted later.
+  static void insert_with_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list, HashCounters* counters,
+                                 View<const HashKey> keys, View<std::int32_t> blocks_out);
+
+  // Copies (key, value) of the given slots out (for rehashing and host inspection).
+  static void hash_gather(const Exec& ex, HashTableView t, View<const std::int32_t> slots, View<HashKey> keys_out,
+                          View<std::int32_t> values_out);
+
+  // Copies whole blocks out of / into the pool: out[i*512 + k] = pool[blocks[i]*512 + k] and back
+  // (host download, streaming, dense <-> hash conversion); scatter skips blocks[i] < 0.
+  static void gather_blocks(const Exec& ex, const Voxel* pool, View<const std::int32_t> blocks, View<Voxel> out);
+
+  static void scatter_blocks(const Exec& ex, Voxel* pool, View<const std::int32_t> blocks, View<const Voxel> in);
+};
 
 // --- per-frame fusion (family recon/tsdf_fusion) -----------------------------------------------
 struct FrameInput {
@@ -80,7 +83,7 @@ struct FrameInput {
 struct TileGrid {
   int tile = 8, tiles_x = 0, tiles_y = 0;
   static TileGrid covering(int width, int height, int tile) {
-    return {tile, (width + tile - 1) / tile, (height + tile - 1) / tile};
+           return {tile, (width + tile - 1) / tile, (height + tile - 1) / tile};
   }
   SEAMLESS_HD std::int64_t count() const { return static_cast<std::int64_t>(tiles_x) * tiles_y; }
   SEAMLESS_HD std::int64_t tile_of(int x, int y) const {
@@ -95,48 +98,49 @@ struct TileGrid {
 struct DepthTiles : TileGrid {
   std::int32_t* zmax = nullptr;  // nullptr: no tiles, nothing is culled
 };
-template <class Exec>
-void clear_depth_tiles(const Exec& ex, DepthTiles tiles);
-// Inserts every block that the truncation band [d - mu, d + mu] of each depth ray passes through
-// (Niessner section 4.1), popping a block from the pool for each new key; failures are counted.
-// Raises each tile of `tiles` (when given) to the farthest valid reading in it.
-template <class Exec>
-void allocate_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list, HashCounters* counters,
-                     FrameInput in, VoxelGeometry geom, DepthTiles tiles = {});
-// Appends to visible_slots every allocated block that the frame may change (counters->visible is
-// the count) and zeroes its keep flag (keep may be empty): blocks whose voxels may project into
-// the image, less those that tiles (when given) show to be occluded or unobserved. Also clamps
-// free_top after a failed allocation pass.
-template <class Exec>
-void find_visible_blocks(const Exec& ex, HashTableView t, HashCounters* counters, FrameInput in, VoxelGeometry geom,
-                         View<std::int32_t> visible_slots, View<std::int32_t> keep, DepthTiles tiles = {});
-// Fuses one frame into the listed blocks, one thread per voxel. When keep is not empty, keep[j]
-// becomes 1 if block j still has a voxel near a surface afterwards (voxel_keeps_block), so that
-// finding the empty blocks costs no second pass over the voxels.
-template <class Exec>
-void fuse_hash_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
-                      Voxel* voxels, FrameInput in, VoxelGeometry geom, float max_weight, bool color,
-                      View<std::int32_t> keep, float keep_below);
-// Fuses one frame into every block of a dense grid.
-template <class Exec>
-void fuse_dense_blocks(const Exec& ex, DenseAccess grid, FrameInput in, float max_weight, bool color);
-
 // A block is worth keeping while one of its voxels is observed (weight > 0) and near a surface
 // (|sdf| < keep_below, metres); a block of free space or never-observed voxels can go.
 SEAMLESS_HD inline bool voxel_keeps_block(const Voxel& v, float keep_below) {
   return v.weight > 0.f && fabsf(v.sdf) < keep_below;
 }
-// keep[j] = 1 if listed block j has a voxel that keeps it (the caller zeroes keep), one thread
-// per voxel: the stand-alone version of the marking that fuse_hash_blocks does.
-template <class Exec>
-void mark_kept_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
-                      const Voxel* voxels, View<std::int32_t> keep, float keep_below);
-// Frees the listed blocks whose keep flag is 0: zeroes their voxels, tombstones their keys and
-// pushes them on the free list (counters->removed counts). A few threads per block.
-template <class Exec>
-void remove_unkept_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
-                          View<const std::int32_t> keep, Voxel* voxels, View<std::int32_t> free_list,
-                          HashCounters* counters);
+template <Executor Exec>
+struct TsdfFusion {
+  static void clear_depth_tiles(const Exec& ex, DepthTiles tiles);
+
+  // Inserts every block that the truncation band [d - mu, d + mu] of each depth ray passes through
+  // (Niessner section 4.1), popping a block from the pool for each new key; failures are counted.
+  // Raises each tile of `tiles` (when given) to the farthest valid reading in it.
+  static void allocate_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list, HashCounters* counters,
+                              FrameInput in, VoxelGeometry geom, DepthTiles tiles = {});
+
+  // Appends to visible_slots every allocated block that the frame may change (counters->visible is
+  // the count) and zeroes its keep flag (keep may be empty): blocks whose voxels may project into
+  // the image, less those that tiles (when given) show to be occluded or unobserved. Also clamps
+  // free_top after a failed allocation pass.
+  static void find_visible_blocks(const Exec& ex, HashTableView t, HashCounters* counters, FrameInput in, VoxelGeometry geom,
+                                  View<std::int32_t> visible_slots, View<std::int32_t> keep, DepthTiles tiles = {});
+
+  // Fuses one frame into the listed blocks, one thread per voxel. When keep is not empty, keep[j]
+  // becomes 1 if block j still has a voxel near a surface afterwards (voxel_keeps_block), so that
+  // finding the empty blocks costs no second pass over the voxels.
+  static void fuse_hash_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
+                               Voxel* voxels, FrameInput in, VoxelGeometry geom, float max_weight, bool color,
+                               View<std::int32_t> keep, float keep_below);
+
+  // Fuses one frame into every block of a dense grid.
+  static void fuse_dense_blocks(const Exec& ex, DenseAccess grid, FrameInput in, float max_weight, bool color);
+
+  // keep[j] = 1 if listed block j has a voxel that keeps it (the caller zeroes keep), one thread
+  // per voxel: the stand-alone version of the marking that fuse_hash_blocks does.
+  static void mark_kept_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
+                               const Voxel* voxels, View<std::int32_t> keep, float keep_below);
+
+  // Frees the listed blocks whose keep flag is 0: zeroes their voxels, tombstones their keys and
+  // pushes them on the free list (counters->removed counts). A few threads per block.
+  static void remove_unkept_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
+                                   View<const std::int32_t> keep, Voxel* voxels, View<std::int32_t> free_list,
+                                   HashCounters* counters);
+};
 
 // --- raycasting (family recon/tsdf_raycast) ----------------------------------------------------
 struct RaycastOutput {
@@ -155,32 +159,33 @@ struct RayIntervals : TileGrid {
 };
 constexpr std::int32_t kEmptyNear = 0x7f800000;  // +infinity
 constexpr std::int32_t kEmptyFar = 0;            // +0: no block splatted
-// Empties every tile (near = +inf, far = 0), and window w when given (every entry -1).
-template <class Exec>
-void clear_ray_intervals(const Exec& ex, RayIntervals iv, BlockWindow w = {});
-// One thread per hash slot: each live block's cell box [8b, 8b+8]^3 (voxel units; every sample a
-// ray can take in the block lies in it), clipped to the depth slab [min_depth, max_depth], is
-// projected, and the tiles under its pixel bounding box take the min / max of its depth range.
-// With a window w (cleared by clear_ray_intervals) the same pass fills it, as fill_block_window
-// does: one pass over the slots instead of two.
-template <class Exec>
-void splat_ray_intervals(const Exec& ex, HashTableView t, VoxelGeometry geom, Intrinsics K, SE3 world_T_camera,
-                         float min_depth, float max_depth, RayIntervals iv, BlockWindow w = {});
 
-// Fills window w from the hash table: -1 everywhere, then the pool index of every live block
-// inside it. Run after the last change to the table and before the kernels that read through it.
-template <class Exec>
-void fill_block_window(const Exec& ex, HashTableView t, BlockWindow w);
+template <Executor Exec, class Acc = HashAccess>
+struct TsdfRaycast {
+  // Empties every tile (near = +inf, far = 0), and window w when given (every entry -1).
+  static void clear_ray_intervals(const Exec& ex, RayIntervals iv, BlockWindow w = {});
 
-// One ray per pixel from min_depth to max_depth, or only over its tile's interval when iv.bits is
-// set: skips unallocated blocks whole, steps by the TSDF inside allocated ones, refines the +/-
-// zero crossing by regula falsi on the trilinear field (KinectFusion section 3.5; Niessner section
-// 4.3); a second pass takes each hit's normal from its neighbours' vertices (vertex_map_normal). A ray starting before its tile's near depth is
-// in unallocated blocks up to there, where the full march skips block by block, so both take the
-// same samples from the first block on and hit the same surfaces.
-template <class Exec, class Acc>
-void raycast(const Exec& ex, Acc a, Intrinsics K, SE3 world_T_camera, float min_depth, float max_depth,
-             RaycastOutput out, RayIntervals iv = {});
+  // One thread per hash slot: each live block's cell box [8b, 8b+8]^3 (voxel units; every sample a
+  // ray can take in the block lies in it), clipped to the depth slab [min_depth, max_depth], is
+  // projected, and the tiles under its pixel bounding box take the min / max of its depth range.
+  // With a window w (cleared by clear_ray_intervals) the same pass fills it, as fill_block_window
+  // does: one pass over the slots instead of two.
+  static void splat_ray_intervals(const Exec& ex, HashTableView t, VoxelGeometry geom, Intrinsics K, SE3 world_T_camera,
+                                  float min_depth, float max_depth, RayIntervals iv, BlockWindow w = {});
+
+  // Fills window w from the hash table: -1 everywhere, then the pool index of every live block
+  // inside it. Run after the last change to the table and before the kernels that read through it.
+  static void fill_block_window(const Exec& ex, HashTableView t, BlockWindow w);
+
+  // One ray per pixel from min_depth to max_depth, or only over its tile's interval when iv.bits is
+  // set: skips unallocated blocks whole, steps by the TSDF inside allocated ones, refines the +/-
+  // zero crossing by regula falsi on the trilinear field (KinectFusion section 3.5; Niessner section
+  // 4.3); a second pass takes each hit's normal from its neighbours' vertices (vertex_map_normal). A ray starting before its tile's near depth is
+  // in unallocated blocks up to there, where the full march skips block by block, so both take the
+  // same samples from the first block on and hit the same surfaces.
+  static void raycast(const Exec& ex, Acc a, Intrinsics K, SE3 world_T_camera, float min_depth, float max_depth,
+                      RaycastOutput out, RayIntervals iv = {});
+};
 
 }  // namespace seamless::kernels
 
@@ -193,21 +198,6 @@ namespace seamless::kernels {
 // (recon/marching_cubes.cpp generates it). Edge e joins corners kMcEdge[e][0] and [1]; corner k
 // is g + (k&1, (k>>1)&1, k>>2).
 constexpr int kMcRow = 16;
-// counts[i] = triangles of cell i (block i / 512, voxel i % 512); returns the total and turns
-// counts into exclusive offsets.
-template <class Exec, class Acc>
-std::int64_t mesh_count(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,
-                        View<std::int32_t> counts);
-// Writes 3 vertices per triangle at 3 * offsets[i]: position (world), normal (TSDF gradient),
-// colour, and a key naming the voxel edge it lies on (equal keys = the same vertex).
-template <class Exec, class Acc>
-void mesh_emit(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,
-               View<const std::int32_t> offsets, View<vec3> positions, View<vec3> normals, View<uchar3> colors,
-               View<std::uint64_t> edge_keys);
-// Block coordinates of the given hash slots.
-template <class Exec>
-void slot_block_coords(const Exec& ex, HashTableView t, View<const std::int32_t> slots, View<int3> out);
-
 }  // namespace seamless::kernels
 
 namespace seamless::kernels {
@@ -224,30 +214,47 @@ namespace seamless::kernels {
 SEAMLESS_HD inline int lattice_per_block(float voxel_size, float spacing) {
   return static_cast<int>(ceilf(kBlockSide * voxel_size / spacing)) + 1;
 }
-template <class Exec, class Acc>
-std::int64_t scene_particle_count(const Exec& ex, Acc a, View<const int3> blocks, float spacing, float interior_depth,
-                                  View<std::int32_t> counts);
-// Writes each candidate's position, unit normal (TSDF gradient) and thinning score at offsets[i].
-template <class Exec, class Acc>
-void scene_particle_emit(const Exec& ex, Acc a, View<const int3> blocks, float spacing, float interior_depth,
-                         View<const std::int32_t> offsets, View<vec3> positions, View<vec3> normals,
-                         View<float> scores);
-// keep[i] = 0 for a candidate within min_distance of one that outranks it (higher score first),
-// else 1; keys and order are scratch (one per candidate). Returns how many are kept and turns keep
-// into offsets for scene_particle_compact, which copies the kept ones to out (kept of them).
-template <class Exec>
-std::int64_t scene_particle_thin(const Exec& ex, View<const vec3> positions, View<const float> scores,
-                                 float min_distance, View<std::uint64_t> keys, View<std::int32_t> order,
-                                 View<std::int32_t> keep);
-template <class Exec>
-void scene_particle_compact(const Exec& ex, View<const std::int32_t> offsets, std::int64_t kept,
-                            View<const vec3> positions, View<const vec3> normals, View<vec3> out_positions,
-                            View<vec3> out_normals);
 
-// Samples the SDF (sample_sdf) on a regular grid, x fastest: out[(z * dims.y + y) * dims.x + x] at
-// origin + voxel * (x, y, z). Unknown points (unobserved or outside the band) get `unknown`.
-// For collisions against the TSDF through a dense grid (the solver's scene_collision: sdf).
-template <class Exec, class Acc>
-void sample_sdf_grid(const Exec& ex, Acc a, vec3 origin, int3 dims, float voxel, float unknown, View<float> out);
+template <Executor Exec, class Acc = HashAccess>
+struct TsdfExtract {
+  // counts[i] = triangles of cell i (block i / 512, voxel i % 512); returns the total and turns
+  // counts into exclusive offsets.
+  static std::int64_t mesh_count(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,
+                                 View<std::int32_t> counts);
+
+  // Writes 3 vertices per triangle at 3 * offsets[i]: position (world), normal (TSDF gradient),
+  // colour, and a key naming the voxel edge it lies on (equal keys = the same vertex).
+  static void mesh_emit(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,
+                        View<const std::int32_t> offsets, View<vec3> positions, View<vec3> normals, View<uchar3> colors,
+                        View<std::uint64_t> edge_keys);
+
+  // Block coordinates of the given hash slots.
+  static void slot_block_coords(const Exec& ex, HashTableView t, View<const std::int32_t> slots, View<int3> out);
+
+  // The candidates' counts of the lattice points (see lattice_per_block above).
+  static std::int64_t scene_particle_count(const Exec& ex, Acc a, View<const int3> blocks, float spacing, float interior_depth,
+                                           View<std::int32_t> counts);
+
+  // Writes each candidate's position, unit normal (TSDF gradient) and thinning score at offsets[i].
+  static void scene_particle_emit(const Exec& ex, Acc a, View<const int3> blocks, float spacing, float interior_depth,
+                                  View<const std::int32_t> offsets, View<vec3> positions, View<vec3> normals,
+                                  View<float> scores);
+
+  // keep[i] = 0 for a candidate within min_distance of one that outranks it (higher score first),
+  // else 1; keys and order are scratch (one per candidate). Returns how many are kept and turns keep
+  // into offsets for scene_particle_compact, which copies the kept ones to out (kept of them).
+  static std::int64_t scene_particle_thin(const Exec& ex, View<const vec3> positions, View<const float> scores,
+                                          float min_distance, View<std::uint64_t> keys, View<std::int32_t> order,
+                                          View<std::int32_t> keep);
+
+  static void scene_particle_compact(const Exec& ex, View<const std::int32_t> offsets, std::int64_t kept,
+                                     View<const vec3> positions, View<const vec3> normals, View<vec3> out_positions,
+                                     View<vec3> out_normals);
+
+  // Samples the SDF (sample_sdf) on a regular grid, x fastest: out[(z * dims.y + y) * dims.x + x] at
+  // origin + voxel * (x, y, z). Unknown points (unobserved or outside the band) get `unknown`.
+  // For collisions against the TSDF through a dense grid (the solver's scene_collision: sdf).
+  static void sample_sdf_grid(const Exec& ex, Acc a, vec3 origin, int3 dims, float voxel, float unknown, View<float> out);
+};
 
 }  // namespace seamless::kernels

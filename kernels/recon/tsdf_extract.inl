@@ -56,8 +56,8 @@ SEAMLESS_HD inline int3 cell_of(View<const int3> blocks, std::int64_t i) {
   return {b.x * 8 + l.x, b.y * 8 + l.y, b.z * 8 + l.z};
 }
 
-template <class Exec, class Acc>
-std::int64_t mesh_count(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,
+template <Executor Exec, class Acc>
+std::int64_t TsdfExtract<Exec, Acc>::mesh_count(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,
                         View<std::int32_t> counts) {
   const std::int64_t n = blocks.size * kBlockVoxels;
   ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) {
@@ -79,8 +79,8 @@ SEAMLESS_HD inline std::uint64_t edge_key(int3 g, int axis) {
          (((std::uint64_t(g.z) + bias) & m) << 2) | std::uint64_t(axis);
 }
 
-template <class Exec, class Acc>
-void mesh_emit(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,
+template <Executor Exec, class Acc>
+void TsdfExtract<Exec, Acc>::mesh_emit(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,
                View<const std::int32_t> offsets, View<vec3> positions, View<vec3> normals, View<uchar3> colors,
                View<std::uint64_t> edge_keys) {
   const std::int64_t n = blocks.size * kBlockVoxels;
@@ -345,8 +345,8 @@ SEAMLESS_HD inline bool interior_point(const Acc& a, int3 L, float spacing, floa
   return true;
 }
 
-template <class Exec, class Acc>
-std::int64_t scene_particle_count(const Exec& ex, Acc a, View<const int3> blocks, float spacing, float interior_depth,
+template <Executor Exec, class Acc>
+std::int64_t TsdfExtract<Exec, Acc>::scene_particle_count(const Exec& ex, Acc a, View<const int3> blocks, float spacing, float interior_depth,
                                   View<std::int32_t> counts) {
   ex.for_each(counts.size, [=] SEAMLESS_HD(std::int64_t i) {
     int3 L;
@@ -359,8 +359,8 @@ std::int64_t scene_particle_count(const Exec& ex, Acc a, View<const int3> blocks
   return ex.exclusive_scan(counts.data, counts.data, counts.size);
 }
 
-template <class Exec, class Acc>
-void scene_particle_emit(const Exec& ex, Acc a, View<const int3> blocks, float spacing, float interior_depth,
+template <Executor Exec, class Acc>
+void TsdfExtract<Exec, Acc>::scene_particle_emit(const Exec& ex, Acc a, View<const int3> blocks, float spacing, float interior_depth,
                          View<const std::int32_t> offsets, View<vec3> positions, View<vec3> normals,
                          View<float> scores) {
   ex.for_each(offsets.size, [=] SEAMLESS_HD(std::int64_t i) {
@@ -412,8 +412,8 @@ SEAMLESS_HD inline bool outranks(vec3 pj, float sj, std::int64_t j, vec3 pi, flo
   return j < i;
 }
 
-template <class Exec>
-std::int64_t scene_particle_thin(const Exec& ex, View<const vec3> positions, View<const float> scores,
+template <Executor Exec, class Acc>
+std::int64_t TsdfExtract<Exec, Acc>::scene_particle_thin(const Exec& ex, View<const vec3> positions, View<const float> scores,
                                  float min_distance, View<std::uint64_t> keys, View<std::int32_t> order,
                                  View<std::int32_t> keep) {
   const std::int64_t n = positions.size;
@@ -441,8 +441,8 @@ std::int64_t scene_particle_thin(const Exec& ex, View<const vec3> positions, Vie
   return ex.exclusive_scan(keep.data, keep.data, n);
 }
 
-template <class Exec>
-void scene_particle_compact(const Exec& ex, View<const std::int32_t> offsets, std::int64_t kept,
+template <Executor Exec, class Acc>
+void TsdfExtract<Exec, Acc>::scene_particle_compact(const Exec& ex, View<const std::int32_t> offsets, std::int64_t kept,
                             View<const vec3> positions, View<const vec3> normals, View<vec3> out_positions,
                             View<vec3> out_normals) {
   const std::int64_t n = offsets.size;
@@ -454,8 +454,8 @@ void scene_particle_compact(const Exec& ex, View<const std::int32_t> offsets, st
   });
 }
 
-template <class Exec, class Acc>
-void sample_sdf_grid(const Exec& ex, Acc a, vec3 origin, int3 dims, float voxel, float unknown, View<float> out) {
+template <Executor Exec, class Acc>
+void TsdfExtract<Exec, Acc>::sample_sdf_grid(const Exec& ex, Acc a, vec3 origin, int3 dims, float voxel, float unknown, View<float> out) {
   ex.for_each(out.size, [=] SEAMLESS_HD(std::int64_t i) {
     const std::int64_t plane = static_cast<std::int64_t>(dims.x) * dims.y;
     int z = static_cast<int>(i / plane), y = static_cast<int>((i % plane) / dims.x), x = static_cast<int>(i % dims.x);
@@ -465,33 +465,9 @@ void sample_sdf_grid(const Exec& ex, Acc a, vec3 origin, int3 dims, float voxel,
   });
 }
 
-template <class Exec>
-void slot_block_coords(const Exec& ex, HashTableView t, View<const std::int32_t> slots, View<int3> out) {
+template <Executor Exec, class Acc>
+void TsdfExtract<Exec, Acc>::slot_block_coords(const Exec& ex, HashTableView t, View<const std::int32_t> slots, View<int3> out) {
   ex.for_each(slots.size, [=] SEAMLESS_HD(std::int64_t i) { out[i] = unpack_block(t.keys[slots[i]]); });
 }
 
 }  // namespace seamless::kernels
-
-#define SEAMLESS_INSTANTIATE_TSDF_EXTRACT_ACC(EXEC, ACC)                                                          \
-  namespace seamless::kernels {                                                                                   \
-  template std::int64_t mesh_count<EXEC, ACC>(const EXEC&, ACC, View<const int3>, const std::int8_t*,             \
-                                              View<std::int32_t>);                                                \
-  template void mesh_emit<EXEC, ACC>(const EXEC&, ACC, View<const int3>, const std::int8_t*,                      \
-                                     View<const std::int32_t>, View<vec3>, View<vec3>, View<uchar3>,              \
-                                     View<std::uint64_t>);                                                        \
-  template std::int64_t scene_particle_count<EXEC, ACC>(const EXEC&, ACC, View<const int3>, float, float,         \
-                                                        View<std::int32_t>);                                      \
-  template void scene_particle_emit<EXEC, ACC>(const EXEC&, ACC, View<const int3>, float, float,                  \
-                                               View<const std::int32_t>, View<vec3>, View<vec3>, View<float>);    \
-  template void sample_sdf_grid<EXEC, ACC>(const EXEC&, ACC, vec3, int3, float, float, View<float>);              \
-  }
-#define SEAMLESS_INSTANTIATE_TSDF_EXTRACT(EXEC)                                                                   \
-  SEAMLESS_INSTANTIATE_TSDF_EXTRACT_ACC(EXEC, HashAccess)                                                         \
-  SEAMLESS_INSTANTIATE_TSDF_EXTRACT_ACC(EXEC, DenseAccess)                                                        \
-  namespace seamless::kernels {                                                                                   \
-  template void slot_block_coords<EXEC>(const EXEC&, HashTableView, View<const std::int32_t>, View<int3>);        \
-  template std::int64_t scene_particle_thin<EXEC>(const EXEC&, View<const vec3>, View<const float>, float,         \
-                                                  View<std::uint64_t>, View<std::int32_t>, View<std::int32_t>);    \
-  template void scene_particle_compact<EXEC>(const EXEC&, View<const std::int32_t>, std::int64_t,                 \
-                                             View<const vec3>, View<const vec3>, View<vec3>, View<vec3>);         \
-  }

@@ -1,3 +1,4 @@
 #include "core/exec_cpu.hpp"
 #include "kernels/recon/tsdf_extract.inl"
-SEAMLESS_INSTANTIATE_TSDF_EXTRACT(seamless::CpuExec)
+template struct seamless::kernels::TsdfExtract<seamless::CpuExec, seamless::kernels::HashAccess>;
+template struct seamless::kernels::TsdfExtract<seamless::CpuExec, seamless::kernels::DenseAccess>;

@@ -1,3 +1,4 @@
 #include "core/exec_cuda.cuh"
 #include "kernels/recon/tsdf_extract.inl"
-SEAMLESS_INSTANTIATE_TSDF_EXTRACT(seamless::CudaExec)
+template struct seamless::kernels::TsdfExtract<seamless::CudaExec, seamless::kernels::HashAccess>;
+template struct seamless::kernels::TsdfExtract<seamless::CudaExec, seamless::kernels::DenseAccess>;

@@ -61,8 +61,8 @@ SEAMLESS_HD inline void traverse_blocks(vec3 a, vec3 b, F visit) {
   }
 }
 
-template <class Exec>
-void allocate_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list, HashCounters* counters,
+template <Executor Exec>
+void TsdfFusion<Exec>::allocate_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list, HashCounters* counters,
                      FrameInput in, VoxelGeometry geom, DepthTiles tiles) {
   const int w = in.depth.width;
   const float mu = geom.truncation;
@@ -128,13 +128,13 @@ SEAMLESS_HD inline bool block_maybe_visible(int3 b, const FrameInput& in, const 
   return tiles_reach(tiles, u0, u1, v0, v1, zmin - geom.truncation);
 }
 
-template <class Exec>
-void clear_depth_tiles(const Exec& ex, DepthTiles tiles) {
+template <Executor Exec>
+void TsdfFusion<Exec>::clear_depth_tiles(const Exec& ex, DepthTiles tiles) {
   ex.for_each(tiles.count(), [=] SEAMLESS_HD(std::int64_t i) { tiles.zmax[i] = 0; });
 }
 
-template <class Exec>
-void find_visible_blocks(const Exec& ex, HashTableView t, HashCounters* counters, FrameInput in, VoxelGeometry geom,
+template <Executor Exec>
+void TsdfFusion<Exec>::find_visible_blocks(const Exec& ex, HashTableView t, HashCounters* counters, FrameInput in, VoxelGeometry geom,
                          View<std::int32_t> visible_slots, View<std::int32_t> keep, DepthTiles tiles) {
   const SE3 camera_T_world = in.world_T_camera.inverse();
   ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
@@ -201,8 +201,8 @@ SEAMLESS_HD inline void fuse_voxel(Voxel& v, vec3 p_world, const FrameInput& in,
   v.weight = fminf(wt + 1.f, max_weight);
 }
 
-template <class Exec>
-void fuse_hash_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
+template <Executor Exec>
+void TsdfFusion<Exec>::fuse_hash_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
                       Voxel* voxels, FrameInput in, VoxelGeometry geom, float max_weight, bool color,
                       View<std::int32_t> keep, float keep_below) {
   const SE3 camera_T_world = in.world_T_camera.inverse();
@@ -221,8 +221,8 @@ void fuse_hash_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> 
   });
 }
 
-template <class Exec>
-void fuse_dense_blocks(const Exec& ex, DenseAccess grid, FrameInput in, float max_weight, bool color) {
+template <Executor Exec>
+void TsdfFusion<Exec>::fuse_dense_blocks(const Exec& ex, DenseAccess grid, FrameInput in, float max_weight, bool color) {
   const SE3 camera_T_world = in.world_T_camera.inverse();
   const int n = grid.blocks_per_side;
   const std::int64_t blocks = static_cast<std::int64_t>(n) * n * n;
@@ -236,8 +236,8 @@ void fuse_dense_blocks(const Exec& ex, DenseAccess grid, FrameInput in, float ma
   });
 }
 
-template <class Exec>
-void mark_kept_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
+template <Executor Exec>
+void TsdfFusion<Exec>::mark_kept_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
                       const Voxel* voxels, View<std::int32_t> keep, float keep_below) {
   ex.for_each(count * kBlockVoxels, [=] SEAMLESS_HD(std::int64_t i) {
     const std::int64_t j = i / kBlockVoxels;
@@ -248,8 +248,8 @@ void mark_kept_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> 
   });
 }
 
-template <class Exec>
-void remove_unkept_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
+template <Executor Exec>
+void TsdfFusion<Exec>::remove_unkept_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
                           View<const std::int32_t> keep, Voxel* voxels, View<std::int32_t> free_list,
                           HashCounters* counters) {
   // kParts threads per block, each zeroing 512 / kParts voxels: one thread clearing a whole block
@@ -275,20 +275,3 @@ void remove_unkept_blocks(const Exec& ex, HashTableView t, View<const std::int32
 }
 
 }  // namespace seamless::kernels
-
-#define SEAMLESS_INSTANTIATE_TSDF_FUSION(EXEC)                                                                    \
-  namespace seamless::kernels {                                                                                   \
-  template void allocate_blocks<EXEC>(const EXEC&, HashTableView, View<const std::int32_t>, HashCounters*,        \
-                                      FrameInput, VoxelGeometry, DepthTiles);                                     \
-  template void find_visible_blocks<EXEC>(const EXEC&, HashTableView, HashCounters*, FrameInput, VoxelGeometry,   \
-                                          View<std::int32_t>, View<std::int32_t>, DepthTiles);                    \
-  template void clear_depth_tiles<EXEC>(const EXEC&, DepthTiles);                                        \
-  template void fuse_hash_blocks<EXEC>(const EXEC&, HashTableView, View<const std::int32_t>, std::int64_t,        \
-                                       Voxel*, FrameInput, VoxelGeometry, float, bool, View<std::int32_t>,        \
-                                       float);                                                                    \
-  template void fuse_dense_blocks<EXEC>(const EXEC&, DenseAccess, FrameInput, float, bool);                       \
-  template void mark_kept_blocks<EXEC>(const EXEC&, HashTableView, View<const std::int32_t>, std::int64_t,        \
-                                       const Voxel*, View<std::int32_t>, float);                                  \
-  template void remove_unkept_blocks<EXEC>(const EXEC&, HashTableView, View<const std::int32_t>, std::int64_t,    \
-                                           View<const std::int32_t>, Voxel*, View<std::int32_t>, HashCounters*);  \
-  }

@@ -1,3 +1,3 @@
 #include "core/exec_cpu.hpp"
 #include "kernels/recon/tsdf_fusion.inl"
-SEAMLESS_INSTANTIATE_TSDF_FUSION(seamless::CpuExec)
+template struct seamless::kernels::TsdfFusion<seamless::CpuExec>;

@@ -72,8 +72,8 @@ SEAMLESS_HD inline bool block_screen_bounds(int3 b, const VoxelGeometry& g, cons
   return s.z0 <= s.z1;
 }
 
-template <class Exec>
-void clear_ray_intervals(const Exec& ex, RayIntervals iv, BlockWindow w) {
+template <Executor Exec, class Acc>
+void TsdfRaycast<Exec, Acc>::clear_ray_intervals(const Exec& ex, RayIntervals iv, BlockWindow w) {
   const std::int64_t tiles = iv.count(), entries = w.index ? w.count() : 0;
   ex.for_each(tiles > entries ? tiles : entries, [=] SEAMLESS_HD(std::int64_t t) {
     if (t < entries) w.index[t] = -1;
@@ -83,8 +83,8 @@ void clear_ray_intervals(const Exec& ex, RayIntervals iv, BlockWindow w) {
   });
 }
 
-template <class Exec>
-void splat_ray_intervals(const Exec& ex, HashTableView t, VoxelGeometry geom, Intrinsics K, SE3 world_T_camera,
+template <Executor Exec, class Acc>
+void TsdfRaycast<Exec, Acc>::splat_ray_intervals(const Exec& ex, HashTableView t, VoxelGeometry geom, Intrinsics K, SE3 world_T_camera,
                          float min_depth, float max_depth, RayIntervals iv, BlockWindow w) {
   const SE3 camera_T_world = world_T_camera.inverse();
   const float zn = fmaxf(min_depth, 1e-3f);
@@ -113,8 +113,8 @@ void splat_ray_intervals(const Exec& ex, HashTableView t, VoxelGeometry geom, In
   });
 }
 
-template <class Exec>
-void fill_block_window(const Exec& ex, HashTableView t, BlockWindow w) {
+template <Executor Exec, class Acc>
+void TsdfRaycast<Exec, Acc>::fill_block_window(const Exec& ex, HashTableView t, BlockWindow w) {
   ex.for_each(w.count(), [=] SEAMLESS_HD(std::int64_t i) { w.index[i] = -1; });
   ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
     const HashKey k = t.keys[i];
@@ -232,8 +232,8 @@ SEAMLESS_HD inline vec3 vertex_map_normal(View2D<const vec3> vtx, View2D<const f
   return dot(n, eye - v) < 0.f ? n * -1.f : n;
 }
 
-template <class Exec, class Acc>
-void raycast(const Exec& ex, Acc a, Intrinsics K, SE3 world_T_camera, float min_depth, float max_depth,
+template <Executor Exec, class Acc>
+void TsdfRaycast<Exec, Acc>::raycast(const Exec& ex, Acc a, Intrinsics K, SE3 world_T_camera, float min_depth, float max_depth,
              RaycastOutput out, RayIntervals iv) {
   const int w = out.depth.width, h = out.depth.height;
   const int groups_x = (w + kRayGroupW - 1) / kRayGroupW, groups_y = (h + kRayGroupH - 1) / kRayGroupH;
@@ -258,17 +258,3 @@ void raycast(const Exec& ex, Acc a, Intrinsics K, SE3 world_T_camera, float min_
 }
 
 }  // namespace seamless::kernels
-
-#define SEAMLESS_INSTANTIATE_TSDF_RAYCAST(EXEC)                                                                  \
-  namespace seamless::kernels {                                                                                  \
-  template void raycast<EXEC, HashAccess>(const EXEC&, HashAccess, Intrinsics, SE3, float, float, RaycastOutput,  \
-                                          RayIntervals);                                                         \
-  template void raycast<EXEC, DenseAccess>(const EXEC&, DenseAccess, Intrinsics, SE3, float, float,              \
-                                           RaycastOutput, RayIntervals);                                         \
-  template void raycast<EXEC, WindowedHashAccess>(const EXEC&, WindowedHashAccess, Intrinsics, SE3, float, float, \
-                                                  RaycastOutput, RayIntervals);                                  \
-  template void fill_block_window<EXEC>(const EXEC&, HashTableView, BlockWindow);                                \
-  template void clear_ray_intervals<EXEC>(const EXEC&, RayIntervals, BlockWindow);                               \
-  template void splat_ray_intervals<EXEC>(const EXEC&, HashTableView, VoxelGeometry, Intrinsics, SE3, float,     \
-                                          float, RayIntervals, BlockWindow);                                     \
-  }

@@ -1,3 +1,5 @@
 #include "core/exec_cpu.hpp"
 #include "kernels/recon/tsdf_raycast.inl"
-SEAMLESS_INSTANTIATE_TSDF_RAYCAST(seamless::CpuExec)
+template struct seamless::kernels::TsdfRaycast<seamless::CpuExec, seamless::kernels::HashAccess>;
+template struct seamless::kernels::TsdfRaycast<seamless::CpuExec, seamless::kernels::DenseAccess>;
+template struct seamless::kernels::TsdfRaycast<seamless::CpuExec, seamless::kernels::WindowedHashAccess>;

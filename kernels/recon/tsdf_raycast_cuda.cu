@@ -1,3 +1,5 @@
 #include "core/exec_cuda.cuh"
 #include "kernels/recon/tsdf_raycast.inl"
-SEAMLESS_INSTANTIATE_TSDF_RAYCAST(seamless::CudaExec)
+template struct seamless::kernels::TsdfRaycast<seamless::CudaExec, seamless::kernels::HashAccess>;
+template struct seamless::kernels::TsdfRaycast<seamless::CudaExec, seamless::kernels::DenseAccess>;
+template struct seamless::kernels::TsdfRaycast<seamless::CudaExec, seamless::kernels::WindowedHashAccess>;

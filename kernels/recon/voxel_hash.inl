@@ -3,16 +3,16 @@
 
 namespace seamless::kernels {
 
-template <class Exec>
-void hash_clear(const Exec& ex, HashTableView t) {
+template <Executor Exec>
+void VoxelHash<Exec>::hash_clear(const Exec& ex, HashTableView t) {
   ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
     t.keys[i] = kEmptyKey;
     t.values[i] = -1;
   });
 }
 
-template <class Exec>
-void pool_reset(const Exec& ex, View<std::int32_t> free_list, HashCounters* counters) {
+template <Executor Exec>
+void VoxelHash<Exec>::pool_reset(const Exec& ex, View<std::int32_t> free_list, HashCounters* counters) {
   ex.for_each(free_list.size, [=] SEAMLESS_HD(std::int64_t i) {
     // Reversed so that pops hand out blocks 0, 1, 2, ... (cache-friendly, easy to read in tests).
     free_list[i] = static_cast<std::int32_t>(free_list.size - 1 - i);
@@ -21,8 +21,8 @@ void pool_reset(const Exec& ex, View<std::int32_t> free_list, HashCounters* coun
   ex.for_each(1, [=] SEAMLESS_HD(std::int64_t) { *counters = HashCounters{n, 0, 0, 0, 0, 0, 0, 0}; });
 }
 
-template <class Exec>
-void pool_append(const Exec& ex, View<std::int32_t> free_list, HashCounters* counters, std::int32_t first,
+template <Executor Exec>
+void VoxelHash<Exec>::pool_append(const Exec& ex, View<std::int32_t> free_list, HashCounters* counters, std::int32_t first,
                  std::int32_t n) {
   // One thread: reads free_top once, so the appended range is contiguous above it.
   ex.for_each(1, [=] SEAMLESS_HD(std::int64_t) {
@@ -32,16 +32,16 @@ void pool_append(const Exec& ex, View<std::int32_t> free_list, HashCounters* cou
   });
 }
 
-template <class Exec>
-void reset_frame_counters(const Exec& ex, HashCounters* counters) {
+template <Executor Exec>
+void VoxelHash<Exec>::reset_frame_counters(const Exec& ex, HashCounters* counters) {
   ex.for_each(1, [=] SEAMLESS_HD(std::int64_t) {
     HashCounters& c = *counters;
     c.inserted = c.collisions = c.probe_failures = c.pool_failures = c.visible = c.removed = 0;
   });
 }
 
-template <class Exec>
-void hash_insert(const Exec& ex, HashTableView t, View<const HashKey> keys, View<const std::int32_t> value_in,
+template <Executor Exec>
+void VoxelHash<Exec>::hash_insert(const Exec& ex, HashTableView t, View<const HashKey> keys, View<const std::int32_t> value_in,
                  View<std::int32_t> slot_out, View<std::int32_t> result_out, HashCounters* counters) {
   ex.for_each(keys.size, [=] SEAMLESS_HD(std::int64_t i) {
     std::int32_t slot = -1;
@@ -59,13 +59,13 @@ void hash_insert(const Exec& ex, HashTableView t, View<const HashKey> keys, View
   });
 }
 
-template <class Exec>
-void hash_find(const Exec& ex, HashTableView t, View<const HashKey> keys, View<std::int32_t> slot_out) {
+template <Executor Exec>
+void VoxelHash<Exec>::hash_find(const Exec& ex, HashTableView t, View<const HashKey> keys, View<std::int32_t> slot_out) {
   ex.for_each(keys.size, [=] SEAMLESS_HD(std::int64_t i) { slot_out[i] = t.find(keys[i]); });
 }
 
-template <class Exec>
-void hash_erase(const Exec& ex, HashTableView t, View<const HashKey> keys, View<std::int32_t> slot_out,
+template <Executor Exec>
+void VoxelHash<Exec>::hash_erase(const Exec& ex, HashTableView t, View<const HashKey> keys, View<std::int32_t> slot_out,
                 HashCounters* counters) {
   ex.for_each(keys.size, [=] SEAMLESS_HD(std::int64_t i) {
     std::int32_t s = t.erase(keys[i]);
@@ -88,14 +88,14 @@ std::int64_t compact_slots(const Exec& ex, HashTableView t, View<std::int32_t> f
   return total;
 }
 
-template <class Exec>
-std::int64_t hash_live_slots(const Exec& ex, HashTableView t, View<std::int32_t> flags, View<std::int32_t> slots_out) {
+template <Executor Exec>
+std::int64_t VoxelHash<Exec>::hash_live_slots(const Exec& ex, HashTableView t, View<std::int32_t> flags, View<std::int32_t> slots_out) {
   return compact_slots(ex, t, flags, slots_out,
                        [=] SEAMLESS_HD(std::int64_t i) { return is_live_key(t.keys[i]) && t.values[i] >= 0; });
 }
 
-template <class Exec>
-std::int64_t hash_slots_beyond(const Exec& ex, HashTableView t, vec3 center, float radius, View<std::int32_t> flags,
+template <Executor Exec>
+std::int64_t VoxelHash<Exec>::hash_slots_beyond(const Exec& ex, HashTableView t, vec3 center, float radius, View<std::int32_t> flags,
                                View<std::int32_t> slots_out) {
   const float r2 = radius * radius;
   return compact_slots(ex, t, flags, slots_out, [=] SEAMLESS_HD(std::int64_t i) {
@@ -107,8 +107,8 @@ std::int64_t hash_slots_beyond(const Exec& ex, HashTableView t, vec3 center, flo
   });
 }
 
-template <class Exec>
-void insert_with_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list, HashCounters* counters,
+template <Executor Exec>
+void VoxelHash<Exec>::insert_with_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list, HashCounters* counters,
                         View<const HashKey> keys, View<std::int32_t> blocks_out) {
   ex.for_each(keys.size, [=] SEAMLESS_HD(std::int64_t i) {
     blocks_out[i] = -1;
@@ -131,8 +131,8 @@ void insert_with_blocks(const Exec& ex, HashTableView t, View<const std::int32_t
   });
 }
 
-template <class Exec>
-void hash_gather(const Exec& ex, HashTableView t, View<const std::int32_t> slots, View<HashKey> keys_out,
+template <Executor Exec>
+void VoxelHash<Exec>::hash_gather(const Exec& ex, HashTableView t, View<const std::int32_t> slots, View<HashKey> keys_out,
                  View<std::int32_t> values_out) {
   ex.for_each(slots.size, [=] SEAMLESS_HD(std::int64_t i) {
     keys_out[i] = t.keys[slots[i]];
@@ -140,15 +140,15 @@ void hash_gather(const Exec& ex, HashTableView t, View<const std::int32_t> slots
   });
 }
 
-template <class Exec>
-void gather_blocks(const Exec& ex, const Voxel* pool, View<const std::int32_t> blocks, View<Voxel> out) {
+template <Executor Exec>
+void VoxelHash<Exec>::gather_blocks(const Exec& ex, const Voxel* pool, View<const std::int32_t> blocks, View<Voxel> out) {
   ex.for_each(blocks.size * kBlockVoxels, [=] SEAMLESS_HD(std::int64_t i) {
     out[i] = pool[static_cast<std::int64_t>(blocks[i / kBlockVoxels]) * kBlockVoxels + i % kBlockVoxels];
   });
 }
 
-template <class Exec>
-void scatter_blocks(const Exec& ex, Voxel* pool, View<const std::int32_t> blocks, View<const Voxel> in) {
+template <Executor Exec>
+void VoxelHash<Exec>::scatter_blocks(const Exec& ex, Voxel* pool, View<const std::int32_t> blocks, View<const Voxel> in) {
   ex.for_each(blocks.size * kBlockVoxels, [=] SEAMLESS_HD(std::int64_t i) {
     const std::int32_t block = blocks[i / kBlockVoxels];
     if (block >= 0) pool[static_cast<std::int64_t>(block) * kBlockVoxels + i % kBlockVoxels] = in[i];
@@ -156,25 +156,3 @@ void scatter_blocks(const Exec& ex, Voxel* pool, View<const std::int32_t> blocks
 }
 
 }  // namespace seamless::kernels
-
-#define SEAMLESS_INSTANTIATE_VOXEL_HASH(EXEC)                                                                    \
-  namespace seamless::kernels {                                                                                  \
-  template void hash_clear<EXEC>(const EXEC&, HashTableView);                                                    \
-  template void pool_reset<EXEC>(const EXEC&, View<std::int32_t>, HashCounters*);                                \
-  template void pool_append<EXEC>(const EXEC&, View<std::int32_t>, HashCounters*, std::int32_t, std::int32_t);   \
-  template void reset_frame_counters<EXEC>(const EXEC&, HashCounters*);                                          \
-  template void hash_insert<EXEC>(const EXEC&, HashTableView, View<const HashKey>, View<const std::int32_t>,     \
-                                  View<std::int32_t>, View<std::int32_t>, HashCounters*);                        \
-  template void hash_find<EXEC>(const EXEC&, HashTableView, View<const HashKey>, View<std::int32_t>);            \
-  template void hash_erase<EXEC>(const EXEC&, HashTableView, View<const HashKey>, View<std::int32_t>,            \
-                                 HashCounters*);                                                                 \
-  template std::int64_t hash_live_slots<EXEC>(const EXEC&, HashTableView, View<std::int32_t>, View<std::int32_t>); \
-  template std::int64_t hash_slots_beyond<EXEC>(const EXEC&, HashTableView, vec3, float, View<std::int32_t>,     \
-                                                View<std::int32_t>);                                             \
-  template void insert_with_blocks<EXEC>(const EXEC&, HashTableView, View<const std::int32_t>, HashCounters*,    \
-                                         View<const HashKey>, View<std::int32_t>);                               \
-  template void hash_gather<EXEC>(const EXEC&, HashTableView, View<const std::int32_t>, View<HashKey>,          \
-                                  View<std::int32_t>);                                                           \
-  template void gather_blocks<EXEC>(const EXEC&, const Voxel*, View<const std::int32_t>, View<Voxel>);          \
-  template void scatter_blocks<EXEC>(const EXEC&, Voxel*, View<const std::int32_t>, View<const Voxel>);         \
-  }

@@ -1,3 +1,3 @@
 #include "core/exec_cpu.hpp"
 #include "kernels/recon/voxel_hash.inl"
-SEAMLESS_INSTANTIATE_VOXEL_HASH(seamless::CpuExec)
+template struct seamless::kernels::VoxelHash<seamless::CpuExec>;

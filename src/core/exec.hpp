@@ -39,15 +39,24 @@
 //                                        block's shared memory) for the whole sweep, written
 //                                        back at the end unless T is const (see Staged below)
 //   ex.synchronize()
+//   ex.device                            the Device it runs on (a constant)
 // plus the SEAMLESS_HD atomics in core/atomics.hpp. Pointers passed in live on ex.device.
+// The concept Executor below states this list; both backends are checked against it
+// (static_assert in core/exec_cpu.hpp and core/exec_cuda.cuh).
 //
 // CpuExec's members are defined in core/exec_cpu.hpp (OpenMP), CudaExec's in core/exec_cuda.cuh
-// (CUDA + CUB). Host code includes only this header and calls kernel templates through
-// with_exec(); the kernel's .inl is compiled once per backend by two tiny instantiation files.
+// (CUDA + CUB). A kernel family is a class template `template <Executor Exec> struct Name`
+// whose kernels are static member functions, declared in the family's header and defined in its
+// .inl; each backend instantiates the whole family with one line
+// (`template struct seamless::kernels::Name<seamless::CpuExec>;`). Host code includes only this
+// header and the family's, and picks the backend with with_exec():
+//   with_exec(dev, [&]<class E>(const E& ex) { kernels::Name<E>::kernel(ex, ...); });
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <concepts>
 #include <cstring>
+#include <type_traits>
 
 #include "core/device.hpp"
 #include "core/error.hpp"
@@ -188,6 +197,50 @@ struct CudaExec {
   void for_each_phases_staged(int phases, const std::int64_t* begin, const std::int64_t* end, F fn,
                               Staged<T>... arrays) const;
   void synchronize() const;
+};
+
+// The executor's primitives (the list at the top of this file), checked on small probe functors:
+// only the calls' forms (arguments and results) are checked here, not what they compute (that is
+// tests/core). A kernel family is a template over an Executor.
+namespace exec_probe {
+struct Index {  // for_each
+  SEAMLESS_HD void operator()(std::int64_t) const {}
+};
+struct Value {  // transform_reduce*: a number per element
+  SEAMLESS_HD float operator()(std::int64_t) const { return 0.f; }
+};
+struct Round {  // transform_reduce_rounds' then: true = stop
+  SEAMLESS_HD bool operator()(int, const float&) const { return true; }
+};
+struct Grouped {  // for_each_grouped
+  SEAMLESS_HD void operator()(std::int64_t, const Lanes&) const {}
+};
+struct Phase {  // for_each_phases
+  SEAMLESS_HD void operator()(int, std::int64_t) const {}
+};
+struct StagedPhase {  // for_each_phases_staged with one float array
+  SEAMLESS_HD void operator()(int, std::int64_t, float*) const {}
+};
+}  // namespace exec_probe
+
+template <class E>
+concept Executor = requires(const E& ex, std::int64_t n, int k, const int* in, int* out, unsigned* keys,
+                            float* sum, const std::int64_t* begin, const std::int64_t* end) {
+  typename std::integral_constant<Device, E::device>;  // a constant: kernels branch on it
+  ex.for_each(n, exec_probe::Index{});
+  { ex.exclusive_scan(in, out, n) } -> std::same_as<int>;
+  ex.sort_by_key(keys, out, n, k);
+  ex.sort_by_key(keys, out, n);
+  { ex.transform_reduce(n, 0.0, exec_probe::Value{}) } -> std::same_as<double>;
+  ex.transform_reduce_into(n, exec_probe::Value{}, sum);
+  ex.transform_reduce_into(n, exec_probe::Value{}, sum, NoThen{});
+  ex.transform_reduce_rounds(n, k, exec_probe::Value{}, sum, exec_probe::Round{});
+  ex.for_each_grouped(n, k, exec_probe::Grouped{});
+  ex.for_each_grouped(n, k, exec_probe::Grouped{}, MinBlocks<2>{});
+  { ex.lanes(n, k) } -> std::same_as<int>;
+  ex.for_each_phases(k, begin, end, exec_probe::Phase{});
+  ex.for_each_phases_staged(k, begin, end, exec_probe::StagedPhase{}, Staged<float>{sum, n});
+  ex.synchronize();
 };
 
 #if SEAMLESS_HAS_CUDA

@@ -11,6 +11,9 @@
 
 namespace seamless {
 
+// Every primitive of core/exec.hpp's list, with the forms the kernels call.
+static_assert(Executor<CpuExec>);
+
 template <class F>
 void CpuExec::for_each(std::int64_t n, F fn) const {
   // Small ranges are not worth waking the thread team.

@@ -14,6 +14,9 @@
 
 namespace seamless {
 
+// Every primitive of core/exec.hpp's list, with the forms the kernels call.
+static_assert(Executor<CudaExec>);
+
 namespace cuda_detail {
 // One growing scratch allocation shared by the collectives (they run one at a time on stream 0).
 void* scratch(std::size_t bytes);

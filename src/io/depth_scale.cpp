@@ -134,8 +134,8 @@ void DepthScaleCheck::check(const Image<std::uint16_t>& raw, const std::string& 
 }
 
 void fill_depth_gaps_host(const Image<float>& in, Image<float>& out) {
-  with_exec(Device::CPU, [&](const auto& ex) {
-    kernels::fill_depth_gaps(ex, in.cview(), out.view(), kernels::kFillGapsMaxRelDiff);
+  with_exec(Device::CPU, [&]<class E>(const E& ex) {
+    kernels::FillGaps<E>::fill_depth_gaps(ex, in.cview(), out.view(), kernels::kFillGapsMaxRelDiff);
   });
 }
 

@@ -122,8 +122,8 @@ void SyntheticSource::render(const SE3& T, std::uint32_t frame_number, const ker
   std::uint32_t seed = static_cast<std::uint32_t>(p_.seed ^ (p_.seed >> 32));
   const bool with_mask = !p_.movers.empty();
   if (with_mask && mask_dev_.width() != K_.width) mask_dev_ = Image<std::uint8_t>(K_.width, K_.height, device_);
-  with_exec(device_, [&](const auto& ex) {
-    kernels::render_room(ex, K_, T, noise, seed, frame_number, movers, scratch_.view(), depth_dev_.view(),
+  with_exec(device_, [&]<class E>(const E& ex) {
+    kernels::RenderRoom<E>::render_room(ex, K_, T, noise, seed, frame_number, movers, scratch_.view(), depth_dev_.view(),
                          rgb_dev_.view(), with_mask ? mask_dev_.view() : View2D<std::uint8_t>{});
     ex.synchronize();
   });

@@ -247,13 +247,13 @@ void TumSource::load_frame(const TumPair& pair, RgbdFrame& frame) {
   check_median_depth(depth, scale, depth_path);
   scale_check_->check(raw, depth_path);
   if (undistort) {  // on the host: this is input decoding
-    with_exec(Device::CPU, [&](const auto& ex) {
+    with_exec(Device::CPU, [&]<class E>(const E& ex) {
       if (undistort_map_.width() != depth.width()) {
         undistort_map_ = Image<vec2>(depth.width(), depth.height(), Device::CPU);
-        kernels::undistort_map(ex, K_, undistort_map_.view());
+        kernels::Undistort<E>::undistort_map(ex, K_, undistort_map_.view());
       }
-      kernels::remap_depth(ex, undistort_map_.cview(), depth.cview(), frame.depth.view());
-      kernels::remap_rgb(ex, undistort_map_.cview(), rgb.cview(), frame.rgb.view());
+      kernels::Undistort<E>::remap_depth(ex, undistort_map_.cview(), depth.cview(), frame.depth.view());
+      kernels::Undistort<E>::remap_rgb(ex, undistort_map_.cview(), rgb.cview(), frame.rgb.view());
     });
   } else {
     frame.rgb.buffer().copy_from(rgb.buffer());

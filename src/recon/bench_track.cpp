@@ -36,7 +36,7 @@ std::shared_ptr<FramePyramid> pyramid(const RgbdFrame& f, Device d) {
   auto p = std::make_shared<FramePyramid>(d, f.intrinsics, 3);
   Image<float> depth = f.depth.clone(d), inten(f.depth.width(), f.depth.height(), d);
   Image<uchar3> rgb = f.rgb.clone(d);
-  with_exec(d, [&](const auto& ex) { kernels::rgb_to_intensity(ex, rgb.cview(), inten.view()); });
+  with_exec(d, [&]<class E>(const E& ex) { kernels::Rgbd<E>::rgb_to_intensity(ex, rgb.cview(), inten.view()); });
   p->build(depth, &inten, PreprocessParams{});
   return p;
 }

@@ -36,8 +36,8 @@ void DenseVolume::integrate(const Image<float>& depth, const Image<uchar3>& rgb,
                          params_.min_depth, params_.max_depth};
   in.carve = carve_;
   if (timer) timer->begin("fuse");
-  with_exec(device_, [&](const auto& ex) {
-    kernels::fuse_dense_blocks(ex, device_view(), in, params_.max_weight, params_.integrate_color);
+  with_exec(device_, [&]<class E>(const E& ex) {
+    kernels::TsdfFusion<E>::fuse_dense_blocks(ex, device_view(), in, params_.max_weight, params_.integrate_color);
   });
   if (timer) timer->end("fuse");
   ++frames_;
@@ -47,8 +47,8 @@ void DenseVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, Raycas
   detail::resize_maps(maps, K, device_);
   kernels::RaycastOutput out{maps.depth.view(), maps.vertex.view(), maps.normal.view(), maps.color.view()};
   if (timer) timer->begin("raycast");
-  with_exec(device_, [&](const auto& ex) {
-    kernels::raycast(ex, device_view(), K, world_T_camera, params_.min_depth, params_.max_depth, out);
+  with_exec(device_, [&]<class E>(const E& ex) {
+    kernels::TsdfRaycast<E, kernels::DenseAccess>::raycast(ex, device_view(), K, world_T_camera, params_.min_depth, params_.max_depth, out);
   });
   if (timer) timer->end("raycast");
 }

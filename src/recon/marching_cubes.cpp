@@ -87,15 +87,15 @@ Mesh marching_cubes(Device d, const Acc& a, const Buffer<int3>& blocks, std::int
     std::int64_t nb = std::min(kChunk, block_count - first);
     View<const int3> chunk{blocks.data() + first, nb};
     Buffer<std::int32_t> offsets(nb * kernels::kBlockVoxels, d);
-    std::int64_t tris = with_exec(d, [&](const auto& ex) {
-      return kernels::mesh_count(ex, a, chunk, table.data(), offsets.view());
+    std::int64_t tris = with_exec(d, [&]<class E>(const E& ex) {
+      return kernels::TsdfExtract<E, Acc>::mesh_count(ex, a, chunk, table.data(), offsets.view());
     });
     if (tris == 0) continue;
     Buffer<vec3> pos(3 * tris, d), nrm(3 * tris, d);
     Buffer<uchar3> col(3 * tris, d);
     Buffer<std::uint64_t> keys(3 * tris, d);
-    with_exec(d, [&](const auto& ex) {
-      kernels::mesh_emit(ex, a, chunk, table.data(), offsets.cview(), pos.view(), nrm.view(), col.view(), keys.view());
+    with_exec(d, [&]<class E>(const E& ex) {
+      kernels::TsdfExtract<E, Acc>::mesh_emit(ex, a, chunk, table.data(), offsets.cview(), pos.view(), nrm.view(), col.view(), keys.view());
     });
     auto hp = pos.to_host(), hn = nrm.to_host();
     auto hc = col.to_host();

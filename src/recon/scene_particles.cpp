@@ -46,14 +46,14 @@ Candidates candidates(Device d, const Acc& a, const Buffer<int3>& blocks, std::i
     std::int64_t nb = std::min(chunk, block_count - first);
     View<const int3> part{blocks.data() + first, nb};
     Buffer<std::int32_t> offsets(nb * per_block, d);
-    std::int64_t n = with_exec(d, [&](const auto& ex) {
-      return kernels::scene_particle_count(ex, a, part, p.spacing, p.interior_depth, offsets.view());
+    std::int64_t n = with_exec(d, [&]<class E>(const E& ex) {
+      return kernels::TsdfExtract<E, Acc>::scene_particle_count(ex, a, part, p.spacing, p.interior_depth, offsets.view());
     });
     if (n == 0) continue;
     Buffer<vec3> pos(n, d), nrm(n, d);
     Buffer<float> score(n, d);
-    with_exec(d, [&](const auto& ex) {
-      kernels::scene_particle_emit(ex, a, part, p.spacing, p.interior_depth, offsets.cview(), pos.view(), nrm.view(),
+    with_exec(d, [&]<class E>(const E& ex) {
+      kernels::TsdfExtract<E, Acc>::scene_particle_emit(ex, a, part, p.spacing, p.interior_depth, offsets.cview(), pos.view(), nrm.view(),
                                    score.view());
     });
     c.count += n;
@@ -71,14 +71,14 @@ SceneParticles thin(Device d, const Candidates& c, float min_distance) {
   if (c.count == 0) return out;
   Buffer<std::uint64_t> keys(c.count, d);
   Buffer<std::int32_t> order(c.count, d), keep(c.count, d);
-  with_exec(d, [&](const auto& ex) {
-    out.count = kernels::scene_particle_thin(ex, c.positions.cview(), c.scores.cview(), min_distance, keys.view(),
+  with_exec(d, [&]<class E>(const E& ex) {
+    out.count = kernels::TsdfExtract<E>::scene_particle_thin(ex, c.positions.cview(), c.scores.cview(), min_distance, keys.view(),
                                              order.view(), keep.view());
   });
   out.positions = Buffer<vec3>(out.count, d);
   out.normals = Buffer<vec3>(out.count, d);
-  with_exec(d, [&](const auto& ex) {
-    kernels::scene_particle_compact(ex, keep.cview(), out.count, c.positions.cview(), c.normals.cview(),
+  with_exec(d, [&]<class E>(const E& ex) {
+    kernels::TsdfExtract<E>::scene_particle_compact(ex, keep.cview(), out.count, c.positions.cview(), c.normals.cview(),
                                     out.positions.view(), out.normals.view());
   });
   return out;
@@ -110,7 +110,7 @@ std::vector<float> sample_sdf_grid(Device d, const Acc& a, vec3 origin, int3 dim
   if (dims.x <= 0 || dims.y <= 0 || dims.z <= 0 || !(voxel > 0.f))
     throw Error("SDF grid: dimensions and voxel size must be positive");
   Buffer<float> out(n, d);
-  with_exec(d, [&](const auto& ex) { kernels::sample_sdf_grid(ex, a, origin, dims, voxel, unknown, out.view()); });
+  with_exec(d, [&]<class E>(const E& ex) { kernels::TsdfExtract<E, Acc>::sample_sdf_grid(ex, a, origin, dims, voxel, unknown, out.view()); });
   return out.to_host();
 }
 

@@ -79,15 +79,15 @@ void ReferenceMaps::set_from_raycast(const RaycastMaps& maps, const Intrinsics& 
   Device d = maps.vertex.device();
   resize(K, levels, d, intensity);
   const SE3 camera_T_world = world_T_camera.inverse();
-  with_exec(d, [&](const auto& ex) {
-    kernels::transform_maps(ex, maps.vertex.cview(), maps.normal.cview(), camera_T_world, levels_[0].vertices.view(),
+  with_exec(d, [&]<class E>(const E& ex) {
+    kernels::Icp<E>::transform_maps(ex, maps.vertex.cview(), maps.normal.cview(), camera_T_world, levels_[0].vertices.view(),
                             levels_[0].normals.view());
-    if (from_model) kernels::rgb_to_intensity(ex, maps.color.cview(), levels_[0].intensity.view());
+    if (from_model) kernels::Rgbd<E>::rgb_to_intensity(ex, maps.color.cview(), levels_[0].intensity.view());
     for (int l = 1; l < levels; ++l) {
-      kernels::pyr_down_maps(ex, levels_[l - 1].vertices.cview(), levels_[l - 1].normals.cview(),
+      kernels::Icp<E>::pyr_down_maps(ex, levels_[l - 1].vertices.cview(), levels_[l - 1].normals.cview(),
                              levels_[l].vertices.view(), levels_[l].normals.view(), max_diff);
       if (from_model)
-        kernels::pyr_down_intensity(ex, levels_[l - 1].intensity.cview(), levels_[l].intensity.view());
+        kernels::Preprocess<E>::pyr_down_intensity(ex, levels_[l - 1].intensity.cview(), levels_[l].intensity.view());
     }
   });
   if (from_frame)
@@ -176,10 +176,10 @@ void Tracker::reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, i
   if (level < static_cast<int>(params_.pixel_stride.size())) L.stride = params_.pixel_stride[level];
   kernels::IcpState* st = state();
   kernels::IcpSums* out = sums_slot(level);
-  with_exec(device_, [&](const auto& ex) {
+  with_exec(device_, [&]<class E>(const E& ex) {
     if (!use_photometric(frame, ref)) {
-      if (steps == 0) return kernels::icp_reduce_into(ex, L, &st->pose, out);
-      return kernels::icp_level_steps(ex, L, &st->pose, out, steps);
+      if (steps == 0) return kernels::Icp<E>::icp_reduce_into(ex, L, &st->pose, out);
+      return kernels::Icp<E>::icp_level_steps(ex, L, &st->pose, out, steps);
     }
     kernels::RgbdLevel R{L, cur.intensity.cview(), rl.intensity.cview(), 1.f, params_.photometric_weight,
                          params_.max_intensity_diff, robust(frame, ref) ? params_.robust_dof : 0.f,
@@ -187,8 +187,8 @@ void Tracker::reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, i
     R.photometric_all_visible = params_.photometric_pixels == "visible";
     R.min_gradient = params_.min_gradient;
     if (rgbd_sums_.size() != 1 || rgbd_sums_.device() != device_) rgbd_sums_ = Buffer<kernels::RgbdSums>(1, device_);
-    if (steps == 0) return kernels::rgbd_reduce_into(ex, R, &st->pose, rgbd_sums_.data(), out);
-    kernels::rgbd_level_steps(ex, R, &st->pose, rgbd_sums_.data(), out, steps);
+    if (steps == 0) return kernels::Rgbd<E>::rgbd_reduce_into(ex, R, &st->pose, rgbd_sums_.data(), out);
+    kernels::Rgbd<E>::rgbd_level_steps(ex, R, &st->pose, rgbd_sums_.data(), out, steps);
   });
 }
 

@@ -155,10 +155,10 @@ const ReferenceMaps* TrackingSession::mask_before_tracking() {
     kept_vertices_ = lv.vertices.clone(device_), kept_normals_ = lv.normals.clone(device_);
     kept_ = true;
   }
-  with_exec(device_, [&](const auto& ex) {
+  with_exec(device_, [&]<class E>(const E& ex) {
     for (int l = 0; l < pyr_.levels(); ++l) {
       PyramidLevel& lv = pyr_.mutable_level(l);
-      kernels::mask_vertices(ex, dyn_mask_.cview(), 1 << l, lv.vertices.view(), lv.normals.view());
+      kernels::Dynamic<E>::mask_vertices(ex, dyn_mask_.cview(), 1 << l, lv.vertices.view(), lv.normals.view());
     }
   });
   return model;
@@ -184,9 +184,9 @@ void TrackingSession::find_dynamic(const ReferenceMaps& model, const SE3& world_
   in.residual_sigmas = d.residual_sigmas;
   in.free_space = d.free_space_truncations * (volume_ ? volume_->params().truncation : p_.volume.truncation);
   in.search_radius = d.search_radius;
-  with_exec(device_, [&](const auto& ex) {
-    kernels::classify_dynamic(ex, in, dyn_candidates_.view());
-    kernels::filter_dynamic(ex, dyn_candidates_.cview(), dyn_prev_.cview(), l0.depth.cview(), d.support_radius,
+  with_exec(device_, [&]<class E>(const E& ex) {
+    kernels::Dynamic<E>::classify_dynamic(ex, in, dyn_candidates_.view());
+    kernels::Dynamic<E>::filter_dynamic(ex, dyn_candidates_.cview(), dyn_prev_.cview(), l0.depth.cview(), d.support_radius,
                             d.min_support, d.dilate_max_step, dyn_kept_.view(), dyn_mask_.view());
   });
 }
@@ -218,7 +218,7 @@ void TrackingSession::preprocess() {
   if (colour && p_.tracker.kind == "rgbd") {
     if (intensity_.width() != K_.width) intensity_ = Image<float>(K_.width, K_.height, device_);
     join_colour();
-    with_exec(device_, [&](const auto& ex) { kernels::rgb_to_intensity(ex, rgb_.cview(), intensity_.view()); });
+    with_exec(device_, [&]<class E>(const E& ex) { kernels::Rgbd<E>::rgb_to_intensity(ex, rgb_.cview(), intensity_.view()); });
     intensity = &intensity_;
   }
   pyr_.build(depth_, intensity, p_.preprocess);
@@ -446,9 +446,9 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
   if (dyn_model && rec.result.ok()) {
     // The mask at the tracked pose is the frame's: fusion skips it, the next frame's filter reads it.
     find_dynamic(*dyn_model, rec.result.world_T_camera);
-    with_exec(device_, [&](const auto& ex) {
-      kernels::mask_depth(ex, dyn_mask_.cview(), depth_.view());
-      rec.dynamic_fraction = static_cast<double>(kernels::count_dynamic(ex, dyn_mask_.cview())) /
+    with_exec(device_, [&]<class E>(const E& ex) {
+      kernels::Dynamic<E>::mask_depth(ex, dyn_mask_.cview(), depth_.view());
+      rec.dynamic_fraction = static_cast<double>(kernels::Dynamic<E>::count_dynamic(ex, dyn_mask_.cview())) /
                              static_cast<double>(K_.width * K_.height);
     });
     dyn_prev_.buffer().copy_from(dyn_mask_.buffer());

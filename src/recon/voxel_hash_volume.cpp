@@ -55,9 +55,9 @@ VoxelHashVolume::VoxelHashVolume(const VolumeParams& p, Device d) : params_(p), 
   visible_ = Buffer<std::int32_t>(p.capacity, d);
   keep_ = Buffer<std::int32_t>(p.capacity, d);
   counters_ = Buffer<HashCounters>(1, d);
-  with_exec(d, [&](const auto& ex) {
-    kernels::hash_clear(ex, table());
-    kernels::pool_reset(ex, free_list_.view(), counters_.data());
+  with_exec(d, [&]<class E>(const E& ex) {
+    kernels::VoxelHash<E>::hash_clear(ex, table());
+    kernels::VoxelHash<E>::pool_reset(ex, free_list_.view(), counters_.data());
   });
   last_ = read_counters();
 }
@@ -90,14 +90,14 @@ void VoxelHashVolume::integrate(const Image<float>& depth, const Image<uchar3>& 
   // Fusion flags the visible blocks that keep a voxel near a surface, so removing the others
   // needs no second pass over their voxels (one thread per voxel there, not per block).
   const View<std::int32_t> keep = params_.remove_empty_blocks ? keep_.view() : View<std::int32_t>{};
-  with_exec(device_, [&](const auto& ex) {
+  with_exec(device_, [&]<class E>(const E& ex) {
     staged(timer, "fuse", [&] {
-      kernels::fuse_hash_blocks(ex, table(), visible_.cview(), n, voxels_.data(), in, geom_, params_.max_weight,
+      kernels::TsdfFusion<E>::fuse_hash_blocks(ex, table(), visible_.cview(), n, voxels_.data(), in, geom_, params_.max_weight,
                                 params_.integrate_color, keep, keep_below());
     });
     if (params_.remove_empty_blocks)
       staged(timer, "remove_empty", [&] {
-        kernels::remove_unkept_blocks(ex, table(), visible_.cview(), n, keep_.cview(), voxels_.data(),
+        kernels::TsdfFusion<E>::remove_unkept_blocks(ex, table(), visible_.cview(), n, keep_.cview(), voxels_.data(),
                                       free_list_.view(), counters_.data());
       });
   });
@@ -115,14 +115,14 @@ void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTime
   }
   const std::int64_t pool_before = free_list_.size(), slots_before = keys_.size();
   for (int attempt = 0;; ++attempt) {
-    with_exec(device_, [&](const auto& ex) {
-      kernels::reset_frame_counters(ex, counters_.data());
+    with_exec(device_, [&]<class E>(const E& ex) {
+      kernels::VoxelHash<E>::reset_frame_counters(ex, counters_.data());
       staged(timer, "allocate", [&] {
-        if (tiles.zmax) kernels::clear_depth_tiles(ex, tiles);
-        kernels::allocate_blocks(ex, table(), free_list_.cview(), counters_.data(), in, geom_, tiles);
+        if (tiles.zmax) kernels::TsdfFusion<E>::clear_depth_tiles(ex, tiles);
+        kernels::TsdfFusion<E>::allocate_blocks(ex, table(), free_list_.cview(), counters_.data(), in, geom_, tiles);
       });
       staged(timer, "visible", [&] {
-        kernels::find_visible_blocks(ex, table(), counters_.data(), in, geom_, visible_.view(), keep_.view(), tiles);
+        kernels::TsdfFusion<E>::find_visible_blocks(ex, table(), counters_.data(), in, geom_, visible_.view(), keep_.view(), tiles);
       });
     });
     last_ = read_counters();
@@ -197,7 +197,7 @@ void VoxelHashVolume::maybe_rehash(const HashCounters& c, std::int64_t extra) {
 
 std::int64_t VoxelHashVolume::live_slots(Buffer<std::int32_t>& slots) const {
   if (slots.size() < free_list_.size() || slots.device() != device_) slots = Buffer<std::int32_t>(free_list_.size(), device_);
-  return with_exec(device_, [&](const auto& ex) { return kernels::hash_live_slots(ex, table(), scratch_.view(), slots.view()); });
+  return with_exec(device_, [&]<class E>(const E& ex) { return kernels::VoxelHash<E>::hash_live_slots(ex, table(), scratch_.view(), slots.view()); });
 }
 
 void VoxelHashVolume::rehash(std::int64_t new_slots) {
@@ -209,8 +209,8 @@ void VoxelHashVolume::rehash(std::int64_t new_slots) {
   const std::int64_t n = live_slots(slots);
   Buffer<kernels::HashKey> keys(n, device_);
   Buffer<std::int32_t> values(n, device_), slot_out(n, device_), result(n, device_);
-  with_exec(device_, [&](const auto& ex) {
-    kernels::hash_gather(ex, table(), View<const std::int32_t>{slots.data(), n}, keys.view(), values.view());
+  with_exec(device_, [&]<class E>(const E& ex) {
+    kernels::VoxelHash<E>::hash_gather(ex, table(), View<const std::int32_t>{slots.data(), n}, keys.view(), values.view());
   });
   keys_ = Buffer<kernels::HashKey>(new_slots, device_);
   values_ = Buffer<std::int32_t>(new_slots, device_);
@@ -219,9 +219,9 @@ void VoxelHashVolume::rehash(std::int64_t new_slots) {
   c.tombstones = 0;
   c.probe_failures = 0;
   counters_.copy_from_host(&c, 1);
-  with_exec(device_, [&](const auto& ex) {
-    kernels::hash_clear(ex, table());
-    kernels::hash_insert(ex, table(), keys.cview(), values.cview(), slot_out.view(), result.view(), counters_.data());
+  with_exec(device_, [&]<class E>(const E& ex) {
+    kernels::VoxelHash<E>::hash_clear(ex, table());
+    kernels::VoxelHash<E>::hash_insert(ex, table(), keys.cview(), values.cview(), slot_out.view(), result.view(), counters_.data());
   });
   HashCounters after = read_counters();
   if (after.probe_failures > 0)
@@ -247,8 +247,8 @@ void VoxelHashVolume::grow_pool(std::int64_t blocks) {
   free_list_ = std::move(free_list);
   visible_ = Buffer<std::int32_t>(blocks, device_);
   keep_ = Buffer<std::int32_t>(blocks, device_);
-  with_exec(device_, [&](const auto& ex) {
-    kernels::pool_append(ex, free_list_.view(), counters_.data(), static_cast<std::int32_t>(old),
+  with_exec(device_, [&]<class E>(const E& ex) {
+    kernels::VoxelHash<E>::pool_append(ex, free_list_.view(), counters_.data(), static_cast<std::int32_t>(old),
                          static_cast<std::int32_t>(blocks - old));
   });
   params_.capacity = blocks;
@@ -260,10 +260,10 @@ std::int64_t VoxelHashVolume::remove_empty_blocks() {
   Buffer<std::int32_t> keep(n, device_);
   keep.zero();
   const View<const std::int32_t> listed{slots.data(), n};
-  with_exec(device_, [&](const auto& ex) {
-    kernels::reset_frame_counters(ex, counters_.data());
-    kernels::mark_kept_blocks(ex, table(), listed, n, voxels_.data(), keep.view(), keep_below());
-    kernels::remove_unkept_blocks(ex, table(), listed, n, keep.cview(), voxels_.data(), free_list_.view(),
+  with_exec(device_, [&]<class E>(const E& ex) {
+    kernels::VoxelHash<E>::reset_frame_counters(ex, counters_.data());
+    kernels::TsdfFusion<E>::mark_kept_blocks(ex, table(), listed, n, voxels_.data(), keep.view(), keep_below());
+    kernels::TsdfFusion<E>::remove_unkept_blocks(ex, table(), listed, n, keep.cview(), voxels_.data(), free_list_.view(),
                                   counters_.data());
   });
   last_ = read_counters();
@@ -275,8 +275,8 @@ std::vector<int3> VoxelHashVolume::allocated_block_coords() const {
   const std::int64_t n = live_slots(slots);
   Buffer<kernels::HashKey> keys(n, device_);
   Buffer<std::int32_t> values(n, device_);
-  with_exec(device_, [&](const auto& ex) {
-    kernels::hash_gather(ex, table(), View<const std::int32_t>{slots.data(), n}, keys.view(), values.view());
+  with_exec(device_, [&]<class E>(const E& ex) {
+    kernels::VoxelHash<E>::hash_gather(ex, table(), View<const std::int32_t>{slots.data(), n}, keys.view(), values.view());
   });
   std::vector<int3> out;
   for (kernels::HashKey k : keys.to_host()) out.push_back(kernels::unpack_block(k));
@@ -290,9 +290,9 @@ std::vector<VoxelHashVolume::HostBlock> VoxelHashVolume::download_blocks() const
   Buffer<kernels::HashKey> keys(n, device_);
   Buffer<std::int32_t> values(n, device_);
   Buffer<kernels::Voxel> vox(n * kBlockVoxels, device_);
-  with_exec(device_, [&](const auto& ex) {
-    kernels::hash_gather(ex, table(), View<const std::int32_t>{slots.data(), n}, keys.view(), values.view());
-    kernels::gather_blocks(ex, voxels_.data(), values.cview(), vox.view());
+  with_exec(device_, [&]<class E>(const E& ex) {
+    kernels::VoxelHash<E>::hash_gather(ex, table(), View<const std::int32_t>{slots.data(), n}, keys.view(), values.view());
+    kernels::VoxelHash<E>::gather_blocks(ex, voxels_.data(), values.cview(), vox.view());
   });
   std::vector<kernels::HashKey> hk = keys.to_host();
   std::vector<kernels::Voxel> hv = vox.to_host();
@@ -335,22 +335,22 @@ void VoxelHashVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, Ra
     intervals_.reserve_discard(2 * grid.count(), device_);
     iv = {grid, intervals_.data()};
   }
-  with_exec(device_, [&](const auto& ex) {
+  with_exec(device_, [&]<class E>(const E& ex) {
     staged(timer, "raycast", [&] {
       const kernels::BlockWindow w = raycast_window(world_T_camera);
       if (iv.bits)  // one pass over the slots splats the intervals and fills the window
         staged(timer, "raycast_splat", [&] {  // part of "raycast"
-          kernels::clear_ray_intervals(ex, iv, w);
-          kernels::splat_ray_intervals(ex, table(), geom_, K, world_T_camera, params_.min_depth, params_.max_depth,
+          kernels::TsdfRaycast<E>::clear_ray_intervals(ex, iv, w);
+          kernels::TsdfRaycast<E>::splat_ray_intervals(ex, table(), geom_, K, world_T_camera, params_.min_depth, params_.max_depth,
                                        iv, w);
         });
       if (!w.index) {
-        kernels::raycast(ex, device_view(), K, world_T_camera, params_.min_depth, params_.max_depth, out, iv);
+        kernels::TsdfRaycast<E, kernels::HashAccess>::raycast(ex, device_view(), K, world_T_camera, params_.min_depth, params_.max_depth, out, iv);
         return;
       }
       if (!iv.bits)
-        staged(timer, "raycast_window", [&] { kernels::fill_block_window(ex, table(), w); });  // part of "raycast"
-      kernels::raycast(ex, kernels::WindowedHashAccess{device_view(), w}, K, world_T_camera, params_.min_depth,
+        staged(timer, "raycast_window", [&] { kernels::TsdfRaycast<E>::fill_block_window(ex, table(), w); });  // part of "raycast"
+      kernels::TsdfRaycast<E, kernels::HashAccess>::raycast(ex, kernels::WindowedHashAccess{device_view(), w}, K, world_T_camera, params_.min_depth,
                        params_.max_depth, out, iv);
     });
   });
@@ -360,8 +360,8 @@ std::int64_t VoxelHashVolume::live_block_coords(Buffer<int3>& coords) const {
   Buffer<std::int32_t> slots;
   const std::int64_t n = live_slots(slots);
   coords = Buffer<int3>(n, device_);
-  with_exec(device_, [&](const auto& ex) {
-    kernels::slot_block_coords(ex, table(), View<const std::int32_t>{slots.data(), n}, coords.view());
+  with_exec(device_, [&]<class E>(const E& ex) {
+    kernels::TsdfExtract<E>::slot_block_coords(ex, table(), View<const std::int32_t>{slots.data(), n}, coords.view());
   });
   return n;
 }

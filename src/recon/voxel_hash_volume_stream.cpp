@@ -87,8 +87,8 @@ bool VoxelHashVolume::beyond_radius(HashKey key, const vec3& camera_position) co
 void VoxelHashVolume::stream_out(const vec3& camera_position) {
   Buffer<std::int32_t> slots(free_list_.size(), device_);
   const float radius = params_.stream_radius / geom_.voxel_size;
-  const std::int64_t n = with_exec(device_, [&](const auto& ex) {
-    return kernels::hash_slots_beyond(ex, table(), geom_.to_voxel(camera_position), radius, scratch_.view(),
+  const std::int64_t n = with_exec(device_, [&]<class E>(const E& ex) {
+    return kernels::VoxelHash<E>::hash_slots_beyond(ex, table(), geom_.to_voxel(camera_position), radius, scratch_.view(),
                                       slots.view());
   });
   if (n == 0) return;
@@ -97,10 +97,10 @@ void VoxelHashVolume::stream_out(const vec3& camera_position) {
   Buffer<std::int32_t> blocks(n, device_);
   Buffer<Voxel> staging(n * kBlockVoxels, device_);
   memory::fill_zero(keep_.data(), device_, sizeof(std::int32_t) * static_cast<std::size_t>(n));
-  with_exec(device_, [&](const auto& ex) {
-    kernels::hash_gather(ex, table(), listed, keys.view(), blocks.view());
-    kernels::gather_blocks(ex, voxels_.data(), blocks.cview(), staging.view());
-    kernels::remove_unkept_blocks(ex, table(), listed, n, View<const std::int32_t>{keep_.data(), n}, voxels_.data(),
+  with_exec(device_, [&]<class E>(const E& ex) {
+    kernels::VoxelHash<E>::hash_gather(ex, table(), listed, keys.view(), blocks.view());
+    kernels::VoxelHash<E>::gather_blocks(ex, voxels_.data(), blocks.cview(), staging.view());
+    kernels::TsdfFusion<E>::remove_unkept_blocks(ex, table(), listed, n, View<const std::int32_t>{keep_.data(), n}, voxels_.data(),
                                   free_list_.view(), counters_.data());
   });
   const std::vector<HashKey> hk = keys.to_host();
@@ -172,11 +172,11 @@ void VoxelHashVolume::upload(std::vector<HashKey>& keys, std::vector<Voxel>& vox
   Buffer<HashKey> dkeys = Buffer<HashKey>::from_host(keys, device_);
   Buffer<Voxel> dvox = Buffer<Voxel>::from_host(voxels, device_);
   Buffer<std::int32_t> blocks(fit, device_);
-  with_exec(device_, [&](const auto& ex) {
-    kernels::reset_frame_counters(ex, counters_.data());
-    kernels::insert_with_blocks(ex, table(), free_list_.cview(), counters_.data(), View<const HashKey>{dkeys.data(), fit},
+  with_exec(device_, [&]<class E>(const E& ex) {
+    kernels::VoxelHash<E>::reset_frame_counters(ex, counters_.data());
+    kernels::VoxelHash<E>::insert_with_blocks(ex, table(), free_list_.cview(), counters_.data(), View<const HashKey>{dkeys.data(), fit},
                                 blocks.view());
-    kernels::scatter_blocks(ex, voxels_.data(), blocks.cview(), dvox.cview());
+    kernels::VoxelHash<E>::scatter_blocks(ex, voxels_.data(), blocks.cview(), dvox.cview());
   });
   const std::vector<std::int32_t> got = blocks.to_host();
   const HashCounters after = read_counters();

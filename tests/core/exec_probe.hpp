@@ -3,6 +3,7 @@
 #pragma once
 #include <cstdint>
 
+#include "core/exec.hpp"
 #include "core/math.hpp"
 #include "core/view.hpp"
 
@@ -15,10 +16,6 @@ struct Moments {
   SEAMLESS_HD Moments operator+(const Moments& o) const { return {sum + o.sum, sum_sq + o.sum_sq, count + o.count}; }
 };
 
-template <class Exec> void square(const Exec& ex, View<const float> in, View<float> out);
-template <class Exec> Moments moments(const Exec& ex, View<const float> in);
-// The same sum left on the device in *out (transform_reduce_into).
-template <class Exec> void moments_into(const Exec& ex, View<const float> in, Moments* out);
 // transform_reduce_rounds: each round sums in[i] x scale into out->sum, then doubles the scale
 // and logs the round's sum; the rounds stop after `rounds` or once a sum exceeds stop_above.
 // The per-element terms are floats (the rounds sum float components), 40 of them so that the
@@ -49,12 +46,25 @@ struct RoundsLog {
   int rounds_run = 0;
   double sums[16][40] = {};
 };
-template <class Exec>
-void doubling_rounds(const Exec& ex, View<const float> in, int rounds, double stop_above, RoundSums* out, RoundsLog* log);
-template <class Exec> std::uint32_t scan(const Exec& ex, View<const std::uint32_t> in, View<std::uint32_t> out);
-template <class Exec> void sort(const Exec& ex, View<std::uint32_t> keys, View<std::int32_t> values, int bits);
-// Histogram with atomics: counts[v % bins]++ for every v.
-template <class Exec> void histogram(const Exec& ex, View<const std::uint32_t> in, View<std::uint32_t> counts);
-template <class Exec> void atomic_float_sum(const Exec& ex, View<const float> in, float* total);
+template <Executor Exec>
+struct ExecProbe {
+  static void square(const Exec& ex, View<const float> in, View<float> out);
+
+  static Moments moments(const Exec& ex, View<const float> in);
+
+  // The same sum left on the device in *out (transform_reduce_into).
+  static void moments_into(const Exec& ex, View<const float> in, Moments* out);
+
+  static void doubling_rounds(const Exec& ex, View<const float> in, int rounds, double stop_above, RoundSums* out, RoundsLog* log);
+
+  static std::uint32_t scan(const Exec& ex, View<const std::uint32_t> in, View<std::uint32_t> out);
+
+  static void sort(const Exec& ex, View<std::uint32_t> keys, View<std::int32_t> values, int bits);
+
+  // Histogram with atomics: counts[v % bins]++ for every v.
+  static void histogram(const Exec& ex, View<const std::uint32_t> in, View<std::uint32_t> counts);
+
+  static void atomic_float_sum(const Exec& ex, View<const float> in, float* total);
+};
 
 }  // namespace seamless::probe

@@ -1,3 +1,3 @@
 #include "core/exec_cpu.hpp"
 #include "exec_probe.inl"
-SEAMLESS_INSTANTIATE_PROBE(seamless::CpuExec)
+template struct seamless::probe::ExecProbe<seamless::CpuExec>;

@@ -1,3 +1,3 @@
 #include "core/exec_cuda.cuh"
 #include "exec_probe.inl"
-SEAMLESS_INSTANTIATE_PROBE(seamless::CudaExec)
+template struct seamless::probe::ExecProbe<seamless::CudaExec>;

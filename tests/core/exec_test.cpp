@@ -38,7 +38,7 @@ TEST_P(ExecTest, ForEachCoversEveryElementOnce) {
   for (std::int64_t i = 0; i < n; ++i) h[i] = static_cast<float>(i % 1000);
   auto in = Buffer<float>::from_host(h, dev());
   Buffer<float> out(n, dev());
-  with_exec(dev(), [&](const auto& ex) { probe::square(ex, in.cview(), out.view()); });
+  with_exec(dev(), [&]<class E>(const E& ex) { probe::ExecProbe<E>::square(ex, in.cview(), out.view()); });
   auto r = out.to_host();
   for (std::int64_t i = 0; i < n; ++i) ASSERT_EQ(r[i], h[i] * h[i]) << "at " << i;
 }
@@ -53,7 +53,7 @@ TEST_P(ExecTest, TransformReduceOfStruct) {
     sq += double(h[i]) * h[i];
   }
   auto in = Buffer<float>::from_host(h, dev());
-  auto m = with_exec(dev(), [&](const auto& ex) { return probe::moments(ex, in.cview()); });
+  auto m = with_exec(dev(), [&]<class E>(const E& ex) { return probe::ExecProbe<E>::moments(ex, in.cview()); });
   EXPECT_EQ(m.count, n);
   EXPECT_EQ(m.sum, sum);
   EXPECT_EQ(m.sum_sq, sq);
@@ -68,7 +68,7 @@ TEST_P(ExecTest, TransformReduceIntoLeavesTheSumOnTheDevice) {
     for (std::int64_t i = 0; i < n; ++i) sum += h[i] = static_cast<float>(i % 13);
     auto in = Buffer<float>::from_host(h, dev());
     auto out = Buffer<probe::Moments>::from_host({probe::Moments{-1.0, -1.0, -1}}, dev());  // poisoned
-    with_exec(dev(), [&](const auto& ex) { probe::moments_into(ex, in.cview(), out.data()); });
+    with_exec(dev(), [&]<class E>(const E& ex) { probe::ExecProbe<E>::moments_into(ex, in.cview(), out.data()); });
     probe::Moments m = out.to_host()[0];
     EXPECT_EQ(m.count, n);
     EXPECT_EQ(m.sum, sum);
@@ -91,8 +91,8 @@ TEST_P(ExecTest, TransformReduceRoundsSeesEachRoundsUpdateAndStops) {
       auto log = Buffer<probe::RoundsLog>::from_host({probe::RoundsLog{}}, dev());
       // the sum of round r is sum x 2^r: exceeding sum x 2^(stop_after - 1) x 0.75 stops after stop_after rounds
       const double stop_above = sum * std::ldexp(1.0, stop_after - 1) * 0.75;
-      with_exec(dev(), [&](const auto& ex) {
-        probe::doubling_rounds(ex, in.cview(), 10, stop_above, out.data(), log.data());
+      with_exec(dev(), [&]<class E>(const E& ex) {
+        probe::ExecProbe<E>::doubling_rounds(ex, in.cview(), 10, stop_above, out.data(), log.data());
       });
       const probe::RoundsLog l = log.to_host()[0];
       ASSERT_EQ(l.rounds_run, sum > 0 ? stop_after : 10) << "n " << n;
@@ -108,7 +108,7 @@ TEST_P(ExecTest, ExclusiveScanAndTotal) {
   auto h = random_keys(77777, 9, 1);
   auto in = Buffer<std::uint32_t>::from_host(h, dev());
   Buffer<std::uint32_t> out(in.size(), dev());
-  auto total = with_exec(dev(), [&](const auto& ex) { return probe::scan(ex, in.cview(), out.view()); });
+  auto total = with_exec(dev(), [&]<class E>(const E& ex) { return probe::ExecProbe<E>::scan(ex, in.cview(), out.view()); });
   std::vector<std::uint32_t> expect(h.size());
   std::exclusive_scan(h.begin(), h.end(), expect.begin(), 0u);
   EXPECT_EQ(out.to_host(), expect);
@@ -123,7 +123,7 @@ TEST_P(ExecTest, SortByKeyIsStable) {
     std::iota(vals.begin(), vals.end(), 0);
     auto k = Buffer<std::uint32_t>::from_host(keys, dev());
     auto v = Buffer<std::int32_t>::from_host(vals, dev());
-    with_exec(dev(), [&](const auto& ex) { probe::sort(ex, k.view(), v.view(), bits); });
+    with_exec(dev(), [&]<class E>(const E& ex) { probe::ExecProbe<E>::sort(ex, k.view(), v.view(), bits); });
     std::vector<std::int32_t> order(vals);
     std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return keys[a] < keys[b]; });
     EXPECT_EQ(v.to_host(), order) << bits << " bits";
@@ -137,7 +137,7 @@ TEST_P(ExecTest, AtomicsUnderContention) {
   auto in = Buffer<std::uint32_t>::from_host(h, dev());
   Buffer<std::uint32_t> counts(7, dev());
   counts.zero();
-  with_exec(dev(), [&](const auto& ex) { probe::histogram(ex, in.cview(), counts.view()); });
+  with_exec(dev(), [&]<class E>(const E& ex) { probe::ExecProbe<E>::histogram(ex, in.cview(), counts.view()); });
   std::vector<std::uint32_t> expect(7, 0);
   for (auto x : h) ++expect[x % 7];
   EXPECT_EQ(counts.to_host(), expect);
@@ -146,7 +146,7 @@ TEST_P(ExecTest, AtomicsUnderContention) {
   auto f = Buffer<float>::from_host(ones, dev());
   Buffer<float> total(1, dev());
   total.zero();
-  with_exec(dev(), [&](const auto& ex) { probe::atomic_float_sum(ex, f.cview(), total.data()); });
+  with_exec(dev(), [&]<class E>(const E& ex) { probe::ExecProbe<E>::atomic_float_sum(ex, f.cview(), total.data()); });
   EXPECT_EQ(total.to_host()[0], 100000.0f);
 }
 

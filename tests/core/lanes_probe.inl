@@ -3,8 +3,8 @@
 
 namespace seamless::probe {
 
-template <class Exec>
-void grouped_sums(const Exec& ex, const int* counts, const float* vals, std::int64_t n, int cap, int max_lanes,
+template <Executor Exec>
+void LanesProbe<Exec>::grouped_sums(const Exec& ex, const int* counts, const float* vals, std::int64_t n, int cap, int max_lanes,
                   SumCount* out) {
   ex.for_each_grouped(n, max_lanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
     SumCount part;
@@ -15,8 +15,8 @@ void grouped_sums(const Exec& ex, const int* counts, const float* vals, std::int
   });
 }
 
-template <class Exec>
-void grouped_compact(const Exec& ex, const int* counts, const float* vals, std::int64_t n, int cap, int max_lanes,
+template <Executor Exec>
+void LanesProbe<Exec>::grouped_compact(const Exec& ex, const int* counts, const float* vals, std::int64_t n, int cap, int max_lanes,
                      int* kept, int* nkept) {
   ex.for_each_grouped(n, max_lanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
     int cnt = 0;
@@ -38,8 +38,8 @@ struct PhaseRanges {
   std::int64_t b[64], e[64];
 };
 
-template <class Exec>
-void phase_chain(const Exec& ex, std::uint32_t* a, std::uint32_t* b, std::int64_t m, int phases,
+template <Executor Exec>
+void LanesProbe<Exec>::phase_chain(const Exec& ex, std::uint32_t* a, std::uint32_t* b, std::int64_t m, int phases,
                  const std::int64_t* begin, const std::int64_t* end) {
   // Each phase writes all of dst: the phase's range computes, the rest copies. Expressed as
   // phases over [0, m) with the range as data, so that the executor sees m-element phases.
@@ -55,12 +55,3 @@ void phase_chain(const Exec& ex, std::uint32_t* a, std::uint32_t* b, std::int64_
 }
 
 }  // namespace seamless::probe
-
-#define SEAMLESS_INSTANTIATE_LANES_PROBE(EXEC)                                                                \
-  namespace seamless::probe {                                                                                 \
-  template void grouped_sums<EXEC>(const EXEC&, const int*, const float*, std::int64_t, int, int, SumCount*); \
-  template void grouped_compact<EXEC>(const EXEC&, const int*, const float*, std::int64_t, int, int, int*,    \
-                                      int*);                                                                  \
-  template void phase_chain<EXEC>(const EXEC&, std::uint32_t*, std::uint32_t*, std::int64_t, int,            \
-                                  const std::int64_t*, const std::int64_t*);                                  \
-  }

@@ -1,3 +1,3 @@
 #include "core/exec_cpu.hpp"
 #include "lanes_probe.inl"
-SEAMLESS_INSTANTIATE_LANES_PROBE(seamless::CpuExec)
+template struct seamless::probe::LanesProbe<seamless::CpuExec>;

@@ -43,7 +43,7 @@ Lists random_lists(std::int64_t n, unsigned seed) {
 TEST_P(LanesTest, LanesAreAPowerOfTwoWithinTheCap) {
   for (std::int64_t n : {1, 100, 10000, 1000000})
     for (int cap : {1, 3, 8, 16, 64}) {
-      int g = with_exec(dev(), [&](const auto& ex) { return ex.lanes(n, cap); });
+      int g = with_exec(dev(), [&]<class E>(const E& ex) { return ex.lanes(n, cap); });
       EXPECT_GE(g, 1);
       EXPECT_LE(g, std::max(1, std::min(cap, 32)));
       EXPECT_EQ(g & (g - 1), 0) << g;
@@ -60,8 +60,8 @@ TEST_P(LanesTest, GroupedSumsEqualTheSerialSums) {
       auto counts = Buffer<int>::from_host(l.counts, dev());
       auto vals = Buffer<float>::from_host(l.vals, dev());
       Buffer<probe::SumCount> out(n, dev());
-      with_exec(dev(), [&](const auto& ex) {
-        probe::grouped_sums(ex, counts.data(), vals.data(), n, kCap, max_lanes, out.data());
+      with_exec(dev(), [&]<class E>(const E& ex) {
+        probe::LanesProbe<E>::grouped_sums(ex, counts.data(), vals.data(), n, kCap, max_lanes, out.data());
       });
       auto r = out.to_host();
       for (std::int64_t i = 0; i < n; ++i) {
@@ -80,8 +80,8 @@ TEST_P(LanesTest, GroupedCompactionKeepsTheSerialOrder) {
       auto counts = Buffer<int>::from_host(l.counts, dev());
       auto vals = Buffer<float>::from_host(l.vals, dev());
       Buffer<int> kept(n * kCap, dev()), nkept(n, dev());
-      with_exec(dev(), [&](const auto& ex) {
-        probe::grouped_compact(ex, counts.data(), vals.data(), n, kCap, max_lanes, kept.data(), nkept.data());
+      with_exec(dev(), [&]<class E>(const E& ex) {
+        probe::LanesProbe<E>::grouped_compact(ex, counts.data(), vals.data(), n, kCap, max_lanes, kept.data(), nkept.data());
       });
       auto rk = kept.to_host();
       auto rn = nkept.to_host();
@@ -110,8 +110,8 @@ TEST_P(LanesTest, EachPhaseSeesThePreviousOne) {
     std::vector<std::uint32_t> a(m), b(m, 0);
     for (std::int64_t i = 0; i < m; ++i) a[i] = static_cast<std::uint32_t>(i * 7 + 1);
     auto da = Buffer<std::uint32_t>::from_host(a, dev()), db = Buffer<std::uint32_t>::from_host(b, dev());
-    with_exec(dev(), [&](const auto& ex) {
-      probe::phase_chain(ex, da.data(), db.data(), m, phases, begin.data(), end.data());
+    with_exec(dev(), [&]<class E>(const E& ex) {
+      probe::LanesProbe<E>::phase_chain(ex, da.data(), db.data(), m, phases, begin.data(), end.data());
     });
     for (int p = 0; p < phases; ++p) {  // the same chain on the host
       auto& src = p % 2 == 0 ? a : b;

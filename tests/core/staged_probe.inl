@@ -11,8 +11,8 @@ SEAMLESS_HD inline void relax_one(int p, std::int64_t j, float* x, int* visits, 
   visits[i] += 1;
 }
 
-template <class Exec>
-void relax_ring(const Exec& ex, float* x, int* visits, const float* w, const float* pad, std::int64_t pad_n,
+template <Executor Exec>
+void StagedProbe<Exec>::relax_ring(const Exec& ex, float* x, int* visits, const float* w, const float* pad, std::int64_t pad_n,
                 std::int64_t m, int phases, const std::int64_t* begin, const std::int64_t* end, bool staged) {
   if (!staged) {
     ex.for_each_phases(phases, begin, end, [=] SEAMLESS_HD(int p, std::int64_t j) {
@@ -29,9 +29,3 @@ void relax_ring(const Exec& ex, float* x, int* visits, const float* w, const flo
 }
 
 }  // namespace seamless::probe
-
-#define SEAMLESS_INSTANTIATE_STAGED_PROBE(EXEC)                                                              \
-  namespace seamless::probe {                                                                                \
-  template void relax_ring<EXEC>(const EXEC&, float*, int*, const float*, const float*, std::int64_t,        \
-                                 std::int64_t, int, const std::int64_t*, const std::int64_t*, bool);         \
-  }

@@ -1,3 +1,3 @@
 #include "core/exec_cpu.hpp"
 #include "staged_probe.inl"
-SEAMLESS_INSTANTIATE_STAGED_PROBE(seamless::CpuExec)
+template struct seamless::probe::StagedProbe<seamless::CpuExec>;

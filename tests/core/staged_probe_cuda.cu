@@ -1,3 +1,3 @@
 #include "core/exec_cuda.cuh"
 #include "staged_probe.inl"
-SEAMLESS_INSTANTIATE_STAGED_PROBE(seamless::CudaExec)
+template struct seamless::probe::StagedProbe<seamless::CudaExec>;

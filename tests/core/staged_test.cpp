@@ -45,8 +45,8 @@ Result run(Device d, const Case& c, const std::vector<std::int64_t>& begin, cons
   auto visits = Buffer<int>::from_host(std::vector<int>(c.m, 0), d);
   auto dw = Buffer<float>::from_host(w, d);
   auto pad = Buffer<float>::from_host(std::vector<float>(c.pad_n, 1.f), d);
-  with_exec(d, [&](const auto& ex) {
-    probe::relax_ring(ex, x.data(), visits.data(), dw.data(), pad.data(), c.pad_n, c.m, c.phases, begin.data(),
+  with_exec(d, [&]<class E>(const E& ex) {
+    probe::StagedProbe<E>::relax_ring(ex, x.data(), visits.data(), dw.data(), pad.data(), c.pad_n, c.m, c.phases, begin.data(),
                       end.data(), staged);
     ex.synchronize();
   });

@@ -44,9 +44,9 @@ struct Maps {
 Maps vertex_normal_maps(Device dev, const std::vector<float>& depth, const Intrinsics& K, float max_edge) {
   auto d = Image<float>::from_host(depth, K.width, K.height, dev);
   Image<vec3> v(K.width, K.height, dev), n(K.width, K.height, dev);
-  with_exec(dev, [&](const auto& ex) {
-    kernels::depth_to_vertices(ex, d.cview(), K, v.view());
-    kernels::vertices_to_normals(ex, v.cview(), n.view(), max_edge);
+  with_exec(dev, [&]<class E>(const E& ex) {
+    kernels::Preprocess<E>::depth_to_vertices(ex, d.cview(), K, v.view());
+    kernels::Preprocess<E>::vertices_to_normals(ex, v.cview(), n.view(), max_edge);
   });
   return {v.to_host(), n.to_host()};
 }
@@ -111,7 +111,7 @@ TEST(Preprocess, BilateralKeepsPlanesAndEdges) {
   depth[10 * kK.width + 10] = 0.f;  // a hole stays a hole
   auto in = Image<float>::from_host(depth, kK.width, kK.height, Device::CPU);
   Image<float> out(kK.width, kK.height, Device::CPU);
-  kernels::bilateral_filter(CpuExec{}, in.cview(), out.view(), 4.5f, 0.03f, 3);
+  kernels::Preprocess<CpuExec>::bilateral_filter(CpuExec{}, in.cview(), out.view(), 4.5f, 0.03f, 3);
   auto r = out.to_host();
   for (std::size_t i = 0; i < r.size(); ++i) ASSERT_NEAR(r[i], depth[i], 1e-6f) << i;
 }
@@ -122,14 +122,14 @@ TEST(Preprocess, PyramidAveragesWithoutBridgingEdges) {
                           1.04f, 0.0f, 3.0f, 3.1f};
   auto in = Image<float>::from_host(d, 4, 2, Device::CPU);
   Image<float> out(2, 1, Device::CPU);
-  kernels::pyr_down_depth(CpuExec{}, in.cview(), out.view(), 0.1f);
+  kernels::Preprocess<CpuExec>::pyr_down_depth(CpuExec{}, in.cview(), out.view(), 0.1f);
   auto r = out.to_host();
   EXPECT_NEAR(r[0], (1.0f + 1.02f + 1.04f) / 3, 1e-6f);  // the hole is ignored
   EXPECT_NEAR(r[1], (3.0f + 3.0f + 3.0f + 3.1f) / 4, 1e-6f);
   std::vector<float> far = {1.0f, 2.0f, 2.0f, 2.0f};  // first valid depth is the reference
   auto in2 = Image<float>::from_host(far, 2, 2, Device::CPU);
   Image<float> out2(1, 1, Device::CPU);
-  kernels::pyr_down_depth(CpuExec{}, in2.cview(), out2.view(), 0.1f);
+  kernels::Preprocess<CpuExec>::pyr_down_depth(CpuExec{}, in2.cview(), out2.view(), 0.1f);
   EXPECT_FLOAT_EQ(out2.to_host()[0], 1.0f);
 }
 
@@ -146,12 +146,12 @@ TEST(PreprocessParity, CpuMatchesCuda) {
     auto d = Image<float>::from_host(depth, 640, 480, dev);
     Image<float> f(640, 480, dev), half(320, 240, dev), ihalf(320, 240, dev);
     Image<vec3> v(640, 480, dev), n(640, 480, dev);
-    with_exec(dev, [&](const auto& ex) {
-      kernels::bilateral_filter(ex, d.cview(), f.view(), 4.5f, 0.03f, 3);
-      kernels::pyr_down_depth(ex, f.cview(), half.view(), 0.09f);
-      kernels::pyr_down_intensity(ex, d.cview(), ihalf.view());
-      kernels::depth_to_vertices(ex, f.cview(), kK, v.view());
-      kernels::vertices_to_normals(ex, v.cview(), n.view(), 0.1f);
+    with_exec(dev, [&]<class E>(const E& ex) {
+      kernels::Preprocess<E>::bilateral_filter(ex, d.cview(), f.view(), 4.5f, 0.03f, 3);
+      kernels::Preprocess<E>::pyr_down_depth(ex, f.cview(), half.view(), 0.09f);
+      kernels::Preprocess<E>::pyr_down_intensity(ex, d.cview(), ihalf.view());
+      kernels::Preprocess<E>::depth_to_vertices(ex, f.cview(), kK, v.view());
+      kernels::Preprocess<E>::vertices_to_normals(ex, v.cview(), n.view(), 0.1f);
     });
     return std::make_tuple(f.to_host(), half.to_host(), ihalf.to_host(), v.to_host(), n.to_host());
   };

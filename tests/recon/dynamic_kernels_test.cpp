@@ -68,23 +68,23 @@ Masks run_on(Device d, const Scene& v) {
       fn(v.K.width, v.K.height, d);
   Image<std::uint8_t> cand(v.K.width, v.K.height, d), kept(v.K.width, v.K.height, d), mask(v.K.width, v.K.height, d);
   Masks out;
-  with_exec(d, [&](const auto& ex) {
-    kernels::depth_to_vertices(ex, model.cview(), v.K, mv.view());
-    kernels::vertices_to_normals(ex, mv.cview(), mn.view(), 0.1f);
-    kernels::depth_to_vertices(ex, depth.cview(), v.K, fv.view());
-    kernels::vertices_to_normals(ex, fv.cview(), fn.view(), 0.1f);
+  with_exec(d, [&]<class E>(const E& ex) {
+    kernels::Preprocess<E>::depth_to_vertices(ex, model.cview(), v.K, mv.view());
+    kernels::Preprocess<E>::vertices_to_normals(ex, mv.cview(), mn.view(), 0.1f);
+    kernels::Preprocess<E>::depth_to_vertices(ex, depth.cview(), v.K, fv.view());
+    kernels::Preprocess<E>::vertices_to_normals(ex, fv.cview(), fn.view(), 0.1f);
     kernels::DynamicInput in = defaults;
     in.depth = depth.cview();
     in.K = v.K;
     in.model_vertices = mv.cview();
     in.model_normals = mn.cview();
     in.ref_T_cur = SE3::identity();
-    kernels::classify_dynamic(ex, in, cand.view());
-    kernels::filter_dynamic(ex, cand.cview(), View2D<const std::uint8_t>{}, depth.cview(), 1, 5, 0.05f, kept.view(),
+    kernels::Dynamic<E>::classify_dynamic(ex, in, cand.view());
+    kernels::Dynamic<E>::filter_dynamic(ex, cand.cview(), View2D<const std::uint8_t>{}, depth.cview(), 1, 5, 0.05f, kept.view(),
                             mask.view());
-    kernels::mask_vertices(ex, mask.cview(), 1, fv.view(), fn.view());
-    kernels::mask_depth(ex, mask.cview(), depth.view());
-    out.count = kernels::count_dynamic(ex, mask.cview());
+    kernels::Dynamic<E>::mask_vertices(ex, mask.cview(), 1, fv.view(), fn.view());
+    kernels::Dynamic<E>::mask_depth(ex, mask.cview(), depth.view());
+    out.count = kernels::Dynamic<E>::count_dynamic(ex, mask.cview());
   });
   out.candidates = cand.to_host();
   out.mask = mask.to_host();

@@ -347,9 +347,9 @@ TEST(Rgbd, BlackRgbIsNoIntensityReading) {
   std::vector<uchar3> rgb = {{0, 0, 0}, {255, 255, 255}, {0, 0, 1}, {10, 20, 30}};
   Image<uchar3> im = Image<uchar3>::from_host(rgb, 2, 2, Device::CPU);
   Image<float> g(2, 2, Device::CPU), half(1, 1, Device::CPU);
-  with_exec(Device::CPU, [&](const auto& ex) {
-    kernels::rgb_to_intensity(ex, im.cview(), g.view());
-    kernels::pyr_down_intensity(ex, g.cview(), half.view());
+  with_exec(Device::CPU, [&]<class E>(const E& ex) {
+    kernels::Rgbd<E>::rgb_to_intensity(ex, im.cview(), g.view());
+    kernels::Preprocess<E>::pyr_down_intensity(ex, g.cview(), half.view());
   });
   std::vector<float> v = g.to_host();
   EXPECT_EQ(v[0], kernels::kNoIntensity);
@@ -388,7 +388,7 @@ std::vector<BorderFrame> border_frames(int count, int border) {
         }
     Image<uchar3> im = Image<uchar3>::from_host(rgb, w, h, Device::CPU);
     Image<float> inten(w, h, Device::CPU);
-    with_exec(Device::CPU, [&](const auto& ex) { kernels::rgb_to_intensity(ex, im.cview(), inten.view()); });
+    with_exec(Device::CPU, [&]<class E>(const E& ex) { kernels::Rgbd<E>::rgb_to_intensity(ex, im.cview(), inten.view()); });
     BorderFrame b{*f.ground_truth, std::make_unique<FramePyramid>(Device::CPU, src.intrinsics(), 3),
                   std::make_unique<FramePyramid>(Device::CPU, src.intrinsics(), 3)};
     b.full->build(full_depth, nullptr, PreprocessParams{});

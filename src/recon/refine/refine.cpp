@@ -118,7 +118,7 @@ std::unique_ptr<FramePyramid> build_pyramid(const RgbdFrame& f, const Intrinsics
   if (has_rgb) {
     Image<uchar3> rgb = f.rgb.clone(d);
     intensity = Image<float>(K.width, K.height, d);
-    with_exec(d, [&](const auto& ex) { kernels::rgb_to_intensity(ex, rgb.cview(), intensity.view()); });
+    with_exec(d, [&]<class E>(const E& ex) { kernels::Rgbd<E>::rgb_to_intensity(ex, rgb.cview(), intensity.view()); });
   }
   pyr->build(depth, has_rgb ? &intensity : nullptr, pre);
   return pyr;
