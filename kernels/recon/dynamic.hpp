@@ -35,8 +35,9 @@ SEAMLESS_HD inline float dynamic_threshold(const DynamicInput& in, float z) {
   return fmaxf(in.residual_min, in.residual_sigmas * in.noise_coeff * z * z);
 }
 
-// Candidates (1) per pixel: the measurement lies in front of the model, either (a) by more than the
-// residual threshold from every model plane near its projection (point-to-plane, signed: in front)
+// Candidates (1) per pixel: the measurement lies in front of the model, either (a) no model plane
+// near its projection lies within the residual threshold of it (point-to-plane, either side) and
+// it is in front of one of them by more than the threshold (planes it is behind are occluders'),
 // or (b) by more than free_space from the nearest model surface along the ray. Pixels without depth
 // or without any model surface near their projection are 0 (nothing to compare with: unknown space
 // is not evidence of motion). Only "in front" counts: a measurement behind the model is what an
@@ -45,8 +46,8 @@ template <class Exec>
 void classify_dynamic(const Exec& ex, DynamicInput in, View2D<std::uint8_t> candidates);
 
 // Region and temporal consistency: a candidate stays dynamic when at least min_support of the
-// (2r+1)^2 candidates around it (itself included) are candidates, or when the previous frame's
-// mask had it (prev may be empty: data == nullptr); then the kept pixels are dilated by r into
+// (2r+1)^2 candidates around it (itself included) are candidates, or when the previous frame kept
+// it (its `kept`, not its grown mask) (prev may be empty: data == nullptr); then the kept pixels are dilated by r into
 // neighbours whose depth is within max_step of theirs (the silhouette's mixed pixels, never the
 // background behind) and into neighbours without a reading (the sensor drops a mover's silhouette
 // and scattered pixels on it: a fifth of a person's pixels in the synthetic Kinect model; they
