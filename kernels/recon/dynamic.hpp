@@ -52,9 +52,8 @@ SEAMLESS_HD inline float dynamic_threshold(const DynamicInput& in, float z) {
 // Candidates (1) per pixel: the measurement lies in front of the model, either (a) no model plane
 // near its projection lies within the residual threshold of it (point-to-plane, either side) and
 // it is in front of one of them by more than the threshold (planes it is behind are occluders'),
-// or (b) by more than free_space from the nearest model surface along the ray. Pixels without depth,
-// or whose projection has no model surface (the raycast missed: a thin slab the TSDF lost, space
-// never seen), or none near it, are 0 (nothing to compare with: unknown space
+// or (b) by more than free_space from the nearest model surface along the ray. Pixels without depth
+// or without any model surface near their projection are 0 (nothing to compare with: unknown space
 // is not evidence of motion). Only "in front" counts: a measurement behind the model is what an
 // object that left, or background it uncovered, gives, and fusing it carves the old surface away.
 template <class Exec>

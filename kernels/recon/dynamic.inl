@@ -17,15 +17,6 @@ void classify_dynamic(const Exec& ex, DynamicInput in, View2D<std::uint8_t> cand
     if (p.z <= 0.f) return;
     const vec2 uv = in.K.project(p);
     const int u0 = static_cast<int>(floorf(uv.x + 0.5f)), v0 = static_cast<int>(floorf(uv.y + 0.5f));
-    // The ray must meet the model within a pixel: where the raycast missed along a strip (the desk
-    // top's 4 cm slab seen edge on, thinner than the TSDF resolves), the window holds only the
-    // surfaces beyond it, and a static reading would be "in front" of them. (A pixel, not the
-    // pixel itself: the raycast of a wall seen only a few times has scattered holes.)
-    bool hit = false;
-    for (int dy = -1; dy <= 1 && !hit; ++dy)
-      for (int dx = -1; dx <= 1 && !hit; ++dx)
-        hit = in.model_vertices.inside(u0 + dx, v0 + dy) && in.model_vertices(u0 + dx, v0 + dy).z > 0.f;
-    if (!hit) return;
     // The model planes and the nearest model surface in a small window: projective association is
     // off by the pose error (a pixel or two), which at a depth edge would otherwise pair a
     // measurement on the near side with model on the far side. A plane explains the measurement
