@@ -29,31 +29,48 @@ struct DynamicInput {
   float residual_sigmas = 3.f;   // the residual threshold in noise sigmas
   float free_space = 0.12f;      // metres in front of the nearest model surface along the ray
   int search_radius = 2;         // pixels around the projection searched for the best-fitting model point
+  // Kinect v1 triangulation: disparity d = f b / z measured in 1/8-pixel steps (baseline b 7.5 cm;
+  // Khoshelham & Elberink 2012, Konolige & Mihelich 2010), so depths come in steps of
+  // dz = z^2 * disparity_step / (f b) (src/io/depth_scale.cpp; the synthetic sensor quantises the
+  // same way with the frame's own fx). Pixels per metre of baseline; 0: no quantisation.
+  float disparity_step_per_baseline = 0.125f / 0.075f;
 };
 
-// The residual threshold at depth z: the larger of residual_min and residual_sigmas * sigma(z).
+// One depth quantisation step at depth z (metres).
+SEAMLESS_HD inline float depth_step(const DynamicInput& in, float z) {
+  return in.K.fx > 0.f ? z * z * in.disparity_step_per_baseline / in.K.fx : 0.f;
+}
+
+// The residual threshold at depth z: the larger of residual_min and residual_sigmas * sigma(z) plus
+// one quantisation step. A reading lies within half a step of the true surface and so does the
+// model (an average of such readings), so the two can be a whole step apart with no noise at all:
+// 6.7 cm at 3.25 m at 320x240, more than 3 sigma of the noise model, and a far wall seen one step
+// in front of its model made speckles in the mask. The noise comes on top of that step.
 SEAMLESS_HD inline float dynamic_threshold(const DynamicInput& in, float z) {
-  return fmaxf(in.residual_min, in.residual_sigmas * in.noise_coeff * z * z);
+  return fmaxf(in.residual_min, in.residual_sigmas * in.noise_coeff * z * z + depth_step(in, z));
 }
 
 template <Executor Exec>
 struct Dynamic {
-  // Candidates (1) per pixel: the measurement lies in front of the model, either (a) by more than the
-  // residual threshold from every model plane near its projection (point-to-plane, signed: in front)
-  // or (b) by more than free_space from the nearest model surface along the ray. Pixels without depth
-  // or without any model surface near their projection are 0 (nothing to compare with: unknown space
-  // is not evidence of motion). Only "in front" counts: a measurement behind the model is what an
-  // object that left, or background it uncovered, gives, and fusing it carves the old surface away.
+  // Candidates (1) per pixel: the measurement lies in front of the model, either (a) no model plane
+  // near its projection lies within the residual threshold of it (point-to-plane, either side) and
+  // it is in front of one of them by more than the threshold (planes it is behind are occluders'),
+  // or (b) by more than free_space from the nearest model surface along the ray. Pixels without
+  // depth or without any model surface near their projection are 0 (nothing to compare with:
+  // unknown space is not evidence of motion). Only "in front" counts: a measurement behind the
+  // model is what an object that left, or background it uncovered, gives, and fusing it carves the
+  // old surface away.
   static void classify_dynamic(const Exec& ex, DynamicInput in, View2D<std::uint8_t> candidates);
 
   // Region and temporal consistency: a candidate stays dynamic when at least min_support of the
-  // (2r+1)^2 candidates around it (itself included) are candidates, or when the previous frame's
-  // mask had it (prev may be empty: data == nullptr); then the kept pixels are dilated by r into
-  // neighbours whose depth is within max_step of theirs (the silhouette's mixed pixels, never the
-  // background behind) and into neighbours without a reading (the sensor drops a mover's silhouette
-  // and scattered pixels on it: a fifth of a person's pixels in the synthetic Kinect model; they
-  // carry no depth to fuse or track, but the mask is also what the physics and the view show). The opening removes isolated speckles of noise; the previous mask keeps a
-  // mover's thin parts (arms) that flicker in and out of the support test.
+  // (2r+1)^2 candidates around it (itself included) are candidates, or when the previous frame kept
+  // it (its `kept`, not its grown mask; prev may be empty: data == nullptr); then the kept pixels
+  // are dilated by r into neighbours whose depth is within max_step of theirs (the silhouette's
+  // mixed pixels, never the background behind) and into neighbours without a reading (the sensor
+  // drops a mover's silhouette and scattered pixels on it: a fifth of a person's pixels in the
+  // synthetic Kinect model; they carry no depth to fuse or track, but the mask is also what the
+  // physics and the view show). The opening removes isolated speckles of noise; the previous frame's
+  // kept pixels keep a mover's thin parts (arms) that flicker in and out of the support test.
   static void filter_dynamic(const Exec& ex, View2D<const std::uint8_t> candidates, View2D<const std::uint8_t> prev,
                              View2D<const float> depth, int radius, int min_support, float max_step,
                              View2D<std::uint8_t> kept, View2D<std::uint8_t> mask);

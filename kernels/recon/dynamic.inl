@@ -17,11 +17,16 @@ void Dynamic<Exec>::classify_dynamic(const Exec& ex, DynamicInput in, View2D<std
     if (p.z <= 0.f) return;
     const vec2 uv = in.K.project(p);
     const int u0 = static_cast<int>(floorf(uv.x + 0.5f)), v0 = static_cast<int>(floorf(uv.y + 0.5f));
-    // The best-fitting model plane and the nearest model surface in a small window: projective
-    // association is off by the pose error (a pixel or two), which at a depth edge would otherwise
-    // pair a measurement on the near side with model on the far side.
-    float best = 1e30f, nearest = 1e30f;
-    bool any = false;
+    // The model planes and the nearest model surface in a small window: projective association is
+    // off by the pose error (a pixel or two), which at a depth edge would otherwise pair a
+    // measurement on the near side with model on the far side. A plane explains the measurement
+    // when it lies within the threshold of it on either side; one the measurement lies well behind
+    // is an occluder's (a mover just behind a model edge, e.g. a person behind the desk's edge),
+    // which must not hide the planes it is in front of (ReFusion's residual, section III-C, taken
+    // per plane of the window).
+    const float threshold = dynamic_threshold(in, d);
+    float front = -1e30f, nearest = 1e30f;
+    bool any = false, fits = false;
     for (int dy = -in.search_radius; dy <= in.search_radius; ++dy)
       for (int dx = -in.search_radius; dx <= in.search_radius; ++dx) {
         const int u = u0 + dx, v = v0 + dy;
@@ -30,11 +35,13 @@ void Dynamic<Exec>::classify_dynamic(const Exec& ex, DynamicInput in, View2D<std
         if (!(m.z > 0.f) || length2(n) == 0.f) continue;
         any = true;
         // n faces the camera, so in front of the plane is dot(p - m, n) > 0.
-        best = fminf(best, dot(p - m, n));
+        const float r = dot(p - m, n);
+        fits = fits || fabsf(r) <= threshold;
+        front = fmaxf(front, r);
         nearest = fminf(nearest, m.z);
       }
     if (!any) return;
-    const bool residual = best > dynamic_threshold(in, d);          // (a)
+    const bool residual = !fits && front > threshold;                // (a)
     const bool free_space = p.z < nearest - in.free_space;          // (b)
     candidates(x, y) = residual || free_space ? 1 : 0;
   });

@@ -8,7 +8,8 @@ namespace seamless {
 
 struct DynamicParams {
   bool enabled = false;
-  // Residual threshold: max(residual_min, residual_sigmas * noise_coeff * z^2). Kinect v1 depth
+  // Residual threshold: max(residual_min, residual_sigmas * noise_coeff * z^2 + one depth
+  // quantisation step z^2 / (8 fx b), kernels/recon/dynamic.hpp). Kinect v1 depth
   // noise grows with the square of the distance (Khoshelham & Elberink 2012: about 1.5 mm at 1 m,
   // 4 cm at 5 m, so sigma ~ 1.5e-3 z^2); 3 sigma keeps 99.7% of static noise out. The floor of
   // 3 cm covers what the noise model does not: the pose error of the prediction and the raycast's

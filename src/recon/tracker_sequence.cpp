@@ -451,7 +451,10 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
       rec.dynamic_fraction = static_cast<double>(kernels::Dynamic<E>::count_dynamic(ex, dyn_mask_.cview())) /
                              static_cast<double>(K_.width * K_.height);
     });
-    dyn_prev_.buffer().copy_from(dyn_mask_.buffer());
+    // The next frame's temporal support is what this frame kept, not the mask grown from it: the
+    // grown border reaches static neighbours at the mover's depth, which are then never fused and,
+    // from the mask, would support themselves frame after frame (a line left on the desk's edge).
+    dyn_prev_.buffer().copy_from(dyn_kept_.buffer());
   } else if (p_.dynamic.enabled) {
     rec.dynamic_fraction = 0;  // the first frame, or a lost one: nothing masked, nothing fused
   }
