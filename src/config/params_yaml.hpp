@@ -111,6 +111,7 @@ bool read_leaf(LoadContext& ctx, const YAML::Node& n, const std::string& path, T
     check_constraint(ctx, n, path, out, c...);
     return true;
   } else if constexpr (NamedEnum<T>) {
+    static_assert(sizeof...(C) == 0, "a named enum's allowed values come from its enum_names table");
     std::string text;  // `path:` with nothing after it is the empty string, which no table holds
     if (!n.IsNull() && !read_scalar_text<T>(ctx, n, path, text)) return false;
     if (enum_from_name(text, out)) return true;
