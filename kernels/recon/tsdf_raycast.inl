@@ -219,7 +219,7 @@ SEAMLESS_HD inline vec3 vertex_map_normal(View2D<const vec3> vtx, View2D<const f
     return length2(*out - v) <= max_jump * max_jump;
   };
   auto axis_diff = [&](int dx, int dy, vec3* d) {
-    vec3 p, m;
+    vec3 p{}, m{};  // set by neighbour() when it returns true; zeroed for the compiler's flow analysis
     const bool hp = neighbour(x + dx, y + dy, &p), hm = neighbour(x - dx, y - dy, &m);
     if (hp && hm) *d = p - m;
     else if (hp) *d = p - v;

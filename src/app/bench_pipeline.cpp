@@ -227,7 +227,7 @@ void write_json(const std::string& path, const PipelineBenchOptions& o, const Ex
   Json j = {{"benchmark", "pipeline"}, {"seamless_version", SEAMLESS_VERSION}, {"commit", SEAMLESS_GIT_COMMIT},
             {"device", device_name(o.device)}, {"gpu", cuda_device_description()}, {"mode", o.mode},
             {"config", o.config}, {"data", e.input.path}, {"tracker", e.tracker.kind},
-            {"tracker_mode", e.tracker.mode}, {"voxel_size", e.volume.voxel_size}, {"volume", e.volume.layout},
+            {"tracker_mode", e.tracker.mode}, {"voxel_size", e.volume.voxel_size}, {"volume", enum_name(e.volume.layout)},
             {"frames_requested", e.frames}, {"reps", static_cast<int>(reps.size())}};
   j["render"] = render_note.empty() ? std::string(o.mode == "live" ? "measured" : "not in scan mode") : render_note;
   j["stages"] = stages;

@@ -40,15 +40,15 @@ std::vector<BenchCase> make_recon_bench(const BenchOptions& o) {
   Intrinsics K;
   const std::vector<ReconFrame> frames = load_frames(o, 40, &K);
   std::vector<BenchCase> cases;
-  for (const char* layout : {"hash", "dense"}) {
+  for (VolumeLayout layout : {VolumeLayout::hash, VolumeLayout::dense}) {
     VolumeParams vp;
     vp.layout = layout;
-    if (vp.layout == "dense") vp.voxel_size = 0.01f;  // 512^3 at 5 mm would be 1.6 GB; 4 m / 1 cm
+    if (vp.layout == VolumeLayout::dense) vp.voxel_size = 0.01f;  // 512^3 at 5 mm would be 1.6 GB; 4 m / 1 cm
     auto bench = std::make_shared<ReconBench>(frames, K, vp, o.device);
-    std::string detail = std::string(layout) + ", voxel " + std::to_string(static_cast<int>(vp.voxel_size * 1000)) +
+    std::string detail = std::string(enum_name(layout)) + ", voxel " + std::to_string(static_cast<int>(vp.voxel_size * 1000)) +
                          " mm, " + std::to_string(frames.size()) + " frames cycled";
     // One step = one frame: allocate + fuse + raycast of the next recorded frame (cycling).
-    cases.push_back({std::string("frame_") + layout, [bench] { bench->step(); }, detail,
+    cases.push_back({std::string("frame_") + enum_name(layout), [bench] { bench->step(); }, detail,
                      [bench] { return bench->report(); }});
   }
   return cases;

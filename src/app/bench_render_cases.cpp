@@ -12,7 +12,7 @@ namespace {
 RenderBenchResult run_one(const char* label, const RenderParams& settings, int reps) {
   RenderBenchResult r = bench_render(1920, 1080, 1'000'000, reps, settings);
   std::printf("render %s (fluid_splat %s): %dx%d, %lld particles, %d frames on %s\n", label,
-              settings.fluid_splat.c_str(), r.width, r.height, static_cast<long long>(r.particles), r.frames,
+              enum_name(settings.fluid_splat), r.width, r.height, static_cast<long long>(r.particles), r.frames,
               r.gl_renderer.c_str());
   std::printf("  median GPU time per frame %.3f ms (sum of the passes below, timer queries)\n", r.median_gpu_ms);
   std::printf("  median wall time: draw only %.3f ms, upload + draw %.3f ms, readback %.3f ms", r.median_draw_ms,
@@ -42,7 +42,7 @@ int run_render_bench(const BenchOptions& o, int reps, const std::string& json) {
     no_shadows.shadows = false;
     run_one("default settings without shadows", no_shadows, reps);
     RenderParams raster;
-    raster.fluid_splat = "raster";
+    raster.fluid_splat = FluidSplat::raster;
     run_one("default settings but raster sprites", raster, reps);
     run_one("without the speed remedies", unoptimised_render_settings(), reps);
   }

@@ -126,7 +126,7 @@ int run(const CommonOptions& o) {
                                             2 * e.volume.voxel_size);
   summary.online_refine = scan_result.online_refine;
   std::optional<SdfGrid> grid;
-  if (e.solver.scene_collision == "sdf") grid = scene_sdf_grid(*scan_result.volume, scan_result.mesh, e);
+  if (e.solver.scene_collision == SceneCollision::sdf) grid = scene_sdf_grid(*scan_result.volume, scan_result.mesh, e);
   SceneParticleParams sp;
   sp.spacing = e.solver.particle_diameter;
   sp.interior_depth = e.scene_interior_depth;

@@ -46,7 +46,7 @@ TrackSequenceParams tracking_params(const Experiment& e, StageTimer* volume_stag
   p.preprocess = e.preprocess;
   p.volume = e.volume;
   p.dynamic = e.dynamic;
-  if (e.solver.dynamic_colliders != "none") p.keep_unmasked_level = e.solver.collider_level;
+  if (e.solver.dynamic_colliders != DynamicColliders::none) p.keep_unmasked_level = e.solver.collider_level;
   p.max_frames = e.frames;
   p.write_files = e.output.write_trajectory;
   return p;
@@ -318,10 +318,10 @@ class LiveLoop : public FrameLoop {
                                                   online_feedback(e_.tracker));
     sp_.spacing = e_.solver.particle_diameter;
     sp_.interior_depth = e_.scene_interior_depth;
-    if (e_.solver.dynamic_colliders == "depth" && !e_.dynamic.enabled)
+    if (e_.solver.dynamic_colliders == DynamicColliders::depth && !e_.dynamic.enabled)
       spdlog::warn("solver.dynamic_colliders: depth with dynamic.enabled false: no pixel is dynamic, so nothing "
                    "from the camera collides");
-    if (e_.solver.dynamic_colliders != "none")
+    if (e_.solver.dynamic_colliders != DynamicColliders::none)
       colliders_.emplace(e_.solver.particle_diameter, e_.solver.collider_thickness, e_.solver.max_speed);
   }
 
@@ -430,7 +430,7 @@ class LiveLoop : public FrameLoop {
     const auto [vertices, normals] = session_.unmasked_level();
     const int w = vertices->width(), h = vertices->height();
     std::vector<std::uint8_t> mask;  // empty: every pixel (dynamic_colliders: all)
-    if (e_.solver.dynamic_colliders == "depth") mask = block_any(session_.dynamic_mask(), w, h);
+    if (e_.solver.dynamic_colliders == DynamicColliders::depth) mask = block_any(session_.dynamic_mask(), w, h);
     colliders_->update(depth_surface(vertices->to_host(), normals->to_host(), w, h, world_T_camera, mask),
                        frame_time);
   }

@@ -44,8 +44,8 @@ Experiment parse_experiment(const std::string& yaml_text, const std::vector<std:
 
 void Experiment::validate() const {
   volume.validate();
-  if (solver.dynamic_colliders != "none" && mode != "live")
-    throw ConfigError("solver.dynamic_colliders: " + solver.dynamic_colliders +
+  if (solver.dynamic_colliders != DynamicColliders::none && mode != "live")
+    throw ConfigError("solver.dynamic_colliders: " + std::string(enum_name(solver.dynamic_colliders)) +
                       " needs mode: live (the colliders are each frame's depth points while the camera runs)");
 
 }

@@ -22,9 +22,10 @@ struct ProbeVisitor {
 };
 template <class T> concept Visitable = requires(T& t, ProbeVisitor& p) { t.visit(p); };
 template <class T> concept Integer = std::integral<T> && !std::same_as<T, bool>;
-// A leaf is one YAML value: a scalar, or vec3 as a 3-element sequence.
+// A leaf is one YAML value: a scalar (a named enum is a string from its table), or vec3 as a
+// 3-element sequence.
 template <class T> concept Leaf = std::same_as<T, bool> || Integer<T> || std::floating_point<T> ||
-                                  std::same_as<T, std::string> || std::same_as<T, vec3>;
+                                  std::same_as<T, std::string> || std::same_as<T, vec3> || NamedEnum<T>;
 
 template <class T> struct VectorOf { using type = void; };
 template <class T> struct VectorOf<std::vector<T>> { using type = T; };
@@ -39,7 +40,7 @@ template <class T> std::string type_name() {
   else if constexpr (Integer<T>) return "uint" + std::to_string(8 * sizeof(T));
   else if constexpr (std::same_as<T, float>) return "float";
   else if constexpr (std::same_as<T, double>) return "double";
-  else if constexpr (std::same_as<T, std::string>) return "string";
+  else if constexpr (std::same_as<T, std::string> || NamedEnum<T>) return "string";
   else if constexpr (std::same_as<T, vec3>) return "vec3";
   else if constexpr (LeafVector<T>) return "list of " + type_name<typename VectorOf<T>::type>();
   else if constexpr (SectionVector<T>) return "list of sections";
@@ -61,6 +62,11 @@ std::string format_vec3(vec3 v);
 std::string constraint_text();
 std::string constraint_text(const Range& r);
 std::string constraint_text(const Choices& c);
+// The constraint of a field of type T: a named enum's allowed names, else the one passed (if any).
+template <class T, class... C> std::string field_constraint_text(const C&... c) {
+  if constexpr (NamedEnum<T>) return constraint_text(enum_choices<T>());
+  else return constraint_text(c...);
+}
 
 template <class T> std::string format_value(const T& v) {
   if constexpr (std::same_as<T, bool>) return format_bool(v);
@@ -68,6 +74,7 @@ template <class T> std::string format_value(const T& v) {
   else if constexpr (std::floating_point<T>) return format_number(v);
   else if constexpr (std::same_as<T, std::string>) return format_string(v);
   else if constexpr (std::same_as<T, vec3>) return format_vec3(v);
+  else if constexpr (NamedEnum<T>) return format_string(enum_name(v));
   else {
     static_assert(LeafVector<T>, "format_value: leaf or list of leaves");
     std::string s = "[";
@@ -96,7 +103,7 @@ class YamlWriter {
         element.visit(item);
       }
     } else {
-      line(std::string(name) + ": " + format_value(field), doc + constraint_text(c...));
+      line(std::string(name) + ": " + format_value(field), doc + field_constraint_text<T>(c...));
     }
   }
 
@@ -137,7 +144,7 @@ class KeyLister {
 
   template <class T, class... C> void operator()(const char* name, T& field, const char* doc, const C&... c) {
     std::string path = prefix_.empty() ? name : prefix_ + "." + name;
-    std::string cons = constraint_text(c...);
+    std::string cons = field_constraint_text<T>(c...);
     if (!cons.empty()) cons.erase(0, 1);  // drop the separating space
     if constexpr (Visitable<T>) {
       out_.push_back({path, type_name<T>(), "", doc, ""});

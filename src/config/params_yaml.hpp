@@ -76,7 +76,7 @@ template <class T> std::string expected_text() {
   else if constexpr (Integer<T> && std::is_signed_v<T>) return "an integer (" + type_name<T>() + ")";
   else if constexpr (Integer<T>) return "a non-negative integer (" + type_name<T>() + ")";
   else if constexpr (std::floating_point<T>) return "a number (" + type_name<T>() + ")";
-  else if constexpr (std::same_as<T, std::string>) return "a string";
+  else if constexpr (std::same_as<T, std::string> || NamedEnum<T>) return "a string";
   else return "a list of 3 numbers [x, y, z]";
 }
 
@@ -110,6 +110,13 @@ bool read_leaf(LoadContext& ctx, const YAML::Node& n, const std::string& path, T
     }
     check_constraint(ctx, n, path, out, c...);
     return true;
+  } else if constexpr (NamedEnum<T>) {
+    static_assert(sizeof...(C) == 0, "a named enum's allowed values come from its enum_names table");
+    std::string text;  // `path:` with nothing after it is the empty string, which no table holds
+    if (!n.IsNull() && !read_scalar_text<T>(ctx, n, path, text)) return false;
+    if (enum_from_name(text, out)) return true;
+    check_constraint(ctx, n, path, text, enum_choices<T>());  // reports the allowed names
+    return false;
   } else if constexpr (std::same_as<T, vec3>) {
     float xyz[3];
     bool ok = n.IsSequence() && n.size() == 3;

@@ -11,6 +11,20 @@
 
 namespace seamless {
 
+enum class SceneCollision { particles, sdf };
+inline std::span<const EnumName<SceneCollision>> enum_names(SceneCollision) {
+  static constexpr EnumName<SceneCollision> names[] = {{SceneCollision::particles, "particles"},
+                                           {SceneCollision::sdf, "sdf"}};
+  return names;
+}
+enum class DynamicColliders { none, depth, all };
+inline std::span<const EnumName<DynamicColliders>> enum_names(DynamicColliders) {
+  static constexpr EnumName<DynamicColliders> names[] = {{DynamicColliders::none, "none"},
+                                           {DynamicColliders::depth, "depth"},
+                                           {DynamicColliders::all, "all"}};
+  return names;
+}
+
 struct SolverParams {
   float particle_diameter = 0.04f;      // metres; one radius for every particle (Macklin 2014)
   float dt = 0.01f;                     // seconds per frame step
@@ -27,7 +41,7 @@ struct SolverParams {
   float vorticity = 0.0001f;            // vorticity confinement epsilon (ibid., eq. 16)
   float cohesion = 0.01f;               // Akinci 2013 cohesion gamma
   float surface_tension = 0.01f;        // Akinci 2013 curvature term
-  std::string scene_collision = "particles";
+  SceneCollision scene_collision = SceneCollision::particles;
   float sleep_threshold = 0.f;          // m/s; 0 = never sleep
   float max_speed = 4.f;                // m/s: speed limit; sets the substeps (docs/PHYSICS.md)
   int max_neighbours = 64;
@@ -54,7 +68,7 @@ struct SolverParams {
   bool cuda_graph = true;               // CUDA: replay a step as one captured graph (docs/PHYSICS.md)
   // Issue 22: the live depth camera's points as kinematic colliders each frame (people and moving
   // objects push the simulation): none, the dynamic pixels only (dynamic.enabled), or every pixel.
-  std::string dynamic_colliders = "none";
+  DynamicColliders dynamic_colliders = DynamicColliders::none;
   int collider_level = 2;               // pyramid level whose vertex map gives the points (2: 160x120)
   float collider_thickness = 0.1f;      // metres of colliders behind each seen surface point, along its ray
 
@@ -77,8 +91,7 @@ struct SolverParams {
     v("vorticity", vorticity, "vorticity confinement strength", Range{0.0, 10.0});
     v("cohesion", cohesion, "fluid cohesion strength (Akinci 2013)", Range{0.0, 100.0});
     v("surface_tension", surface_tension, "fluid surface tension strength (Akinci 2013)", Range{0.0, 100.0});
-    v("scene_collision", scene_collision, "collide against static scene particles or the sampled TSDF",
-      Choices{"particles", "sdf"});
+    v("scene_collision", scene_collision, "collide against static scene particles or the sampled TSDF");
     v("sleep_threshold", sleep_threshold, "particles slower than this are frozen, m/s; 0 = off", Range{0.0, 100.0});
     v("max_speed", max_speed, "speed limit, m/s; sets the substeps so that nothing tunnels", Range{0.01, 1e4});
     v("max_neighbours", max_neighbours, "neighbours kept per particle", Range{1, 1024});
@@ -107,8 +120,7 @@ struct SolverParams {
     v("cuda_graph", cuda_graph, "CUDA: capture a step as a graph and replay it while the scene is unchanged");
     v("dynamic_colliders", dynamic_colliders,
       "live mode: each frame's depth points become kinematic collider particles: none, the dynamic pixels only "
-      "(depth; needs dynamic.enabled) or every pixel (all)",
-      Choices{"none", "depth", "all"});
+      "(depth; needs dynamic.enabled) or every pixel (all)");
     v("collider_level", collider_level,
       "dynamic_colliders: the depth pyramid level whose points are used (0 = full resolution; each level halves "
       "both sides)",

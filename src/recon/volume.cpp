@@ -7,9 +7,9 @@
 namespace seamless {
 
 std::unique_ptr<Volume> make_volume(const VolumeParams& params, Device d) {
-  if (params.layout == "hash") return std::make_unique<VoxelHashVolume>(params, d);
-  if (params.layout == "dense") return std::make_unique<DenseVolume>(params, d);
-  throw Error("volume.layout '" + params.layout + "' is not available (use hash or dense)");
+  if (params.layout == VolumeLayout::hash) return std::make_unique<VoxelHashVolume>(params, d);
+  if (params.layout == VolumeLayout::dense) return std::make_unique<DenseVolume>(params, d);
+  throw Error("volume.layout '" + std::string(enum_name(params.layout)) + "' is not available (use hash or dense)");
 }
 
 namespace detail {

@@ -10,8 +10,14 @@
 
 namespace seamless {
 
+enum class VolumeLayout { hash, dense };
+inline std::span<const EnumName<VolumeLayout>> enum_names(VolumeLayout) {
+  static constexpr EnumName<VolumeLayout> names[] = {{VolumeLayout::hash, "hash"}, {VolumeLayout::dense, "dense"}};
+  return names;
+}
+
 struct VolumeParams {
-  std::string layout = "hash";
+  VolumeLayout layout = VolumeLayout::hash;
   float voxel_size = 0.005f;         // metres
   float truncation = 0.02f;          // metres (4 voxels at the default size)
   float max_weight = 100.f;          // running-average weight cap (lets the model adapt)
@@ -41,7 +47,7 @@ struct VolumeParams {
   }
 
   template <class V> void visit(V& v) {
-    v("layout", layout, "volume layout: voxel hashing or dense grid", Choices{"hash", "dense"});
+    v("layout", layout, "volume layout: voxel hashing or dense grid");
     v("voxel_size", voxel_size, "voxel edge length, metres", Range{0.0005, 1.0});
     v("truncation", truncation, "TSDF truncation distance, metres", Range{0.001, 2.0});
     v("max_weight", max_weight, "maximum fusion weight per voxel", Range{1.0, 1e6});

@@ -84,11 +84,11 @@ RenderParams unoptimised_render_settings() {
   RenderParams p;
   p.thickness_downsample = 1;
   p.depth_prepass = false;
-  p.fluid_filter = "bilateral";
+  p.fluid_filter = FluidFilter::bilateral;
   p.filter_iterations = 2;
   p.filter_max_taps = 128;
   p.max_point_size = 2048.f;
-  p.fluid_splat = "raster";
+  p.fluid_splat = FluidSplat::raster;
   return p;
 }
 

@@ -9,6 +9,18 @@
 
 namespace seamless {
 
+enum class FluidFilter { narrow_range, bilateral };
+inline std::span<const EnumName<FluidFilter>> enum_names(FluidFilter) {
+  static constexpr EnumName<FluidFilter> names[] = {{FluidFilter::narrow_range, "narrow_range"},
+                                           {FluidFilter::bilateral, "bilateral"}};
+  return names;
+}
+enum class FluidSplat { compute, raster };
+inline std::span<const EnumName<FluidSplat>> enum_names(FluidSplat) {
+  static constexpr EnumName<FluidSplat> names[] = {{FluidSplat::compute, "compute"}, {FluidSplat::raster, "raster"}};
+  return names;
+}
+
 struct RenderParams {
   std::string mode = "none";
   int width = 1280;
@@ -59,7 +71,7 @@ struct RenderParams {
   // particles sit about one diameter apart, and on a cubic lattice seen face-on the gaps between
   // four touching spheres close only above sqrt(2) (the gap centre is sqrt(2) r from each).
   float fluid_radius_scale = 1.5f;
-  std::string fluid_filter = "narrow_range";  // depth smoothing: narrow_range (Truong & Yuksel 2018) or bilateral
+  FluidFilter fluid_filter = FluidFilter::narrow_range;  // depth smoothing: narrow_range (Truong & Yuksel 2018) or bilateral
   int filter_iterations = 1;          // separable filter passes (x then y) over the depth
   int filter_max_taps = 12;           // taps per side at most: wider kernels sample every k-th pixel
   float filter_size = 3.f;            // filter half-width in particle radii (world), projected per pixel
@@ -76,7 +88,7 @@ struct RenderParams {
   // and the full-screen passes as compute shaders; raster: point sprites and full-screen
   // triangles. Compute is the default because GH100 (H100/H200) keeps raster units on only a few
   // of its SMs; a context below GL 4.3 falls back to raster.
-  std::string fluid_splat = "compute";
+  FluidSplat fluid_splat = FluidSplat::compute;
   int thickness_downsample = 2;       // thickness pass and its blur at 1/this resolution (1, 2 or 4), bilinear up
   bool depth_prepass = true;          // hardware depth test of the sprites against the scene depth (early-Z)
   float max_point_size = 64.f;        // sprite size limit, pixels: nearer spheres are cut to this square
@@ -130,7 +142,7 @@ struct RenderParams {
     v("cloth_color", cloth_color, "colour of cloth, RGB 0..1");
     v("fluid_radius_scale", fluid_radius_scale, "fluid sphere size in the SSFR passes, particle radii",
       Range{0.5, 4.0});
-    v("fluid_filter", fluid_filter, "fluid depth filter", Choices{"narrow_range", "bilateral"});
+    v("fluid_filter", fluid_filter, "fluid depth filter");
     v("filter_iterations", filter_iterations, "depth filter passes (x then y)", Range{0, 16});
     v("filter_max_taps", filter_max_taps, "depth filter taps per side at most (wider: strided)", Range{1, 128});
     v("filter_size", filter_size, "depth filter half-width, particle radii", Range{0.0, 50.0});
@@ -144,8 +156,7 @@ struct RenderParams {
     v("light_intensity", light_intensity,
       "light_dir's radiance on a white diffuse surface facing it (1 = white): strength of highlights", Range{0.0, 100.0});
     v("cube_size", cube_size, "reflection cube map face size, pixels", Range{16, 4096});
-    v("fluid_splat", fluid_splat, "fluid passes: compute shaders (GL 4.3: splats, screen passes) or raster sprites",
-      Choices{"compute", "raster"});
+    v("fluid_splat", fluid_splat, "fluid passes: compute shaders (GL 4.3: splats, screen passes) or raster sprites");
     v("thickness_downsample", thickness_downsample, "fluid thickness at 1/this resolution (1, 2 or 4)", Range{1, 4});
     v("depth_prepass", depth_prepass, "early depth test of fluid sprites against the scene");
     v("max_point_size", max_point_size, "largest particle sprite, pixels", Range{4.0, 2048.0});

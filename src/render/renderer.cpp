@@ -18,10 +18,6 @@ vec3 srgb_to_linear(vec3 c) {  // IEC 61966-2-1, as color.glsl
 
 namespace {
 
-std::vector<float> mat3_cols(const mat3& R) {  // column-major for glUniformMatrix3fv
-  return {R.m[0][0], R.m[1][0], R.m[2][0], R.m[0][1], R.m[1][1], R.m[2][1], R.m[0][2], R.m[1][2], R.m[2][2]};
-}
-
 // The mean of an sRGB image in linear radiance (what the fluid reflects in the Kinect view).
 vec3 mean_linear_color(const std::vector<uchar3>& c) {
   float lut[256];
@@ -351,7 +347,7 @@ void init(Renderer::Impl& m, const RenderParams& params, int width, int height) 
   // Compute shaders and image atomics are core in GL 4.3.
   m.has_compute = epoxy_gl_version() >= 43;
   if (m.has_compute) m.build_compute_programs();
-  else if (params.fluid_splat == "compute")
+  else if (params.fluid_splat == FluidSplat::compute)
     spdlog::info("render: OpenGL {} has no compute shaders (4.3); fluid spheres are drawn as raster sprites",
                  epoxy_gl_version() / 10.0);
   m.build_shadow_programs();

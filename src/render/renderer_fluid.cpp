@@ -215,7 +215,7 @@ void Renderer::Impl::fluid_filter_passes(float radius, const RenderCamera& cam) 
   glUniform1i(fp.loc("u_max_taps"), p.filter_max_taps);
   glUniform1f(fp.loc("u_range_sigma"), p.filter_depth_sigma * radius);
   glUniform1i(fp.loc("u_skip_empty"), 1);
-  glUniform1i(fp.loc("u_narrow_range"), p.fluid_filter == "narrow_range");
+  glUniform1i(fp.loc("u_narrow_range"), p.fluid_filter == FluidFilter::narrow_range);
   for (int it = 0; it < p.filter_iterations; ++it) {
     filter_pass(fluid_depth[0], fluid_depth[1], fluid_filter_fbo[1], 1, 0, w, h);
     filter_pass(fluid_depth[1], fluid_depth[0], fluid_filter_fbo[0], 0, 1, w, h);

@@ -182,7 +182,7 @@ struct Renderer::Impl {
   void composite_pass(const RenderCamera& cam);
   void thickness_blur(const RenderCamera& low);
   // renderer_splat.cpp: the compute path of SSFR 1 and 2.
-  bool use_compute_splat() const { return has_compute && p.fluid_splat == "compute"; }
+  bool use_compute_splat() const { return has_compute && p.fluid_splat == FluidSplat::compute; }
   void build_compute_programs();
   void make_splat_targets();
   void splat_uniforms(const Program& prog, std::int64_t n, float sphere_r, const RenderCamera& cam);

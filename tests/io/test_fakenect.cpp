@@ -79,9 +79,9 @@ TEST(Fakenect, DumpFormatIsWhatFakenectParses) {
     unsigned stamp;
     ASSERT_EQ(std::sscanf(l.c_str(), "%c-%lf-%u-", &type, &t, &stamp), 3) << l;  // fakenect's own parse
     auto size = std::filesystem::file_size(dir.path / "dump" / l);
-    if (type == 'd') EXPECT_EQ(size, std::string("P5 640 480 65535\n").size() + 640 * 480 * 2);
-    if (type == 'r') EXPECT_EQ(size, std::string("P6 640 480 255\n").size() + 640 * 480 * 3);
-    if (type == 'a') EXPECT_EQ(size, 12u);  // sizeof(freenect_raw_tilt_state), checked by fakenect
+    if (type == 'd') { EXPECT_EQ(size, std::string("P5 640 480 65535\n").size() + 640 * 480 * 2); }
+    if (type == 'r') { EXPECT_EQ(size, std::string("P6 640 480 255\n").size() + 640 * 480 * 3); }
+    if (type == 'a') { EXPECT_EQ(size, 12u); }  // sizeof(freenect_raw_tilt_state), checked by fakenect
   }
 }
 

@@ -155,7 +155,7 @@ TEST(TumReader, NineFrameDeskPairsAllNineByTime) {
   std::int64_t n = 0;
   RgbdFrame f;
   while (src.next(f)) {
-    if (n == 0) EXPECT_DOUBLE_EQ(f.timestamp, 1305031453.359684);
+    if (n == 0) { EXPECT_DOUBLE_EQ(f.timestamp, 1305031453.359684); }
     EXPECT_TRUE(f.ground_truth);
     EXPECT_FALSE(f.accelerometer);  // no accelerometer.txt in this folder
     EXPECT_EQ(f.depth.width(), 640);

@@ -137,7 +137,7 @@ inline void expect_same_blocks(const std::vector<VoxelHashVolume::HostBlock>& a,
     for (int k = 0; k < kernels::kBlockVoxels; ++k) {
       ASSERT_EQ(a[i].voxels[k].weight, b[i].voxels[k].weight);
       ASSERT_NEAR(a[i].voxels[k].sdf, b[i].voxels[k].sdf, 1e-5f);
-      if (colour) ASSERT_NEAR(a[i].voxels[k].color.x, b[i].voxels[k].color.x, 1);
+      if (colour) { ASSERT_NEAR(a[i].voxels[k].color.x, b[i].voxels[k].color.x, 1); }
     }
   }
 }

@@ -16,9 +16,9 @@ TEST(VolumeDense, MatchesTheHashedVolume) {
   p.dense_origin = {-0.64f, -0.64f, 0.8f};  // holds the sphere and the wall's centre
   test::Scene s;
   Intrinsics K = test::camera(160, 120, 140.f);
-  p.layout = "hash";
+  p.layout = VolumeLayout::hash;
   auto hash = make_volume(p, Device::CPU);
-  p.layout = "dense";
+  p.layout = VolumeLayout::dense;
   auto dense = make_volume(p, Device::CPU);
   for (SE3 T : {test::pose({0.f, 0.f, 0.f}), test::pose({0.03f, 0.02f, 0.f})}) {
     auto depth = Image<float>::from_host(s.render(K, T), K.width, K.height, Device::CPU);

@@ -49,7 +49,7 @@ struct Drawn {
   bool compute = false;
   Image<uchar3> frame;
 };
-Drawn draw_with(RenderParams p, const Block& b, const Intrinsics& K, float wall_z, const char* splat) {
+Drawn draw_with(RenderParams p, const Block& b, const Intrinsics& K, float wall_z, FluidSplat splat) {
   p.fluid_splat = splat;
   Renderer r(p, K.width, K.height);
   r.set_scene_mesh(rectangle(-2.f, 2.f, -2.f, 2.f, wall_z, uchar3{90, 120, 60}));
@@ -101,8 +101,8 @@ TEST(RenderSplat, ComputeDepthMatchesRaster) {
   SEAMLESS_REQUIRE_EGL();
   const Intrinsics K = intrinsics(400.f, 79.5f, 59.5f, 160, 120);
   const Block b;
-  const auto ras = draw_with(splat_params(1), b, K, kWallZ, "raster").fluid;
-  const Drawn c = draw_with(splat_params(1), b, K, kWallZ, "compute");
+  const auto ras = draw_with(splat_params(1), b, K, kWallZ, FluidSplat::raster).fluid;
+  const Drawn c = draw_with(splat_params(1), b, K, kWallZ, FluidSplat::compute);
   if (!c.compute) GTEST_SKIP() << "no GL 4.3 compute here";
   const auto& cmp = c.fluid;
   ASSERT_EQ(ras.depth.size(), cmp.depth.size());
@@ -144,8 +144,8 @@ float thickness_tol(int chords, float t) {
 void expect_same_thickness(int downsample) {
   const Intrinsics K = intrinsics(400.f, 79.5f, 59.5f, 160, 120);
   const Block b;
-  const auto ras = draw_with(splat_params(downsample), b, K, kWallZ, "raster").fluid;
-  const Drawn c = draw_with(splat_params(downsample), b, K, kWallZ, "compute");
+  const auto ras = draw_with(splat_params(downsample), b, K, kWallZ, FluidSplat::raster).fluid;
+  const Drawn c = draw_with(splat_params(downsample), b, K, kWallZ, FluidSplat::compute);
   if (!c.compute) GTEST_SKIP() << "no GL 4.3 compute here";
   const auto& cmp = c.fluid;
   const Intrinsics Kt = scale_intrinsics(K, ras.tw, ras.th);
@@ -180,9 +180,9 @@ TEST(RenderSplat, ComputeThicknessMatchesRasterHalfResolution) {
 TEST(RenderSplat, DefaultIsComputeAndRasterIsSelectable) {
   SEAMLESS_REQUIRE_EGL();
   Renderer r(RenderParams{}, 32, 24);
-  EXPECT_EQ(RenderParams{}.fluid_splat, "compute");
+  EXPECT_EQ(RenderParams{}.fluid_splat, FluidSplat::compute);
   if (!r.uses_compute_splat()) GTEST_SKIP() << "no GL 4.3 compute here";
-  r.params().fluid_splat = "raster";
+  r.params().fluid_splat = FluidSplat::raster;
   EXPECT_FALSE(r.uses_compute_splat());
 }
 
@@ -207,7 +207,7 @@ TEST(RenderSplat, ComputeScreenPassesGiveTheRasterFrame) {
   const Block b;
   RenderParams p;
   p.znear = kNear;
-  const Drawn a = draw_with(p, b, K, 2.5f, "raster"), c = draw_with(p, b, K, 2.5f, "compute");  // wall behind
+  const Drawn a = draw_with(p, b, K, 2.5f, FluidSplat::raster), c = draw_with(p, b, K, 2.5f, FluidSplat::compute);  // wall behind
   if (!c.compute) GTEST_SKIP() << "no GL 4.3 compute here";
   const Pixels ras(a.frame), cmp(c.frame);
   const auto &ras_d = a.fluid.depth, &cmp_d = c.fluid.depth;
