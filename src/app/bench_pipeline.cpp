@@ -178,7 +178,7 @@ RepResult replay(const PipelineBenchOptions& o, const Experiment& e, const std::
       }
       const std::vector<FrameRecord> records = live(ctx, renderer.get(), vs);
       add_tracking_stages(records, o.volume_stages, e.dynamic.enabled, r);
-      for (auto& [stage, v] : timer_stages(ctx.timer(), r.frames, e.solver.dynamic_colliders != "none")) {
+      for (auto& [stage, v] : timer_stages(ctx.timer(), r.frames, e.solver.dynamic_colliders != DynamicColliders::none)) {
         if (stage == "render" && !renderer) continue;
         for (std::size_t k = 0; k < v.size(); ++k) r.per_frame["frame"][k] += v[k];
         r.per_frame[stage] = std::move(v);
