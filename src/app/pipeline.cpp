@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <optional>
 
 #include "core/error.hpp"
@@ -335,6 +334,7 @@ class LiveLoop : public FrameLoop {
     const auto k = static_cast<std::int64_t>(records_.size());
     if (traj_) traj_->write(frame_.timestamp, rec.result.world_T_camera);
     poses_.push_back(TumPose::from_se3(frame_.timestamp, rec.result.world_T_camera));
+    if (frame_.ground_truth) groundtruth_.push_back(TumPose::from_se3(frame_.timestamp, *frame_.ground_truth));
     const bool reextract = rec.fused && (fused_++ % e_.reextract_every) == 0;
     if (reextract) extract_scene();
     if (fused_ > 0) {
@@ -468,9 +468,8 @@ class LiveLoop : public FrameLoop {
     sum.spawns = spawns_;
     sum.physics = solver_.stats();
     sum.dynamic_masked_fraction = mean_dynamic_fraction(records_);
-    if (std::filesystem::exists(ctx_.out_path("groundtruth.txt")))
-      sum.ghost_vertices = ghost_vertices(mesh, e_.input, poses_, read_tum_trajectory(ctx_.out_path("groundtruth.txt")),
-                                          2 * e_.volume.voxel_size);
+    if (!groundtruth_.empty())  // the source's own poses (the synthetic room's)
+      sum.ghost_vertices = ghost_vertices(mesh, e_.input, poses_, groundtruth_, 2 * e_.volume.voxel_size);
     if (online_) sum.online_refine = online_->stats();
     sum.escaped = count_escaped(state, b, e_.solver.particle_diameter);
     add_stage_medians(sum, ctx_.timer());
@@ -525,6 +524,7 @@ class LiveLoop : public FrameLoop {
   std::optional<MovingColliders> colliders_;  // solver.dynamic_colliders
   std::vector<vec3> points_;  // the scene particles of the last extraction
   Trajectory poses_;          // tracked so far (pixel placements)
+  Trajectory groundtruth_;    // the source's ground-truth poses of the same frames, where it has them
   std::vector<SpawnParams> spawns_ = e_.spawn;       // with the live placements resolved
   std::vector<ResolvedPlacement> placements_;
   bool finished_ = false;
