@@ -38,8 +38,7 @@ SEAMLESS_HD inline float fill_gap_at(View2D<const float> in, int x, int y, float
   return n > 0 ? sum / static_cast<float>(n) : 0.f;
 }
 
-template <Executor Exec>
-struct FillGaps {
+template <Executor Exec> struct FillGaps {
   // out = in with its one-pixel gaps filled (out must not alias in).
   static void fill_depth_gaps(const Exec& ex, View2D<const float> in, View2D<float> out, float max_rel_diff);
 };

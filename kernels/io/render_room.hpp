@@ -25,14 +25,14 @@ namespace seamless::kernels {
 
 struct DepthNoise {
   bool enabled = false;
-  float baseline = 0.075f;           // metres, Kinect v1 projector-camera baseline
-  float disparity_step = 0.125f;     // pixels: 1/8 sub-pixel disparity steps
-  float sigma_disparity = 0.f;       // pixels: extra Gaussian disparity noise (0 = quantisation only)
-  float min_depth = 0.4f;            // metres: Kinect v1 working range
+  float baseline = 0.075f;        // metres, Kinect v1 projector-camera baseline
+  float disparity_step = 0.125f;  // pixels: 1/8 sub-pixel disparity steps
+  float sigma_disparity = 0.f;    // pixels: extra Gaussian disparity noise (0 = quantisation only)
+  float min_depth = 0.4f;         // metres: Kinect v1 working range
   float max_depth = 4.0f;
-  float min_incidence_cos = 0.2f;    // cos of the largest incidence angle that still returns (~78 deg)
-  float edge_jump = 0.05f;           // relative depth jump to a neighbour that counts as an edge
-  bool projector_shadow = true;      // drop pixels the projector cannot see
+  float min_incidence_cos = 0.2f;  // cos of the largest incidence angle that still returns (~78 deg)
+  float edge_jump = 0.05f;         // relative depth jump to a neighbour that counts as an edge
+  bool projector_shadow = true;    // drop pixels the projector cannot see
 };
 
 // Counter-based random numbers (a pure function of its inputs, so both backends and any thread
@@ -66,8 +66,7 @@ SEAMLESS_HD inline float kinect_quantise(float z, float f, const DepthNoise& n, 
   return dq > 0.f ? fb / dq : 0.f;
 }
 
-template <Executor Exec>
-struct RenderRoom {
+template <Executor Exec> struct RenderRoom {
   // depth (metres, 0 = none) and rgb of the room seen from world_T_camera through the pinhole K,
   // with the frame's movers (people, balls) in it. scratch is a float image of the same size (holds
   // the noise-free depth between the two passes). mask (optional: an empty view skips it) gets the

@@ -30,9 +30,10 @@ SEAMLESS_HD inline bool in_projector_shadow(vec3 p, vec3 n, vec3 projector, cons
 }  // namespace render_detail
 
 template <Executor Exec>
-void RenderRoom<Exec>::render_room(const Exec& ex, Intrinsics K, SE3 world_T_camera, DepthNoise noise, std::uint32_t seed,
-                 std::uint32_t frame, const movers::Scene& movers, View2D<float> scratch, View2D<float> depth,
-                 View2D<uchar3> rgb, View2D<std::uint8_t> mask) {
+void RenderRoom<Exec>::render_room(const Exec& ex, Intrinsics K, SE3 world_T_camera, DepthNoise noise,
+                                   std::uint32_t seed, std::uint32_t frame, const movers::Scene& movers,
+                                   View2D<float> scratch, View2D<float> depth, View2D<uchar3> rgb,
+                                   View2D<std::uint8_t> mask) {
   const int w = depth.width;
   const SE3 T = world_T_camera;
   const vec3 projector = T * vec3{noise.baseline, 0.f, 0.f};
@@ -57,8 +58,9 @@ void RenderRoom<Exec>::render_room(const Exec& ex, Intrinsics K, SE3 world_T_cam
     const vec3 normal = m.t > 0.f ? m.normal : h.normal;
     vec3 p = T.t + dir * t;
     float z = t / len;  // along the optical axis: |dc| = len for the unit-z ray
-    bool lost = noise.enabled && (dot(normal, -dir) < noise.min_incidence_cos ||
-                                  (noise.projector_shadow && render_detail::in_projector_shadow(p, normal, projector, ms)));
+    bool lost =
+        noise.enabled && (dot(normal, -dir) < noise.min_incidence_cos ||
+                          (noise.projector_shadow && render_detail::in_projector_shadow(p, normal, projector, ms)));
     scratch(x, y) = lost ? -z : z;
     rgb(x, y) = render_detail::shade(m.t > 0.f ? ms.c[m.capsule].albedo : room::surface_colour(h.id, p), normal);
   });

@@ -20,8 +20,7 @@ SEAMLESS_HD inline vec2 distort_pixel(const Intrinsics& K, float x, float y) {
   return {K.fx * xd + K.cx, K.fy * yd + K.cy};
 }
 
-template <Executor Exec>
-struct Undistort {
+template <Executor Exec> struct Undistort {
   // map(x, y) = distort_pixel(K, x, y) for every output pixel: computed once per camera.
   static void undistort_map(const Exec& ex, Intrinsics K, View2D<vec2> map);
 

@@ -5,8 +5,7 @@
 
 namespace seamless::kernels {
 
-template <Executor Exec>
-void Undistort<Exec>::undistort_map(const Exec& ex, Intrinsics K, View2D<vec2> map) {
+template <Executor Exec> void Undistort<Exec>::undistort_map(const Exec& ex, Intrinsics K, View2D<vec2> map) {
   const int w = map.width;
   ex.for_each(map.count(), [=] SEAMLESS_HD(std::int64_t i) {
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);

@@ -84,8 +84,8 @@ SEAMLESS_HD inline vec3 triangle_aero_force(vec3 p0, vec3 p1, vec3 p2, vec3 vrel
     cos_t = -cos_t;
   }
   float q = 0.5f * rho * vl * vl * area;
-  vec3 f = vd * (-drag * q * cos_t);                 // drag opposes the motion, scaled by exposure
-  vec3 u = cross(cross(n, vd), vd);                  // in the plane of n and v, normal to v
+  vec3 f = vd * (-drag * q * cos_t);  // drag opposes the motion, scaled by exposure
+  vec3 u = cross(cross(n, vd), vd);   // in the plane of n and v, normal to v
   float ul = length(u);
   if (ul > 1e-9f) f += (u / ul) * (lift * q * cos_t * sqrtf(fmaxf(1.f - cos_t * cos_t, 0.f)));
   return f;

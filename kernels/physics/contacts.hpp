@@ -7,8 +7,7 @@
 
 namespace seamless::kernels {
 
-template <Executor Exec>
-struct Contacts {
+template <Executor Exec> struct Contacts {
   // Pre-stabilisation: contacts on the start positions, applied to x and p alike (uses tmp).
   static void stabilize(const Exec& ex, const SimViews& S);
 };

@@ -121,7 +121,8 @@ SEAMLESS_HD inline float scene_contact_weight(const SimViews& S, int s, ContactP
 // after count_contacts at the same positions. Each pair's correction is scaled by
 // omega / max(n_s, n_j): averaging as in Macklin 2014 (eq. 11) that keeps every pair's two
 // corrections equal and opposite, so momentum is conserved.
-SEAMLESS_HD inline vec3 contact_part(const SimViews& S, int s, const vec3* P, const vec3* X, ContactPass pass, Lanes g) {
+SEAMLESS_HD inline vec3 contact_part(const SimViews& S, int s, const vec3* P, const vec3* X, ContactPass pass,
+                                     Lanes g) {
   const bool friction = pass == ContactPass::kSolve;
   const float D = S.c.diameter, wi = S.sw[s];
   const bool fl = phase::is(S.sphase[s], phase::kFluid);
@@ -168,7 +169,8 @@ SEAMLESS_HD inline void add_sdf_contact(const SimViews& S, int s, const vec3* P,
   const bool fl = phase::is(S.sphase[s], phase::kFluid);
   const float mu_s = !friction ? 0.f : fl ? S.c.fluid_friction : S.c.static_friction;
   const float mu_k = !friction ? 0.f : fl ? S.c.fluid_friction : S.c.kinetic_friction;
-  acc += contact_delta(xyz(q), S.c.radius - q.w, P[s] - X[s], S.sw[s], 0.f, mu_s, mu_k) * scene_contact_weight(S, s, pass);
+  acc +=
+      contact_delta(xyz(q), S.c.radius - q.w, P[s] - X[s], S.sw[s], 0.f, mu_s, mu_k) * scene_contact_weight(S, s, pass);
 }
 
 // Whether s has list entries that contact_part visits (otherwise its lanes need no sum).
@@ -180,8 +182,7 @@ SEAMLESS_HD inline bool has_contact_lists(const SimViews& S, int s) {
 
 // Macklin 2014, section 4.4: contacts that already exist at the start positions are resolved on
 // x and p together, so that they are removed without adding velocity.
-template <Executor Exec>
-void Contacts<Exec>::stabilize(const Exec& ex, const SimViews& S) {
+template <Executor Exec> void Contacts<Exec>::stabilize(const Exec& ex, const SimViews& S) {
   ex.for_each(S.nbodies, [=] SEAMLESS_HD(std::int64_t b) { S.body_contacts[b] = 0; });
   ex.for_each_grouped(S.n, kPairLanes, [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
     const int s = static_cast<int>(i);

@@ -57,8 +57,7 @@ SEAMLESS_SIMD_INL void gather_packed(const Packed* a, const int* j, simd::v3& xy
 }
 
 // acc += d where the lanes are in (all of them unless Masked).
-template <bool Masked>
-SEAMLESS_SIMD_INL void tile_add(simd::v3& acc, const simd::v3& d, simd::vm in) {
+template <bool Masked> SEAMLESS_SIMD_INL void tile_add(simd::v3& acc, const simd::v3& d, simd::vm in) {
   if constexpr (Masked) acc = select(in, acc + d, acc);
   else acc += d;
 }
@@ -67,8 +66,7 @@ SEAMLESS_SIMD_INL void tile_add(simd::v3& acc, const simd::v3& d, simd::vm in) {
 // j[l] = entry k of lane l, with masked = std::false_type while every lane has an entry k (k
 // below the shortest list: no mask needed) and std::true_type after (in: the lanes that have one,
 // tile_entries). What a tile gathers and sums is all in its pair function.
-template <class Pair>
-SEAMLESS_SIMD_INL void tile_pairs(const SimViews& S, const Tile& t, Pair&& pair) {
+template <class Pair> SEAMLESS_SIMD_INL void tile_pairs(const SimViews& S, const Tile& t, Pair&& pair) {
   auto step = [&](int k, auto masked) __attribute__((always_inline)) {
     int j[simd::kWidth];
     simd::vm in;
@@ -92,17 +90,18 @@ bool vorticity_tile(const SimViews& S, int s0) {
   const SphKernel W = S.c.W;
   const v3 p = simd::load_v3(S.sp + s0), vi = simd::load_v3(S.sv + s0);
   v3 tw{}, tn{}, tdv{};
-  tile_pairs(S, t, [&](const int* j, simd::vm in, auto masked) __attribute__((always_inline)) {
-    constexpr bool kMasked = decltype(masked)::value;
-    v3 q, vj;
-    simd::vf rho, hj;
-    gather_packed(S.spd, j, q, rho);
-    gather_packed(S.svh, j, vj, hj);
-    const auto d = vorticity_pair<false>(W, inv_rho0, coh_c, p - q, vi, vj, hj);
-    tile_add<kMasked>(tw, d.w, in);
-    tile_add<kMasked>(tn, d.n, in);
-    tile_add<kMasked>(tdv, d.dv, in);
-  });
+  tile_pairs(
+      S, t, [&](const int* j, simd::vm in, auto masked) __attribute__((always_inline)) {
+        constexpr bool kMasked = decltype(masked)::value;
+        v3 q, vj;
+        simd::vf rho, hj;
+        gather_packed(S.spd, j, q, rho);
+        gather_packed(S.svh, j, vj, hj);
+        const auto d = vorticity_pair<false>(W, inv_rho0, coh_c, p - q, vi, vj, hj);
+        tile_add<kMasked>(tw, d.w, in);
+        tile_add<kMasked>(tn, d.n, in);
+        tile_add<kMasked>(tdv, d.dv, in);
+      });
   for (int l = 0; l < simd::kWidth; ++l) {
     const int s = s0 + l;
     S.vort[s] = simd::lane(tw, l);
@@ -129,22 +128,24 @@ bool density_tile(const SimViews& S, int s0) {
   const v3 p = simd::load_v3(S.sp + s0);
   vf rho(W.poly6(0.f)), sum2(0.f);
   v3 gi{};
-  tile_pairs(S, t, [&](const int* j, simd::vm in, auto masked) __attribute__((always_inline)) {
-    constexpr bool kMasked = decltype(masked)::value;
-    v3 q;
-    vf ph;
-    gather_packed(S.spk, j, q, ph);
-    const auto d = density_pair<vf>(W, inv_rho0, p - q);
-    if constexpr (kMasked) {
-      rho = select(in, rho + d.wgt, rho);
-      sum2 = select(in, sum2 + length2(d.grad), sum2);
-    } else {
-      rho = rho + d.wgt;
-      sum2 = sum2 + length2(d.grad);
-    }
-    tile_add<kMasked>(gi, d.grad, in);
-  });
-  for (int l = 0; l < simd::kWidth; ++l) finish_density(S, s0 + l, nc[l], DensitySum{rho[l], sum2[l], simd::lane(gi, l)});
+  tile_pairs(
+      S, t, [&](const int* j, simd::vm in, auto masked) __attribute__((always_inline)) {
+        constexpr bool kMasked = decltype(masked)::value;
+        v3 q;
+        vf ph;
+        gather_packed(S.spk, j, q, ph);
+        const auto d = density_pair<vf>(W, inv_rho0, p - q);
+        if constexpr (kMasked) {
+          rho = select(in, rho + d.wgt, rho);
+          sum2 = select(in, sum2 + length2(d.grad), sum2);
+        } else {
+          rho = rho + d.wgt;
+          sum2 = sum2 + length2(d.grad);
+        }
+        tile_add<kMasked>(gi, d.grad, in);
+      });
+  for (int l = 0; l < simd::kWidth; ++l)
+    finish_density(S, s0 + l, nc[l], DensitySum{rho[l], sum2[l], simd::lane(gi, l)});
   return true;
 }
 
@@ -162,20 +163,23 @@ bool solve_tile(const SimViews& S, int s0) {
   vf li;
   for (int l = 0; l < simd::kWidth; ++l) li.v[l] = S.lambda[s0 + l];
   v3 f{};
-  tile_pairs(S, t, [&](const int* j, simd::vm in, auto masked) __attribute__((always_inline)) {
-    constexpr bool kMasked = decltype(masked)::value;
-    v3 q;
-    vf lj;
-    gather_packed(S.spl, j, q, lj);
-    const v3 r = p - q;
-    const v3 grad = pair_grad(W, r);
-    const vf wgt = W.poly6(length2(r));  // (s_corr off: unused, see pbf_factor)
-    tile_add<kMasked>(f, grad * pbf_factor(S.c, wgt, li, lj), in);
-  });
+  tile_pairs(
+      S, t, [&](const int* j, simd::vm in, auto masked) __attribute__((always_inline)) {
+        constexpr bool kMasked = decltype(masked)::value;
+        v3 q;
+        vf lj;
+        gather_packed(S.spl, j, q, lj);
+        const v3 r = p - q;
+        const v3 grad = pair_grad(W, r);
+        const vf wgt = W.poly6(length2(r));  // (s_corr off: unused, see pbf_factor)
+        tile_add<kMasked>(f, grad * pbf_factor(S.c, wgt, li, lj), in);
+      });
   for (int l = 0; l < simd::kWidth; ++l) {
     const int s = s0 + l;
     if (!(S.sw[s] > 0.f)) S.tmp[s] = S.sp[s];
-    else finish_solve(S, s, SolveSum{contact_part(S, s, S.sp, S.sx, ContactPass::kSolve, Lanes{}), simd::lane(f, l)}, true, false);
+    else
+      finish_solve(S, s, SolveSum{contact_part(S, s, S.sp, S.sx, ContactPass::kSolve, Lanes{}), simd::lane(f, l)}, true,
+                   false);
   }
   return true;
 }
@@ -194,20 +198,21 @@ bool forces_tile(const SimViews& S, int s0) {
   vf rho_i;
   for (int l = 0; l < simd::kWidth; ++l) rho_i.v[l] = S.density[s0 + l];
   v3 eta{}, acc{};
-  tile_pairs(S, t, [&](const int* j, simd::vm in, auto masked) __attribute__((always_inline)) {
-    constexpr bool kMasked = decltype(masked)::value;
-    v3 q, nj;
-    vf rho_j, wj;
-    gather_packed(S.spd, j, q, rho_j);
-    gather_packed(S.cnv, j, nj, wj);
-    const v3 r = p - q;
-    const v3 grad = pair_grad(W, r);
-    const vf cf = pair_cohesion(W, coh_c, r);
-    v3 e, a;
-    force_pair(inv_rho0, two_rho0, st, r, grad, cf, ni, nj, wj, rho_i, rho_j, e, a);
-    tile_add<kMasked>(eta, e, in);
-    tile_add<kMasked>(acc, a, in);
-  });
+  tile_pairs(
+      S, t, [&](const int* j, simd::vm in, auto masked) __attribute__((always_inline)) {
+        constexpr bool kMasked = decltype(masked)::value;
+        v3 q, nj;
+        vf rho_j, wj;
+        gather_packed(S.spd, j, q, rho_j);
+        gather_packed(S.cnv, j, nj, wj);
+        const v3 r = p - q;
+        const v3 grad = pair_grad(W, r);
+        const vf cf = pair_cohesion(W, coh_c, r);
+        v3 e, a;
+        force_pair(inv_rho0, two_rho0, st, r, grad, cf, ni, nj, wj, rho_i, rho_j, e, a);
+        tile_add<kMasked>(eta, e, in);
+        tile_add<kMasked>(acc, a, in);
+      });
   for (int l = 0; l < simd::kWidth; ++l) {
     const int s = s0 + l;
     S.vtmp[s] = fluid_velocity(S, s, finish_forces(S, s, ForceSum{simd::lane(eta, l), simd::lane(acc, l)}));
@@ -444,6 +449,5 @@ bool neighbors_tile(const SimViews& S, int s0) {
 #if SEAMLESS_SIMD_X86
 #pragma GCC pop_options
 #endif
-
 
 }  // namespace seamless::kernels

@@ -31,8 +31,7 @@ bool neighbors_tile(const SimViews& S, int s0);
 // declines, on the CPU when the SIMD lanes are available; false otherwise (the caller then runs
 // its loop). Each tile is taken by the task of its first particle (for_each's threshold and
 // schedule stay those of the particles).
-template <class Exec, class Tile, class One>
-bool cpu_tiles(const Exec& ex, const SimViews& S, Tile tile, One one) {
+template <class Exec, class Tile, class One> bool cpu_tiles(const Exec& ex, const SimViews& S, Tile tile, One one) {
   if constexpr (Exec::device != Device::CPU) return false;
   if (!simd::cpu_simd()) return false;
   ex.for_each(S.n, [=](std::int64_t i) {

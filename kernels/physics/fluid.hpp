@@ -6,8 +6,7 @@
 
 namespace seamless::kernels {
 
-template <Executor Exec>
-struct Fluid {
+template <Executor Exec> struct Fluid {
   // Fluid density and lambda (PBF eqs. 1-11); number of active contacts of every particle.
   static void prepare_constraints(const Exec& ex, const SimViews& S);
   // Contacts (particles, static particles, SDF) with friction, plus the PBF position update

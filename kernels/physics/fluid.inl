@@ -24,13 +24,11 @@ SEAMLESS_HD inline DensitySum operator+(const DensitySum& a, const DensitySum& b
 
 // One pair's kernel values for r = p_i - p_j (poly6 wgt, spiky gradient gw) and grad_j C_i =
 // gw / rho_0; F is float or the CPU's SIMD lanes (V their vec3).
-template <class F, class V>
-struct DensityPair {
+template <class F, class V> struct DensityPair {
   V gw, grad;
   F wgt;
 };
-template <class F, class V>
-SEAMLESS_HD inline DensityPair<F, V> density_pair(const SphKernel& W, float inv_rho0, V r) {
+template <class F, class V> SEAMLESS_HD inline DensityPair<F, V> density_pair(const SphKernel& W, float inv_rho0, V r) {
   DensityPair<F, V> d;
   d.wgt = W.poly6(length2(r));
   d.gw = pair_grad(W, r);
@@ -40,8 +38,7 @@ SEAMLESS_HD inline DensityPair<F, V> density_pair(const SphKernel& W, float inv_
 
 // Lane g's share of rho_i (starting from W(0) in lane 0), sum_j |grad_j C_i|^2 and grad_i C_i;
 // with Cache, each pair's kernel values are kept in pair_w for pbf_part.
-template <bool Cache>
-SEAMLESS_HD inline DensitySum density_part(const SimViews& S, int s, Lanes g) {
+template <bool Cache> SEAMLESS_HD inline DensitySum density_part(const SimViews& S, int s, Lanes g) {
   const vec3 p = S.sp[s];
   const float inv_rho0 = 1.f / S.c.rest_density, sw = S.c.solid_density_scale;
   DensitySum d{g.lane == 0 ? S.c.W.poly6(0.f) : 0.f, 0.f, {0.f, 0.f, 0.f}};
@@ -85,8 +82,7 @@ SEAMLESS_HD inline void finish_density(const SimViews& S, int s, int nc, const D
 }
 }  // namespace detail
 
-template <Executor Exec>
-void Fluid<Exec>::prepare_constraints(const Exec& ex, const SimViews& S) {
+template <Executor Exec> void Fluid<Exec>::prepare_constraints(const Exec& ex, const SimViews& S) {
   ex.for_each(S.nbodies, [=] SEAMLESS_HD(std::int64_t b) { S.body_contacts[b] = 0; });
   detail::pack_positions(ex, S);
   auto one = [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
@@ -121,8 +117,7 @@ SEAMLESS_HD inline SolveSum operator+(const SolveSum& a, const SolveSum& b) { re
 // One fluid pair's term of the PBF sum is grad times this factor, lambda_i + lambda_j + s_corr,
 // s_corr from the pair's poly6 wgt (eq. 13, n = 4); F is float or the CPU's SIMD lanes.
 // Without a branch: with s_corr off (scorr_k = 0), sc is -0 and li + lj + sc is li + lj to the bit.
-template <class F>
-SEAMLESS_HD inline F pbf_factor(const SimConstants& c, F wgt, F li, F lj) {
+template <class F> SEAMLESS_HD inline F pbf_factor(const SimConstants& c, F wgt, F li, F lj) {
   const F q = wgt * c.scorr_inv_wdq;
   const F sc = -c.scorr_k * q * q * q * q;
   return li + lj + sc;
@@ -134,8 +129,7 @@ SEAMLESS_HD inline F pbf_factor(const SimConstants& c, F wgt, F li, F lj) {
 // Mixed: whether s has neighbours that are not fluid (nsolid); otherwise a loop of its own without
 // phase loads (a runtime test left predicated loads and byte moves in every pair; the two loops
 // are faster on fluid_1m, docs/PERFORMANCE.md).
-template <bool Cached, bool Mixed>
-SEAMLESS_HD inline vec3 pbf_part(const SimViews& S, int s, Lanes g) {
+template <bool Cached, bool Mixed> SEAMLESS_HD inline vec3 pbf_part(const SimViews& S, int s, Lanes g) {
   const vec3 p = S.sp[s];
   const float li = S.lambda[s], sw = S.c.solid_density_scale;
   constexpr bool mixed = Mixed;
@@ -159,7 +153,8 @@ SEAMLESS_HD inline vec3 pbf_part(const SimViews& S, int s, Lanes g) {
     }
     f += grad * (n.fluid ? pbf_factor(S.c, wgt, li, lj) : li * sw);  // a solid neighbour: li * sw alone
   });
-  for (int k = g.lane, m = S.nsnbr[s]; k < m; k += g.size) f += S.c.W.spiky_grad(p - S.stat[S.snbrs(s)[k * S.snbr_col]]) * (li * sw);
+  for (int k = g.lane, m = S.nsnbr[s]; k < m; k += g.size)
+    f += S.c.W.spiky_grad(p - S.stat[S.snbrs(s)[k * S.snbr_col]]) * (li * sw);
   return f;
 }
 
@@ -188,8 +183,7 @@ SEAMLESS_HD inline vec3 coupling_part(const SimViews& S, int s, Lanes g) {
 }
 }  // namespace detail
 
-template <Executor Exec>
-void Fluid<Exec>::solve_contacts_fluid(const Exec& ex, const SimViews& S) {
+template <Executor Exec> void Fluid<Exec>::solve_contacts_fluid(const Exec& ex, const SimViews& S) {
   auto one = [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
     const int s = static_cast<int>(i);
     const vec3 p = S.sp[s];
@@ -226,8 +220,7 @@ SEAMLESS_HD inline ForceSum operator+(const ForceSum& a, const ForceSum& b) { re
 
 // Akinci's cohesion term of the pair r = p_i - p_j (eq. 1, before K_ij) is r times this factor
 // of l = |r| (0 for coincident particles); coh_c = -cohesion / rho_0.
-template <class F>
-SEAMLESS_HD inline F cohesion_factor(const SphKernel& W, float coh_c, F l) {
+template <class F> SEAMLESS_HD inline F cohesion_factor(const SphKernel& W, float coh_c, F l) {
   return select(l > 1e-9f, coh_c * W.akinci(l) / l, F(0.f));
 }
 
@@ -235,8 +228,8 @@ SEAMLESS_HD inline F cohesion_factor(const SphKernel& W, float coh_c, F l) {
 // factor cf, n_i, n_j, |omega_j| (wj), rho_i, rho_j; F is float or the CPU's SIMD lanes (V their
 // vec3).
 template <class F, class V>
-SEAMLESS_HD inline void force_pair(float inv_rho0, float two_rho0, float st, V r, V grad, F cf, V ni, V nj, F wj, F rho_i,
-                                   F rho_j, V& eta, V& acc) {
+SEAMLESS_HD inline void force_pair(float inv_rho0, float two_rho0, float st, V r, V grad, F cf, V ni, V nj, F wj,
+                                   F rho_i, F rho_j, V& eta, V& acc) {
   eta = grad * (wj * inv_rho0);
   F K = fast_div(two_rho0, rho_i + rho_j);  // __fdividef on CUDA
   V coh = r * cf;
@@ -257,8 +250,7 @@ SEAMLESS_HD inline vec3 fluid_velocity(const SimViews& S, int s, vec3 forces) {
   return S.sv[s] + (S.vtmp[s] * S.c.viscosity + forces * S.c.dt);
 }
 // cohesion_factor of |r| (r = p_i - p_j), with one reciprocal square root on CUDA (pair_grad).
-template <class V>
-SEAMLESS_HD inline auto pair_cohesion(const SphKernel& W, float coh_c, V r) {
+template <class V> SEAMLESS_HD inline auto pair_cohesion(const SphKernel& W, float coh_c, V r) {
 #if defined(__CUDA_ARCH__)
   const float l2 = length2(r);
   if (!(l2 > 1e-18f)) return 0.f;  // l <= 1e-9, as cohesion_factor
@@ -272,8 +264,7 @@ SEAMLESS_HD inline auto pair_cohesion(const SphKernel& W, float coh_c, V r) {
 // With Cached, each pair's spiky gradient and cohesion factor come from pair_w (vorticity_part,
 // at the same positions) instead of a square root, a division and both kernels.
 // Mixed: as pbf_part.
-template <bool Cached, bool Mixed>
-SEAMLESS_HD inline vec3 fluid_forces(const SimViews& S, int s, Lanes g) {
+template <bool Cached, bool Mixed> SEAMLESS_HD inline vec3 fluid_forces(const SimViews& S, int s, Lanes g) {
   const float inv_rho0 = 1.f / S.c.rest_density;
   const vec3 p = S.sp[s], ni = S.cnormal[s];
   constexpr bool mixed = Mixed;
@@ -336,13 +327,13 @@ SEAMLESS_HD inline VortSum operator+(const VortSum& a, const VortSum& b) {
 // One pair's terms of VortSum for r = p_i - p_j, the velocities v_i, v_j and h / rho_j (hj), and
 // (With) the pair's spiky gradient and cohesion factor for pair_w; F is float or the CPU's SIMD
 // lanes (V their vec3).
-template <class F, class V>
-struct VortPair {
+template <class F, class V> struct VortPair {
   V grad, w, n, dv;
   F cf;
 };
 template <bool With, class F, class V>
-SEAMLESS_HD inline VortPair<F, V> vorticity_pair(const SphKernel& W, float inv_rho0, float coh_c, V r, V vi, V vj, F hj) {
+SEAMLESS_HD inline VortPair<F, V> vorticity_pair(const SphKernel& W, float inv_rho0, float coh_c, V r, V vi, V vj,
+                                                 F hj) {
   VortPair<F, V> d;
   d.grad = pair_grad(W, r);
   if constexpr (With) d.cf = pair_cohesion(W, coh_c, r);
@@ -355,8 +346,7 @@ SEAMLESS_HD inline VortPair<F, V> vorticity_pair(const SphKernel& W, float inv_r
 // With Cache, each pair's spiky gradient and cohesion factor are kept in pair_w for
 // fluid_forces, which runs next at the same positions.
 // Mixed: as pbf_part.
-template <bool Cache, bool Mixed>
-SEAMLESS_HD inline VortSum vorticity_part(const SimViews& S, int s, Lanes g) {
+template <bool Cache, bool Mixed> SEAMLESS_HD inline VortSum vorticity_part(const SimViews& S, int s, Lanes g) {
   const float inv_rho0 = 1.f / S.c.rest_density;
   const vec3 p = S.sp[s], vi = S.sv[s];
   constexpr bool mixed = Mixed;
@@ -383,8 +373,7 @@ SEAMLESS_HD inline VortSum vorticity_part(const SimViews& S, int s, Lanes g) {
 }
 }  // namespace detail
 
-template <Executor Exec>
-void Fluid<Exec>::velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
+template <Executor Exec> void Fluid<Exec>::velocity_effects(const Exec& ex, const SimViews& S, bool has_fluid) {
   if (has_fluid) {
     // Vorticity omega_i = sum_j v_ij x grad_j W_ij (PBF eq. 15), Akinci's colour-field normal
     // n_i = h sum_j (1 / rho_j) grad W_ij (Akinci 2013, eq. 4; dissertation eq. 4.21), and the
@@ -395,7 +384,7 @@ void Fluid<Exec>::velocity_effects(const Exec& ex, const SimViews& S, bool has_f
       if (!phase::is(S.sphase[s], phase::kFluid)) return;
       constexpr bool kCache = detail::kCachePairs<Exec>;
       const detail::VortSum t = g.sum(S.nsolid[s] != 0 ? detail::vorticity_part<kCache, true>(S, s, g)
-                                                        : detail::vorticity_part<kCache, false>(S, s, g));
+                                                       : detail::vorticity_part<kCache, false>(S, s, g));
       if (g.lane != 0) return;
       S.vort[s] = t.w;
       S.vort_len[s] = length(t.w);
@@ -416,7 +405,8 @@ void Fluid<Exec>::velocity_effects(const Exec& ex, const SimViews& S, bool has_f
     vec3 forces{0.f, 0.f, 0.f};
     if (fluid) {
       constexpr bool kCache = detail::kCachePairs<Exec>;
-      forces = S.nsolid[s] != 0 ? detail::fluid_forces<kCache, true>(S, s, g) : detail::fluid_forces<kCache, false>(S, s, g);
+      forces =
+          S.nsolid[s] != 0 ? detail::fluid_forces<kCache, true>(S, s, g) : detail::fluid_forces<kCache, false>(S, s, g);
     }
     if (g.lane != 0) return;  // vtmp[s] is read and written by lane 0 only
     vec3 v = S.sv[s];

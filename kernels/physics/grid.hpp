@@ -9,8 +9,7 @@
 
 namespace seamless::kernels {
 
-template <Executor Exec>
-struct NeighbourGrid {
+template <Executor Exec> struct NeighbourGrid {
   // External forces, speed limit, prediction p = x + v dt; cell keys of p; order = identity.
   static void predict(const Exec& ex, const SimViews& S);
   // Stable sort of (key, value) pairs by the low `bits` bits of key (the executor's radix sort).

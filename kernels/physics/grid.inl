@@ -6,8 +6,7 @@
 
 namespace seamless::kernels {
 
-template <Executor Exec>
-void NeighbourGrid<Exec>::predict(const Exec& ex, const SimViews& S) {
+template <Executor Exec> void NeighbourGrid<Exec>::predict(const Exec& ex, const SimViews& S) {
   ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t i) {
     vec3 v = S.v[i];
     if (S.w[i] > 0.f) v = v + S.c.gravity * S.c.dt;
@@ -34,8 +33,7 @@ std::size_t NeighbourGrid<Exec>::sort_cells_temp_bytes(const Exec& ex, std::int6
 
 // Gathers the slot state into the sorted order; order[s] becomes the particle id of sorted index
 // s (each thread rewrites only its own entry) and rank its inverse.
-template <Executor Exec>
-void NeighbourGrid<Exec>::reorder(const Exec& ex, const SimViews& S) {
+template <Executor Exec> void NeighbourGrid<Exec>::reorder(const Exec& ex, const SimViews& S) {
   ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
     const int slot = S.order[s], id = S.slot_id[slot];
     S.order[s] = id;
@@ -51,7 +49,8 @@ void NeighbourGrid<Exec>::reorder(const Exec& ex, const SimViews& S) {
 }
 
 template <Executor Exec>
-void NeighbourGrid<Exec>::cell_starts(const Exec& ex, const std::uint32_t* keys, std::int64_t n, int* start, std::int64_t cells) {
+void NeighbourGrid<Exec>::cell_starts(const Exec& ex, const std::uint32_t* keys, std::int64_t n, int* start,
+                                      std::int64_t cells) {
   // Each task fills a block of cells: one binary search for the first, then a merge walk along
   // the sorted keys (work per task: the block's cells plus the entries in them). Parallel on both
   // backends, no atomics, no host sync, and no task fills a long run of empty cells alone. Blocks
@@ -88,7 +87,8 @@ void NeighbourGrid<Exec>::cell_starts(const Exec& ex, const std::uint32_t* keys,
 }
 
 template <Executor Exec>
-void NeighbourGrid<Exec>::cell_keys(const Exec& ex, const vec3* p, std::int64_t n, GridSpec g, std::uint32_t* keys, int* idx) {
+void NeighbourGrid<Exec>::cell_keys(const Exec& ex, const vec3* p, std::int64_t n, GridSpec g, std::uint32_t* keys,
+                                    int* idx) {
   ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) {
     keys[i] = g.key(g.cell_of(p[i]));
     idx[i] = static_cast<int>(i);
@@ -108,8 +108,8 @@ namespace detail {
 // written to the spare slot, which nothing reads. cnt counts every accepted candidate (also past
 // the cap); kept(j) is called for those stored.
 template <class Keep, class Kept>
-SEAMLESS_HD inline void append_run(int a, int e, Lanes g, int* list, std::int64_t col, int cap, int& cnt,
-                                   Keep&& keep, Kept&& kept) {
+SEAMLESS_HD inline void append_run(int a, int e, Lanes g, int* list, std::int64_t col, int cap, int& cnt, Keep&& keep,
+                                   Kept&& kept) {
   for (int b = a; b < e; b += g.size) {  // the same trip count in every lane of the group
     const bool in = b + g.lane < e;
     const int j = in ? b + g.lane : a;  // lanes past the run look at a valid entry, and reject it
@@ -132,8 +132,8 @@ SEAMLESS_HD inline void append_run(int a, int e, Lanes g, int* list, std::int64_
 // locals, so that the stores to list cannot make the compiler reload s, cap or the count.
 // Returns the count.
 template <bool General, bool Clamp>
-SEAMLESS_HD inline int scan_candidates(const SimViews& S, vec3 p, float R2, std::uint32_t ph, int s, int a, int e, int* list,
-                                       int cap, int c) {
+SEAMLESS_HD inline int scan_candidates(const SimViews& S, vec3 p, float R2, std::uint32_t ph, int s, int a, int e,
+                                       int* list, int cap, int c) {
   const Packed* const spk = S.spk;
   for (int j = a; j < e; ++j) {
     const Packed q = spk[j];  // position and phase in one load
@@ -159,7 +159,8 @@ SEAMLESS_HD inline int scan_candidates(const SimViews& S, vec3 p, float R2, std:
 // without a bit of solid_mask.
 template <bool General>
 SEAMLESS_HD inline void scan_run_lane(const SimViews& S, vec3 p, float R2, std::uint32_t ph, int s,
-                                      std::uint32_t solid_mask, int a, int e, int* list, int cap, int& cnt, int& solid) {
+                                      std::uint32_t solid_mask, int a, int e, int* list, int cap, int& cnt,
+                                      int& solid) {
   const int col = static_cast<int>(S.nbr_col);  // particle count on CUDA (< 2^31)
   int c = cnt, so = solid;
   int* out = list + static_cast<std::int64_t>(c < cap ? c : cap) * col;
@@ -199,8 +200,7 @@ SEAMLESS_HD inline void finish_neighbors(const SimViews& S, int s, int cnt, int 
 }
 }  // namespace detail
 
-template <Executor Exec>
-void NeighbourGrid<Exec>::find_neighbors(const Exec& ex, const SimViews& S) {
+template <Executor Exec> void NeighbourGrid<Exec>::find_neighbors(const Exec& ex, const SimViews& S) {
   auto one = [=] SEAMLESS_HD(std::int64_t i, Lanes g) {
     // A CPU thread walks a particle's runs alone (Lanes{}); CUDA does from about 270k particles.
     // (Declared here: an extended CUDA lambda cannot capture what an if constexpr tests.)
@@ -229,12 +229,16 @@ void NeighbourGrid<Exec>::find_neighbors(const Exec& ex, const SimViews& S) {
           // needs no clamp.
           const bool self = a <= s && s < e;
           if (cnt + (e - a) <= cap) {
-            if (self) cnt = detail::scan_candidates<kGeneral, false>(S, p, R2, ph, s, s + 1, e, list, cap,
-                                                                     detail::scan_candidates<kGeneral, false>(S, p, R2, ph, s, a, s, list, cap, cnt));
+            if (self)
+              cnt = detail::scan_candidates<kGeneral, false>(
+                  S, p, R2, ph, s, s + 1, e, list, cap,
+                  detail::scan_candidates<kGeneral, false>(S, p, R2, ph, s, a, s, list, cap, cnt));
             else cnt = detail::scan_candidates<kGeneral, false>(S, p, R2, ph, s, a, e, list, cap, cnt);
           } else {
-            if (self) cnt = detail::scan_candidates<kGeneral, true>(S, p, R2, ph, s, s + 1, e, list, cap,
-                                                                    detail::scan_candidates<kGeneral, true>(S, p, R2, ph, s, a, s, list, cap, cnt));
+            if (self)
+              cnt = detail::scan_candidates<kGeneral, true>(
+                  S, p, R2, ph, s, s + 1, e, list, cap,
+                  detail::scan_candidates<kGeneral, true>(S, p, R2, ph, s, a, s, list, cap, cnt));
             else cnt = detail::scan_candidates<kGeneral, true>(S, p, R2, ph, s, a, e, list, cap, cnt);
           }
         });
@@ -243,7 +247,8 @@ void NeighbourGrid<Exec>::find_neighbors(const Exec& ex, const SimViews& S) {
       if (plain && simd::cpu_simd()) cnt = detail::scan_runs_simd(S, p, R, s, list, cap);
       else
 #endif
-      if (plain) walk(std::false_type{});
+          if (plain)
+        walk(std::false_type{});
       else walk(std::true_type{});
       const int stored = cnt < cap ? cnt : cap;
       if (!sfluid) solid = stored;
@@ -277,8 +282,7 @@ void NeighbourGrid<Exec>::find_neighbors(const Exec& ex, const SimViews& S) {
       for_each_run_in_radius(S.sgrid, S.scell_start, p, R, [&](int a, int e) {
         detail::append_run(
             a, e, g, S.snbr + s * S.snbr_row, S.snbr_col, S.c.max_static_neighbors, scnt,
-            [&](int j) { return length2(p - S.stat[j]) < R2; },
-            [](int, bool) {});
+            [&](int j) { return length2(p - S.stat[j]) < R2; }, [](int, bool) {});
       });
     }
     solid = g.sum(solid);

@@ -8,8 +8,7 @@
 
 namespace seamless::kernels {
 
-template <Executor Exec>
-struct Integration {
+template <Executor Exec> struct Integration {
   // v = v_pred + (p - p0) / dt (exactly symplectic Euler when nothing acted), restitution, sleeping.
   static void update_velocity(const Exec& ex, const SimViews& S);
   // x, v back to id order; counters[4] = bits of the largest |v|^2 (reset by predict).

@@ -6,8 +6,7 @@
 
 namespace seamless::kernels {
 
-template <Executor Exec>
-void Integration<Exec>::update_velocity(const Exec& ex, const SimViews& S) {
+template <Executor Exec> void Integration<Exec>::update_velocity(const Exec& ex, const SimViews& S) {
   ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
     // v_pred + (p - p0)/dt equals (p - x)/dt, but is exactly v_pred when no constraint acted.
     vec3 v = S.sv[s] + (S.sp[s] - S.sp0[s]) * S.c.inv_dt;
@@ -29,10 +28,8 @@ void Integration<Exec>::update_velocity(const Exec& ex, const SimViews& S) {
   });
 }
 
-
 // The sorted state becomes the slot state (slot s = sorted index s: coalesced, no scatter by id).
-template <Executor Exec>
-void Integration<Exec>::write_back(const Exec& ex, const SimViews& S) {
+template <Executor Exec> void Integration<Exec>::write_back(const Exec& ex, const SimViews& S) {
   ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) {
     S.x[s] = S.sp[s];
     S.v[s] = S.sv[s];
@@ -45,7 +42,6 @@ void Integration<Exec>::write_back(const Exec& ex, const SimViews& S) {
     if (v2 > atomic_load(&S.counters[4])) atomic_max(&S.counters[4], v2);
   });
 }
-
 
 // The slot state's positions and phases in id order (for what reads particles by id: the
 // renderer's cloth triangles, downloads).

@@ -34,8 +34,7 @@ SEAMLESS_HD inline bool both_fluid(std::uint32_t a, std::uint32_t b) {
 // division: ~25 instructions a pair) costs more than storing and reloading 16 bytes from cache;
 // not on CUDA, where that would be ~0.5 GB of extra memory traffic per iteration at 1M particles
 // against arithmetic a latency-bound kernel gets almost for free.
-template <class Exec>
-inline constexpr bool kCachePairs = Exec::device == Device::CPU;
+template <class Exec> inline constexpr bool kCachePairs = Exec::device == Device::CPU;
 
 // Calls use(k, gather(j)) with j = list[k * col] for a lane's entries k = g.lane,
 // g.lane + g.size, ... below m, in k order (sums keep the order of a plain loop). gather(j)
@@ -124,8 +123,7 @@ __device__ inline float rsqrt_normal(float x) {
   return r;
 }
 #endif
-template <class V>
-SEAMLESS_HD inline V pair_grad(const SphKernel& W, V r) {
+template <class V> SEAMLESS_HD inline V pair_grad(const SphKernel& W, V r) {
 #if defined(__CUDA_ARCH__)
   const float l2 = length2(r);
   if (l2 >= W.h2 || l2 <= 1e-24f) return {0.f, 0.f, 0.f};  // l >= h or l <= 1e-12, as spiky_grad
@@ -135,8 +133,7 @@ SEAMLESS_HD inline V pair_grad(const SphKernel& W, V r) {
   return W.spiky_grad(r);
 #endif
 }
-template <class F>
-SEAMLESS_HD inline F fast_div(float a, F b) {
+template <class F> SEAMLESS_HD inline F fast_div(float a, F b) {
 #if defined(__CUDA_ARCH__)
   return __fdividef(a, b);
 #else
@@ -145,8 +142,7 @@ SEAMLESS_HD inline F fast_div(float a, F b) {
 }
 
 // spk = (sp, phase bits): the packed copy that the next neighbour loops gather (Packed).
-template <class Exec>
-void pack_positions(const Exec& ex, const SimViews& S) {
+template <class Exec> void pack_positions(const Exec& ex, const SimViews& S) {
   ex.for_each(S.n, [=] SEAMLESS_HD(std::int64_t s) { S.spk[s] = Packed::of_phase(S.sp[s], S.sphase[s]); });
 }
 

@@ -72,23 +72,20 @@ struct SphKernel {
   // early returns.
 
   // Poly6 (Mueller 2003, used for density in Macklin & Mueller 2013, eq. 2).
-  template <class F>
-  SEAMLESS_HD F poly6(F r2) const {
+  template <class F> SEAMLESS_HD F poly6(F r2) const {
     const F t = h2 - r2;
     return select(r2 < h2, poly6_c * t * t * t, F(0.f));
   }
 
   // Gradient of the spiky kernel with respect to p_i for r = p_i - p_j (Mueller 2003; PBF eq. 8).
-  template <class V>
-  SEAMLESS_HD V spiky_grad(V r) const {
+  template <class V> SEAMLESS_HD V spiky_grad(V r) const {
     const auto l = length(r);
     const auto t = h - l;
     return select((l < h) & (l > 1e-12f), r * (spiky_c * t * t / l), V{});
   }
 
   // Akinci 2013 cohesion spline C(r) (eq. 2 there), zero beyond h.
-  template <class F>
-  SEAMLESS_HD F akinci(F r) const {
+  template <class F> SEAMLESS_HD F akinci(F r) const {
     const F a = (h - r) * (h - r) * (h - r) * r * r * r;
     const F c = select(2.f * r > h, akinci_c * a, akinci_c * (2.f * a - h6_64));
     return select((r < h) & (r > 0.f), c, F(0.f));
@@ -119,9 +116,9 @@ SEAMLESS_HD inline int floor_int(float x) {
 // searched then hug the search sphere (see for_each_in_radius), about 100 candidates per particle
 // at the fluid rest spacing instead of the 216 of 27 cells of one search radius.
 struct GridSpec {
-  float inv_cell;  // 1 / cell size
-  int bits;        // cells per axis = 1 << bits
-  float cell;      // cell size
+  float inv_cell;                  // 1 / cell size
+  int bits;                        // cells per axis = 1 << bits
+  float cell;                      // cell size
   static constexpr int reach = 2;  // cells searched on each side: search radius / cell
   SEAMLESS_HD std::uint32_t key(int3 c) const {
     std::uint32_t m = (1u << bits) - 1u;
@@ -139,8 +136,7 @@ struct GridSpec {
 // Distance along one axis from coordinate v to cell i's slab [i cs, (i + 1) cs), made smaller by
 // pad so that rounding never drops a cell that holds a neighbour.
 // F: float, or the CPU's SIMD lanes.
-template <class F>
-SEAMLESS_HD inline F slab_gap(F v, int i, float cs, float pad) {
+template <class F> SEAMLESS_HD inline F slab_gap(F v, int i, float cs, float pad) {
   const float lo = static_cast<float>(i) * cs;
   const F a = lo - v, b = v - (lo + cs);  // at most one is > 0
   const F g = select(a > b, a, b) - pad;  // max, without a branch

@@ -38,11 +38,11 @@ struct SdfSample3 {
 struct SceneSdf {
   int count = 0;
   SdfPrimitive prims[kMaxSdfPrimitives];
-  int synthetic_room = 0;     // 1: include kernels::room::room_sample
+  int synthetic_room = 0;       // 1: include kernels::room::room_sample
   const float* grid = nullptr;  // dense samples, x fastest; nullptr = none
   int3 dims{0, 0, 0};
-  vec3 origin{0, 0, 0};       // world position of sample (0,0,0)
-  float voxel = 0.f;          // sample spacing, metres
+  vec3 origin{0, 0, 0};  // world position of sample (0,0,0)
+  float voxel = 0.f;     // sample spacing, metres
   SEAMLESS_HD bool active() const { return count > 0 || synthetic_room || grid != nullptr; }
 };
 
@@ -80,8 +80,7 @@ SEAMLESS_HD inline SdfSample3 sdf_primitive(const SdfPrimitive& q, vec3 p) {
 SEAMLESS_HD inline float sdf_grid_value(const SceneSdf& s, vec3 p) {
   vec3 g = (p - s.origin) / s.voxel;
   int3 c = floor_to_int(g);
-  if (c.x < 0 || c.y < 0 || c.z < 0 || c.x >= s.dims.x - 1 || c.y >= s.dims.y - 1 || c.z >= s.dims.z - 1)
-    return 1e30f;
+  if (c.x < 0 || c.y < 0 || c.z < 0 || c.x >= s.dims.x - 1 || c.y >= s.dims.y - 1 || c.z >= s.dims.z - 1) return 1e30f;
   vec3 f = g - to_vec3(c);
   const std::int64_t sx = 1, sy = s.dims.x, sz = static_cast<std::int64_t>(s.dims.x) * s.dims.y;
   const float* q = s.grid + c.z * sz + c.y * sy + c.x;

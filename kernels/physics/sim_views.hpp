@@ -42,17 +42,17 @@ struct SimConstants {
   float radius = 0.02f, diameter = 0.04f;  // contact distance = diameter (one radius per solver)
   float search_radius = 0.08f;             // neighbour radius = grid cell size
   float max_speed = 4.f;
-  float omega = 1.f;                       // SOR factor of averaged constraints (Macklin 2014, eq. 11)
+  float omega = 1.f;  // SOR factor of averaged constraints (Macklin 2014, eq. 11)
   float static_friction = 0.5f, kinetic_friction = 0.3f, restitution = 0.f;
-  float fluid_friction = 0.f;              // fluid against the scene and solids (0: fluids slip)
+  float fluid_friction = 0.f;  // fluid against the scene and solids (0: fluids slip)
   // Position Based Fluids (Macklin & Mueller 2013), in number-density units.
-  float h = 0.08f;                  // smoothing radius
-  SphKernel W = SphKernel::make(0.08f);  // kernels of radius h (host: SphKernel::make(h))
-  float rest_density = 1.f;         // rho_0: kernel sum of the rest lattice
-  float relaxation = 1.f;           // epsilon of eq. 11 (CFM)
+  float h = 0.08f;                           // smoothing radius
+  SphKernel W = SphKernel::make(0.08f);      // kernels of radius h (host: SphKernel::make(h))
+  float rest_density = 1.f;                  // rho_0: kernel sum of the rest lattice
+  float relaxation = 1.f;                    // epsilon of eq. 11 (CFM)
   float scorr_k = 0.f, scorr_inv_wdq = 0.f;  // tensile instability term, eq. 13
-  int unilateral = 1;               // C_i <= 0 only (Macklin 2014, section 7.1)
-  float solid_density_scale = 1.f;  // weight of solid neighbours in fluid density (ibid.)
+  int unilateral = 1;                        // C_i <= 0 only (Macklin 2014, section 7.1)
+  float solid_density_scale = 1.f;           // weight of solid neighbours in fluid density (ibid.)
   float viscosity = 0.01f, vorticity = 0.f, cohesion = 0.f, surface_tension = 0.f;
   // cloth aerodynamics (Keckeisen 2004)
   float drag = 0.f, lift = 0.f, air_density = 1.2f;
@@ -60,7 +60,8 @@ struct SimConstants {
   float sleep_threshold = 0.f;
   float cloth_self_exclusion = 0.06f;
   float strain_omega = 1.5f;           // over-relaxation of cloth strain limiting (Provot 1995)
-  float strain_contact_weight = 0.3f;  // inverse-mass factor there of particles touching the scene  // same-cloth pairs closer than this at rest never collide
+  float strain_contact_weight = 0.3f;  // inverse-mass factor there of particles touching the scene  // same-cloth pairs
+                                       // closer than this at rest never collide
   int max_neighbors = 64, max_static_neighbors = 64;
   int rotation_iterations = 8;
 };
@@ -140,8 +141,8 @@ struct SimViews {
   const int *body_chunk_start = nullptr, *body_chunk_count = nullptr;
   const float* body_stiffness = nullptr;
   int* body_contacts = nullptr;  // particles of the body touching the scene (this iteration)
-  vec3* body_c = nullptr;  // centre of mass (also the reference point of the next sums)
-  vec3* body_shift = nullptr;  // scratch: new centre minus body_c
+  vec3* body_c = nullptr;        // centre of mass (also the reference point of the next sums)
+  vec3* body_shift = nullptr;    // scratch: new centre minus body_c
   vec4* body_q = nullptr;
   mat3* body_R = nullptr;
   int nchunks = 0;

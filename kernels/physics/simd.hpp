@@ -163,7 +163,9 @@ SEAMLESS_SIMD_INL vf dot(v3 a, v3 b) { return a.x * b.x + a.y * b.y + a.z * b.z;
 SEAMLESS_SIMD_INL v3 cross(v3 a, v3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
 SEAMLESS_SIMD_INL vf length2(v3 a) { return dot(a, a); }
 SEAMLESS_SIMD_INL vf length(v3 a) { return sqrt(dot(a, a)); }
-SEAMLESS_SIMD_INL v3 select(vm m, v3 a, v3 b) { return {select(m, a.x, b.x), select(m, a.y, b.y), select(m, a.z, b.z)}; }
+SEAMLESS_SIMD_INL v3 select(vm m, v3 a, v3 b) {
+  return {select(m, a.x, b.x), select(m, a.y, b.y), select(m, a.z, b.z)};
+}
 SEAMLESS_SIMD_INL v3 broadcast(vec3 a) { return {vf(a.x), vf(a.y), vf(a.z)}; }
 SEAMLESS_SIMD_INL vec3 lane(const v3& a, int l) { return {a.x[l], a.y[l], a.z[l]}; }
 
@@ -176,8 +178,8 @@ SEAMLESS_SIMD_INL void load_transpose(const void* const* e, vf& x, vf& y, vf& z,
   const f8 c1 = __builtin_shufflevector(a[1], a[5], 0, 1, 2, 3, 4, 5, 6, 7);
   const f8 c2 = __builtin_shufflevector(a[2], a[6], 0, 1, 2, 3, 4, 5, 6, 7);
   const f8 c3 = __builtin_shufflevector(a[3], a[7], 0, 1, 2, 3, 4, 5, 6, 7);
-  const f8 t0 = __builtin_shufflevector(c0, c1, 0, 8, 1, 9, 4, 12, 5, 13);   // x0 x1 y0 y1 | x4 x5 y4 y5
-  const f8 t1 = __builtin_shufflevector(c2, c3, 0, 8, 1, 9, 4, 12, 5, 13);   // x2 x3 y2 y3 | ...
+  const f8 t0 = __builtin_shufflevector(c0, c1, 0, 8, 1, 9, 4, 12, 5, 13);    // x0 x1 y0 y1 | x4 x5 y4 y5
+  const f8 t1 = __builtin_shufflevector(c2, c3, 0, 8, 1, 9, 4, 12, 5, 13);    // x2 x3 y2 y3 | ...
   const f8 t2 = __builtin_shufflevector(c0, c1, 2, 10, 3, 11, 6, 14, 7, 15);  // z0 z1 w0 w1 | ...
   const f8 t3 = __builtin_shufflevector(c2, c3, 2, 10, 3, 11, 6, 14, 7, 15);
   x = __builtin_shufflevector(t0, t1, 0, 1, 8, 9, 4, 5, 12, 13);

@@ -9,8 +9,7 @@
 
 namespace seamless::kernels {
 
-template <Executor Exec>
-struct Solids {
+template <Executor Exec> struct Solids {
   // Shape matching of every rigid body (Mueller 2005): per-body sums, rotation, goal positions.
   static void shape_match(const Exec& ex, const SimViews& S);
   // Static friction of each rigid body as a whole, after shape_match (solids.inl).

@@ -17,8 +17,7 @@ namespace seamless::kernels {
 // mean normal correction in the step (eq. 24's condition, for the body's contact patch). The
 // contact points then stay put on average, without a torque (the body may still turn about them).
 // Otherwise the particles' kinetic friction acts alone.
-template <Executor Exec>
-void Solids<Exec>::body_static_friction(const Exec& ex, const SimViews& S) {
+template <Executor Exec> void Solids<Exec>::body_static_friction(const Exec& ex, const SimViews& S) {
   ex.for_each(S.nchunks, [=] SEAMLESS_HD(std::int64_t c) {
     SlipSum sum{{0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}, 0.f, 0.f};
     for (int id = S.chunk_start[c], e = S.chunk_start[c] + S.chunk_count[c]; id < e; ++id) {
@@ -48,8 +47,7 @@ void Solids<Exec>::body_static_friction(const Exec& ex, const SimViews& S) {
   });
 }
 
-template <Executor Exec>
-void Solids<Exec>::shape_match(const Exec& ex, const SimViews& S) {
+template <Executor Exec> void Solids<Exec>::shape_match(const Exec& ex, const SimViews& S) {
   if (S.nbodies == 0) return;
   // Partial sums over fixed-size chunks of each body's particles, then per-body totals: a
   // deterministic segmented reduction (no float atomics). Offsets are taken from the previous
@@ -128,7 +126,8 @@ void Solids<Exec>::cloth_stretch(const Exec& ex, const SimViews& S, const std::i
 // limiter pulling the particle into the scene (mass scaling in the spirit of Macklin 2014's
 // stacking heuristic).
 template <Executor Exec>
-void Solids<Exec>::cloth_strain_limit(const Exec& ex, const SimViews& S, const std::int64_t* colour_off, int colours, int passes) {
+void Solids<Exec>::cloth_strain_limit(const Exec& ex, const SimViews& S, const std::int64_t* colour_off, int colours,
+                                      int passes) {
   std::vector<std::int64_t> begin, end;
   for (int pass = 0; pass < passes; ++pass)
     for (int c = 0; c < colours; ++c) begin.push_back(colour_off[c]), end.push_back(colour_off[c + 1]);
@@ -158,8 +157,7 @@ void Solids<Exec>::cloth_strain_limit(const Exec& ex, const SimViews& S, const s
 // four corrections once (bend_delta[4 b + vertex]), then every particle gathers its own, in the
 // order of its incidence list (no float atomics), which names the slots directly (one dependent
 // load less than looking the vertex up in the constraint's Quad).
-template <Executor Exec>
-void Solids<Exec>::cloth_bend(const Exec& ex, const SimViews& S) {
+template <Executor Exec> void Solids<Exec>::cloth_bend(const Exec& ex, const SimViews& S) {
   ex.for_each(S.nbends, [=] SEAMLESS_HD(std::int64_t b) {
     Quad q = S.bend_ids[b];
     int ids[4] = {q.a, q.b, q.c, q.d};

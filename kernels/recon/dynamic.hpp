@@ -19,16 +19,16 @@ namespace seamless::kernels {
 // pinhole camera K; the model in the coordinates of the camera it was rendered from (ref), the
 // frame at ref_T_cur (the predicted pose before tracking, the tracked pose after).
 struct DynamicInput {
-  View2D<const float> depth;          // metres, 0 = no reading (the filtered level 0)
+  View2D<const float> depth;  // metres, 0 = no reading (the filtered level 0)
   Intrinsics K;
   View2D<const vec3> model_vertices;  // reference camera coordinates, zero = no surface
   View2D<const vec3> model_normals;   // facing the reference camera, zero = none
   SE3 ref_T_cur;
-  float residual_min = 0.03f;    // metres: the residual threshold's floor (tracking and raycast error)
-  float noise_coeff = 0.0015f;   // depth noise sigma(z) = noise_coeff * z^2 (Khoshelham & Elberink 2012)
-  float residual_sigmas = 3.f;   // the residual threshold in noise sigmas
-  float free_space = 0.12f;      // metres in front of the nearest model surface along the ray
-  int search_radius = 2;         // pixels around the projection searched for the best-fitting model point
+  float residual_min = 0.03f;   // metres: the residual threshold's floor (tracking and raycast error)
+  float noise_coeff = 0.0015f;  // depth noise sigma(z) = noise_coeff * z^2 (Khoshelham & Elberink 2012)
+  float residual_sigmas = 3.f;  // the residual threshold in noise sigmas
+  float free_space = 0.12f;     // metres in front of the nearest model surface along the ray
+  int search_radius = 2;        // pixels around the projection searched for the best-fitting model point
   // Kinect v1 triangulation: disparity d = f b / z measured in 1/8-pixel steps (baseline b 7.5 cm;
   // Khoshelham & Elberink 2012, Konolige & Mihelich 2010), so depths come in steps of
   // dz = z^2 * disparity_step / (f b) (src/io/depth_scale.cpp; the synthetic sensor quantises the
@@ -50,8 +50,7 @@ SEAMLESS_HD inline float dynamic_threshold(const DynamicInput& in, float z) {
   return fmaxf(in.residual_min, in.residual_sigmas * in.noise_coeff * z * z + depth_step(in, z));
 }
 
-template <Executor Exec>
-struct Dynamic {
+template <Executor Exec> struct Dynamic {
   // Candidates (1) per pixel: the measurement lies in front of the model, either (a) no model plane
   // near its projection lies within the residual threshold of it (point-to-plane, either side) and
   // it is in front of one of them by more than the threshold (planes it is behind are occluders'),

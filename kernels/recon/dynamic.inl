@@ -41,16 +41,17 @@ void Dynamic<Exec>::classify_dynamic(const Exec& ex, DynamicInput in, View2D<std
         nearest = fminf(nearest, m.z);
       }
     if (!any) return;
-    const bool residual = !fits && front > threshold;                // (a)
-    const bool free_space = p.z < nearest - in.free_space;          // (b)
+    const bool residual = !fits && front > threshold;       // (a)
+    const bool free_space = p.z < nearest - in.free_space;  // (b)
     candidates(x, y) = residual || free_space ? 1 : 0;
   });
 }
 
 template <Executor Exec>
-void Dynamic<Exec>::filter_dynamic(const Exec& ex, View2D<const std::uint8_t> candidates, View2D<const std::uint8_t> prev,
-                    View2D<const float> depth, int radius, int min_support, float max_step,
-                    View2D<std::uint8_t> kept, View2D<std::uint8_t> mask) {
+void Dynamic<Exec>::filter_dynamic(const Exec& ex, View2D<const std::uint8_t> candidates,
+                                   View2D<const std::uint8_t> prev, View2D<const float> depth, int radius,
+                                   int min_support, float max_step, View2D<std::uint8_t> kept,
+                                   View2D<std::uint8_t> mask) {
   const int w = candidates.width;
   const bool has_prev = prev.data != nullptr && prev.width == candidates.width && prev.height == candidates.height;
   ex.for_each(candidates.count(), [=] SEAMLESS_HD(std::int64_t i) {
@@ -81,7 +82,7 @@ void Dynamic<Exec>::filter_dynamic(const Exec& ex, View2D<const std::uint8_t> ca
 
 template <Executor Exec>
 void Dynamic<Exec>::mask_vertices(const Exec& ex, View2D<const std::uint8_t> mask, int scale, View2D<vec3> vertices,
-                   View2D<vec3> normals) {
+                                  View2D<vec3> normals) {
   const int w = vertices.width;
   ex.for_each(vertices.count(), [=] SEAMLESS_HD(std::int64_t i) {
     const int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
@@ -104,8 +105,7 @@ void Dynamic<Exec>::mask_depth(const Exec& ex, View2D<const std::uint8_t> mask, 
   });
 }
 
-template <Executor Exec>
-std::int64_t Dynamic<Exec>::count_dynamic(const Exec& ex, View2D<const std::uint8_t> mask) {
+template <Executor Exec> std::int64_t Dynamic<Exec>::count_dynamic(const Exec& ex, View2D<const std::uint8_t> mask) {
   const int w = mask.width;
   return ex.transform_reduce(mask.count(), std::int64_t{0}, [=] SEAMLESS_HD(std::int64_t i) {
     return static_cast<std::int64_t>(mask(static_cast<int>(i % w), static_cast<int>(i / w)) != 0);

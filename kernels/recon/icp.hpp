@@ -24,8 +24,7 @@ namespace seamless::kernels {
 // reduce). A pixel's terms are floats (IcpTerms: half the GPU registers, so twice the threads in
 // flight); the sums over a level are doubles (IcpSums): 300k pixels of float products summed in
 // float lose digits the 6x6 solve needs. The reductions add terms into sums (operator+ below).
-template <class S>
-struct IcpSumsOf {
+template <class S> struct IcpSumsOf {
   S jtj[21];
   S jtr[6];
   S error;    // sum w r^2
@@ -35,8 +34,7 @@ struct IcpSumsOf {
 using IcpSums = IcpSumsOf<double>;
 using IcpTerms = IcpSumsOf<float>;
 
-template <class A, class B>
-SEAMLESS_HD inline IcpSumsOf<A> operator+(const IcpSumsOf<A>& a, const IcpSumsOf<B>& b) {
+template <class A, class B> SEAMLESS_HD inline IcpSumsOf<A> operator+(const IcpSumsOf<A>& a, const IcpSumsOf<B>& b) {
   // Fully unrolled here and in add_row: constant indices keep the sums in registers (a run-time
   // index would put them in local memory, several times slower on the GPU).
   IcpSumsOf<A> s;
@@ -51,8 +49,7 @@ SEAMLESS_HD inline IcpSumsOf<A> operator+(const IcpSumsOf<A>& a, const IcpSumsOf
 }
 
 // Adds one residual row r with Jacobian J = [a^T, b^T] (6 entries) and weight w.
-template <class S>
-SEAMLESS_HD inline void add_row(IcpSumsOf<S>& s, vec3 a, vec3 b, float r, float w) {
+template <class S> SEAMLESS_HD inline void add_row(IcpSumsOf<S>& s, vec3 a, vec3 b, float r, float w) {
   const float J[6] = {a.x, a.y, a.z, b.x, b.y, b.z};
 #pragma unroll
   for (int i = 0; i < 6; ++i) {
@@ -132,11 +129,11 @@ SEAMLESS_HD inline void add_point_to_plane(IcpTerms& s, const Correspondence& c,
 // The estimate ref_T_cur of one Gauss-Newton loop, kept on the device in double: ~20 left
 // compositions of float rotations would drift from orthonormal.
 struct IcpPose {
-  double R[9];     // row-major
+  double R[9];  // row-major
   double t[3];
-  int stalled;     // the solve failed at this level: the level's later steps change nothing
-  int steps;       // Gauss-Newton steps taken; a stalled level counts its failing step
-  int converged;   // this level's last step was below the stop thresholds: its later steps are skipped
+  int stalled;    // the solve failed at this level: the level's later steps change nothing
+  int steps;      // Gauss-Newton steps taken; a stalled level counts its failing step
+  int converged;  // this level's last step was below the stop thresholds: its later steps are skipped
   // RGB-D robust weighting only (kernels/recon/rgbd.hpp, RgbdScale): the geometric (m^2) and
   // photometric residual variances estimated by the previous step; 0 = not estimated yet. Kept next
   // to the estimate so that one host copy starts a frame; the ICP kernel never reads them.
@@ -231,7 +228,8 @@ SEAMLESS_HD inline void left_update(IcpPose& p, const double xi[6]) {
   }
   double R[9], t[3];
   for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) R[3 * r + c] = D[3 * r] * p.R[c] + D[3 * r + 1] * p.R[3 + c] + D[3 * r + 2] * p.R[6 + c];
+    for (int c = 0; c < 3; ++c)
+      R[3 * r + c] = D[3 * r] * p.R[c] + D[3 * r + 1] * p.R[3 + c] + D[3 * r + 2] * p.R[6 + c];
     t[r] = D[3 * r] * p.t[0] + D[3 * r + 1] * p.t[1] + D[3 * r + 2] * p.t[2] + xi[3 + r];
   }
   for (int i = 0; i < 9; ++i) p.R[i] = R[i];
@@ -267,8 +265,7 @@ SEAMLESS_HD inline void gauss_newton_update(const IcpSums& s, IcpPose& p, IcpUpd
 // The step of round `step` of a level's loop: its first clears the previous level's flags.
 SEAMLESS_HD inline IcpUpdate level_step(int step) { return step == 0 ? IcpUpdate::first_step : IcpUpdate::step; }
 
-template <Executor Exec>
-struct Icp {
+template <Executor Exec> struct Icp {
   // Sums the point-to-plane normal equations over every pixel of the current level (one pass) at the
   // estimate *pose (level.ref_T_cur is ignored) into *out on the device, without a step (tests,
   // statistics).

@@ -18,8 +18,7 @@ SEAMLESS_HD inline IcpTerms icp_pixel_terms(const IcpLevel& level, const IcpPose
   return s;
 }
 
-template <Executor Exec>
-void Icp<Exec>::icp_reduce_into(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSums* out) {
+template <Executor Exec> void Icp<Exec>::icp_reduce_into(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSums* out) {
   ex.transform_reduce_into(
       level_pixel_count(L), [=] SEAMLESS_HD(std::int64_t i) { return icp_pixel_terms(L, *pose, i); }, out);
 }
@@ -36,7 +35,7 @@ void Icp<Exec>::icp_level_steps(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSu
 
 template <Executor Exec>
 void Icp<Exec>::transform_maps(const Exec& ex, View2D<const vec3> vin, View2D<const vec3> nin, SE3 T, View2D<vec3> vout,
-                    View2D<vec3> nout) {
+                               View2D<vec3> nout) {
   const int w = vin.width;
   ex.for_each(vin.count(), [=] SEAMLESS_HD(std::int64_t i) {
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
@@ -52,7 +51,7 @@ void Icp<Exec>::transform_maps(const Exec& ex, View2D<const vec3> vin, View2D<co
 
 template <Executor Exec>
 void Icp<Exec>::pyr_down_maps(const Exec& ex, View2D<const vec3> vin, View2D<const vec3> nin, View2D<vec3> vout,
-                   View2D<vec3> nout, float max_diff) {
+                              View2D<vec3> nout, float max_diff) {
   const int w = vout.width;
   ex.for_each(vout.count(), [=] SEAMLESS_HD(std::int64_t i) {
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);

@@ -9,8 +9,7 @@
 
 namespace seamless::kernels {
 
-template <Executor Exec>
-struct Preprocess {
+template <Executor Exec> struct Preprocess {
   // Edge-preserving smoothing of depth (KinectFusion eq. 2): Gaussian weights in pixel distance
   // (sigma_space, pixels) and in depth difference (sigma_depth, metres) over a (2r+1)^2 window.
   static void bilateral_filter(const Exec& ex, View2D<const float> depth, View2D<float> out, float sigma_space,

@@ -7,7 +7,7 @@ namespace seamless::kernels {
 
 template <Executor Exec>
 void Preprocess<Exec>::bilateral_filter(const Exec& ex, View2D<const float> depth, View2D<float> out, float sigma_space,
-                      float sigma_depth, int radius) {
+                                        float sigma_depth, int radius) {
   const float inv_s2 = 0.5f / (sigma_space * sigma_space);
   const float inv_d2 = 0.5f / (sigma_depth * sigma_depth);
   const int w = depth.width;
@@ -66,7 +66,8 @@ void Preprocess<Exec>::pyr_down_intensity(const Exec& ex, View2D<const float> in
 }
 
 template <Executor Exec>
-void Preprocess<Exec>::depth_to_vertices(const Exec& ex, View2D<const float> depth, Intrinsics K, View2D<vec3> vertices) {
+void Preprocess<Exec>::depth_to_vertices(const Exec& ex, View2D<const float> depth, Intrinsics K,
+                                         View2D<vec3> vertices) {
   const int w = depth.width;
   ex.for_each(depth.count(), [=] SEAMLESS_HD(std::int64_t i) {
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
@@ -76,7 +77,8 @@ void Preprocess<Exec>::depth_to_vertices(const Exec& ex, View2D<const float> dep
 }
 
 template <Executor Exec>
-void Preprocess<Exec>::vertices_to_normals(const Exec& ex, View2D<const vec3> vertices, View2D<vec3> normals, float max_edge) {
+void Preprocess<Exec>::vertices_to_normals(const Exec& ex, View2D<const vec3> vertices, View2D<vec3> normals,
+                                           float max_edge) {
   const int w = vertices.width;
   const float max_edge2 = max_edge * max_edge;
   ex.for_each(vertices.count(), [=] SEAMLESS_HD(std::int64_t i) {

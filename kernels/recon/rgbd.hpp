@@ -56,8 +56,7 @@ struct RgbdLevel {
 // w_g, the photometric row photometric_weight * w_I * sigma_g^2 / sigma_I^2 (photometric_weight 1 =
 // equal trust in one whitened residual of each type). Until a scale is known (a frame's first,
 // scale-only reduction) the t-weights are 1, so the first estimate is the plain RMS.
-template <class S>
-struct RgbdSumsOf {
+template <class S> struct RgbdSumsOf {
   IcpSumsOf<S> icp;  // the combined weighted system, as the ICP's
   S geo_wr2;         // sum over geometric rows of w_g r_g^2 (robust weighting only)
   S photo_wr2;       // sum over photometric rows of w_I r_I^2 (robust weighting only)
@@ -66,8 +65,7 @@ struct RgbdSumsOf {
 using RgbdSums = RgbdSumsOf<double>;
 using RgbdTerms = RgbdSumsOf<float>;
 
-template <class A, class B>
-SEAMLESS_HD inline RgbdSumsOf<A> operator+(const RgbdSumsOf<A>& a, const RgbdSumsOf<B>& b) {
+template <class A, class B> SEAMLESS_HD inline RgbdSumsOf<A> operator+(const RgbdSumsOf<A>& a, const RgbdSumsOf<B>& b) {
   RgbdSumsOf<A> s;
   s.icp = a.icp + b.icp;
   s.geo_wr2 = a.geo_wr2 + b.geo_wr2;
@@ -189,8 +187,7 @@ SEAMLESS_HD inline bool find_rgbd_correspondence(const RgbdLevel& L, int x, int 
   return true;
 }
 
-template <Executor Exec>
-struct Rgbd {
+template <Executor Exec> struct Rgbd {
   // Sums the combined geometric + photometric normal equations over the current level (one pass) at
   // the estimate *pose into *out on the device; then, in the same launch, copies the system into
   // *level_sums (where the tracker reads each level's last system) and, with robust weighting,
@@ -200,7 +197,8 @@ struct Rgbd {
 
   // Up to `steps` Gauss-Newton steps of one level in one device launch, like icp_level_steps: each
   // sums at *pose, keeps the system in *level_sums, steps, and re-estimates the variances.
-  static void rgbd_level_steps(const Exec& ex, RgbdLevel level, IcpPose* pose, RgbdSums* out, IcpSums* level_sums, int steps);
+  static void rgbd_level_steps(const Exec& ex, RgbdLevel level, IcpPose* pose, RgbdSums* out, IcpSums* level_sums,
+                               int steps);
 
   // Intensity in [0, 1] from 8-bit RGB (ITU-R BT.601 luma weights); kNoIntensity where RGB is
   // (0, 0, 0), no colour reading (see kNoIntensity).

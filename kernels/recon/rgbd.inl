@@ -36,10 +36,11 @@ void Rgbd<Exec>::rgbd_reduce_into(const Exec& ex, RgbdLevel R, IcpPose* pose, Rg
 }
 
 template <Executor Exec>
-void Rgbd<Exec>::rgbd_level_steps(const Exec& ex, RgbdLevel R, IcpPose* pose, RgbdSums* out, IcpSums* level_sums, int steps) {
+void Rgbd<Exec>::rgbd_level_steps(const Exec& ex, RgbdLevel R, IcpPose* pose, RgbdSums* out, IcpSums* level_sums,
+                                  int steps) {
   ex.transform_reduce_rounds(
-      level_pixel_count(R.geo), steps, [=] SEAMLESS_HD(std::int64_t i) { return rgbd_pixel_terms(R, *pose, i); },
-      out, [=] SEAMLESS_HD(int step, const RgbdSums& sum) {
+      level_pixel_count(R.geo), steps, [=] SEAMLESS_HD(std::int64_t i) { return rgbd_pixel_terms(R, *pose, i); }, out,
+      [=] SEAMLESS_HD(int step, const RgbdSums& sum) {
         rgbd_update(R, sum, *pose, *level_sums, level_step(step));
         return level_done(*pose);
       });

@@ -13,8 +13,7 @@
 
 namespace seamless::kernels {
 
-template <Executor Exec>
-struct VoxelHash {
+template <Executor Exec> struct VoxelHash {
   // --- hash table maintenance (family recon/voxel_hash) ------------------------------------------
   // Empties every slot (keys -> empty, values -> -1).
   static void hash_clear(const Exec& ex, HashTableView t);
@@ -23,7 +22,8 @@ struct VoxelHash {
   static void pool_reset(const Exec& ex, View<std::int32_t> free_list, HashCounters* counters);
 
   // Puts blocks first..first+n-1 on the free list (after the pool grew); free_top += n.
-  static void pool_append(const Exec& ex, View<std::int32_t> free_list, HashCounters* counters, std::int32_t first, std::int32_t n);
+  static void pool_append(const Exec& ex, View<std::int32_t> free_list, HashCounters* counters, std::int32_t first,
+                          std::int32_t n);
 
   // Zeroes the per-frame fields of the counters (inserted, collisions, failures, visible, removed).
   static void reset_frame_counters(const Exec& ex, HashCounters* counters);
@@ -42,18 +42,19 @@ struct VoxelHash {
 
   // Slots holding a live key with a block, in slot order (deterministic); returns how many. flags
   // must hold one int per slot (scratch).
-  static std::int64_t hash_live_slots(const Exec& ex, HashTableView t, View<std::int32_t> flags, View<std::int32_t> slots_out);
+  static std::int64_t hash_live_slots(const Exec& ex, HashTableView t, View<std::int32_t> flags,
+                                      View<std::int32_t> slots_out);
 
   // Slots of the live blocks whose centre lies farther than radius from center (both in voxel
   // units), in slot order; returns how many (streaming out, Niessner section 5). flags as above.
-  static std::int64_t hash_slots_beyond(const Exec& ex, HashTableView t, vec3 center, float radius, View<std::int32_t> flags,
-                                        View<std::int32_t> slots_out);
+  static std::int64_t hash_slots_beyond(const Exec& ex, HashTableView t, vec3 center, float radius,
+                                        View<std::int32_t> flags, View<std::int32_t> slots_out);
 
   // Inserts each key (distinct, absent) with a block popped from the pool: blocks_out[i] = the block,
   // or -1 when the key was already present or no slot (probe_failures) or block (pool_failures)
   // was left; a key left without a block is tombstoned again, so it can be inserted later.
-  static void insert_with_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list, HashCounters* counters,
-                                 View<const HashKey> keys, View<std::int32_t> blocks_out);
+  static void insert_with_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list,
+                                 HashCounters* counters, View<const HashKey> keys, View<std::int32_t> blocks_out);
 
   // Copies (key, value) of the given slots out (for rehashing and host inspection).
   static void hash_gather(const Exec& ex, HashTableView t, View<const std::int32_t> slots, View<HashKey> keys_out,
@@ -68,8 +69,8 @@ struct VoxelHash {
 
 // --- per-frame fusion (family recon/tsdf_fusion) -----------------------------------------------
 struct FrameInput {
-  View2D<const float> depth;   // metres, 0 = no reading
-  View2D<const uchar3> rgb;    // same size as depth, or data == nullptr for none
+  View2D<const float> depth;  // metres, 0 = no reading
+  View2D<const uchar3> rgb;   // same size as depth, or data == nullptr for none
   Intrinsics K;
   SE3 world_T_camera;
   float min_depth = 0.3f, max_depth = 4.f;
@@ -83,7 +84,7 @@ struct FrameInput {
 struct TileGrid {
   int tile = 8, tiles_x = 0, tiles_y = 0;
   static TileGrid covering(int width, int height, int tile) {
-           return {tile, (width + tile - 1) / tile, (height + tile - 1) / tile};
+    return {tile, (width + tile - 1) / tile, (height + tile - 1) / tile};
   }
   SEAMLESS_HD std::int64_t count() const { return static_cast<std::int64_t>(tiles_x) * tiles_y; }
   SEAMLESS_HD std::int64_t tile_of(int x, int y) const {
@@ -103,22 +104,22 @@ struct DepthTiles : TileGrid {
 SEAMLESS_HD inline bool voxel_keeps_block(const Voxel& v, float keep_below) {
   return v.weight > 0.f && fabsf(v.sdf) < keep_below;
 }
-template <Executor Exec>
-struct TsdfFusion {
+template <Executor Exec> struct TsdfFusion {
   static void clear_depth_tiles(const Exec& ex, DepthTiles tiles);
 
   // Inserts every block that the truncation band [d - mu, d + mu] of each depth ray passes through
   // (Niessner section 4.1), popping a block from the pool for each new key; failures are counted.
   // Raises each tile of `tiles` (when given) to the farthest valid reading in it.
-  static void allocate_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list, HashCounters* counters,
-                              FrameInput in, VoxelGeometry geom, DepthTiles tiles = {});
+  static void allocate_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list,
+                              HashCounters* counters, FrameInput in, VoxelGeometry geom, DepthTiles tiles = {});
 
   // Appends to visible_slots every allocated block that the frame may change (counters->visible is
   // the count) and zeroes its keep flag (keep may be empty): blocks whose voxels may project into
   // the image, less those that tiles (when given) show to be occluded or unobserved. Also clamps
   // free_top after a failed allocation pass.
-  static void find_visible_blocks(const Exec& ex, HashTableView t, HashCounters* counters, FrameInput in, VoxelGeometry geom,
-                                  View<std::int32_t> visible_slots, View<std::int32_t> keep, DepthTiles tiles = {});
+  static void find_visible_blocks(const Exec& ex, HashTableView t, HashCounters* counters, FrameInput in,
+                                  VoxelGeometry geom, View<std::int32_t> visible_slots, View<std::int32_t> keep,
+                                  DepthTiles tiles = {});
 
   // Fuses one frame into the listed blocks, one thread per voxel. When keep is not empty, keep[j]
   // becomes 1 if block j still has a voxel near a surface afterwards (voxel_keeps_block), so that
@@ -144,10 +145,10 @@ struct TsdfFusion {
 
 // --- raycasting (family recon/tsdf_raycast) ----------------------------------------------------
 struct RaycastOutput {
-  View2D<float> depth;    // camera z of the hit, metres; 0 = no hit
-  View2D<vec3> vertex;    // world coordinates; zero where no hit
-  View2D<vec3> normal;    // world coordinates, unit, facing the camera; zero where no hit
-  View2D<uchar3> color;   // fused colour; zero where no hit
+  View2D<float> depth;   // camera z of the hit, metres; 0 = no hit
+  View2D<vec3> vertex;   // world coordinates; zero where no hit
+  View2D<vec3> normal;   // world coordinates, unit, facing the camera; zero where no hit
+  View2D<uchar3> color;  // fused colour; zero where no hit
 };
 // Ray intervals (Niessner section 4.3): the image is cut into tile x tile pixel tiles, and each
 // tile holds the camera-depth range [near, far] covered by the blocks whose boxes project onto it,
@@ -160,8 +161,7 @@ struct RayIntervals : TileGrid {
 constexpr std::int32_t kEmptyNear = 0x7f800000;  // +infinity
 constexpr std::int32_t kEmptyFar = 0;            // +0: no block splatted
 
-template <Executor Exec, class Acc = HashAccess>
-struct TsdfRaycast {
+template <Executor Exec, class Acc = HashAccess> struct TsdfRaycast {
   // Empties every tile (near = +inf, far = 0), and window w when given (every entry -1).
   static void clear_ray_intervals(const Exec& ex, RayIntervals iv, BlockWindow w = {});
 
@@ -180,9 +180,9 @@ struct TsdfRaycast {
   // One ray per pixel from min_depth to max_depth, or only over its tile's interval when iv.bits is
   // set: skips unallocated blocks whole, steps by the TSDF inside allocated ones, refines the +/-
   // zero crossing by regula falsi on the trilinear field (KinectFusion section 3.5; Niessner section
-  // 4.3); a second pass takes each hit's normal from its neighbours' vertices (vertex_map_normal). A ray starting before its tile's near depth is
-  // in unallocated blocks up to there, where the full march skips block by block, so both take the
-  // same samples from the first block on and hit the same surfaces.
+  // 4.3); a second pass takes each hit's normal from its neighbours' vertices (vertex_map_normal). A ray starting
+  // before its tile's near depth is in unallocated blocks up to there, where the full march skips block by block, so
+  // both take the same samples from the first block on and hit the same surfaces.
   static void raycast(const Exec& ex, Acc a, Intrinsics K, SE3 world_T_camera, float min_depth, float max_depth,
                       RaycastOutput out, RayIntervals iv = {});
 };
@@ -215,8 +215,7 @@ SEAMLESS_HD inline int lattice_per_block(float voxel_size, float spacing) {
   return static_cast<int>(ceilf(kBlockSide * voxel_size / spacing)) + 1;
 }
 
-template <Executor Exec, class Acc = HashAccess>
-struct TsdfExtract {
+template <Executor Exec, class Acc = HashAccess> struct TsdfExtract {
   // counts[i] = triangles of cell i (block i / 512, voxel i % 512); returns the total and turns
   // counts into exclusive offsets.
   static std::int64_t mesh_count(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,
@@ -232,8 +231,8 @@ struct TsdfExtract {
   static void slot_block_coords(const Exec& ex, HashTableView t, View<const std::int32_t> slots, View<int3> out);
 
   // The candidates' counts of the lattice points (see lattice_per_block above).
-  static std::int64_t scene_particle_count(const Exec& ex, Acc a, View<const int3> blocks, float spacing, float interior_depth,
-                                           View<std::int32_t> counts);
+  static std::int64_t scene_particle_count(const Exec& ex, Acc a, View<const int3> blocks, float spacing,
+                                           float interior_depth, View<std::int32_t> counts);
 
   // Writes each candidate's position, unit normal (TSDF gradient) and thinning score at offsets[i].
   static void scene_particle_emit(const Exec& ex, Acc a, View<const int3> blocks, float spacing, float interior_depth,
@@ -254,7 +253,8 @@ struct TsdfExtract {
   // Samples the SDF (sample_sdf) on a regular grid, x fastest: out[(z * dims.y + y) * dims.x + x] at
   // origin + voxel * (x, y, z). Unknown points (unobserved or outside the band) get `unknown`.
   // For collisions against the TSDF through a dense grid (the solver's scene_collision: sdf).
-  static void sample_sdf_grid(const Exec& ex, Acc a, vec3 origin, int3 dims, float voxel, float unknown, View<float> out);
+  static void sample_sdf_grid(const Exec& ex, Acc a, vec3 origin, int3 dims, float voxel, float unknown,
+                              View<float> out);
 };
 
 }  // namespace seamless::kernels

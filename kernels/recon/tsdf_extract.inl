@@ -23,8 +23,7 @@ SEAMLESS_HD inline void mc_edge(int e, int* c0, int* c1) {
 
 // The cube at cell g: its 8 corner voxels, or -1 when one is missing or unobserved, or when the
 // sign change is between truncated values (the +mu / -mu seam behind a surface, not a surface).
-template <class Acc>
-SEAMLESS_HD inline int mc_cube(const Acc& a, int3 g, BlockCache& c, const Voxel* v[8]) {
+template <class Acc> SEAMLESS_HD inline int mc_cube(const Acc& a, int3 g, BlockCache& c, const Voxel* v[8]) {
   int cube = 0;
   bool truncated = false;
   const float trunc = 0.999f * a.geom.truncation;
@@ -57,8 +56,8 @@ SEAMLESS_HD inline int3 cell_of(View<const int3> blocks, std::int64_t i) {
 }
 
 template <Executor Exec, class Acc>
-std::int64_t TsdfExtract<Exec, Acc>::mesh_count(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,
-                        View<std::int32_t> counts) {
+std::int64_t TsdfExtract<Exec, Acc>::mesh_count(const Exec& ex, Acc a, View<const int3> blocks,
+                                                const std::int8_t* table, View<std::int32_t> counts) {
   const std::int64_t n = blocks.size * kBlockVoxels;
   ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) {
     BlockCache c;
@@ -81,8 +80,8 @@ SEAMLESS_HD inline std::uint64_t edge_key(int3 g, int axis) {
 
 template <Executor Exec, class Acc>
 void TsdfExtract<Exec, Acc>::mesh_emit(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,
-               View<const std::int32_t> offsets, View<vec3> positions, View<vec3> normals, View<uchar3> colors,
-               View<std::uint64_t> edge_keys) {
+                                       View<const std::int32_t> offsets, View<vec3> positions, View<vec3> normals,
+                                       View<uchar3> colors, View<std::uint64_t> edge_keys) {
   const std::int64_t n = blocks.size * kBlockVoxels;
   ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) {
     BlockCache c;
@@ -170,8 +169,7 @@ SEAMLESS_HD inline vec3 line_sample(int3 L, int axis, int j, int n, float spacin
 
 // TSDF at world point p for the crossing search: false where unknown, and where truncated (a sign
 // change between +mu and -mu is the seam behind a surface, not a surface; as mc_cube).
-template <class Acc>
-SEAMLESS_HD inline bool band_sdf(const Acc& a, vec3 p, BlockCache& c, float* v) {
+template <class Acc> SEAMLESS_HD inline bool band_sdf(const Acc& a, vec3 p, BlockCache& c, float* v) {
   return sample_tsdf(a, a.geom.to_voxel(p), c, v) && fabsf(*v) < 0.999f * a.geom.truncation;
 }
 
@@ -183,8 +181,7 @@ SEAMLESS_HD inline bool band_sdf(const Acc& a, vec3 p, BlockCache& c, float* v) 
 // kSolid: observed, the trilinear TSDF in *v is >= 0 or < 0.
 enum SampleState : int { kUnallocated = 0, kUnseen = 1, kFree = 2, kSolid = 3 };
 
-template <class Acc>
-SEAMLESS_HD inline int sample_state(const Acc& a, vec3 p, BlockCache& c, float* v) {
+template <class Acc> SEAMLESS_HD inline int sample_state(const Acc& a, vec3 p, BlockCache& c, float* v) {
   const vec3 q = a.geom.to_voxel(p);
   const Voxel* corner[8];
   if (!cell_voxels(a, floor_to_int(q), c, corner)) return kUnallocated;
@@ -294,8 +291,7 @@ SEAMLESS_HD inline int unseen_boundaries(const Acc& a, int3 L, int axis, int j, 
 // The surface particles owned by lattice point L: crossings on the three segments L -> L + e_axis,
 // and the boundaries of unseen space at their samples (unseen_boundaries).
 // Writes them to out (unless out.position is null); returns how many there are.
-template <class Acc>
-SEAMLESS_HD inline int surface_crossings(const Acc& a, int3 L, float spacing, CandidateOut out) {
+template <class Acc> SEAMLESS_HD inline int surface_crossings(const Acc& a, int3 L, float spacing, CandidateOut out) {
   const int n = line_steps(a.geom.voxel_size, spacing);
   const float band = 0.999f * a.geom.truncation;  // as band_sdf
   BlockCache c;
@@ -319,8 +315,7 @@ SEAMLESS_HD inline int surface_crossings(const Acc& a, int3 L, float spacing, Ca
         float ga[3] = {fabsf(g.x), fabsf(g.y), fabsf(g.z)}, gl = length(g);
         float gmax = fmaxf(ga[0], fmaxf(ga[1], ga[2]));
         if (gl > 0.f && ga[axis] >= kAxisShare * gmax) {
-          if (out.position)
-            out.position[found] = x, out.normal[found] = g / gl, out.score[found] = ga[axis] / gl;
+          if (out.position) out.position[found] = x, out.normal[found] = g / gl, out.score[found] = ga[axis] / gl;
           ++found;
         }
       }
@@ -346,23 +341,24 @@ SEAMLESS_HD inline bool interior_point(const Acc& a, int3 L, float spacing, floa
 }
 
 template <Executor Exec, class Acc>
-std::int64_t TsdfExtract<Exec, Acc>::scene_particle_count(const Exec& ex, Acc a, View<const int3> blocks, float spacing, float interior_depth,
-                                  View<std::int32_t> counts) {
+std::int64_t TsdfExtract<Exec, Acc>::scene_particle_count(const Exec& ex, Acc a, View<const int3> blocks, float spacing,
+                                                          float interior_depth, View<std::int32_t> counts) {
   ex.for_each(counts.size, [=] SEAMLESS_HD(std::int64_t i) {
     int3 L;
     vec3 p, nrm;
     int k = 0;
     if (lattice_coords(a, blocks, spacing, i, &L))
-      k = surface_crossings(a, L, spacing, CandidateOut{nullptr, nullptr, nullptr}) + (interior_point(a, L, spacing, interior_depth, &p, &nrm) ? 1 : 0);
+      k = surface_crossings(a, L, spacing, CandidateOut{nullptr, nullptr, nullptr}) +
+          (interior_point(a, L, spacing, interior_depth, &p, &nrm) ? 1 : 0);
     counts[i] = k;
   });
   return ex.exclusive_scan(counts.data, counts.data, counts.size);
 }
 
 template <Executor Exec, class Acc>
-void TsdfExtract<Exec, Acc>::scene_particle_emit(const Exec& ex, Acc a, View<const int3> blocks, float spacing, float interior_depth,
-                         View<const std::int32_t> offsets, View<vec3> positions, View<vec3> normals,
-                         View<float> scores) {
+void TsdfExtract<Exec, Acc>::scene_particle_emit(const Exec& ex, Acc a, View<const int3> blocks, float spacing,
+                                                 float interior_depth, View<const std::int32_t> offsets,
+                                                 View<vec3> positions, View<vec3> normals, View<float> scores) {
   ex.for_each(offsets.size, [=] SEAMLESS_HD(std::int64_t i) {
     int3 L;
     if (!lattice_coords(a, blocks, spacing, i, &L)) return;
@@ -413,9 +409,10 @@ SEAMLESS_HD inline bool outranks(vec3 pj, float sj, std::int64_t j, vec3 pi, flo
 }
 
 template <Executor Exec, class Acc>
-std::int64_t TsdfExtract<Exec, Acc>::scene_particle_thin(const Exec& ex, View<const vec3> positions, View<const float> scores,
-                                 float min_distance, View<std::uint64_t> keys, View<std::int32_t> order,
-                                 View<std::int32_t> keep) {
+std::int64_t TsdfExtract<Exec, Acc>::scene_particle_thin(const Exec& ex, View<const vec3> positions,
+                                                         View<const float> scores, float min_distance,
+                                                         View<std::uint64_t> keys, View<std::int32_t> order,
+                                                         View<std::int32_t> keep) {
   const std::int64_t n = positions.size;
   const float r = min_distance;
   ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) {
@@ -443,8 +440,8 @@ std::int64_t TsdfExtract<Exec, Acc>::scene_particle_thin(const Exec& ex, View<co
 
 template <Executor Exec, class Acc>
 void TsdfExtract<Exec, Acc>::scene_particle_compact(const Exec& ex, View<const std::int32_t> offsets, std::int64_t kept,
-                            View<const vec3> positions, View<const vec3> normals, View<vec3> out_positions,
-                            View<vec3> out_normals) {
+                                                    View<const vec3> positions, View<const vec3> normals,
+                                                    View<vec3> out_positions, View<vec3> out_normals) {
   const std::int64_t n = offsets.size;
   ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) {
     const std::int64_t next = i + 1 < n ? offsets[i + 1] : kept;
@@ -455,7 +452,8 @@ void TsdfExtract<Exec, Acc>::scene_particle_compact(const Exec& ex, View<const s
 }
 
 template <Executor Exec, class Acc>
-void TsdfExtract<Exec, Acc>::sample_sdf_grid(const Exec& ex, Acc a, vec3 origin, int3 dims, float voxel, float unknown, View<float> out) {
+void TsdfExtract<Exec, Acc>::sample_sdf_grid(const Exec& ex, Acc a, vec3 origin, int3 dims, float voxel, float unknown,
+                                             View<float> out) {
   ex.for_each(out.size, [=] SEAMLESS_HD(std::int64_t i) {
     const std::int64_t plane = static_cast<std::int64_t>(dims.x) * dims.y;
     int z = static_cast<int>(i / plane), y = static_cast<int>((i % plane) / dims.x), x = static_cast<int>(i % dims.x);
@@ -466,7 +464,8 @@ void TsdfExtract<Exec, Acc>::sample_sdf_grid(const Exec& ex, Acc a, vec3 origin,
 }
 
 template <Executor Exec, class Acc>
-void TsdfExtract<Exec, Acc>::slot_block_coords(const Exec& ex, HashTableView t, View<const std::int32_t> slots, View<int3> out) {
+void TsdfExtract<Exec, Acc>::slot_block_coords(const Exec& ex, HashTableView t, View<const std::int32_t> slots,
+                                               View<int3> out) {
   ex.for_each(slots.size, [=] SEAMLESS_HD(std::int64_t i) { out[i] = unpack_block(t.keys[slots[i]]); });
 }
 

@@ -31,8 +31,7 @@ SEAMLESS_HD inline void allocate_block(HashTableView t, const std::int32_t* free
 
 // Amanatides & Woo (1987) traversal of the block grid along the segment a -> b (block units):
 // visits every block the segment touches, in order.
-template <class F>
-SEAMLESS_HD inline void traverse_blocks(vec3 a, vec3 b, F visit) {
+template <class F> SEAMLESS_HD inline void traverse_blocks(vec3 a, vec3 b, F visit) {
   int3 c = floor_to_int(a), e = floor_to_int(b);
   vec3 d = b - a;
   const float inf = 1e30f;
@@ -62,8 +61,8 @@ SEAMLESS_HD inline void traverse_blocks(vec3 a, vec3 b, F visit) {
 }
 
 template <Executor Exec>
-void TsdfFusion<Exec>::allocate_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list, HashCounters* counters,
-                     FrameInput in, VoxelGeometry geom, DepthTiles tiles) {
+void TsdfFusion<Exec>::allocate_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list,
+                                       HashCounters* counters, FrameInput in, VoxelGeometry geom, DepthTiles tiles) {
   const int w = in.depth.width;
   const float mu = geom.truncation;
   const float to_block = 1.f / (geom.voxel_size * kBlockSide);
@@ -123,19 +122,21 @@ SEAMLESS_HD inline bool block_maybe_visible(int3 b, const FrameInput& in, const 
     return false;
   if (!tiles.zmax) return true;
   const float wl = in.depth.width - 1.f, hl = in.depth.height - 1.f;  // clamped, then rounded as fuse_voxel rounds
-  const int u0 = static_cast<int>(floorf(fmaxf(umin, 0.f) + 0.5f)), u1 = static_cast<int>(floorf(fminf(umax, wl) + 0.5f));
-  const int v0 = static_cast<int>(floorf(fmaxf(vmin, 0.f) + 0.5f)), v1 = static_cast<int>(floorf(fminf(vmax, hl) + 0.5f));
+  const int u0 = static_cast<int>(floorf(fmaxf(umin, 0.f) + 0.5f)),
+            u1 = static_cast<int>(floorf(fminf(umax, wl) + 0.5f));
+  const int v0 = static_cast<int>(floorf(fmaxf(vmin, 0.f) + 0.5f)),
+            v1 = static_cast<int>(floorf(fminf(vmax, hl) + 0.5f));
   return tiles_reach(tiles, u0, u1, v0, v1, zmin - geom.truncation);
 }
 
-template <Executor Exec>
-void TsdfFusion<Exec>::clear_depth_tiles(const Exec& ex, DepthTiles tiles) {
+template <Executor Exec> void TsdfFusion<Exec>::clear_depth_tiles(const Exec& ex, DepthTiles tiles) {
   ex.for_each(tiles.count(), [=] SEAMLESS_HD(std::int64_t i) { tiles.zmax[i] = 0; });
 }
 
 template <Executor Exec>
-void TsdfFusion<Exec>::find_visible_blocks(const Exec& ex, HashTableView t, HashCounters* counters, FrameInput in, VoxelGeometry geom,
-                         View<std::int32_t> visible_slots, View<std::int32_t> keep, DepthTiles tiles) {
+void TsdfFusion<Exec>::find_visible_blocks(const Exec& ex, HashTableView t, HashCounters* counters, FrameInput in,
+                                           VoxelGeometry geom, View<std::int32_t> visible_slots,
+                                           View<std::int32_t> keep, DepthTiles tiles) {
   const SE3 camera_T_world = in.world_T_camera.inverse();
   ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
     if (i == 0 && counters->free_top < 0) counters->free_top = 0;  // after failed pops
@@ -202,9 +203,9 @@ SEAMLESS_HD inline void fuse_voxel(Voxel& v, vec3 p_world, const FrameInput& in,
 }
 
 template <Executor Exec>
-void TsdfFusion<Exec>::fuse_hash_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
-                      Voxel* voxels, FrameInput in, VoxelGeometry geom, float max_weight, bool color,
-                      View<std::int32_t> keep, float keep_below) {
+void TsdfFusion<Exec>::fuse_hash_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots,
+                                        std::int64_t count, Voxel* voxels, FrameInput in, VoxelGeometry geom,
+                                        float max_weight, bool color, View<std::int32_t> keep, float keep_below) {
   const SE3 camera_T_world = in.world_T_camera.inverse();
   ex.for_each(count * kBlockVoxels, [=] SEAMLESS_HD(std::int64_t i) {
     const std::int64_t j = i / kBlockVoxels;
@@ -222,7 +223,8 @@ void TsdfFusion<Exec>::fuse_hash_blocks(const Exec& ex, HashTableView t, View<co
 }
 
 template <Executor Exec>
-void TsdfFusion<Exec>::fuse_dense_blocks(const Exec& ex, DenseAccess grid, FrameInput in, float max_weight, bool color) {
+void TsdfFusion<Exec>::fuse_dense_blocks(const Exec& ex, DenseAccess grid, FrameInput in, float max_weight,
+                                         bool color) {
   const SE3 camera_T_world = in.world_T_camera.inverse();
   const int n = grid.blocks_per_side;
   const std::int64_t blocks = static_cast<std::int64_t>(n) * n * n;
@@ -237,8 +239,9 @@ void TsdfFusion<Exec>::fuse_dense_blocks(const Exec& ex, DenseAccess grid, Frame
 }
 
 template <Executor Exec>
-void TsdfFusion<Exec>::mark_kept_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
-                      const Voxel* voxels, View<std::int32_t> keep, float keep_below) {
+void TsdfFusion<Exec>::mark_kept_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots,
+                                        std::int64_t count, const Voxel* voxels, View<std::int32_t> keep,
+                                        float keep_below) {
   ex.for_each(count * kBlockVoxels, [=] SEAMLESS_HD(std::int64_t i) {
     const std::int64_t j = i / kBlockVoxels;
     std::int32_t block = t.values[slots[j]];
@@ -249,9 +252,9 @@ void TsdfFusion<Exec>::mark_kept_blocks(const Exec& ex, HashTableView t, View<co
 }
 
 template <Executor Exec>
-void TsdfFusion<Exec>::remove_unkept_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
-                          View<const std::int32_t> keep, Voxel* voxels, View<std::int32_t> free_list,
-                          HashCounters* counters) {
+void TsdfFusion<Exec>::remove_unkept_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots,
+                                            std::int64_t count, View<const std::int32_t> keep, Voxel* voxels,
+                                            View<std::int32_t> free_list, HashCounters* counters) {
   // kParts threads per block, each zeroing 512 / kParts voxels: one thread clearing a whole block
   // (6 KiB) would hold up the kernel. Part 0 also frees the slot and the block; the block is not
   // handed out again before the next allocation kernel, after this one has finished. The slot's

@@ -84,8 +84,9 @@ void TsdfRaycast<Exec, Acc>::clear_ray_intervals(const Exec& ex, RayIntervals iv
 }
 
 template <Executor Exec, class Acc>
-void TsdfRaycast<Exec, Acc>::splat_ray_intervals(const Exec& ex, HashTableView t, VoxelGeometry geom, Intrinsics K, SE3 world_T_camera,
-                         float min_depth, float max_depth, RayIntervals iv, BlockWindow w) {
+void TsdfRaycast<Exec, Acc>::splat_ray_intervals(const Exec& ex, HashTableView t, VoxelGeometry geom, Intrinsics K,
+                                                 SE3 world_T_camera, float min_depth, float max_depth, RayIntervals iv,
+                                                 BlockWindow w) {
   const SE3 camera_T_world = world_T_camera.inverse();
   const float zn = fmaxf(min_depth, 1e-3f);
   ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
@@ -102,7 +103,8 @@ void TsdfRaycast<Exec, Acc>::splat_ray_intervals(const Exec& ex, HashTableView t
     // outwards keeps the splat conservative.
     if (s.u1 < 0.f || s.v1 < 0.f || s.u0 > K.width - 1.f || s.v0 > K.height - 1.f) return;
     const int x0 = static_cast<int>(floorf(fmaxf(s.u0, 0.f))), x1 = static_cast<int>(ceilf(fminf(s.u1, K.width - 1.f)));
-    const int y0 = static_cast<int>(floorf(fmaxf(s.v0, 0.f))), y1 = static_cast<int>(ceilf(fminf(s.v1, K.height - 1.f)));
+    const int y0 = static_cast<int>(floorf(fmaxf(s.v0, 0.f))),
+              y1 = static_cast<int>(ceilf(fminf(s.v1, K.height - 1.f)));
     const std::int32_t z_near = float_bits(s.z0), z_far = float_bits(s.z1);
     for (int ty = y0 / iv.tile; ty <= y1 / iv.tile; ++ty)
       for (int tx = x0 / iv.tile; tx <= x1 / iv.tile; ++tx) {
@@ -136,7 +138,7 @@ SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z
   // least one observed sample in front of the next surface, where the march below takes over.
   const float unobserved_step = fmaxf(min_step, 0.5f * a.geom.truncation / (dlen * a.geom.voxel_size));
   const float step_per_sdf = 0.8f / (dlen * a.geom.voxel_size);  // see the step below
-  const vec3 inv_d{1.f / d.x, 1.f / d.y, 1.f / d.z};               // +-inf on an axis d does not move along
+  const vec3 inv_d{1.f / d.x, 1.f / d.y, 1.f / d.z};             // +-inf on an axis d does not move along
   float z_prev = 0.f, f_prev = 0.f;
   bool have_prev = false;
   for (int it = 0; it < 8192 && z < z_end; ++it) {
@@ -233,17 +235,18 @@ SEAMLESS_HD inline vec3 vertex_map_normal(View2D<const vec3> vtx, View2D<const f
 }
 
 template <Executor Exec, class Acc>
-void TsdfRaycast<Exec, Acc>::raycast(const Exec& ex, Acc a, Intrinsics K, SE3 world_T_camera, float min_depth, float max_depth,
-             RaycastOutput out, RayIntervals iv) {
+void TsdfRaycast<Exec, Acc>::raycast(const Exec& ex, Acc a, Intrinsics K, SE3 world_T_camera, float min_depth,
+                                     float max_depth, RaycastOutput out, RayIntervals iv) {
   const int w = out.depth.width, h = out.depth.height;
   const int groups_x = (w + kRayGroupW - 1) / kRayGroupW, groups_y = (h + kRayGroupH - 1) / kRayGroupH;
-  ex.for_each(static_cast<std::int64_t>(groups_x) * groups_y * kRayGroupW * kRayGroupH, [=] SEAMLESS_HD(std::int64_t i) {
-    const std::int64_t group = i / (kRayGroupW * kRayGroupH);
-    const int lane = static_cast<int>(i % (kRayGroupW * kRayGroupH));
-    const int x = static_cast<int>(group % groups_x) * kRayGroupW + lane % kRayGroupW;
-    const int y = static_cast<int>(group / groups_x) * kRayGroupH + lane / kRayGroupW;
-    if (x < w && y < h) raycast_pixel(a, x, y, K, world_T_camera, min_depth, max_depth, out, iv);
-  });
+  ex.for_each(static_cast<std::int64_t>(groups_x) * groups_y * kRayGroupW * kRayGroupH,
+              [=] SEAMLESS_HD(std::int64_t i) {
+                const std::int64_t group = i / (kRayGroupW * kRayGroupH);
+                const int lane = static_cast<int>(i % (kRayGroupW * kRayGroupH));
+                const int x = static_cast<int>(group % groups_x) * kRayGroupW + lane % kRayGroupW;
+                const int y = static_cast<int>(group / groups_x) * kRayGroupH + lane / kRayGroupW;
+                if (x < w && y < h) raycast_pixel(a, x, y, K, world_T_camera, min_depth, max_depth, out, iv);
+              });
   // Ten pixel footprints at the hit's depth: surfaces up to ~84 degrees from the view direction
   // keep their neighbours; a jump beyond that is a silhouette.
   const float jump_per_metre = 10.f / fminf(K.fx, K.fy);

@@ -48,8 +48,8 @@ SEAMLESS_HD inline HashKey pack_block(int3 b) {
 }
 SEAMLESS_HD inline int3 unpack_block(HashKey k) {
   const HashKey m = (1ull << kCoordBits) - 1ull;
-  return {static_cast<int>((k >> (2 * kCoordBits)) & m) - kCoordBias, static_cast<int>((k >> kCoordBits) & m) - kCoordBias,
-          static_cast<int>(k & m) - kCoordBias};
+  return {static_cast<int>((k >> (2 * kCoordBits)) & m) - kCoordBias,
+          static_cast<int>((k >> kCoordBits) & m) - kCoordBias, static_cast<int>(k & m) - kCoordBias};
 }
 SEAMLESS_HD inline bool is_live_key(HashKey k) { return k != kEmptyKey && k != kTombstone; }
 
@@ -108,8 +108,7 @@ struct HashTableView {
     return InsertResult::Full;
   }
 
-  template <bool Atomic>
-  SEAMLESS_HD std::int32_t probe(HashKey key) const {
+  template <bool Atomic> SEAMLESS_HD std::int32_t probe(HashKey key) const {
     std::uint32_t s = home(key);
     for (int p = 0; p < max_probe; ++p, s = (s + 1) & mask) {
       HashKey k = Atomic ? atomic_load(&keys[s]) : keys[s];
@@ -230,8 +229,7 @@ struct BlockCache {
 };
 
 // Block index of b (-1: none) through the cache.
-template <class Acc>
-SEAMLESS_HD inline std::int32_t cached_block(const Acc& a, int3 b, BlockCache& c) {
+template <class Acc> SEAMLESS_HD inline std::int32_t cached_block(const Acc& a, int3 b, BlockCache& c) {
   // A window lookup is one cached load: cheaper than the cache's compares and shuffling.
   if constexpr (requires { a.window; }) return a.find_block(b);
   if (b == c.block) return c.index;
@@ -243,8 +241,7 @@ SEAMLESS_HD inline std::int32_t cached_block(const Acc& a, int3 b, BlockCache& c
   return c.index;
 }
 
-template <class Acc>
-SEAMLESS_HD inline const Voxel* find_voxel(const Acc& a, int3 g, BlockCache& c) {
+template <class Acc> SEAMLESS_HD inline const Voxel* find_voxel(const Acc& a, int3 g, BlockCache& c) {
   std::int32_t index = cached_block(a, block_of_voxel(g), c);
   return index < 0 ? nullptr : a.voxels + static_cast<std::int64_t>(index) * kBlockVoxels + local_index(g);
 }
@@ -263,8 +260,7 @@ SEAMLESS_HD inline bool corner_voxels(const Acc& a, int3 g0, const std::int32_t 
 // The 8 corner voxels of cell g0 (corner k at g0 + (k&1, (k>>1)&1, k>>2)), each block looked up
 // once: the cell reaches into the next block only along the axes where g0 is a block's last
 // voxel. False when a corner's block is missing.
-template <class Acc>
-SEAMLESS_HD inline bool cell_voxels(const Acc& a, int3 g0, BlockCache& c, const Voxel* v[8]) {
+template <class Acc> SEAMLESS_HD inline bool cell_voxels(const Acc& a, int3 g0, BlockCache& c, const Voxel* v[8]) {
   const int3 b0 = block_of_voxel(g0);
   const bool ex = (g0.x & 7) == 7, ey = (g0.y & 7) == 7, ez = (g0.z & 7) == 7;
   if (!(ex || ey || ez)) {  // 343 of a block's 512 cells: all corners in b0, at fixed offsets
@@ -353,8 +349,7 @@ SEAMLESS_HD inline vec3 tsdf_gradient(const Acc& a, vec3 q, float s0, BlockCache
 // SDF value (metres) and gradient (unit-free, ~unit length near the surface) at world point p, for
 // collisions against the fused scene (DESIGN "Physics": the smoother alternative of the
 // dissertation's section 2.6.4). False where the TSDF is unknown (unallocated or unobserved).
-template <class Acc>
-SEAMLESS_HD inline bool sample_sdf(const Acc& a, vec3 p, float* value, vec3* gradient) {
+template <class Acc> SEAMLESS_HD inline bool sample_sdf(const Acc& a, vec3 p, float* value, vec3* gradient) {
   BlockCache c;
   vec3 q = a.geom.to_voxel(p);
   float s0;

@@ -3,8 +3,7 @@
 
 namespace seamless::kernels {
 
-template <Executor Exec>
-void VoxelHash<Exec>::hash_clear(const Exec& ex, HashTableView t) {
+template <Executor Exec> void VoxelHash<Exec>::hash_clear(const Exec& ex, HashTableView t) {
   ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
     t.keys[i] = kEmptyKey;
     t.values[i] = -1;
@@ -22,8 +21,8 @@ void VoxelHash<Exec>::pool_reset(const Exec& ex, View<std::int32_t> free_list, H
 }
 
 template <Executor Exec>
-void VoxelHash<Exec>::pool_append(const Exec& ex, View<std::int32_t> free_list, HashCounters* counters, std::int32_t first,
-                 std::int32_t n) {
+void VoxelHash<Exec>::pool_append(const Exec& ex, View<std::int32_t> free_list, HashCounters* counters,
+                                  std::int32_t first, std::int32_t n) {
   // One thread: reads free_top once, so the appended range is contiguous above it.
   ex.for_each(1, [=] SEAMLESS_HD(std::int64_t) {
     int top = counters->free_top < 0 ? 0 : counters->free_top;
@@ -32,8 +31,7 @@ void VoxelHash<Exec>::pool_append(const Exec& ex, View<std::int32_t> free_list, 
   });
 }
 
-template <Executor Exec>
-void VoxelHash<Exec>::reset_frame_counters(const Exec& ex, HashCounters* counters) {
+template <Executor Exec> void VoxelHash<Exec>::reset_frame_counters(const Exec& ex, HashCounters* counters) {
   ex.for_each(1, [=] SEAMLESS_HD(std::int64_t) {
     HashCounters& c = *counters;
     c.inserted = c.collisions = c.probe_failures = c.pool_failures = c.visible = c.removed = 0;
@@ -41,8 +39,9 @@ void VoxelHash<Exec>::reset_frame_counters(const Exec& ex, HashCounters* counter
 }
 
 template <Executor Exec>
-void VoxelHash<Exec>::hash_insert(const Exec& ex, HashTableView t, View<const HashKey> keys, View<const std::int32_t> value_in,
-                 View<std::int32_t> slot_out, View<std::int32_t> result_out, HashCounters* counters) {
+void VoxelHash<Exec>::hash_insert(const Exec& ex, HashTableView t, View<const HashKey> keys,
+                                  View<const std::int32_t> value_in, View<std::int32_t> slot_out,
+                                  View<std::int32_t> result_out, HashCounters* counters) {
   ex.for_each(keys.size, [=] SEAMLESS_HD(std::int64_t i) {
     std::int32_t slot = -1;
     int probes = 0;
@@ -60,13 +59,14 @@ void VoxelHash<Exec>::hash_insert(const Exec& ex, HashTableView t, View<const Ha
 }
 
 template <Executor Exec>
-void VoxelHash<Exec>::hash_find(const Exec& ex, HashTableView t, View<const HashKey> keys, View<std::int32_t> slot_out) {
+void VoxelHash<Exec>::hash_find(const Exec& ex, HashTableView t, View<const HashKey> keys,
+                                View<std::int32_t> slot_out) {
   ex.for_each(keys.size, [=] SEAMLESS_HD(std::int64_t i) { slot_out[i] = t.find(keys[i]); });
 }
 
 template <Executor Exec>
 void VoxelHash<Exec>::hash_erase(const Exec& ex, HashTableView t, View<const HashKey> keys, View<std::int32_t> slot_out,
-                HashCounters* counters) {
+                                 HashCounters* counters) {
   ex.for_each(keys.size, [=] SEAMLESS_HD(std::int64_t i) {
     std::int32_t s = t.erase(keys[i]);
     slot_out[i] = s;
@@ -89,14 +89,15 @@ std::int64_t compact_slots(const Exec& ex, HashTableView t, View<std::int32_t> f
 }
 
 template <Executor Exec>
-std::int64_t VoxelHash<Exec>::hash_live_slots(const Exec& ex, HashTableView t, View<std::int32_t> flags, View<std::int32_t> slots_out) {
+std::int64_t VoxelHash<Exec>::hash_live_slots(const Exec& ex, HashTableView t, View<std::int32_t> flags,
+                                              View<std::int32_t> slots_out) {
   return compact_slots(ex, t, flags, slots_out,
                        [=] SEAMLESS_HD(std::int64_t i) { return is_live_key(t.keys[i]) && t.values[i] >= 0; });
 }
 
 template <Executor Exec>
-std::int64_t VoxelHash<Exec>::hash_slots_beyond(const Exec& ex, HashTableView t, vec3 center, float radius, View<std::int32_t> flags,
-                               View<std::int32_t> slots_out) {
+std::int64_t VoxelHash<Exec>::hash_slots_beyond(const Exec& ex, HashTableView t, vec3 center, float radius,
+                                                View<std::int32_t> flags, View<std::int32_t> slots_out) {
   const float r2 = radius * radius;
   return compact_slots(ex, t, flags, slots_out, [=] SEAMLESS_HD(std::int64_t i) {
     HashKey k = t.keys[i];
@@ -108,8 +109,9 @@ std::int64_t VoxelHash<Exec>::hash_slots_beyond(const Exec& ex, HashTableView t,
 }
 
 template <Executor Exec>
-void VoxelHash<Exec>::insert_with_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list, HashCounters* counters,
-                        View<const HashKey> keys, View<std::int32_t> blocks_out) {
+void VoxelHash<Exec>::insert_with_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list,
+                                         HashCounters* counters, View<const HashKey> keys,
+                                         View<std::int32_t> blocks_out) {
   ex.for_each(keys.size, [=] SEAMLESS_HD(std::int64_t i) {
     blocks_out[i] = -1;
     std::int32_t slot = -1;
@@ -132,8 +134,8 @@ void VoxelHash<Exec>::insert_with_blocks(const Exec& ex, HashTableView t, View<c
 }
 
 template <Executor Exec>
-void VoxelHash<Exec>::hash_gather(const Exec& ex, HashTableView t, View<const std::int32_t> slots, View<HashKey> keys_out,
-                 View<std::int32_t> values_out) {
+void VoxelHash<Exec>::hash_gather(const Exec& ex, HashTableView t, View<const std::int32_t> slots,
+                                  View<HashKey> keys_out, View<std::int32_t> values_out) {
   ex.for_each(slots.size, [=] SEAMLESS_HD(std::int64_t i) {
     keys_out[i] = t.keys[slots[i]];
     values_out[i] = t.values[slots[i]];
@@ -141,14 +143,16 @@ void VoxelHash<Exec>::hash_gather(const Exec& ex, HashTableView t, View<const st
 }
 
 template <Executor Exec>
-void VoxelHash<Exec>::gather_blocks(const Exec& ex, const Voxel* pool, View<const std::int32_t> blocks, View<Voxel> out) {
+void VoxelHash<Exec>::gather_blocks(const Exec& ex, const Voxel* pool, View<const std::int32_t> blocks,
+                                    View<Voxel> out) {
   ex.for_each(blocks.size * kBlockVoxels, [=] SEAMLESS_HD(std::int64_t i) {
     out[i] = pool[static_cast<std::int64_t>(blocks[i / kBlockVoxels]) * kBlockVoxels + i % kBlockVoxels];
   });
 }
 
 template <Executor Exec>
-void VoxelHash<Exec>::scatter_blocks(const Exec& ex, Voxel* pool, View<const std::int32_t> blocks, View<const Voxel> in) {
+void VoxelHash<Exec>::scatter_blocks(const Exec& ex, Voxel* pool, View<const std::int32_t> blocks,
+                                     View<const Voxel> in) {
   ex.for_each(blocks.size * kBlockVoxels, [=] SEAMLESS_HD(std::int64_t i) {
     const std::int32_t block = blocks[i / kBlockVoxels];
     if (block >= 0) pool[static_cast<std::int64_t>(block) * kBlockVoxels + i % kBlockVoxels] = in[i];

@@ -15,8 +15,8 @@ constexpr int kMaxCapsules = 32;
 struct Capsule {
   vec3 a, b;
   float r;
-  int mover;     // 1-based id of the mover it belongs to (the mask's value)
-  vec3 albedo;   // linear RGB in [0, 1]
+  int mover;    // 1-based id of the mover it belongs to (the mask's value)
+  vec3 albedo;  // linear RGB in [0, 1]
 };
 
 // The movers of one frame: a small POD passed to kernels by value.

@@ -36,7 +36,7 @@ struct Primitive {
 
 constexpr int kNumPrimitives = 17;
 constexpr float kFloorZ = 0.f;
-constexpr float kDeskTopZ = 0.75f;                  // upper face of the desk top
+constexpr float kDeskTopZ = 0.75f;  // upper face of the desk top
 SEAMLESS_HD inline vec3 room_centre() { return {0.f, 0.f, 1.3f}; }
 SEAMLESS_HD inline vec3 room_half_extents() { return {2.f, 2.5f, 1.3f}; }
 SEAMLESS_HD inline vec3 desk_centre() { return {0.f, 0.6f, kDeskTopZ}; }  // the cameras look here
@@ -80,9 +80,7 @@ SEAMLESS_HD inline vec3 rot_z(vec3 p, float a) {
 }
 SEAMLESS_HD inline vec3 to_local(const Primitive& q, vec3 p) { return rot_z(p - q.c, -q.yaw); }
 SEAMLESS_HD inline float comp(vec3 v, int i) { return i == 0 ? v.x : (i == 1 ? v.y : v.z); }
-SEAMLESS_HD inline vec3 axis(int i, float s) {
-  return {i == 0 ? s : 0.f, i == 1 ? s : 0.f, i == 2 ? s : 0.f};
-}
+SEAMLESS_HD inline vec3 axis(int i, float s) { return {i == 0 ? s : 0.f, i == 1 ? s : 0.f, i == 2 ? s : 0.f}; }
 
 // Distance and gradient of one primitive at p.
 struct SdfSample {
@@ -153,9 +151,9 @@ SEAMLESS_HD inline SdfSample primitive_sdf(const Primitive& q, vec3 p) {
 // ---- the scene's SDF -------------------------------------------------------------------------
 
 struct RoomSample {
-  float d;     // signed distance, metres (positive in free space)
-  vec3 grad;   // gradient of d
-  int id;      // nearest primitive
+  float d;    // signed distance, metres (positive in free space)
+  vec3 grad;  // gradient of d
+  int id;     // nearest primitive
 };
 
 SEAMLESS_HD inline RoomSample room_sample(vec3 p) {
@@ -229,8 +227,15 @@ SEAMLESS_HD inline Hit hit_local_box(vec3 o, vec3 d, vec3 h) {
       continue;
     }
     float t1 = (-hi - oi) / di, t2 = (hi - oi) / di;
-    if (t1 > t2) { float s = t1; t1 = t2; t2 = s; }
-    if (t1 > tn) { tn = t1; ax = i; }
+    if (t1 > t2) {
+      float s = t1;
+      t1 = t2;
+      t2 = s;
+    }
+    if (t1 > tn) {
+      tn = t1;
+      ax = i;
+    }
     if (t2 < tf) tf = t2;
   }
   if (tn > tf || tn <= 0.f) return {-1.f, {0, 0, 0}, 0};
@@ -287,8 +292,7 @@ SEAMLESS_HD inline Hit hit_cylinder(const Primitive& q, vec3 o, vec3 d) {
     float zc = l.z > 0.f ? q.h.z : -q.h.z;
     float t = (zc - l.z) / d.z;
     float x = l.x + t * d.x, y = l.y + t * d.y;
-    if (t > 0.f && x * x + y * y <= q.h.x * q.h.x && (best.t < 0.f || t < best.t))
-      best = {t, {0.f, 0.f, sgn(zc)}, 0};
+    if (t > 0.f && x * x + y * y <= q.h.x * q.h.x && (best.t < 0.f || t < best.t)) best = {t, {0.f, 0.f, sgn(zc)}, 0};
   }
   return best;
 }

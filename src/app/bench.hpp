@@ -14,14 +14,14 @@ namespace seamless::app {
 struct BenchCase {
   std::string name;
   std::function<void()> step;
-  std::string detail;  // e.g. "640x480, 3 levels"
+  std::string detail;                        // e.g. "640x480, 3 levels"
   std::function<std::string()> report = {};  // extra figures after the timing (blocks, counts)
 };
 
 struct BenchOptions {
   Device device = Device::CPU;
-  std::string data_dir;  // TUM folder for benchmarks on real frames ("" = synthetic input)
-  std::string filter;    // run only cases whose name contains this
+  std::string data_dir;       // TUM folder for benchmarks on real frames ("" = synthetic input)
+  std::string filter;         // run only cases whose name contains this
   std::string scale = "all";  // benchmarks with sized scenes: paper (the dissertation's), large, all
 };
 

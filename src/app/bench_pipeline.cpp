@@ -35,8 +35,8 @@ namespace {
 // frame time (TrackingSession::process marks): upload + preprocess + dynamic + track + allocate +
 // fuse + raycast = frame (dynamic: the dynamic pixels, with dynamic.enabled only). Live mode adds
 // the run's own stages of the frame (colliders: solver.dynamic_colliders only).
-const std::vector<std::string> kTrackingStages = {"upload", "preprocess", "dynamic", "track", "allocate", "fuse",
-                                                  "raycast"};
+const std::vector<std::string> kTrackingStages = {"upload",   "preprocess", "dynamic", "track",
+                                                  "allocate", "fuse",       "raycast"};
 const std::vector<std::string> kLiveStages = {"colliders", "physics", "extract", "render"};
 
 // Linear interpolation between order statistics (numpy's default): q = 0.5 is the usual median,
@@ -53,9 +53,7 @@ double quantile(std::vector<double> v, double q) {
 struct Summary {
   double median = 0, p90 = 0, max = 0;
 };
-Summary summarise(const std::vector<double>& v) {
-  return {quantile(v, 0.5), quantile(v, 0.9), quantile(v, 1.0)};
-}
+Summary summarise(const std::vector<double>& v) { return {quantile(v, 0.5), quantile(v, 0.9), quantile(v, 1.0)}; }
 
 struct RepResult {
   std::map<std::string, std::vector<double>> per_frame;  // stage -> one value a frame, in frame order
@@ -89,11 +87,10 @@ std::vector<std::string> bench_overrides(const PipelineBenchOptions& o) {
   if (o.frames > 0) s.push_back("frames=" + std::to_string(o.frames));
   if (o.mode == "live")
     // The Kinect view of the live AR loop at 640x480, drawn but not written out (no PNGs, no video).
-    s.insert(s.end(), {"mode=live", "render.mode=headless", "render.view=kinect", "render.fluid=ssfr",
-                       "render.width=640", "render.height=480", "render.write_frames=false", "render.video=false",
-                       "render.stage_images=false"});
-  else
-    s.push_back("mode=scan_then_simulate");
+    s.insert(s.end(),
+             {"mode=live", "render.mode=headless", "render.view=kinect", "render.fluid=ssfr", "render.width=640",
+              "render.height=480", "render.write_frames=false", "render.video=false", "render.stage_images=false"});
+  else s.push_back("mode=scan_then_simulate");
   s.insert(s.end(), o.sets.begin(), o.sets.end());
   return s;
 }
@@ -178,7 +175,8 @@ RepResult replay(const PipelineBenchOptions& o, const Experiment& e, const std::
       }
       const std::vector<FrameRecord> records = live(ctx, renderer.get(), vs);
       add_tracking_stages(records, o.volume_stages, e.dynamic.enabled, r);
-      for (auto& [stage, v] : timer_stages(ctx.timer(), r.frames, e.solver.dynamic_colliders != DynamicColliders::none)) {
+      for (auto& [stage, v] :
+           timer_stages(ctx.timer(), r.frames, e.solver.dynamic_colliders != DynamicColliders::none)) {
         if (stage == "render" && !renderer) continue;
         for (std::size_t k = 0; k < v.size(); ++k) r.per_frame["frame"][k] += v[k];
         r.per_frame[stage] = std::move(v);
@@ -224,11 +222,20 @@ void print_table(const std::vector<std::string>& stages, const std::vector<RepRe
 void write_json(const std::string& path, const PipelineBenchOptions& o, const Experiment& e,
                 const std::vector<std::string>& stages, const std::vector<RepResult>& reps,
                 const std::string& render_note) {
-  Json j = {{"benchmark", "pipeline"}, {"seamless_version", SEAMLESS_VERSION}, {"commit", SEAMLESS_GIT_COMMIT},
-            {"device", device_name(o.device)}, {"gpu", cuda_device_description()}, {"mode", o.mode},
-            {"config", o.config}, {"data", e.input.path}, {"tracker", e.tracker.kind},
-            {"tracker_mode", e.tracker.mode}, {"voxel_size", e.volume.voxel_size}, {"volume", enum_name(e.volume.layout)},
-            {"frames_requested", e.frames}, {"reps", static_cast<int>(reps.size())}};
+  Json j = {{"benchmark", "pipeline"},
+            {"seamless_version", SEAMLESS_VERSION},
+            {"commit", SEAMLESS_GIT_COMMIT},
+            {"device", device_name(o.device)},
+            {"gpu", cuda_device_description()},
+            {"mode", o.mode},
+            {"config", o.config},
+            {"data", e.input.path},
+            {"tracker", e.tracker.kind},
+            {"tracker_mode", e.tracker.mode},
+            {"voxel_size", e.volume.voxel_size},
+            {"volume", enum_name(e.volume.layout)},
+            {"frames_requested", e.frames},
+            {"reps", static_cast<int>(reps.size())}};
   j["render"] = render_note.empty() ? std::string(o.mode == "live" ? "measured" : "not in scan mode") : render_note;
   j["stages"] = stages;
   Json& medians = j["median_of_medians_ms"] = Json::object();
@@ -242,12 +249,16 @@ void write_json(const std::string& path, const PipelineBenchOptions& o, const Ex
     Json per_stage = Json::object();
     for (const std::string& s : stages) {
       const Summary x = summarise(r.per_frame.at(s));
-      per_stage[s] = {{"median_ms", x.median}, {"p90_ms", x.p90}, {"max_ms", x.max},
-                      {"per_frame_ms", r.per_frame.at(s)}};
+      per_stage[s] = {
+          {"median_ms", x.median}, {"p90_ms", x.p90}, {"max_ms", x.max}, {"per_frame_ms", r.per_frame.at(s)}};
     }
-    replays.push_back({{"frames", r.frames}, {"lost_frames", r.lost}, {"wall_s", r.wall_s},
-                       {"peak_buffer_bytes", r.peak_buffer_bytes}, {"peak_rss_bytes", r.peak_rss_bytes},
-                       {"exit_code", r.exit_code}, {"stages", std::move(per_stage)}});
+    replays.push_back({{"frames", r.frames},
+                       {"lost_frames", r.lost},
+                       {"wall_s", r.wall_s},
+                       {"peak_buffer_bytes", r.peak_buffer_bytes},
+                       {"peak_rss_bytes", r.peak_rss_bytes},
+                       {"exit_code", r.exit_code},
+                       {"stages", std::move(per_stage)}});
   }
   j["replays"] = std::move(replays);
   write_json_file(path, j);
@@ -256,8 +267,9 @@ void write_json(const std::string& path, const PipelineBenchOptions& o, const Ex
 // A folder of its own under the system's temporary folder (mkdtemp: no two runs share one).
 std::string temporary_folder() {
   std::string templ = (fs::temp_directory_path() / "seamless-bench-pipeline-XXXXXX").string();
-  if (!mkdtemp(templ.data())) throw Error("bench pipeline: cannot create a temporary folder in " +
-                                          fs::temp_directory_path().string() + "; give --out");
+  if (!mkdtemp(templ.data()))
+    throw Error("bench pipeline: cannot create a temporary folder in " + fs::temp_directory_path().string() +
+                "; give --out");
   return templ;
 }
 
@@ -280,15 +292,17 @@ int run_pipeline_bench(const PipelineBenchOptions& o) {
     std::error_code ec;
     fs::remove_all(root, ec);
   }
-  if (reps.empty() || reps.front().frames == 0) throw InputError("bench pipeline: no frame was replayed from " + e.input.path);
+  if (reps.empty() || reps.front().frames == 0)
+    throw InputError("bench pipeline: no frame was replayed from " + e.input.path);
   const std::vector<std::string> stages = stage_order(o, reps.front());
   print_table(stages, reps);
   const RepResult& last = reps.back();
-  std::printf("\n%lld frames a replay (%lld lost in the last); peak %.1f MiB of %s buffers, peak RSS %s; "
-              "PNG decoding is in no stage (the source decodes before the frame's first mark)\n",
-              static_cast<long long>(last.frames), static_cast<long long>(last.lost),
-              last.peak_buffer_bytes / 1048576.0, device_name(o.device),
-              last.peak_rss_bytes < 0 ? "unknown" : (std::to_string(last.peak_rss_bytes >> 20) + " MiB").c_str());
+  std::printf(
+      "\n%lld frames a replay (%lld lost in the last); peak %.1f MiB of %s buffers, peak RSS %s; "
+      "PNG decoding is in no stage (the source decodes before the frame's first mark)\n",
+      static_cast<long long>(last.frames), static_cast<long long>(last.lost), last.peak_buffer_bytes / 1048576.0,
+      device_name(o.device),
+      last.peak_rss_bytes < 0 ? "unknown" : (std::to_string(last.peak_rss_bytes >> 20) + " MiB").c_str());
   if (o.mode == "live") std::printf("render: %s\n", render_note.empty() ? "measured" : render_note.c_str());
   if (!o.json.empty()) {
     write_json(o.json, o, e, stages, reps, render_note);

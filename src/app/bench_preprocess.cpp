@@ -27,7 +27,8 @@ std::vector<BenchCase> make_preprocess_bench(const BenchOptions& o) {
   auto depth = std::make_shared<Image<float>>(Image<float>::from_host(synthetic_depth(K), 640, 480, o.device));
   auto pyr = std::make_shared<FramePyramid>(o.device, K, 3);
   PreprocessParams p;
-  return {{"pyramid_640x480", [=] { pyr->build(*depth, nullptr, p); }, "bilateral 7x7 + 3 levels + vertices + normals"}};
+  return {
+      {"pyramid_640x480", [=] { pyr->build(*depth, nullptr, p); }, "bilateral 7x7 + 3 levels + vertices + normals"}};
 }
 
 }  // namespace seamless::app

@@ -45,8 +45,9 @@ std::vector<BenchCase> make_recon_bench(const BenchOptions& o) {
     vp.layout = layout;
     if (vp.layout == VolumeLayout::dense) vp.voxel_size = 0.01f;  // 512^3 at 5 mm would be 1.6 GB; 4 m / 1 cm
     auto bench = std::make_shared<ReconBench>(frames, K, vp, o.device);
-    std::string detail = std::string(enum_name(layout)) + ", voxel " + std::to_string(static_cast<int>(vp.voxel_size * 1000)) +
-                         " mm, " + std::to_string(frames.size()) + " frames cycled";
+    std::string detail = std::string(enum_name(layout)) + ", voxel " +
+                         std::to_string(static_cast<int>(vp.voxel_size * 1000)) + " mm, " +
+                         std::to_string(frames.size()) + " frames cycled";
     // One step = one frame: allocate + fuse + raycast of the next recorded frame (cycling).
     cases.push_back({std::string("frame_") + enum_name(layout), [bench] { bench->step(); }, detail,
                      [bench] { return bench->report(); }});

@@ -26,10 +26,15 @@ RenderBenchResult run_one(const char* label, const RenderParams& settings, int r
 void write_json(const std::string& path, const RenderBenchResult& r) {
   Json passes = Json::object();
   for (const RenderTiming& t : r.passes) passes[t.pass] = t.ms;
-  write_json_file(path, {{"benchmark", "render"}, {"seamless_version", SEAMLESS_VERSION}, {"gl", r.gl_renderer},
-                         {"median_gpu_ms", r.median_gpu_ms}, {"median_frame_ms", r.median_frame_ms},
-                         {"median_draw_ms", r.median_draw_ms}, {"median_readback_ms", r.median_readback_ms},
-                         {"median_interop_ms", r.median_interop_ms}, {"passes_ms", std::move(passes)}});
+  write_json_file(path, {{"benchmark", "render"},
+                         {"seamless_version", SEAMLESS_VERSION},
+                         {"gl", r.gl_renderer},
+                         {"median_gpu_ms", r.median_gpu_ms},
+                         {"median_frame_ms", r.median_frame_ms},
+                         {"median_draw_ms", r.median_draw_ms},
+                         {"median_readback_ms", r.median_readback_ms},
+                         {"median_interop_ms", r.median_interop_ms},
+                         {"passes_ms", std::move(passes)}});
 }
 }  // namespace
 

@@ -47,18 +47,26 @@ struct CaseResult {
 void write_json(const std::string& path, const std::string& bench, Device dev, const std::vector<CaseResult>& rows) {
   Json cases = Json::array();
   for (const CaseResult& c : rows)
-    cases.push_back({{"name", c.name}, {"reps", c.reps}, {"min_ms", c.min_ms}, {"median_ms", c.median_ms},
-                     {"max_ms", c.max_ms}, {"detail", c.detail}});
-  write_json_file(path, {{"benchmark", bench}, {"seamless_version", SEAMLESS_VERSION}, {"device", device_name(dev)},
-                         {"gpu", cuda_device_description()}, {"cases", std::move(cases)}});
+    cases.push_back({{"name", c.name},
+                     {"reps", c.reps},
+                     {"min_ms", c.min_ms},
+                     {"median_ms", c.median_ms},
+                     {"max_ms", c.max_ms},
+                     {"detail", c.detail}});
+  write_json_file(path, {{"benchmark", bench},
+                         {"seamless_version", SEAMLESS_VERSION},
+                         {"device", device_name(dev)},
+                         {"gpu", cuda_device_description()},
+                         {"cases", std::move(cases)}});
 }
 
 int run_bench(BenchArgs a) {
   if (a.name == "pipeline") return run_pipeline(a);
   if (!a.config.empty() || !a.tracker.empty() || !a.out.empty() || !a.sets.empty() || a.frames > 0 ||
       a.no_volume_stages || a.mode != "scan")
-    throw UsageError("--config, --set, --tracker, --mode, --frames, --out and --no-volume-stages are options of "
-                     "`seamless bench pipeline` only");
+    throw UsageError(
+        "--config, --set, --tracker, --mode, --frames, --out and --no-volume-stages are options of "
+        "`seamless bench pipeline` only");
   if (a.reps == 0) a.reps = 50;
   auto& reg = bench_registry();
   auto it = reg.find(a.name);
@@ -115,8 +123,9 @@ void add_bench_command(CLI::App& app, std::function<int()>& action) {
       ->check(CLI::IsMember({"scan", "live"}));
   cmd->add_option("--frames", a->frames, "pipeline: replay the first N frames (default: the config's frames)")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--out", a->out, "pipeline: keep each replay's run folder here as rep_<k> (default: a temporary "
-                                   "folder, removed)");
+  cmd->add_option("--out", a->out,
+                  "pipeline: keep each replay's run folder here as rep_<k> (default: a temporary "
+                  "folder, removed)");
   cmd->add_flag("--no-volume-stages", a->no_volume_stages,
                 "pipeline: do not time the volume's kernel steps (allocate is then part of fuse; saves two CUDA "
                 "events per step)");

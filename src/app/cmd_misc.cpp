@@ -11,12 +11,12 @@
 #include "app/json_file.hpp"
 #include "app/run_context.hpp"
 #include "config/config.hpp"
-#include "seamless/build_config.hpp"
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
 #include "eval/trajectory_eval.hpp"
 #include "io/frame_source.hpp"
 #include "io/record.hpp"
+#include "seamless/build_config.hpp"
 
 namespace seamless::app {
 
@@ -37,8 +37,8 @@ bool named_like_groundtruth(const std::string& path) {
 bool named_like_estimate(const std::string& path) {
   const std::string name = std::filesystem::path(path).filename().string();
   // What seamless track and compare_trackers write, and ORB-SLAM's / ElasticFusion's usual names.
-  for (const char* n : {"trajectory.txt", "trajectory_odometry.txt", "aligned.txt", "CameraTrajectory.txt",
-                        "KeyFrameTrajectory.txt"})
+  for (const char* n :
+       {"trajectory.txt", "trajectory_odometry.txt", "aligned.txt", "CameraTrajectory.txt", "KeyFrameTrajectory.txt"})
     if (name == n) return true;
   return false;
 }
@@ -58,9 +58,10 @@ void warn_if_swapped(const std::string& gt_path, const std::string& est_path, co
     why = "the second file has " + std::to_string(est.size()) + " poses, more than twice the first's " +
           std::to_string(gt.size()) + ", as ground truth from motion capture usually has";
   if (why.empty()) return;
-  spdlog::warn("seamless eval takes GROUND TRUTH FIRST, then the estimate (evo_ape's and TUM's evaluate_ate.py's "
-               "order; before seamless 0.2 it was the other way round), and {}: did you mean `seamless eval {} {}`?",
-               why, est_path, gt_path);
+  spdlog::warn(
+      "seamless eval takes GROUND TRUTH FIRST, then the estimate (evo_ape's and TUM's evaluate_ate.py's "
+      "order; before seamless 0.2 it was the other way round), and {}: did you mean `seamless eval {} {}`?",
+      why, est_path, gt_path);
 }
 
 void add_stats(Json& j, const std::string& prefix, const ErrorStats& s, const char* unit) {
@@ -87,8 +88,8 @@ int run_eval(const EvalArgs& a) {
   }
   std::printf("ground truth %s (%zu poses), estimate %s (%zu poses)\n", gt_path.c_str(), gt.size(), est_path.c_str(),
               est.size());
-  std::printf("%zu of %zu estimated poses matched ground truth within %.3f s (offset %g s); alignment %s", ate.trans.count,
-              est.size(), opt.t_max_diff, opt.offset, to_string(opt.align));
+  std::printf("%zu of %zu estimated poses matched ground truth within %.3f s (offset %g s); alignment %s",
+              ate.trans.count, est.size(), opt.t_max_diff, opt.offset, to_string(opt.align));
   if (opt.align == Alignment::sim3) std::printf(", scale %.6f", ate.scale);
   std::printf("\n%-24s %10s %10s %10s %10s %10s\n", "", "rmse", "mean", "median", "std", "max");
   auto row = [](const char* name, const ErrorStats& s, double scale) {
@@ -107,11 +108,12 @@ int run_eval(const EvalArgs& a) {
   if (!a.aligned.empty()) write_tum_trajectory(a.aligned, ate.aligned);
   if (!a.json.empty()) {
     // Schema: docs/TRACKING.md, "seamless eval".
-    Json j = {{"schema", "seamless-eval/1"}, {"seamless_version", SEAMLESS_VERSION},
-              {"groundtruth", gt_path}, {"estimate", est_path},
+    Json j = {{"schema", "seamless-eval/1"},    {"seamless_version", SEAMLESS_VERSION},
+              {"groundtruth", gt_path},         {"estimate", est_path},
               {"groundtruth_poses", gt.size()}, {"estimate_poses", est.size()},
               {"t_max_diff_s", opt.t_max_diff}, {"offset_s", opt.offset},
-              {"align", to_string(opt.align)}, {"scale", ate.scale}, {"pairs", ate.trans.count}};
+              {"align", to_string(opt.align)},  {"scale", ate.scale},
+              {"pairs", ate.trans.count}};
     add_stats(j, "ate", ate.trans, "m");
     j["rpe_frame_pairs"] = rpe_f.trans.count;
     add_stats(j, "rpe_frame_trans", rpe_f.trans, "m");
@@ -190,7 +192,8 @@ int run_record(const RecordArgs& a) {
 void add_record_command(CLI::App& app, std::function<int()>& action) {
   auto a = std::make_shared<RecordArgs>();
   auto* cmd = app.add_subcommand("record", "write a source (Kinect, synthetic room, TUM) as a TUM-format folder");
-  cmd->add_option("config", a->config, "experiment file whose input section to use (optional)")->check(CLI::ExistingFile);
+  cmd->add_option("config", a->config, "experiment file whose input section to use (optional)")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--source", a->source, "synthetic, tum or kinect (overrides input.source)")
       ->check(CLI::IsMember({"synthetic", "tum", "kinect"}));
   cmd->add_option("--path", a->path, "TUM folder when --source tum");

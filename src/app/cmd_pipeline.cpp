@@ -13,8 +13,9 @@ namespace seamless::app {
 
 void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
   auto rec = std::make_shared<CommonOptions>();
-  auto* r = app.add_subcommand("reconstruct", "track and fuse the input into the TSDF volume; write mesh.ply, "
-                                              "trajectory.txt and tracking_stats.csv");
+  auto* r = app.add_subcommand("reconstruct",
+                               "track and fuse the input into the TSDF volume; write mesh.ply, "
+                               "trajectory.txt and tracking_stats.csv");
   add_common_options(*r, *rec);
   r->callback([&action, rec] {
     action = [rec] {
@@ -45,15 +46,17 @@ void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
     };
   });
   auto sim = std::make_shared<CommonOptions>();
-  auto* m = app.add_subcommand("simulate", "run the particle solver on the synthetic room's exact SDF (no scan); "
-                                           "write particle states");
+  auto* m = app.add_subcommand("simulate",
+                               "run the particle solver on the synthetic room's exact SDF (no scan); "
+                               "write particle states");
   add_common_options(*m, *sim);
   m->callback([&action, sim] {
     action = [sim] {
       RunContext ctx(*sim);
       if (ctx.experiment().input.source != "synthetic")
-        throw ConfigError("seamless simulate runs on the synthetic room's analytic scene (input.source: synthetic); to "
-                    "simulate on a scanned scene use `seamless run` with mode: scan_then_simulate");
+        throw ConfigError(
+            "seamless simulate runs on the synthetic room's analytic scene (input.source: synthetic); to "
+            "simulate on a scanned scene use `seamless run` with mode: scan_then_simulate");
       kernels::SceneSdf sdf{};
       sdf.synthetic_room = 1;
       ctx.experiment().solver.gravity = kernels::room::gravity();  // the room's world is z up

@@ -51,7 +51,8 @@ std::map<std::int64_t, std::string> snapshots(const std::string& dir, bool last_
   }
   const std::string last = dir + "/particles.ply";
   if ((out.empty() || last_only) && fs::exists(last)) return {{out.empty() ? 0 : out.rbegin()->first + 1, last}};
-  if (out.empty()) throw Error(dir + " holds no particles_<step>.ply nor particles.ply: is it a `seamless run` folder?");
+  if (out.empty())
+    throw Error(dir + " holds no particles_<step>.ply nor particles.ply: is it a `seamless run` folder?");
   return out;
 }
 
@@ -136,8 +137,10 @@ int render_run(const RenderOptions& o) {
   if (fs::exists(o.run_dir + "/objects.txt")) {
     objects = read_objects(o.run_dir + "/objects.txt");
   } else {
-    spdlog::warn("{}/objects.txt is missing (a run older than `seamless render`): cloth and rigid bodies are drawn "
-                 "as particles", o.run_dir);
+    spdlog::warn(
+        "{}/objects.txt is missing (a run older than `seamless render`): cloth and rigid bodies are drawn "
+        "as particles",
+        o.run_dir);
     e.render.show_particles = true;
   }
   attach_body_meshes(objects, e.spawn, e.solver);
@@ -153,7 +156,7 @@ int render_run(const RenderOptions& o) {
     if (kinect && !kinect->set(r, step)) throw Error("the run's input gives no frame for the Kinect view");
     ParticleState s = read_particles_ply(path);
     std::vector<RigidFrame> frames = rigid_frames_of_state(objects, s, warm);
-    RenderCamera cam{};  // the Kinect view uses its own
+    RenderCamera cam{};      // the Kinect view uses its own
     if (p.view == "mesh") {  // the orbit's progress as in the run: the state's time over the duration
       const float progress = e.duration > 0.0 ? static_cast<float>(step * e.solver.dt / e.duration) : 0.f;
       const SceneCamera c = orbit_camera(scene_cam, p, progress);
@@ -170,8 +173,9 @@ int render_run(const RenderOptions& o) {
 #else
 
 int render_run(const RenderOptions&) {
-  return not_built("render", "this build has no renderer (GL module off: apt-get install libegl-dev libgl-dev "
-                             "libepoxy-dev, then re-run cmake)");
+  return not_built("render",
+                   "this build has no renderer (GL module off: apt-get install libegl-dev libgl-dev "
+                   "libepoxy-dev, then re-run cmake)");
 }
 
 #endif

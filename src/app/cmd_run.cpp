@@ -3,16 +3,16 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
-#include <filesystem>
 #include <cmath>
+#include <filesystem>
 #include <memory>
 #include <optional>
 
 #include "app/commands.hpp"
 #include "app/ghost.hpp"
 #include "app/pipeline.hpp"
-#include "app/render_stage.hpp"
 #include "app/placement.hpp"
+#include "app/render_stage.hpp"
 #include "app/run_context.hpp"
 #include "app/run_summary.hpp"
 #include "config/config.hpp"
@@ -31,16 +31,16 @@ void check_render_zoom(const RenderParams& r) {
   if (!r.zoom_at.empty() && r.zoom_at.size() != 2)
     throw ConfigError("render.zoom_at: expected [u, v] (two numbers), got " + std::to_string(r.zoom_at.size()));
   if ((r.zoom != 1.f || !r.zoom_at.empty()) && (r.camera != "recorded" || r.view != "mesh"))
-    throw ConfigError("render.zoom and render.zoom_at magnify the recorded camera of the mesh view; they need "
-                      "render.camera: recorded and render.view: mesh (the mesh view's fixed camera has render.fov_y)");
+    throw ConfigError(
+        "render.zoom and render.zoom_at magnify the recorded camera of the mesh view; they need "
+        "render.camera: recorded and render.view: mesh (the mesh view's fixed camera has render.fov_y)");
 }
 
 int dry_run(const CommonOptions& o) {
   Experiment e = load_experiment(o.config, overrides(o));
   check_placements(e.spawn);
   check_render_zoom(e.render);
-  spdlog::info("{}: valid ({} spawn entries, input {}, device {})", o.config, e.spawn.size(), e.input.source,
-               e.device);
+  spdlog::info("{}: valid ({} spawn entries, input {}, device {})", o.config, e.spawn.size(), e.input.source, e.device);
   return 0;
 }
 
@@ -78,9 +78,10 @@ SdfGrid scene_sdf_grid(Volume& volume, const Mesh& mesh, const Experiment& e) {
 
 void log_escaped(const EscapedParticles& x, std::size_t dynamic) {
   if (x.total() == 0) return spdlog::info("physics: none of the {} dynamic particles left the scene", dynamic);
-  spdlog::warn("physics: {} of {} dynamic particles left the scene ({} below the floor, {} outside the scanned "
-               "region, {} still falling): holes in the scan (see docs/PLACEMENT.md, 'Physics on real scans')",
-               x.total(), dynamic, x.below_floor, x.outside, x.falling);
+  spdlog::warn(
+      "physics: {} of {} dynamic particles left the scene ({} below the floor, {} outside the scanned "
+      "region, {} still falling): holes in the scan (see docs/PLACEMENT.md, 'Physics on real scans')",
+      x.total(), dynamic, x.below_floor, x.outside, x.falling);
 }
 
 // The input's ground truth for ATE, when it has one: the scan writes it beside trajectory.txt in
@@ -106,8 +107,9 @@ int run(const CommonOptions& o) {
   check_render_zoom(e.render);
   check_render_camera(e.render);
   if (e.render.camera == "recorded" && e.input.source == "kinect" && e.mode != "live")
-    throw ConfigError("render.camera: recorded replays the input after the scan, which a live Kinect cannot; use "
-                "mode: live (each frame drawn from its own pose) or record first (`seamless record`)");
+    throw ConfigError(
+        "render.camera: recorded replays the input after the scan, which a live Kinect cannot; use "
+        "mode: live (each frame drawn from its own pose) or record first (`seamless record`)");
   auto renderer = RunRenderer::make(ctx);
   RunSummary summary;
   summary.command = "run", summary.config = o.config, summary.device = device_name(ctx.device());
@@ -122,8 +124,8 @@ int run(const CommonOptions& o) {
   summary.intrinsics = scan_result.intrinsics;
   add_tracking(summary, scan_result.tracking, scan_result.unreadable, groundtruth_path(ctx));
   if (const std::string gt = groundtruth_path(ctx); !gt.empty())
-    summary.ghost_vertices = ghost_vertices(scan_result.mesh, e.input, traj, read_tum_trajectory(gt),
-                                            2 * e.volume.voxel_size);
+    summary.ghost_vertices =
+        ghost_vertices(scan_result.mesh, e.input, traj, read_tum_trajectory(gt), 2 * e.volume.voxel_size);
   summary.online_refine = scan_result.online_refine;
   std::optional<SdfGrid> grid;
   if (e.solver.scene_collision == SceneCollision::sdf) grid = scene_sdf_grid(*scan_result.volume, scan_result.mesh, e);

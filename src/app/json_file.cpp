@@ -6,9 +6,7 @@
 
 namespace seamless::app {
 
-std::string json_text(const Json& doc) {
-  return doc.dump(2, ' ', false, Json::error_handler_t::replace) + '\n';
-}
+std::string json_text(const Json& doc) { return doc.dump(2, ' ', false, Json::error_handler_t::replace) + '\n'; }
 
 void write_json_file(const std::string& path, const Json& doc) {
   const std::string text = json_text(doc);

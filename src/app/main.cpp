@@ -1,6 +1,6 @@
 // The `seamless` command. Exit codes: app/exit_codes.hpp (README, "Exit codes and interrupted runs").
-#include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
 
 #include "app/bench.hpp"
 #include "app/commands.hpp"

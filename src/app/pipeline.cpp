@@ -6,16 +6,16 @@
 #include <cmath>
 #include <optional>
 
+#include "app/ghost.hpp"
+#include "app/placement.hpp"
+#include "app/render_stage.hpp"
+#include "app/run_summary.hpp"
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
 #include "core/progress.hpp"
 #include "io/frame_source.hpp"
-#include "app/ghost.hpp"
-#include "app/placement.hpp"
 #include "io/intrinsics_presets.hpp"
 #include "io/trajectory.hpp"
-#include "app/render_stage.hpp"
-#include "app/run_summary.hpp"
 #include "physics/builders.hpp"
 #include "physics/depth_colliders.hpp"
 #include "physics/particle_io.hpp"
@@ -60,10 +60,11 @@ RgbdFrame host_copy(const RgbdFrame& f) {
 }
 
 void log_volume(const VolumeStats& s) {
-  spdlog::info("volume: {} blocks of {} bytes ({:.1f} MiB voxels, {:.1f} MiB on the device), hash fill {:.1f}%, "
-               "{} failed insertions, {} retries",
-               s.allocated_blocks, s.bytes_per_block, s.voxel_bytes / 1048576.0, s.device_bytes / 1048576.0,
-               100 * s.hash_fill, s.failed_insertions, s.retries);
+  spdlog::info(
+      "volume: {} blocks of {} bytes ({:.1f} MiB voxels, {:.1f} MiB on the device), hash fill {:.1f}%, "
+      "{} failed insertions, {} retries",
+      s.allocated_blocks, s.bytes_per_block, s.voxel_bytes / 1048576.0, s.device_bytes / 1048576.0, 100 * s.hash_fill,
+      s.failed_insertions, s.retries);
 }
 
 // The intrinsics the frames arrive with (after undistortion), in the log and in the run's folder
@@ -98,7 +99,8 @@ ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
   TrackSequenceParams tp = tracking_params(e, volume_stages);
   std::unique_ptr<OnlineCorrector> online;  // refine.online: the keyframe graph solved while tracking runs
   if (e.refine.online) {
-    online = std::make_unique<OnlineCorrector>(e.refine, e.preprocess, source->intrinsics(), online_feedback(e.tracker));
+    online =
+        std::make_unique<OnlineCorrector>(e.refine, e.preprocess, source->intrinsics(), online_feedback(e.tracker));
     tp.corrector = online.get();
   }
   r.tracking = track_sequence(*source, tp, ctx.device(), ctx.out_dir(), r.volume.get(), on_frame);
@@ -108,9 +110,10 @@ ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
   }
   r.unreadable = source->skipped_frames();
   progress.finish();
-  spdlog::info("{} frames from {} ({} unreadable, skipped); {} lost by tracking; median track {:.3f} ms, frame {:.3f} ms",
-               r.tracking.frames.size(), source->name(), source->skipped_frames(), r.tracking.lost_frames,
-               r.tracking.median_track_ms, r.tracking.median_frame_ms);
+  spdlog::info(
+      "{} frames from {} ({} unreadable, skipped); {} lost by tracking; median track {:.3f} ms, frame {:.3f} ms",
+      r.tracking.frames.size(), source->name(), source->skipped_frames(), r.tracking.lost_frames,
+      r.tracking.median_track_ms, r.tracking.median_frame_ms);
   ctx.report_tracking(static_cast<std::int64_t>(r.tracking.frames.size()), r.tracking.lost_frames);
   if (r.volume) {
     log_volume(r.volume->stats());
@@ -136,8 +139,8 @@ class ReplayFrames {
       : source_(make_source(e.input, d)), traj_(*r.trajectory), start_(r.start) {
     const auto n = static_cast<std::int64_t>(traj_.size());
     if (start_ >= n)
-      throw ConfigError("render.replay_start is " + std::to_string(start_) + " but the scan tracked " + std::to_string(n) +
-                  " frames");
+      throw ConfigError("render.replay_start is " + std::to_string(start_) + " but the scan tracked " +
+                        std::to_string(n) + " frames");
     keep_ = n - start_ <= kMaxKept;
     for (std::int64_t k = 0; k < start_; ++k)
       if (!source_->next(frame_)) throw Error("the input ended before render.replay_start on the replay");
@@ -195,7 +198,8 @@ class SimulationLoop : public FrameLoop {
         steps_(static_cast<std::int64_t>(std::ceil(e_.duration / e_.solver.dt))),
         render_every_(std::max<std::int64_t>(1, std::llround(1.0 / (e_.render.fps * e_.solver.dt)))),
         replay_(replay ? std::make_unique<ReplayFrames>(e_, ctx.device(), *replay) : nullptr),
-        progress_(replay_ ? "replay" : "simulate", replay_ ? replay_->frames() : steps_, true, replay_ ? "fps" : "steps/s") {}
+        progress_(replay_ ? "replay" : "simulate", replay_ ? replay_->frames() : steps_, true,
+                  replay_ ? "fps" : "steps/s") {}
 
   std::int64_t steps() const { return steps_; }
   std::int64_t done_steps() const { return k_; }
@@ -263,10 +267,11 @@ SimulationResult simulate(RunContext& ctx, const std::vector<vec3>& scene_partic
   solver.schedule(e.spawn);  // checks the particle budget up front
   SimulationLoop loop(ctx, solver, renderer, replay);
   if (replay)
-    spdlog::info("replaying input frames {}..{} from their tracked poses, simulating in the recording's time "
-                 "(at least {:.2f} s) in steps of {} s on {} scene particles{}{}",
-                 replay->start, replay->trajectory->size() - 1, e.duration, e.solver.dt, scene_particles.size(),
-                 sdf ? ", analytic SDF primitives" : "", grid ? ", the TSDF sampled on a grid" : "");
+    spdlog::info(
+        "replaying input frames {}..{} from their tracked poses, simulating in the recording's time "
+        "(at least {:.2f} s) in steps of {} s on {} scene particles{}{}",
+        replay->start, replay->trajectory->size() - 1, e.duration, e.solver.dt, scene_particles.size(),
+        sdf ? ", analytic SDF primitives" : "", grid ? ", the TSDF sampled on a grid" : "");
   else
     spdlog::info("simulating {:.2f} s in {} steps of {} s on {} scene particles{}{}", e.duration, loop.steps(),
                  e.solver.dt, scene_particles.size(), sdf ? ", analytic SDF primitives" : "",
@@ -287,10 +292,11 @@ SimulationResult simulate(RunContext& ctx, const std::vector<vec3>& scene_partic
   write_particles_ply(ctx.out_path("particles.ply"), result.state);
   write_objects(ctx.out_path("objects.txt"), solver.objects());  // for `seamless render`
   SolverStats st = solver.stats();
-  spdlog::info("physics: {} particles ({} fluid, {} cloth, {} rigid in {} bodies), {} substeps/step, median {:.3f} ms "
-               "per step; neighbour overflow {} / {}",
-               st.particles, st.fluid_particles, st.cloth_particles, st.rigid_particles, st.rigid_bodies, st.substeps,
-               ctx.timer().median_ms("physics"), st.neighbour_overflow, st.static_neighbour_overflow);
+  spdlog::info(
+      "physics: {} particles ({} fluid, {} cloth, {} rigid in {} bodies), {} substeps/step, median {:.3f} ms "
+      "per step; neighbour overflow {} / {}",
+      st.particles, st.fluid_particles, st.cloth_particles, st.rigid_particles, st.rigid_bodies, st.substeps,
+      ctx.timer().median_ms("physics"), st.neighbour_overflow, st.static_neighbour_overflow);
   if (st.neighbour_overflow || st.static_neighbour_overflow)
     spdlog::warn("some particles had more neighbours than solver.max_neighbours / max_static_neighbours: raise them");
   return result;
@@ -305,8 +311,8 @@ class LiveLoop : public FrameLoop {
       : ctx_(ctx), e_(ctx.experiment()), renderer_(renderer), source_(make_source(e_.input, ctx.device())),
         volume_(make_volume(e_.volume, ctx.device())),
         session_(tracking_params(e_, volume_stages), ctx.device(), source_->intrinsics(), volume_.get()),
-        solver_(e_.solver, ctx.device()),
-        total_(e_.frames > 0 ? e_.frames : source_->size().value_or(0)), progress_("live", total_) {
+        solver_(e_.solver, ctx.device()), total_(e_.frames > 0 ? e_.frames : source_->size().value_or(0)),
+        progress_("live", total_) {
     solver_.schedule(e_.spawn);
     // An entry due with `place:` waits for the surface it is placed on (place_live).
     solver_.set_spawn_gate([this](int i, SpawnParams& sp) { return place_live(i, sp, pose_); });
@@ -318,8 +324,9 @@ class LiveLoop : public FrameLoop {
     sp_.spacing = e_.solver.particle_diameter;
     sp_.interior_depth = e_.scene_interior_depth;
     if (e_.solver.dynamic_colliders == DynamicColliders::depth && !e_.dynamic.enabled)
-      spdlog::warn("solver.dynamic_colliders: depth with dynamic.enabled false: no pixel is dynamic, so nothing "
-                   "from the camera collides");
+      spdlog::warn(
+          "solver.dynamic_colliders: depth with dynamic.enabled false: no pixel is dynamic, so nothing "
+          "from the camera collides");
     if (e_.solver.dynamic_colliders != DynamicColliders::none)
       colliders_.emplace(e_.solver.particle_diameter, e_.solver.collider_thickness, e_.solver.max_speed);
   }
@@ -389,8 +396,10 @@ class LiveLoop : public FrameLoop {
   void finish() {
     progress_.finish();
     if (solver_.pending_spawns())
-      spdlog::warn("live: {} spawn entries were never spawned (their time or their placement's surface never "
-                   "came)", solver_.pending_spawns());
+      spdlog::warn(
+          "live: {} spawn entries were never spawned (their time or their placement's surface never "
+          "came)",
+          solver_.pending_spawns());
     if (renderer_) finish_renderer(ctx_, *renderer_);
     if (online_) {
       traj_.reset();  // trajectory.txt complete under its name before it becomes trajectory_live.txt
@@ -431,8 +440,7 @@ class LiveLoop : public FrameLoop {
     const int w = vertices->width(), h = vertices->height();
     std::vector<std::uint8_t> mask;  // empty: every pixel (dynamic_colliders: all)
     if (e_.solver.dynamic_colliders == DynamicColliders::depth) mask = block_any(session_.dynamic_mask(), w, h);
-    colliders_->update(depth_surface(vertices->to_host(), normals->to_host(), w, h, world_T_camera, mask),
-                       frame_time);
+    colliders_->update(depth_surface(vertices->to_host(), normals->to_host(), w, h, world_T_camera, mask), frame_time);
   }
 
   // The full-resolution dynamic mask at a pyramid level's w x h: a level pixel is dynamic when
@@ -519,13 +527,13 @@ class LiveLoop : public FrameLoop {
   RgbdFrame frame_;
   std::int64_t fused_ = 0, tried_at_ = -1;
   double time_ = 0.0;
-  SE3 pose_ = SE3::identity();  // this frame's tracked pose (placements made while it steps)
-  std::optional<double> t0_;  // timestamp of the first fused frame
-  std::optional<MovingColliders> colliders_;  // solver.dynamic_colliders
-  std::vector<vec3> points_;  // the scene particles of the last extraction
-  Trajectory poses_;          // tracked so far (pixel placements)
-  Trajectory groundtruth_;    // the source's ground-truth poses of the same frames, where it has them
-  std::vector<SpawnParams> spawns_ = e_.spawn;       // with the live placements resolved
+  SE3 pose_ = SE3::identity();                  // this frame's tracked pose (placements made while it steps)
+  std::optional<double> t0_;                    // timestamp of the first fused frame
+  std::optional<MovingColliders> colliders_;    // solver.dynamic_colliders
+  std::vector<vec3> points_;                    // the scene particles of the last extraction
+  Trajectory poses_;                            // tracked so far (pixel placements)
+  Trajectory groundtruth_;                      // the source's ground-truth poses of the same frames, where it has them
+  std::vector<SpawnParams> spawns_ = e_.spawn;  // with the live placements resolved
   std::vector<ResolvedPlacement> placements_;
   bool finished_ = false;
 };

@@ -5,21 +5,21 @@
 
 #include "app/run_context.hpp"
 #include "io/frame_source.hpp"
+#include "kernels/physics/scene_sdf.hpp"
 #include "physics/particle_solver.hpp"
 #include "recon/refine/online_refine.hpp"
 #include "recon/tracker_sequence.hpp"
 #include "recon/volume.hpp"
-#include "kernels/physics/scene_sdf.hpp"
 
 namespace seamless::app {
 
 struct ScanResult {
   std::unique_ptr<Volume> volume;  // null when tracking only
   TrackSequenceResult tracking;
-  Mesh mesh;                       // marching cubes of the volume (empty when tracking only)
-  Intrinsics intrinsics{};         // of the frames (undistorted)
-  RgbdFrame first_frame;           // host copy of the first frame (the Kinect view's fixed camera)
-  std::int64_t unreadable = 0;     // frames the source skipped as unreadable
+  Mesh mesh;                                       // marching cubes of the volume (empty when tracking only)
+  Intrinsics intrinsics{};                         // of the frames (undistorted)
+  RgbdFrame first_frame;                           // host copy of the first frame (the Kinect view's fixed camera)
+  std::int64_t unreadable = 0;                     // frames the source skipped as unreadable
   std::optional<OnlineRefineStats> online_refine;  // refine.online; tracking.trajectory is then the final graph's
 };
 

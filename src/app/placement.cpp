@@ -12,9 +12,7 @@
 namespace seamless::app {
 namespace {
 
-std::string entry_name(int i, const SpawnParams& s) {
-  return "spawn[" + std::to_string(i) + "] (" + s.kind + ")";
-}
+std::string entry_name(int i, const SpawnParams& s) { return "spawn[" + std::to_string(i) + "] (" + s.kind + ")"; }
 
 std::string fmt_vec(vec3 v) {
   char buf[64];
@@ -30,11 +28,11 @@ vec3 pixel_point(int i, const SpawnParams& s, const PlacementScene& scene) {
   if (!scene.volume || !scene.trajectory) throw Error(who + ": a pixel pick needs the scan's volume and trajectory");
   if (pl.frame >= static_cast<int>(scene.trajectory->size()))
     throw ConfigError(who + ".frame is " + std::to_string(pl.frame) + " but the scan has " +
-                std::to_string(scene.trajectory->size()) + " frames");
+                      std::to_string(scene.trajectory->size()) + " frames");
   const int u = pl.pixel[0], v = pl.pixel[1];
   if (u >= scene.K.width || v >= scene.K.height)
     throw ConfigError(who + ".pixel (" + std::to_string(u) + ", " + std::to_string(v) + ") is outside the " +
-                std::to_string(scene.K.width) + "x" + std::to_string(scene.K.height) + " image");
+                      std::to_string(scene.K.width) + "x" + std::to_string(scene.K.height) + " image");
   const SE3 pose = (*scene.trajectory)[pl.frame].se3();
   RaycastMaps maps = scene.volume->raycast(scene.K, pose);
   const std::vector<float> depth = maps.depth.to_host();
@@ -44,8 +42,8 @@ vec3 pixel_point(int i, const SpawnParams& s, const PlacementScene& scene) {
     std::size_t hits = 0;
     for (float d : depth) hits += d > 0.f;
     throw Error(who + ": pixel (" + std::to_string(u) + ", " + std::to_string(v) + ") of frame " +
-                std::to_string(pl.frame) + " sees no scanned surface (" +
-                std::to_string(100 * hits / depth.size()) + "% of that view does; pick a pixel on the scan)");
+                std::to_string(pl.frame) + " sees no scanned surface (" + std::to_string(100 * hits / depth.size()) +
+                "% of that view does; pick a pixel on the scan)");
   }
   return vertex[at];
 }
@@ -107,7 +105,10 @@ std::pair<std::size_t, std::size_t> overlap(const SpawnParams& s, const SolverPa
           auto it = grid.find(key(x + vec3{dx * cell, dy * cell, dz * cell}));
           if (it == grid.end()) continue;
           for (vec3 q : it->second)
-            if (length(q - x) < r) { hit = true; break; }
+            if (length(q - x) < r) {
+              hit = true;
+              break;
+            }
         }
     inside += hit;
   }
@@ -127,7 +128,8 @@ void check_placements(const std::vector<SpawnParams>& spawns) {
     if (!pl.offset.empty() && pl.offset.size() != 2)
       throw ConfigError(who + ".offset: expected [x, z] (two numbers), got " + std::to_string(pl.offset.size()));
     if (!pl.offset.empty() && pl.on == "none")
-      throw ConfigError(who + ".offset moves an `on:` placement across its surface; it needs `on: support` or `on: floor`");
+      throw ConfigError(who +
+                        ".offset moves an `on:` placement across its surface; it needs `on: support` or `on: floor`");
   }
 }
 
@@ -148,8 +150,8 @@ ResolvedPlacement resolve_placement(int i, SpawnParams& s, const SolverParams& s
   } else {
     const HorizontalSurface& f = surface_pick(i, s, scene);
     r.surface_point = s.place.offset.empty() ? f.centre : offset_point(i, s, f, scene.up);
-    r.how = "on " + s.place.on + (s.place.on == "support" ? " " + std::to_string(s.place.index) : "") + ": " +
-            describe(f);
+    r.how =
+        "on " + s.place.on + (s.place.on == "support" ? " " + std::to_string(s.place.index) : "") + ": " + describe(f);
   }
   r.position = r.surface_point + normalize(scene.up) * s.place.above;
   s.position = r.position;

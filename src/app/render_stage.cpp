@@ -82,10 +82,7 @@ class RunDrawState {
 class GlRunRenderer : public RunRenderer {
  public:
   explicit GlRunRenderer(RunContext& ctx)
-      : ctx_(ctx),
-        p_(ctx.experiment().render),
-        renderer_(p_, p_.width, p_.height),
-        out_(ctx.out_dir(), p_) {
+      : ctx_(ctx), p_(ctx.experiment().render), renderer_(p_, p_.width, p_.height), out_(ctx.out_dir(), p_) {
     spdlog::info("rendering {}x{} {} view with {} ({})", p_.width, p_.height, p_.view, renderer_.gl_info().renderer,
                  renderer_.gl_info().version);
 #if SEAMLESS_HAS_CUDA
@@ -205,9 +202,12 @@ class WindowRunRenderer : public RunRenderer {
       return draw_state_.host_list(loop.solver());
     };
     if (const int n = ctx_.window_frames(); n > 0)  // Esc before frame n-1: n frames are shown
-      cb.scripted_keys = [n](int frame) { return frame == n - 1 ? std::vector<int>{GLFW_KEY_ESCAPE} : std::vector<int>{}; };
-    spdlog::info("window: Space pause, N single step, G spawn the next object, 1-5 layers, F fluid style, "
-                 "V mesh/Kinect view, C orbit/fly, drag/wheel/WASDQE move, Esc quit");
+      cb.scripted_keys = [n](int frame) {
+        return frame == n - 1 ? std::vector<int>{GLFW_KEY_ESCAPE} : std::vector<int>{};
+      };
+    spdlog::info(
+        "window: Space pause, N single step, G spawn the next object, 1-5 layers, F fluid style, "
+        "V mesh/Kinect view, C orbit/fly, drag/wheel/WASDQE move, Esc quit");
     run_window(e.render, "seamless: " + e.name, cb, start_view());
     spdlog::info("window closed after {} frames{}", shown, running ? ", before the run was complete" : "");
   }
@@ -246,7 +246,9 @@ class WindowRunRenderer : public RunRenderer {
 std::string no_window_reason() {
   if (!std::getenv("DISPLAY") && !std::getenv("WAYLAND_DISPLAY"))
     return "no display (DISPLAY and WAYLAND_DISPLAY are unset; over ssh use ssh -X, or run under xvfb-run)";
-  if (!window_available()) return "GLFW cannot connect to the display '" + std::string(std::getenv("DISPLAY") ? std::getenv("DISPLAY") : "") + "'";
+  if (!window_available())
+    return "GLFW cannot connect to the display '" + std::string(std::getenv("DISPLAY") ? std::getenv("DISPLAY") : "") +
+           "'";
   return "";
 }
 #endif
@@ -270,9 +272,10 @@ std::unique_ptr<RunRenderer> RunRenderer::make(RunContext& ctx) {
   }
   return std::make_unique<GlRunRenderer>(ctx);
 #else
-  spdlog::warn("render.mode is {} but this build has no renderer (GL module off: apt-get install libegl-dev "
-               "libgl-dev libepoxy-dev); continuing without pictures",
-               p.mode);
+  spdlog::warn(
+      "render.mode is {} but this build has no renderer (GL module off: apt-get install libegl-dev "
+      "libgl-dev libepoxy-dev); continuing without pictures",
+      p.mode);
   return nullptr;
 #endif
 }

@@ -52,7 +52,8 @@ void prepare_output_folder(const std::string& out, bool force, const std::vector
     if (fs::exists(fs::path(out) / m)) found += (found.empty() ? "" : ", ") + m;
   if (found.empty()) return;
   if (!force)
-    throw UsageError("the output folder " + out + " holds an earlier run (" + found + "); choose another --out, or add "
+    throw UsageError("the output folder " + out + " holds an earlier run (" + found +
+                     "); choose another --out, or add "
                      "--force to clear it first");
   std::vector<fs::path> entries;
   for (const auto& entry : fs::directory_iterator(out)) entries.push_back(entry.path());
@@ -77,8 +78,7 @@ RunContext::RunContext(const CommonOptions& o, Experiment e) : exp_(std::move(e)
   install_interrupt_handlers();
 
   std::string gpu = device_ == Device::CUDA ? " (" + cuda_device_description() + ")" : "";
-  spdlog::info("experiment '{}' from {}, device {}{}, output {}", exp_.name, o.config, device_name(device_), gpu,
-               out_);
+  spdlog::info("experiment '{}' from {}, device {}{}, output {}", exp_.name, o.config, device_name(device_), gpu, out_);
 }
 
 void RunContext::report_tracking(std::int64_t frames, std::int64_t lost) {
@@ -86,10 +86,11 @@ void RunContext::report_tracking(std::int64_t frames, std::int64_t lost) {
   const double fraction = static_cast<double>(lost) / static_cast<double>(frames);
   if (fraction <= exp_.output.max_lost_fraction) return;
   exit_code_ = kExitLostFrames;
-  spdlog::error("tracking lost {} of {} frames ({:.0f}%), more than output.max_lost_fraction = {}: the trajectory and "
-                "the model are not to be trusted (exit code {}). tracking_stats.csv says why each frame was lost; "
-                "check input.depth_scale (TUM: 5000, millimetres: 1000), input.intrinsics and the tracker section",
-                lost, frames, 100 * fraction, exp_.output.max_lost_fraction, kExitLostFrames);
+  spdlog::error(
+      "tracking lost {} of {} frames ({:.0f}%), more than output.max_lost_fraction = {}: the trajectory and "
+      "the model are not to be trusted (exit code {}). tracking_stats.csv says why each frame was lost; "
+      "check input.depth_scale (TUM: 5000, millimetres: 1000), input.intrinsics and the tracker section",
+      lost, frames, 100 * fraction, exp_.output.max_lost_fraction, kExitLostFrames);
 }
 
 void RunContext::report_output_failure(const std::string& what) {

@@ -23,8 +23,8 @@ struct CommonOptions {
   std::string out;                // --out; default <output.dir>/<config stem>-<time>
   std::string device;             // --device; overrides the config's device
   bool dry_run = false;
-  bool force = false;             // --force: clear an output folder that holds an earlier run
-  int window_frames = 0;          // run --window-frames: close the window after this many frames
+  bool force = false;     // --force: clear an output folder that holds an earlier run
+  int window_frames = 0;  // run --window-frames: close the window after this many frames
 };
 
 // The config overrides of the options, in order: every --set, then --device as device=...

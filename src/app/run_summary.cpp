@@ -35,8 +35,7 @@ EscapedParticles count_escaped(const ParticleState& s, const SceneBounds& b, flo
     else if (x.x < b.lo.x - margin || x.y < b.lo.y - margin || x.z < b.lo.z - margin || x.x > b.hi.x + margin ||
              x.y > b.hi.y + margin || x.z > b.hi.z + margin)
       ++e.outside;
-    else if (-dot(s.v[i], up) > kFallSpeed)
-      ++e.falling;
+    else if (-dot(s.v[i], up) > kFallSpeed) ++e.falling;
   }
   return e;
 }
@@ -81,11 +80,18 @@ Json median_max(const std::vector<double>& v) {
 // refine.online: the tracking thread's time per frame (handover_ms) and the background's per
 // keyframe and per Ceres solve (docs/OUTPUTS.md).
 Json online_json(const OnlineRefineStats& o) {
-  return {{"keyframes", o.keyframes}, {"solves", o.solves}, {"corrections", o.corrections},
-          {"pair_edges", o.pair_edges}, {"rejected_pairs", o.rejected_pairs}, {"candidate_pairs", o.candidate_pairs},
-          {"max_correction_m", o.max_correction_m}, {"max_correction_deg", o.max_correction_deg},
-          {"handover_ms", median_max(o.handover_ms)}, {"keyframe_s", median_max(o.keyframe_s)},
-          {"solve_s", median_max(o.solve_s)}, {"final_wait_s", o.final_wait_s}};
+  return {{"keyframes", o.keyframes},
+          {"solves", o.solves},
+          {"corrections", o.corrections},
+          {"pair_edges", o.pair_edges},
+          {"rejected_pairs", o.rejected_pairs},
+          {"candidate_pairs", o.candidate_pairs},
+          {"max_correction_m", o.max_correction_m},
+          {"max_correction_deg", o.max_correction_deg},
+          {"handover_ms", median_max(o.handover_ms)},
+          {"keyframe_s", median_max(o.keyframe_s)},
+          {"solve_s", median_max(o.solve_s)},
+          {"final_wait_s", o.final_wait_s}};
 }
 }  // namespace
 
@@ -96,10 +102,11 @@ void write_summary(const std::string& path, const RunSummary& s) {
   j["command"] = s.command, j["config"] = s.config, j["device"] = s.device;
   if (s.intrinsics) {
     const Intrinsics& K = *s.intrinsics;
-    j["intrinsics"] = {{"fx", K.fx}, {"fy", K.fy}, {"cx", K.cx}, {"cy", K.cy}, {"width", K.width}, {"height", K.height}};
+    j["intrinsics"] = {{"fx", K.fx}, {"fy", K.fy},       {"cx", K.cx},
+                       {"cy", K.cy}, {"width", K.width}, {"height", K.height}};
   }
-  j["frames"] = {{"read", s.frames_read}, {"lost", s.frames_lost}, {"fused", s.frames_fused},
-                 {"unreadable", s.frames_unreadable}};
+  j["frames"] = {
+      {"read", s.frames_read}, {"lost", s.frames_lost}, {"fused", s.frames_fused}, {"unreadable", s.frames_unreadable}};
   if (s.ate_rmse_m) j["ate"] = {{"rmse_m", *s.ate_rmse_m}, {"pairs", s.ate_pairs}};
   if (s.dynamic_masked_fraction || s.ghost_vertices) {
     Json& d = j["dynamic"] = Json::object();
@@ -110,8 +117,11 @@ void write_summary(const std::string& path, const RunSummary& s) {
   Json& surfaces = j["surfaces"] = Json::array();
   for (std::size_t i = 0; i < s.surfaces.size() && i < 10; ++i) {
     const HorizontalSurface& h = s.surfaces[i];
-    surfaces.push_back({{"area_m2", h.area}, {"height", h.height}, {"centre", vec_json(h.centre)},
-                        {"open_radius", h.open_radius}, {"floor", h.floor}});
+    surfaces.push_back({{"area_m2", h.area},
+                        {"height", h.height},
+                        {"centre", vec_json(h.centre)},
+                        {"open_radius", h.open_radius},
+                        {"floor", h.floor}});
   }
   Json& spawns = j["spawns"] = Json::array();
   for (std::size_t i = 0; i < s.spawns.size(); ++i) {
@@ -123,9 +133,15 @@ void write_summary(const std::string& path, const RunSummary& s) {
   }
   if (s.physics) {
     const SolverStats& p = *s.physics;
-    Json ph = {{"dynamic", p.particles}, {"fluid", p.fluid_particles}, {"cloth", p.cloth_particles},
-               {"rigid", p.rigid_particles}, {"rigid_bodies", p.rigid_bodies}, {"static", p.static_particles},
-               {"simulated_s", p.time}, {"steps", p.steps}, {"neighbour_overflow", p.neighbour_overflow},
+    Json ph = {{"dynamic", p.particles},
+               {"fluid", p.fluid_particles},
+               {"cloth", p.cloth_particles},
+               {"rigid", p.rigid_particles},
+               {"rigid_bodies", p.rigid_bodies},
+               {"static", p.static_particles},
+               {"simulated_s", p.time},
+               {"steps", p.steps},
+               {"neighbour_overflow", p.neighbour_overflow},
                {"emitter_dropped", p.emitter_dropped}};
     if (s.escaped) {
       ph["escaped"] = s.escaped->total(), ph["escaped_below_floor"] = s.escaped->below_floor;

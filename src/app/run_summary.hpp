@@ -35,15 +35,15 @@ struct RunSummary {
   std::string command, config, device;
   std::optional<Intrinsics> intrinsics;
   std::int64_t frames_read = 0, frames_lost = 0, frames_fused = 0, frames_unreadable = 0;
-  std::optional<double> ate_rmse_m;    // against the input's ground truth, when it has one
+  std::optional<double> ate_rmse_m;  // against the input's ground truth, when it has one
   std::int64_t ate_pairs = 0;
   std::optional<double> dynamic_masked_fraction;  // dynamic.enabled: mean over the tracked frames
-  std::optional<std::int64_t> ghost_vertices;    // synthetic movers: what they left in the map (app/ghost.hpp)
+  std::optional<std::int64_t> ghost_vertices;     // synthetic movers: what they left in the map (app/ghost.hpp)
   std::vector<ResolvedPlacement> placements;
-  std::vector<SpawnParams> spawns;     // as resolved
+  std::vector<SpawnParams> spawns;  // as resolved
   std::optional<SolverStats> physics;
   std::optional<EscapedParticles> escaped;
-  std::optional<float> floor_height;   // of the floor found in the scan (along up), when one was seen
+  std::optional<float> floor_height;        // of the floor found in the scan (along up), when one was seen
   std::vector<HorizontalSurface> surfaces;  // the scan's horizontal surfaces, largest first
   std::vector<std::pair<std::string, double>> stage_median_ms;
   std::optional<OnlineRefineStats> online_refine;  // refine.online: its cost and what it did
@@ -53,8 +53,7 @@ struct RunSummary {
 // dynamic.enabled: the mean fraction of pixels masked as dynamic over the frames that have a mask.
 std::optional<double> mean_dynamic_fraction(const std::vector<FrameRecord>& frames);
 
-void add_tracking(RunSummary& s, const TrackSequenceResult& r, std::int64_t unreadable,
-                  const std::string& groundtruth);
+void add_tracking(RunSummary& s, const TrackSequenceResult& r, std::int64_t unreadable, const std::string& groundtruth);
 // The medians of every stage in the run's timer.
 void add_stage_medians(RunSummary& s, const StageTimer& t);
 // Writes summary.json (as NAME.partial, then renamed: a reader never sees half a file).

@@ -17,7 +17,7 @@ YAML::Node parse_yaml(const std::string& text, const std::string& source) {
     return YAML::Load(text);
   } catch (const YAML::ParserException& e) {
     throw ConfigError(source + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
-                ": YAML syntax error: " + e.msg);
+                      ": YAML syntax error: " + e.msg);
   }
 }
 
@@ -47,7 +47,6 @@ void Experiment::validate() const {
   if (solver.dynamic_colliders != DynamicColliders::none && mode != "live")
     throw ConfigError("solver.dynamic_colliders: " + std::string(enum_name(solver.dynamic_colliders)) +
                       " needs mode: live (the colliders are each frame's depth points while the camera runs)");
-
 }
 
 Experiment load_experiment(const std::string& path, const std::vector<std::string>& overrides) {
@@ -73,7 +72,8 @@ std::string write_effective_config(const Experiment& e, const std::string& path)
   std::ofstream out(partial_path(file.string()));
   out << to_yaml(e);
   out.close();
-  if (!out) throw Error("cannot write the effective config to '" + file.string() + "' (is the output folder writable?)");
+  if (!out)
+    throw Error("cannot write the effective config to '" + file.string() + "' (is the output folder writable?)");
   commit_partial(file.string());
   return file.string();
 }

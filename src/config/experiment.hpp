@@ -20,12 +20,12 @@ namespace seamless {
 // What a run writes into its output folder.
 struct OutputParams {
   std::string dir = "out";
-  bool write_config = true;       // effective config (every key, after --set) as config.yaml
-  bool write_mesh = true;         // mesh.ply (marching cubes, with colour)
-  bool write_trajectory = true;   // trajectory.txt, TUM format
-  bool write_timings = true;      // timings.csv, one row per frame and stage
-  bool write_stats = true;        // tracking_stats.csv: per-frame residual, inliers, timings
-  int particles_every = 25;       // write particles_<step>.ply every this many solver steps; 0 = only the last
+  bool write_config = true;        // effective config (every key, after --set) as config.yaml
+  bool write_mesh = true;          // mesh.ply (marching cubes, with colour)
+  bool write_trajectory = true;    // trajectory.txt, TUM format
+  bool write_timings = true;       // timings.csv, one row per frame and stage
+  bool write_stats = true;         // tracking_stats.csv: per-frame residual, inliers, timings
+  int particles_every = 25;        // write particles_<step>.ply every this many solver steps; 0 = only the last
   double max_lost_fraction = 0.2;  // a run whose tracking loses more of its frames exits with code 6
 
   template <class V> void visit(V& v) {
@@ -48,11 +48,11 @@ struct Experiment {
   std::string name = "experiment";
   std::string device = "auto";
   std::string mode = "live";
-  std::int64_t frames = 0;        // 0 = as many as the input gives
-  double duration = 3.0;          // simulated seconds after the scan (scan_then_simulate)
-  bool floor_plane = true;        // scan_then_simulate: an infinite floor under the scanned floor
+  std::int64_t frames = 0;           // 0 = as many as the input gives
+  double duration = 3.0;             // simulated seconds after the scan (scan_then_simulate)
+  bool floor_plane = true;           // scan_then_simulate: an infinite floor under the scanned floor
   float scene_interior_depth = 0.f;  // scene particles also fill the solid this deep below the surface
-  int reextract_every = 10;       // live mode: scene particles re-extracted every this many fused frames
+  int reextract_every = 10;          // live mode: scene particles re-extracted every this many fused frames
   InputParams input;
   PreprocessParams preprocess;
   VolumeParams volume;
@@ -70,12 +70,12 @@ struct Experiment {
 
   template <class V> void visit(V& v) {
     v("name", name, "experiment name (used in logs and output names)");
-    v("device", device, "compute backend (auto: CUDA when built and a GPU is present)",
-      Choices{"cpu", "cuda", "auto"});
+    v("device", device, "compute backend (auto: CUDA when built and a GPU is present)", Choices{"cpu", "cuda", "auto"});
     v("mode", mode, "reconstruct and simulate at once, or scan first then simulate",
       Choices{"live", "scan_then_simulate"});
     v("frames", frames, "frames to process; 0 = all the input has", Range{0, 1e12});
-    v("floor_plane", floor_plane, "collide with an infinite plane at the scanned floor's height (unseen floor "
+    v("floor_plane", floor_plane,
+      "collide with an infinite plane at the scanned floor's height (unseen floor "
       "would otherwise let objects fall through)");
     v("scene_interior_depth", scene_interior_depth,
       "scene particles also fill the scanned solid this deep below its surface (metres; 0: surface only). A "
@@ -88,7 +88,8 @@ struct Experiment {
     v("preprocess", preprocess, "depth filtering, pyramid, vertex and normal maps");
     v("volume", volume, "TSDF volume");
     v("tracker", tracker, "camera tracking");
-    v("dynamic", dynamic, "people and moving objects: kept out of tracking and fusion, free space carved (docs/DYNAMIC.md)");
+    v("dynamic", dynamic,
+      "people and moving objects: kept out of tracking and fusion, free space carved (docs/DYNAMIC.md)");
     v("refine", refine, "offline keyframe pose-graph refinement of the tracked trajectory (Ceres)");
     v("solver", solver, "particle solver");
     v("spawn", spawn, "what to drop into the scene and when (list)");

@@ -20,8 +20,8 @@ bool is_plain_safe(const std::string& s) {
   if (s.empty() || s == "~" || s == "null" || s == "Null" || s == "NULL") return false;
   if (s.front() == '-' || s.front() == '.' || s.front() == ' ' || s.back() == ' ') return false;
   for (char ch : s) {
-    bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') ||
-              ch == '_' || ch == '.' || ch == '/' || ch == '-' || ch == '+';
+    bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '_' ||
+              ch == '.' || ch == '/' || ch == '-' || ch == '+';
     if (!ok) return false;
   }
   return true;
@@ -62,9 +62,7 @@ std::string format_vec3(vec3 v) {
 }
 
 std::string constraint_text() { return ""; }
-std::string constraint_text(const Range& r) {
-  return " [" + format_number(r.lo) + ", " + format_number(r.hi) + "]";
-}
+std::string constraint_text(const Range& r) { return " [" + format_number(r.lo) + ", " + format_number(r.hi) + "]"; }
 std::string constraint_text(const Choices& c) {
   std::string s = " (";
   for (std::size_t i = 0; i < c.values.size(); ++i) s += (i ? " | " : "") + c.values[i];

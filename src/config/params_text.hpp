@@ -20,17 +20,24 @@ namespace seamless::config {
 struct ProbeVisitor {
   template <class... A> void operator()(A&&...) {}
 };
-template <class T> concept Visitable = requires(T& t, ProbeVisitor& p) { t.visit(p); };
-template <class T> concept Integer = std::integral<T> && !std::same_as<T, bool>;
+template <class T>
+concept Visitable = requires(T& t, ProbeVisitor& p) {
+  t.visit(p);
+};
+template <class T>
+concept Integer = std::integral<T> && !std::same_as<T, bool>;
 // A leaf is one YAML value: a scalar (a named enum is a string from its table), or vec3 as a
 // 3-element sequence.
-template <class T> concept Leaf = std::same_as<T, bool> || Integer<T> || std::floating_point<T> ||
-                                  std::same_as<T, std::string> || std::same_as<T, vec3> || NamedEnum<T>;
+template <class T>
+concept Leaf = std::same_as<T, bool> || Integer<T> || std::floating_point<T> || std::same_as<T, std::string> ||
+    std::same_as<T, vec3> || NamedEnum<T>;
 
 template <class T> struct VectorOf { using type = void; };
 template <class T> struct VectorOf<std::vector<T>> { using type = T; };
-template <class T> concept LeafVector = Leaf<typename VectorOf<T>::type>;
-template <class T> concept SectionVector = Visitable<typename VectorOf<T>::type>;
+template <class T>
+concept LeafVector = Leaf<typename VectorOf<T>::type>;
+template <class T>
+concept SectionVector = Visitable<typename VectorOf<T>::type>;
 
 // "float", "int64", "list of int", ... for docs and error messages.
 template <class T> std::string type_name() {
@@ -131,9 +138,9 @@ template <class P> std::string params_to_yaml(const P& p) {
 // ---- Key lister -------------------------------------------------------------------------------
 
 struct KeyInfo {
-  std::string path;        // "volume.voxel_size"; list elements as "spawn[].kind"
-  std::string type;        // "float", "section", "list of int", ...
-  std::string value;       // default (or current) value as YAML text; empty for sections
+  std::string path;   // "volume.voxel_size"; list elements as "spawn[].kind"
+  std::string type;   // "float", "section", "list of int", ...
+  std::string value;  // default (or current) value as YAML text; empty for sections
   std::string doc;
   std::string constraint;  // "[0.0005, 1]", "(hash | dense)" or empty
 };

@@ -126,8 +126,9 @@ bool parse_bool(const std::string& s, bool& out) {
 
 void check_constraint(LoadContext& ctx, const YAML::Node& n, const std::string& path, double v, const Range& r) {
   if (v >= r.lo && v <= r.hi) return;
-  ctx.error(n, path, "out of range: got " + describe(n) + ", expected a value in [" + format_number(r.lo) + ", " +
-                         format_number(r.hi) + "]");
+  ctx.error(n, path,
+            "out of range: got " + describe(n) + ", expected a value in [" + format_number(r.lo) + ", " +
+                format_number(r.hi) + "]");
 }
 
 void check_constraint(LoadContext& ctx, const YAML::Node& n, const std::string& path, float v, const Range& r) {
@@ -135,8 +136,9 @@ void check_constraint(LoadContext& ctx, const YAML::Node& n, const std::string& 
   // bounds when they are passed through a helper, so the rounding must not rely on that.)
   const float lo = static_cast<float>(r.lo), hi = static_cast<float>(r.hi);
   if (v >= lo && v <= hi) return;
-  ctx.error(n, path, "out of range: got " + describe(n) + ", expected a value in [" + format_number(r.lo) + ", " +
-                         format_number(r.hi) + "]");
+  ctx.error(n, path,
+            "out of range: got " + describe(n) + ", expected a value in [" + format_number(r.lo) + ", " +
+                format_number(r.hi) + "]");
 }
 
 void check_constraint(LoadContext& ctx, const YAML::Node& n, const std::string& path, const std::string& v,
@@ -181,7 +183,8 @@ void LoadContext::unknown_key(const YAML::Node& key, const std::string& path, co
       }
     }
   }
-  std::string section = path.size() > name.size() ? "'" + path.substr(0, path.size() - name.size() - 1) + "'" : "the top level";
+  std::string section =
+      path.size() > name.size() ? "'" + path.substr(0, path.size() - name.size() - 1) + "'" : "the top level";
   what += " (keys of " + section + ": " + join(known, ", ", known.size()) + ")";
   error(key, path, what);
 }
@@ -203,7 +206,8 @@ SectionReader::SectionReader(LoadContext& ctx, const YAML::Node& map, std::strin
     : ctx_(ctx), path_(std::move(path)) {
   for (auto it = map.begin(); it != map.end(); ++it) {
     if (!it->first.IsScalar()) {
-      ctx_.error(it->first, path_.empty() ? "(top level)" : path_, "keys must be plain names, got " + describe(it->first));
+      ctx_.error(it->first, path_.empty() ? "(top level)" : path_,
+                 "keys must be plain names, got " + describe(it->first));
       continue;
     }
     std::string name = it->first.Scalar();

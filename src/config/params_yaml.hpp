@@ -24,8 +24,7 @@ struct Override {
 // Collects the problems found while loading one config; throws them all at once.
 class LoadContext {
  public:
-  explicit LoadContext(std::string source, std::vector<Override> overrides = {},
-                       std::vector<KeyInfo> schema = {})
+  explicit LoadContext(std::string source, std::vector<Override> overrides = {}, std::vector<KeyInfo> schema = {})
       : source_(std::move(source)), overrides_(std::move(overrides)), schema_(std::move(schema)) {}
 
   // Records "where: path: what" with where = file:line:column or (from --set ...).
@@ -90,8 +89,8 @@ void check_constraint(LoadContext& ctx, const YAML::Node& n, const std::string& 
 void check_constraint(LoadContext& ctx, const YAML::Node& n, const std::string& path, const std::string& v,
                       const Choices& c);
 
-template <class T> bool read_scalar_text(LoadContext& ctx, const YAML::Node& n, const std::string& path,
-                                         std::string& text) {
+template <class T>
+bool read_scalar_text(LoadContext& ctx, const YAML::Node& n, const std::string& path, std::string& text) {
   if (n.IsScalar()) {
     text = n.Scalar();
     return true;
@@ -182,8 +181,7 @@ class SectionReader {
 template <class P> void read_section(LoadContext& ctx, const YAML::Node& n, const std::string& path, P& p) {
   if (!n || n.IsNull()) return;  // `section:` with nothing under it keeps the defaults
   if (!n.IsMap()) {
-    ctx.error(n, path.empty() ? "(top level)" : path,
-              "expected a section (a map of key: value), got " + describe(n));
+    ctx.error(n, path.empty() ? "(top level)" : path, "expected a section (a map of key: value), got " + describe(n));
     return;
   }
   SectionReader reader(ctx, n, path);
@@ -201,9 +199,10 @@ void read_field(LoadContext& ctx, const YAML::Node& n, const std::string& path, 
       return;
     }
     if (!n.IsSequence()) {
-      ctx.error(n, path, "expected a list ([...] or '- ' items) of " +
-                             std::string(SectionVector<T> ? "sections" : type_name<typename VectorOf<T>::type>()) +
-                             ", got " + describe(n));
+      ctx.error(n, path,
+                "expected a list ([...] or '- ' items) of " +
+                    std::string(SectionVector<T> ? "sections" : type_name<typename VectorOf<T>::type>()) + ", got " +
+                    describe(n));
       return;
     }
     T result;

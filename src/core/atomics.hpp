@@ -7,8 +7,7 @@
 
 namespace seamless {
 
-template <class T>
-SEAMLESS_HD inline T atomic_add(T* p, T v) {
+template <class T> SEAMLESS_HD inline T atomic_add(T* p, T v) {
 #ifdef __CUDA_ARCH__
   return atomicAdd(p, v);
 #else
@@ -17,8 +16,7 @@ SEAMLESS_HD inline T atomic_add(T* p, T v) {
 }
 
 // Returns the old value; stores desired only if *p == expected.
-template <class T>
-SEAMLESS_HD inline T atomic_cas(T* p, T expected, T desired) {
+template <class T> SEAMLESS_HD inline T atomic_cas(T* p, T expected, T desired) {
 #ifdef __CUDA_ARCH__
   return atomicCAS(p, expected, desired);
 #else
@@ -27,8 +25,7 @@ SEAMLESS_HD inline T atomic_cas(T* p, T expected, T desired) {
 #endif
 }
 
-template <class T>
-SEAMLESS_HD inline T atomic_exch(T* p, T v) {
+template <class T> SEAMLESS_HD inline T atomic_exch(T* p, T v) {
 #ifdef __CUDA_ARCH__
   return atomicExch(p, v);
 #else
@@ -36,8 +33,7 @@ SEAMLESS_HD inline T atomic_exch(T* p, T v) {
 #endif
 }
 
-template <class T>
-SEAMLESS_HD inline T atomic_max(T* p, T v) {
+template <class T> SEAMLESS_HD inline T atomic_max(T* p, T v) {
 #ifdef __CUDA_ARCH__
   return atomicMax(p, v);
 #else
@@ -49,8 +45,7 @@ SEAMLESS_HD inline T atomic_max(T* p, T v) {
 #endif
 }
 
-template <class T>
-SEAMLESS_HD inline T atomic_min(T* p, T v) {
+template <class T> SEAMLESS_HD inline T atomic_min(T* p, T v) {
 #ifdef __CUDA_ARCH__
   return atomicMin(p, v);
 #else
@@ -62,8 +57,7 @@ SEAMLESS_HD inline T atomic_min(T* p, T v) {
 #endif
 }
 
-template <class T>
-SEAMLESS_HD inline T atomic_load(const T* p) {
+template <class T> SEAMLESS_HD inline T atomic_load(const T* p) {
 #ifdef __CUDA_ARCH__
   return *static_cast<const volatile T*>(p);
 #else

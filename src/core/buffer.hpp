@@ -31,8 +31,7 @@ std::size_t peak_bytes(Device d);    // the most bytes_in_use(d) has been since 
 void reset_peak(Device d);           // the peak starts again from the bytes in use now
 }  // namespace memory
 
-template <class T>
-class Buffer {
+template <class T> class Buffer {
   static_assert(std::is_trivially_copyable_v<T>, "Buffer holds plain data only");
 
  public:
@@ -105,8 +104,7 @@ class Buffer {
   std::int64_t size_ = 0;
 };
 
-template <class T>
-class Image {
+template <class T> class Image {
  public:
   Image() = default;
   Image(int w, int h, Device d) : buf_(static_cast<std::int64_t>(w) * h, d), w_(w), h_(h) {}

@@ -20,10 +20,12 @@ struct Intrinsics {
   SEAMLESS_HD Intrinsics level(int lvl) const {
     Intrinsics k = *this;
     for (int i = 0; i < lvl; ++i) {
-      k.fx *= 0.5f; k.fy *= 0.5f;
+      k.fx *= 0.5f;
+      k.fy *= 0.5f;
       k.cx = (k.cx + 0.5f) * 0.5f - 0.5f;
       k.cy = (k.cy + 0.5f) * 0.5f - 0.5f;
-      k.width /= 2; k.height /= 2;
+      k.width /= 2;
+      k.height /= 2;
     }
     return k;
   }

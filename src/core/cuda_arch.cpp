@@ -28,8 +28,8 @@ CudaArchMatch cuda_arch_match(const std::string& archs, int major, int minor) {
 
 std::string cuda_arch_advice(const std::string& archs, int major, int minor, const std::string& gpu_name) {
   const std::string sm = std::to_string(major) + std::to_string(minor);
-  const std::string gpu = gpu_name + " (compute capability " + std::to_string(major) + "." + std::to_string(minor) +
-                          ", sm_" + sm + ")";
+  const std::string gpu =
+      gpu_name + " (compute capability " + std::to_string(major) + "." + std::to_string(minor) + ", sm_" + sm + ")";
   switch (cuda_arch_match(archs, major, minor)) {
     case CudaArchMatch::none:
       return "this build has no CUDA code for " + gpu + ": it was compiled for the architectures \"" + archs +
@@ -37,9 +37,9 @@ std::string cuda_arch_advice(const std::string& archs, int major, int minor, con
     case CudaArchMatch::ptx_only:
       return "this build has no machine code for " + gpu + " (compiled for \"" + archs +
              "\"): the driver compiles its PTX at start-up, which takes a while the first time; "
-             "-DSEAMLESS_CUDA_ARCH=" + sm + " (or auto on this machine) builds its machine code";
-    default:
-      return "";
+             "-DSEAMLESS_CUDA_ARCH=" +
+             sm + " (or auto on this machine) builds its machine code";
+    default: return "";
   }
 }
 

@@ -13,11 +13,10 @@ namespace seamless::detail {
 [[noreturn]] void throw_cuda_error(cudaError_t e, const char* what, const char* file, int line);
 }  // namespace seamless::detail
 
-#define SEAMLESS_CUDA_CHECK(call)                                                         \
-  do {                                                                                    \
-    cudaError_t seamless_err_ = (call);                                                   \
-    if (seamless_err_ != cudaSuccess)                                                     \
-      ::seamless::detail::throw_cuda_error(seamless_err_, #call, __FILE__, __LINE__);     \
+#define SEAMLESS_CUDA_CHECK(call)                                                                                     \
+  do {                                                                                                                \
+    cudaError_t seamless_err_ = (call);                                                                               \
+    if (seamless_err_ != cudaSuccess) ::seamless::detail::throw_cuda_error(seamless_err_, #call, __FILE__, __LINE__); \
   } while (0)
 
 // After a kernel launch: catches launch-configuration errors at once.

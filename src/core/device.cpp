@@ -54,9 +54,10 @@ std::string unusable_gpu(cudaError_t e) {
   }
   std::string m = gpu + " cannot run this build's CUDA kernels (" + cuda_error(e) + "); ";
   if (e == cudaErrorNoKernelImageForDevice || e == cudaErrorInvalidDeviceFunction)
-    return m + "they were compiled for the CUDA architectures \"" SEAMLESS_CUDA_ARCHITECTURES
-               "\": rebuild with -DSEAMLESS_CUDA_ARCH=" + (sm.empty() ? "<its sm number>" : sm) +
-           " (or -DSEAMLESS_CUDA_ARCH=auto on this machine)";
+    return m +
+           "they were compiled for the CUDA architectures \"" SEAMLESS_CUDA_ARCHITECTURES
+           "\": rebuild with -DSEAMLESS_CUDA_ARCH=" +
+           (sm.empty() ? "<its sm number>" : sm) + " (or -DSEAMLESS_CUDA_ARCH=auto on this machine)";
   if (e == cudaErrorUnsupportedPtxVersion || e == cudaErrorInsufficientDriver)
     return m + "the NVIDIA driver is older than this build's CUDA toolkit needs: update the driver";
   return m + "CUDA's error above says why";
@@ -116,13 +117,14 @@ Device resolve_device(const std::string& name) {
   if (name == "cpu") return Device::CPU;
   if (name == "cuda") {
     if (!cuda_built())
-      throw ConfigError("device 'cuda' was asked for, but this build has no CUDA backend "
-                  "(reconfigure with -DSEAMLESS_CUDA=ON on a machine with nvcc, or use --device cpu)");
+      throw ConfigError(
+          "device 'cuda' was asked for, but this build has no CUDA backend "
+          "(reconfigure with -DSEAMLESS_CUDA=ON on a machine with nvcc, or use --device cpu)");
     if (!cuda_available())
-      throw ConfigError("device 'cuda' was asked for, but " +
-                  (cuda_state().problem.empty() ? std::string("no CUDA GPU is usable on this machine")
-                                                : cuda_state().problem) +
-                  " (or use --device cpu)");
+      throw ConfigError(
+          "device 'cuda' was asked for, but " +
+          (cuda_state().problem.empty() ? std::string("no CUDA GPU is usable on this machine") : cuda_state().problem) +
+          " (or use --device cpu)");
     return Device::CUDA;
   }
   if (name == "auto") {

@@ -52,9 +52,9 @@
 // header and the family's, and picks the backend with with_exec():
 //   with_exec(dev, [&]<class E>(const E& ex) { kernels::Name<E>::kernel(ex, ...); });
 #pragma once
+#include <concepts>
 #include <cstddef>
 #include <cstdint>
-#include <concepts>
 #include <cstring>
 #include <type_traits>
 
@@ -83,8 +83,7 @@ struct Lanes {
   // The sum over the group's lanes of v (T trivially copyable, a multiple of 4 bytes, with
   // operator+), in every lane, bit-identical in all of them: a butterfly of shuffles word by
   // word, adding neighbours, then pairs, ... (a tree: the same order for a given size).
-  template <class T>
-  SEAMLESS_HD T sum(T v) const {
+  template <class T> SEAMLESS_HD T sum(T v) const {
 #if defined(__CUDA_ARCH__)
     static_assert(sizeof(T) % 4 == 0, "Lanes::sum shuffles 4-byte words");
     constexpr int kWords = static_cast<int>(sizeof(T) / 4);
@@ -129,15 +128,13 @@ struct Lanes {
 // in argument order while they fit (so the caller lists them most valuable first), and hands the
 // others' ptr: the results are the same bit for bit either way (the same arithmetic on the same
 // values in the same order; only where the values live differs).
-template <class T>
-struct Staged {
+template <class T> struct Staged {
   T* ptr = nullptr;
   std::int64_t count = 0;
 };
 
 // for_each_grouped's optional occupancy request (see the list above); B = 0: none.
-template <int B>
-struct MinBlocks {};
+template <int B> struct MinBlocks {};
 
 struct CpuExec {
   static constexpr Device device = Device::CPU;
@@ -147,16 +144,17 @@ struct CpuExec {
   template <class T> T exclusive_scan(const T* in, T* out, std::int64_t n) const;
   template <class K, class V> void sort_by_key(K* keys, V* values, std::int64_t n, int key_bits = 8 * sizeof(K)) const;
   template <class T, class F> T transform_reduce(std::int64_t n, T init, F fn) const;
-  template <class T, class F, class G = NoThen> void transform_reduce_into(std::int64_t n, F fn, T* out, G then = {}) const;
-  template <class T, class F, class G> void transform_reduce_rounds(std::int64_t n, int rounds, F fn, T* out, G then) const;
+  template <class T, class F, class G = NoThen>
+  void transform_reduce_into(std::int64_t n, F fn, T* out, G then = {}) const;
+  template <class T, class F, class G>
+  void transform_reduce_rounds(std::int64_t n, int rounds, F fn, T* out, G then) const;
   // One thread per element on the CPU: the groups are single lanes.
   int lanes(std::int64_t, int) const { return 1; }
   template <class F> void for_each_grouped(std::int64_t n, int max_lanes, F fn) const;
   template <int B, class F> void for_each_grouped(std::int64_t n, int max_lanes, F fn, MinBlocks<B>) const {
     for_each_grouped(n, max_lanes, fn);
   }
-  template <class F>
-  void for_each_phases(int phases, const std::int64_t* begin, const std::int64_t* end, F fn) const;
+  template <class F> void for_each_phases(int phases, const std::int64_t* begin, const std::int64_t* end, F fn) const;
   // The CPU's caches do the staging: fn gets every array's ptr.
   template <class F, class... T>
   void for_each_phases_staged(int phases, const std::int64_t* begin, const std::int64_t* end, F fn,
@@ -180,16 +178,17 @@ struct CudaExec {
   template <class T> T exclusive_scan(const T* in, T* out, std::int64_t n) const;
   template <class K, class V> void sort_by_key(K* keys, V* values, std::int64_t n, int key_bits = 8 * sizeof(K)) const;
   template <class T, class F> T transform_reduce(std::int64_t n, T init, F fn) const;
-  template <class T, class F, class G = NoThen> void transform_reduce_into(std::int64_t n, F fn, T* out, G then = {}) const;
-  template <class T, class F, class G> void transform_reduce_rounds(std::int64_t n, int rounds, F fn, T* out, G then) const;
+  template <class T, class F, class G = NoThen>
+  void transform_reduce_into(std::int64_t n, F fn, T* out, G then = {}) const;
+  template <class T, class F, class G>
+  void transform_reduce_rounds(std::int64_t n, int rounds, F fn, T* out, G then) const;
   // Lanes per element: the smallest power of two that puts n x lanes threads on the device at
   // once (so that a small n still fills every multiprocessor), at most max_lanes (how far the
   // caller's per-element work splits usefully), at least 1. Defined in core/exec_cuda.cu.
   int lanes(std::int64_t n, int max_lanes) const;
   template <class F> void for_each_grouped(std::int64_t n, int max_lanes, F fn) const;
   template <int B, class F> void for_each_grouped(std::int64_t n, int max_lanes, F fn, MinBlocks<B>) const;
-  template <class F>
-  void for_each_phases(int phases, const std::int64_t* begin, const std::int64_t* end, F fn) const;
+  template <class F> void for_each_phases(int phases, const std::int64_t* begin, const std::int64_t* end, F fn) const;
   // Where for_each_phases runs the sweep in one block, the arrays that fit (in argument order)
   // live in the block's dynamic shared memory for the sweep: a phase then reads and writes them
   // without a round trip to L2 (a phase of a small cloth was ~3 us, mostly such round trips).
@@ -224,8 +223,8 @@ struct StagedPhase {  // for_each_phases_staged with one float array
 }  // namespace exec_probe
 
 template <class E>
-concept Executor = requires(const E& ex, std::int64_t n, int k, const int* in, int* out, unsigned* keys,
-                            float* sum, const std::int64_t* begin, const std::int64_t* end) {
+concept Executor = requires(const E& ex, std::int64_t n, int k, const int* in, int* out, unsigned* keys, float* sum,
+                            const std::int64_t* begin, const std::int64_t* end) {
   typename std::integral_constant<Device, E::device>;  // a constant: kernels branch on it
   ex.for_each(n, exec_probe::Index{});
   { ex.exclusive_scan(in, out, n) } -> std::same_as<int>;
@@ -287,8 +286,7 @@ class CudaGraph {
 #endif
 
 // Calls fn(executor) with the executor for device d.
-template <class F>
-decltype(auto) with_exec(Device d, F&& fn) {
+template <class F> decltype(auto) with_exec(Device d, F&& fn) {
 #if SEAMLESS_HAS_CUDA
   if (d == Device::CUDA) return fn(CudaExec{});
 #else

@@ -14,8 +14,7 @@ namespace seamless {
 // Every primitive of core/exec.hpp's list, with the forms the kernels call.
 static_assert(Executor<CpuExec>);
 
-template <class F>
-void CpuExec::for_each(std::int64_t n, F fn) const {
+template <class F> void CpuExec::for_each(std::int64_t n, F fn) const {
   // Small ranges are not worth waking the thread team.
   if (n < 2048) {
     for (std::int64_t i = 0; i < n; ++i) fn(i);
@@ -25,8 +24,7 @@ void CpuExec::for_each(std::int64_t n, F fn) const {
   for (std::int64_t i = 0; i < n; ++i) fn(i);
 }
 
-template <class F>
-void CpuExec::for_each_grouped(std::int64_t n, int, F fn) const {
+template <class F> void CpuExec::for_each_grouped(std::int64_t n, int, F fn) const {
   // A thread already walks several elements; the neighbour loops inside stay whole (Lanes{}:
   // lane 0 of 1, so sum and rank are the identity and the order of every sum is the loop's).
   for_each(n, [&](std::int64_t i) { fn(i, Lanes{}); });
@@ -47,8 +45,7 @@ void CpuExec::for_each_phases_staged(int phases, const std::int64_t* begin, cons
   for_each_phases(phases, begin, end, [&](int p, std::int64_t i) { fn(p, i, arrays.ptr...); });
 }
 
-template <class T>
-T CpuExec::exclusive_scan(const T* in, T* out, std::int64_t n) const {
+template <class T> T CpuExec::exclusive_scan(const T* in, T* out, std::int64_t n) const {
   T sum{};
   for (std::int64_t i = 0; i < n; ++i) {
     T v = in[i];  // in may alias out
@@ -59,8 +56,7 @@ T CpuExec::exclusive_scan(const T* in, T* out, std::int64_t n) const {
 }
 
 // LSD radix sort, 8 bits a pass: stable, O(n) per pass, like the GPU's radix sort.
-template <class K, class V>
-void CpuExec::sort_by_key(K* keys, V* values, std::int64_t n, int key_bits) const {
+template <class K, class V> void CpuExec::sort_by_key(K* keys, V* values, std::int64_t n, int key_bits) const {
   if (n <= 1) return;
   std::vector<K> k2(static_cast<std::size_t>(n));
   std::vector<V> v2(static_cast<std::size_t>(n));
@@ -87,8 +83,7 @@ void CpuExec::sort_by_key(K* keys, V* values, std::int64_t n, int key_bits) cons
 }
 
 // Per-thread partial sums combined in thread order: deterministic for a fixed thread count.
-template <class T, class F>
-T CpuExec::transform_reduce(std::int64_t n, T init, F fn) const {
+template <class T, class F> T CpuExec::transform_reduce(std::int64_t n, T init, F fn) const {
   int threads = n < 2048 ? 1 : omp_get_max_threads();
   std::vector<T> partial(static_cast<std::size_t>(threads), T{});
 #pragma omp parallel num_threads(threads)
@@ -104,8 +99,7 @@ T CpuExec::transform_reduce(std::int64_t n, T init, F fn) const {
   return sum;
 }
 
-template <class T, class F, class G>
-void CpuExec::transform_reduce_into(std::int64_t n, F fn, T* out, G then) const {
+template <class T, class F, class G> void CpuExec::transform_reduce_into(std::int64_t n, F fn, T* out, G then) const {
   *out = transform_reduce(n, T{}, fn);
   then();
 }

@@ -146,7 +146,8 @@ void* result_slot(std::size_t bytes) {
 
 unsigned* reduce_counter() {
   static GrowingBlock block;
-  if (!block.ptr) SEAMLESS_CUDA_CHECK(cudaMemset(block.at_least(sizeof(unsigned), sizeof(unsigned)), 0, sizeof(unsigned)));
+  if (!block.ptr)
+    SEAMLESS_CUDA_CHECK(cudaMemset(block.at_least(sizeof(unsigned), sizeof(unsigned)), 0, sizeof(unsigned)));
   return static_cast<unsigned*>(block.ptr);
 }
 

@@ -26,15 +26,13 @@ int multiprocessors();
 // Dynamic shared memory one block may use once the kernel opts in (cudaDevAttrMaxSharedMemoryPerBlockOptin).
 int max_shared_per_block();
 
-template <class F>
-__global__ void for_each_kernel(std::int64_t n, F fn) {
+template <class F> __global__ void for_each_kernel(std::int64_t n, F fn) {
   std::int64_t i = static_cast<std::int64_t>(blockIdx.x) * blockDim.x + threadIdx.x;
   if (i < n) fn(i);
 }
 
 struct Plus {
-  template <class T>
-  __device__ T operator()(const T& a, const T& b) const { return a + b; }
+  template <class T> __device__ T operator()(const T& a, const T& b) const { return a + b; }
 };
 
 // Zeroed once; the last block of every reduction puts it back to zero (see below).
@@ -50,8 +48,8 @@ unsigned* reduce_counter();
 // (n / threads in flight), then the block and the partials are summed pairwise (CUB), so the
 // relative error grows with log2(n), not with n as in one long float sum.
 template <int kThreads, class T, class F, class G>
-__global__ void transform_reduce_kernel(std::int64_t n, F fn, decltype(fn(std::int64_t{}))* partial,
-                                        unsigned* counter, T* out, G then) {
+__global__ void transform_reduce_kernel(std::int64_t n, F fn, decltype(fn(std::int64_t{}))* partial, unsigned* counter,
+                                        T* out, G then) {
   using Local = decltype(fn(std::int64_t{}));
   using BlockReduce = cub::BlockReduce<Local, kThreads>;
   __shared__ typename BlockReduce::TempStorage tmp;
@@ -81,8 +79,7 @@ __global__ void transform_reduce_kernel(std::int64_t n, F fn, decltype(fn(std::i
 }
 
 // The float components of a transform_reduce_rounds term, padded to whole warps: kQ per lane.
-template <class Local>
-struct RoundWords {
+template <class Local> struct RoundWords {
   static_assert(sizeof(Local) % sizeof(float) == 0 && alignof(Local) == alignof(float),
                 "transform_reduce_rounds: fn must return a struct of floats (summed component by component)");
   static constexpr int kWords = sizeof(Local) / sizeof(float);
@@ -92,8 +89,7 @@ struct RoundWords {
 // One butterfly step of warp_reduce_scatter over the first M entries of v: the lanes whose bit o
 // is set keep the upper half, the others the lower, and each adds its partner's half of the kept
 // part. M is a template argument so that every index is a constant (v stays in registers).
-template <int M, int N>
-__device__ __forceinline__ void butterfly_step(float (&v)[N], unsigned lane, int o) {
+template <int M, int N> __device__ __forceinline__ void butterfly_step(float (&v)[N], unsigned lane, int o) {
   const bool upper = lane & static_cast<unsigned>(o);
 #pragma unroll
   for (int j = 0; j < M / 2; ++j) {
@@ -105,8 +101,7 @@ __device__ __forceinline__ void butterfly_step(float (&v)[N], unsigned lane, int
 // A warp's reduce-scatter of 32 x kQ floats: five butterfly steps (16 + 8 + 4 + 2 + 1 shuffles
 // x kQ, not 5 x 32 x kQ for a shuffle tree per component). Lane l ends with the warp's sums of
 // components [l kQ, l kQ + kQ) in v[0, kQ): each step's upper half goes with that step's lane bit.
-template <int kQ>
-__device__ __forceinline__ void warp_reduce_scatter(float (&v)[32 * kQ], unsigned lane) {
+template <int kQ> __device__ __forceinline__ void warp_reduce_scatter(float (&v)[32 * kQ], unsigned lane) {
   butterfly_step<32 * kQ>(v, lane, 16);
   butterfly_step<16 * kQ>(v, lane, 8);
   butterfly_step<8 * kQ>(v, lane, 4);
@@ -193,8 +188,7 @@ __global__ void __launch_bounds__(kThreads, 2)
 }
 }  // namespace cuda_detail
 
-template <class F>
-void CudaExec::for_each(std::int64_t n, F fn) const {
+template <class F> void CudaExec::for_each(std::int64_t n, F fn) const {
   if (n <= 0) return;
   constexpr int kThreads = 256;
   auto blocks = static_cast<unsigned>((n + kThreads - 1) / kThreads);
@@ -205,8 +199,7 @@ void CudaExec::for_each(std::int64_t n, F fn) const {
 namespace cuda_detail {
 // Groups of 2^log2_lanes consecutive threads, one per element; blocks of 256 threads hold whole
 // groups, and groups never straddle a warp, so a group's shuffles stay within its warp.
-template <class F>
-__device__ __forceinline__ void grouped_element(std::int64_t n, int log2_lanes, F& fn) {
+template <class F> __device__ __forceinline__ void grouped_element(std::int64_t n, int log2_lanes, F& fn) {
   const std::int64_t t = static_cast<std::int64_t>(blockIdx.x) * blockDim.x + threadIdx.x;
   const std::int64_t i = t >> log2_lanes;
   if (i >= n) return;  // the whole group leaves: its lanes share i
@@ -218,14 +211,14 @@ __device__ __forceinline__ void grouped_element(std::int64_t n, int log2_lanes, 
   fn(i, g);
 }
 
-template <class F>
-__global__ void for_each_grouped_kernel(std::int64_t n, int log2_lanes, F fn) {
+template <class F> __global__ void for_each_grouped_kernel(std::int64_t n, int log2_lanes, F fn) {
   grouped_element(n, log2_lanes, fn);
 }
 
 // The same with kMinBlocks blocks of kThreads resident per multiprocessor (registers capped to fit).
 template <int kThreads, int kMinBlocks, class F>
-__global__ void __launch_bounds__(kThreads, kMinBlocks) for_each_grouped_bounded_kernel(std::int64_t n, int log2_lanes, F fn) {
+__global__ void __launch_bounds__(kThreads, kMinBlocks)
+    for_each_grouped_bounded_kernel(std::int64_t n, int log2_lanes, F fn) {
   grouped_element(n, log2_lanes, fn);
 }
 
@@ -239,8 +232,7 @@ struct PhaseChunk {
   std::int64_t begin[kMax], end[kMax];
 };
 
-template <class F>
-__global__ void __launch_bounds__(1024) for_each_phases_kernel(PhaseChunk c, int first_phase, F fn) {
+template <class F> __global__ void __launch_bounds__(1024) for_each_phases_kernel(PhaseChunk c, int first_phase, F fn) {
   for (int p = 0; p < c.count; ++p) {
     for (std::int64_t i = c.begin[p] + threadIdx.x; i < c.end[p]; i += blockDim.x) fn(first_phase + p, i);
     __syncthreads();
@@ -248,8 +240,7 @@ __global__ void __launch_bounds__(1024) for_each_phases_kernel(PhaseChunk c, int
 }
 
 // fn(p, begin + i): one phase as a plain for_each (phases too large for one block).
-template <class F>
-struct PhaseAt {
+template <class F> struct PhaseAt {
   F fn;
   int p;
   std::int64_t begin;
@@ -258,29 +249,25 @@ struct PhaseAt {
 
 // for_each_phases_staged: one array's place for the sweep, bytes [offset, offset + count x
 // sizeof(T)) of the block's dynamic shared memory if `shared`, else ptr.
-template <class T>
-struct StagedSlot {
+template <class T> struct StagedSlot {
   T* ptr;
   std::int64_t count;
   unsigned offset;
   int shared;
 };
 
-template <class T>
-__device__ T* staged_where(const StagedSlot<T>& s, unsigned char* smem) {
+template <class T> __device__ T* staged_where(const StagedSlot<T>& s, unsigned char* smem) {
   return s.shared ? reinterpret_cast<T*>(smem + s.offset) : s.ptr;
 }
 
-template <class T>
-__device__ void stage_in(const StagedSlot<T>& s, unsigned char* smem) {
+template <class T> __device__ void stage_in(const StagedSlot<T>& s, unsigned char* smem) {
   if (!s.shared) return;
   using U = std::remove_const_t<T>;
   U* d = reinterpret_cast<U*>(smem + s.offset);
   for (std::int64_t i = threadIdx.x; i < s.count; i += blockDim.x) d[i] = s.ptr[i];
 }
 
-template <class T>
-__device__ void stage_out(const StagedSlot<T>& s, unsigned char* smem) {
+template <class T> __device__ void stage_out(const StagedSlot<T>& s, unsigned char* smem) {
   if constexpr (!std::is_const_v<T>) {
     if (!s.shared) return;
     const T* d = reinterpret_cast<const T*>(smem + s.offset);
@@ -306,8 +293,7 @@ __global__ void __launch_bounds__(1024)
 }
 
 // fn(p, begin + i, a...) with the arrays in global memory: one phase as a plain for_each.
-template <class F, class... T>
-struct StagedPhaseAt {
+template <class F, class... T> struct StagedPhaseAt {
   F fn;
   int p;
   std::int64_t begin;
@@ -318,23 +304,19 @@ struct StagedPhaseAt {
 };
 }  // namespace cuda_detail
 
-template <class F>
-void CudaExec::for_each_grouped(std::int64_t n, int max_lanes, F fn) const {
+template <class F> void CudaExec::for_each_grouped(std::int64_t n, int max_lanes, F fn) const {
   for_each_grouped(n, max_lanes, fn, MinBlocks<0>{});
 }
 
-template <int B, class F>
-void CudaExec::for_each_grouped(std::int64_t n, int max_lanes, F fn, MinBlocks<B>) const {
+template <int B, class F> void CudaExec::for_each_grouped(std::int64_t n, int max_lanes, F fn, MinBlocks<B>) const {
   if (n <= 0) return;
   int log2_lanes = 0;
   while ((1 << log2_lanes) < lanes(n, max_lanes)) ++log2_lanes;
   constexpr int kThreads = 256;
   auto blocks = static_cast<unsigned>(((n << log2_lanes) + kThreads - 1) / kThreads);
   const auto st = static_cast<cudaStream_t>(stream);
-  if constexpr (B <= 0)
-    cuda_detail::for_each_grouped_kernel<<<blocks, kThreads, 0, st>>>(n, log2_lanes, fn);
-  else
-    cuda_detail::for_each_grouped_bounded_kernel<kThreads, B><<<blocks, kThreads, 0, st>>>(n, log2_lanes, fn);
+  if constexpr (B <= 0) cuda_detail::for_each_grouped_kernel<<<blocks, kThreads, 0, st>>>(n, log2_lanes, fn);
+  else cuda_detail::for_each_grouped_bounded_kernel<kThreads, B><<<blocks, kThreads, 0, st>>>(n, log2_lanes, fn);
   SEAMLESS_CUDA_CHECK_LAUNCH("for_each_grouped");
 }
 
@@ -401,16 +383,13 @@ void CudaExec::for_each_phases_staged(int phases, const std::int64_t* begin, con
     c.count = std::min(phases - first, cuda_detail::PhaseChunk::kMax);
     for (int p = 0; p < c.count; ++p) c.begin[p] = begin[first + p], c.end[p] = end[first + p];
     cuda::std::apply(
-        [&](auto... s) {
-          kernel<<<1, kThreads, used, static_cast<cudaStream_t>(stream)>>>(c, first, fn, s...);
-        },
+        [&](auto... s) { kernel<<<1, kThreads, used, static_cast<cudaStream_t>(stream)>>>(c, first, fn, s...); },
         slots);
     SEAMLESS_CUDA_CHECK_LAUNCH("for_each_phases_staged");
   }
 }
 
-template <class T>
-T CudaExec::exclusive_scan(const T* in, T* out, std::int64_t n) const {
+template <class T> T CudaExec::exclusive_scan(const T* in, T* out, std::int64_t n) const {
   if (n <= 0) return T{};
   T last_in{};
   SEAMLESS_CUDA_CHECK(cudaMemcpy(&last_in, in + n - 1, sizeof(T), cudaMemcpyDeviceToHost));
@@ -427,8 +406,7 @@ struct SortLayout {
   std::size_t keys, values, cub;  // bytes: alternate keys, alternate values, CUB temp (256-aligned)
   std::size_t total() const { return keys + values + cub; }
 };
-template <class K, class V>
-SortLayout sort_layout(std::int64_t n, int key_bits, cudaStream_t stream = nullptr) {
+template <class K, class V> SortLayout sort_layout(std::int64_t n, int key_bits, cudaStream_t stream = nullptr) {
   auto align = [](std::size_t b) { return (b + 255) / 256 * 256; };
   SortLayout L{align(sizeof(K) * n), align(sizeof(V) * n), 0};
   cub::DoubleBuffer<K> dk(nullptr, nullptr);
@@ -438,13 +416,11 @@ SortLayout sort_layout(std::int64_t n, int key_bits, cudaStream_t stream = nullp
 }
 }  // namespace cuda_detail
 
-template <class K, class V>
-std::size_t CudaExec::sort_by_key_temp_bytes(std::int64_t n, int key_bits) const {
+template <class K, class V> std::size_t CudaExec::sort_by_key_temp_bytes(std::int64_t n, int key_bits) const {
   return n <= 1 ? 0 : cuda_detail::sort_layout<K, V>(n, key_bits).total();
 }
 
-template <class K, class V>
-void CudaExec::sort_by_key(K* keys, V* values, std::int64_t n, int key_bits) const {
+template <class K, class V> void CudaExec::sort_by_key(K* keys, V* values, std::int64_t n, int key_bits) const {
   if (n <= 1) return;
   // Scratch layout: [alternate keys | alternate values | CUB temp].
   cudaStream_t st = static_cast<cudaStream_t>(stream);
@@ -464,8 +440,7 @@ void CudaExec::sort_by_key(K* keys, V* values, std::int64_t n, int key_bits) con
   }
 }
 
-template <class T, class F, class G>
-void CudaExec::transform_reduce_into(std::int64_t n, F fn, T* out, G then) const {
+template <class T, class F, class G> void CudaExec::transform_reduce_into(std::int64_t n, F fn, T* out, G then) const {
   // One wave of as many blocks as fit on the device at once (registers decide): each thread then
   // strides over several elements instead of blocks queueing behind each other.
   constexpr int kThreads = 128;
@@ -511,8 +486,7 @@ void CudaExec::transform_reduce_rounds(std::int64_t n, int rounds, F fn, T* out,
                                                   args, 0, static_cast<cudaStream_t>(stream)));
 }
 
-template <class T, class F>
-T CudaExec::transform_reduce(std::int64_t n, T init, F fn) const {
+template <class T, class F> T CudaExec::transform_reduce(std::int64_t n, T init, F fn) const {
   if (n <= 0) return init;
   T* total_dev = static_cast<T*>(cuda_detail::result_slot(sizeof(T)));
   CudaExec{}.transform_reduce_into(n, fn, total_dev);  // on the legacy default stream, like the copy

@@ -28,7 +28,7 @@ struct ParticleState {
 // One rigid body's frame: x = R q + c for its rest offsets q.
 struct RigidFrame {
   vec3 centre;
-  vec4 rotation;  // quaternion (x, y, z, w)
+  vec4 rotation;                      // quaternion (x, y, z, w)
   std::int64_t first = 0, count = 0;  // particle ids
 };
 

@@ -30,7 +30,9 @@ bool interrupted() {
   if (sig == 0) return false;
   if (!g_reported.exchange(true))
     spdlog::warn("{} received: finishing the current frame, then writing the outputs (send it again to stop at once)",
-                 sig == SIGINT ? "SIGINT (Ctrl-C)" : sig == SIGTERM ? "SIGTERM" : "a signal");
+                 sig == SIGINT    ? "SIGINT (Ctrl-C)"
+                 : sig == SIGTERM ? "SIGTERM"
+                                  : "a signal");
   return true;
 }
 

@@ -10,7 +10,7 @@ namespace seamless {
 
 void init_logging(Verbosity v) {
   auto console = std::make_shared<spdlog::sinks::stderr_color_sink_mt>();
-  console->set_level(v == Verbosity::Quiet ? spdlog::level::warn
+  console->set_level(v == Verbosity::Quiet     ? spdlog::level::warn
                      : v == Verbosity::Verbose ? spdlog::level::debug
                                                : spdlog::level::info);
   auto logger = std::make_shared<spdlog::logger>("seamless", console);

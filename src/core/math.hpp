@@ -2,19 +2,29 @@
 // core/eigen_conv.hpp for the conversions at the boundary.
 #pragma once
 #include <cmath>
-#include <cstring>
 #include <cstdint>
+#include <cstring>
 #include <type_traits>
 
 #include "core/hd.hpp"
 
 namespace seamless {
 
-struct vec2 { float x, y; };
-struct vec3 { float x, y, z; };
-struct vec4 { float x, y, z, w; };
-struct int3 { int x, y, z; };
-struct uchar3 { std::uint8_t x, y, z; };
+struct vec2 {
+  float x, y;
+};
+struct vec3 {
+  float x, y, z;
+};
+struct vec4 {
+  float x, y, z, w;
+};
+struct int3 {
+  int x, y, z;
+};
+struct uchar3 {
+  std::uint8_t x, y, z;
+};
 
 // vec2
 SEAMLESS_HD inline vec2 operator+(vec2 a, vec2 b) { return {a.x + b.x, a.y + b.y}; }
@@ -29,9 +39,18 @@ SEAMLESS_HD inline vec3 operator*(vec3 a, float s) { return {a.x * s, a.y * s, a
 SEAMLESS_HD inline vec3 operator*(float s, vec3 a) { return a * s; }
 SEAMLESS_HD inline vec3 operator/(vec3 a, float s) { return {a.x / s, a.y / s, a.z / s}; }
 SEAMLESS_HD inline vec3 cmul(vec3 a, vec3 b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
-SEAMLESS_HD inline vec3& operator+=(vec3& a, vec3 b) { a = a + b; return a; }
-SEAMLESS_HD inline vec3& operator-=(vec3& a, vec3 b) { a = a - b; return a; }
-SEAMLESS_HD inline vec3& operator*=(vec3& a, float s) { a = a * s; return a; }
+SEAMLESS_HD inline vec3& operator+=(vec3& a, vec3 b) {
+  a = a + b;
+  return a;
+}
+SEAMLESS_HD inline vec3& operator-=(vec3& a, vec3 b) {
+  a = a - b;
+  return a;
+}
+SEAMLESS_HD inline vec3& operator*=(vec3& a, float s) {
+  a = a * s;
+  return a;
+}
 SEAMLESS_HD inline float dot(vec3 a, vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 SEAMLESS_HD inline vec3 cross(vec3 a, vec3 b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
@@ -66,8 +85,7 @@ SEAMLESS_HD inline float bits_float(std::int32_t i) {
 #endif
 }
 
-template <class T, class = std::enable_if_t<std::is_floating_point_v<T>>>
-SEAMLESS_HD inline bool is_finite(T v) {
+template <class T, class = std::enable_if_t<std::is_floating_point_v<T>>> SEAMLESS_HD inline bool is_finite(T v) {
 #ifdef __CUDA_ARCH__
   return isfinite(v);
 #else

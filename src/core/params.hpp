@@ -51,7 +51,8 @@ template <class E> struct EnumName {
   const char* name;
 };
 
-template <class E> concept NamedEnum = std::is_enum_v<E> && requires(E e) {
+template <class E>
+concept NamedEnum = std::is_enum_v<E> && requires(E e) {
   { enum_names(e) } -> std::convertible_to<std::span<const EnumName<E>>>;
 };
 

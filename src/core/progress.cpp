@@ -33,13 +33,9 @@ std::string progress_rate_text(std::int64_t done, std::int64_t total, double sec
 }
 
 Progress::Progress(std::string what, std::int64_t total, bool enabled, std::string unit)
-    : what_(std::move(what)),
-      unit_(std::move(unit)),
-      total_(total),
-      tty_(isatty(fileno(stderr)) != 0),
+    : what_(std::move(what)), unit_(std::move(unit)), total_(total), tty_(isatty(fileno(stderr)) != 0),
       enabled_(enabled && spdlog::default_logger()->should_log(spdlog::level::info)),
-      start_(std::chrono::steady_clock::now()),
-      last_log_(start_) {}
+      start_(std::chrono::steady_clock::now()), last_log_(start_) {}
 
 Progress::~Progress() { finish(); }
 

@@ -37,13 +37,11 @@ class StepGraph {
   // count) changed since the last call: bytes(CudaExec{}) is what the sorts need; the storage
   // grows to that plus a quarter. Returns whether the storage moved (a recorded graph points at
   // it: the owner bumps its generation). Does nothing on the CPU.
-  template <class F>
-  bool reserve_temp(std::int64_t size_key, F&& bytes);
+  template <class F> bool reserve_temp(std::int64_t size_key, F&& bytes);
 
   // Calls fn(executor): on CUDA one that launches on this object's stream and sorts in its temp
   // storage (so that the launches can be recorded), on the CPU the CPU executor.
-  template <class F>
-  void run(F&& fn);
+  template <class F> void run(F&& fn);
 
   // One step: on CUDA on this object's stream, ordered after what the default stream holds and
   // before what it gets next (no host synchronisation). With replay allowed (the owner's graphs
@@ -68,8 +66,7 @@ class StepGraph {
 #endif
 };
 
-template <class F>
-bool StepGraph::reserve_temp(std::int64_t size_key, F&& bytes) {
+template <class F> bool StepGraph::reserve_temp(std::int64_t size_key, F&& bytes) {
 #if SEAMLESS_HAS_CUDA
   const void* before = temp_.data();
   if (dev_ == Device::CUDA && temp_key_ != size_key) {
@@ -85,8 +82,7 @@ bool StepGraph::reserve_temp(std::int64_t size_key, F&& bytes) {
 #endif
 }
 
-template <class F>
-void StepGraph::run(F&& fn) {
+template <class F> void StepGraph::run(F&& fn) {
 #if SEAMLESS_HAS_CUDA
   if (dev_ == Device::CUDA) {
     if (!stream_) stream_ = std::make_unique<CudaStream>();

@@ -2,8 +2,8 @@
 // once per frame (end_frame) so that timing does not serialise the pipeline.
 #pragma once
 #include <chrono>
-#include <functional>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>

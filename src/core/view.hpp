@@ -9,19 +9,16 @@
 
 namespace seamless {
 
-template <class T>
-struct View {
+template <class T> struct View {
   T* data = nullptr;
   std::int64_t size = 0;
   SEAMLESS_HD T& operator[](std::int64_t i) const { return data[i]; }
   template <class U = T>
-    requires(!std::is_const_v<U>)
-  SEAMLESS_HD operator View<const U>() const { return {data, size}; }
+  requires(!std::is_const_v<U>) SEAMLESS_HD operator View<const U>() const { return {data, size}; }
 };
 
 // A pitched 2-D image; pitch is in elements (>= width).
-template <class T>
-struct View2D {
+template <class T> struct View2D {
   T* data = nullptr;
   int width = 0, height = 0;
   std::int64_t pitch = 0;
@@ -29,8 +26,7 @@ struct View2D {
   SEAMLESS_HD bool inside(int x, int y) const { return x >= 0 && y >= 0 && x < width && y < height; }
   SEAMLESS_HD std::int64_t count() const { return static_cast<std::int64_t>(width) * height; }
   template <class U = T>
-    requires(!std::is_const_v<U>)
-  SEAMLESS_HD operator View2D<const U>() const { return {data, width, height, pitch}; }
+  requires(!std::is_const_v<U>) SEAMLESS_HD operator View2D<const U>() const { return {data, width, height, pitch}; }
 };
 
 }  // namespace seamless

@@ -23,7 +23,10 @@ TumPose from_iso(double timestamp, const Eigen::Isometry3d& T) {
   TumPose p;
   p.timestamp = timestamp;
   for (int i = 0; i < 3; ++i) p.t[i] = T.translation()[i];
-  p.q[0] = q.x(); p.q[1] = q.y(); p.q[2] = q.z(); p.q[3] = q.w();
+  p.q[0] = q.x();
+  p.q[1] = q.y();
+  p.q[2] = q.z();
+  p.q[3] = q.w();
   return p;
 }
 
@@ -62,9 +65,7 @@ Alignment parse_alignment(const std::string& name) {
   throw Error("unknown alignment '" + name + "': use se3 (rigid), sim3 (rigid + scale) or none");
 }
 
-const char* to_string(Alignment a) {
-  return a == Alignment::se3 ? "se3" : a == Alignment::sim3 ? "sim3" : "none";
-}
+const char* to_string(Alignment a) { return a == Alignment::se3 ? "se3" : a == Alignment::sim3 ? "sim3" : "none"; }
 
 std::vector<std::pair<std::size_t, std::size_t>> associate(const Trajectory& est, const Trajectory& gt, double max_dt,
                                                            double offset) {
@@ -75,8 +76,8 @@ std::vector<std::pair<std::size_t, std::size_t>> associate(const Trajectory& est
   std::vector<Cand> cands;
   for (std::size_t i = 0; i < est.size(); ++i) {
     const double te = est[i].timestamp + offset;
-    auto lo = std::lower_bound(gt.begin(), gt.end(), te - max_dt,
-                               [](const TumPose& p, double t) { return p.timestamp < t; });
+    auto lo =
+        std::lower_bound(gt.begin(), gt.end(), te - max_dt, [](const TumPose& p, double t) { return p.timestamp < t; });
     for (auto it = lo; it != gt.end() && it->timestamp <= te + max_dt; ++it)
       cands.push_back({std::fabs(it->timestamp - te), i, static_cast<std::size_t>(it - gt.begin())});
   }
@@ -157,7 +158,8 @@ AteResult compute_ate(const Trajectory& est, const Trajectory& gt, const EvalOpt
 
 RpeResult compute_rpe(const Trajectory& est, const Trajectory& gt, double delta, const std::string& unit,
                       const EvalOptions& o) {
-  if (unit != "frames" && unit != "seconds") throw Error("RPE delta unit must be 'frames' or 'seconds', not '" + unit + "'");
+  if (unit != "frames" && unit != "seconds")
+    throw Error("RPE delta unit must be 'frames' or 'seconds', not '" + unit + "'");
   if (!(delta > 0)) throw Error("RPE delta must be positive");
   const Pairs pairs = associated(est, gt, o, "RPE");
   double scale = 1.0;
@@ -183,8 +185,8 @@ RpeResult compute_rpe(const Trajectory& est, const Trajectory& gt, double delta,
       // last pose, as in TUM's evaluate_rpe.py.
       const double target = est[pairs[a].first].timestamp + delta;
       b = a;
-      while (b + 1 < n && std::fabs(est[pairs[b + 1].first].timestamp - target) <
-                              std::fabs(est[pairs[b].first].timestamp - target))
+      while (b + 1 < n &&
+             std::fabs(est[pairs[b + 1].first].timestamp - target) < std::fabs(est[pairs[b].first].timestamp - target))
         ++b;
       if (b == n - 1) continue;
     }

@@ -43,13 +43,13 @@ std::vector<std::pair<std::size_t, std::size_t>> associate(const Trajectory& est
                                                            double max_dt = 0.02, double offset = 0.0);
 
 struct AteResult {
-  ErrorStats trans;                  // metres, per associated pose
-  std::vector<double> errors;        // per pair, in association order
-  std::vector<double> times;         // estimate timestamps of the pairs
-  Trajectory aligned;                // the estimate moved by the alignment (associated poses only)
-  double R[3][3];                    // the alignment: gt position = scale * R * est position + t
+  ErrorStats trans;            // metres, per associated pose
+  std::vector<double> errors;  // per pair, in association order
+  std::vector<double> times;   // estimate timestamps of the pairs
+  Trajectory aligned;          // the estimate moved by the alignment (associated poses only)
+  double R[3][3];              // the alignment: gt position = scale * R * est position + t
   double t[3];
-  double scale = 1.0;                // 1 unless sim3
+  double scale = 1.0;  // 1 unless sim3
   Alignment align = Alignment::se3;
 };
 // Throws seamless::Error when fewer than 3 poses associate.

@@ -54,12 +54,13 @@ std::vector<double> yaml_matrix(const YAML::Node& n, const std::string& key, con
   if (n.IsMap() && !data.IsDefined()) fail(path, key + " has no data (expected rows, cols and data)");
   if (!data.IsSequence()) fail(path, key + " is not a list of numbers (or a matrix with rows, cols and data)");
   std::vector<double> v;
-  for (std::size_t i = 0; i < data.size(); ++i) v.push_back(yaml_number(data[i], key + "[" + std::to_string(i) + "]", path));
+  for (std::size_t i = 0; i < data.size(); ++i)
+    v.push_back(yaml_number(data[i], key + "[" + std::to_string(i) + "]", path));
   if (n.IsMap() && n["rows"].IsDefined() && n["cols"].IsDefined()) {
     const double rows = yaml_number(n["rows"], key + ".rows", path), cols = yaml_number(n["cols"], key + ".cols", path);
     if (rows * cols != static_cast<double>(v.size()))
-      fail(path, key + " says " + n["rows"].Scalar() + "x" + n["cols"].Scalar() + " but holds " + std::to_string(v.size()) +
-                     " numbers");
+      fail(path, key + " says " + n["rows"].Scalar() + "x" + n["cols"].Scalar() + " but holds " +
+                     std::to_string(v.size()) + " numbers");
   }
   return v;
 }
@@ -78,8 +79,9 @@ void set_distortion(Intrinsics& K, const std::vector<double>& d, const std::stri
   for (std::size_t i = 0; i < d.size(); ++i) {
     if (i < 5) K.dist[i] = static_cast<float>(d[i]);
     else if (d[i] != 0)
-      fail(path, key + " has " + std::to_string(d.size()) + " coefficients and coefficient " + std::to_string(i + 1) +
-                     " is not zero: only k1 k2 p1 p2 k3 (OpenCV's radial-tangential model, ROS plumb_bob) are supported");
+      fail(path,
+           key + " has " + std::to_string(d.size()) + " coefficients and coefficient " + std::to_string(i + 1) +
+               " is not zero: only k1 k2 p1 p2 k3 (OpenCV's radial-tangential model, ROS plumb_bob) are supported");
   }
 }
 
@@ -105,8 +107,9 @@ CameraFile read_orbslam(const YAML::Node& root, const std::string& prefix, const
   auto get = [&](const char* name, bool required) -> double {
     const YAML::Node n = root[prefix + name];
     if (!n.IsDefined()) {
-      if (required) fail(path, "has " + prefix + "fx but no " + prefix + name + " (ORB-SLAM layout: " + prefix +
-                                   "fx, fy, cx, cy, optional k1 k2 p1 p2 k3)");
+      if (required)
+        fail(path, "has " + prefix + "fx but no " + prefix + name + " (ORB-SLAM layout: " + prefix +
+                       "fx, fy, cx, cy, optional k1 k2 p1 p2 k3)");
       return 0;
     }
     return yaml_number(n, prefix + name, path);
@@ -123,8 +126,8 @@ CameraFile read_calibration_yaml(const YAML::Node& root, const std::string& path
   CameraFile c;
   c.format = "OpenCV/ROS calibration YAML";
   c.K = from_row_major(yaml_matrix(root["camera_matrix"], "camera_matrix", path), "camera_matrix", path);
-  if (const YAML::Node m = root["distortion_model"]; m.IsDefined() && m.Scalar() != "plumb_bob" &&
-                                                      m.Scalar() != "rational_polynomial")
+  if (const YAML::Node m = root["distortion_model"];
+      m.IsDefined() && m.Scalar() != "plumb_bob" && m.Scalar() != "rational_polynomial")
     fail(path, "distortion_model is '" + m.Scalar() + "'; only plumb_bob (OpenCV's radial-tangential) is supported");
   if (const YAML::Node d = root["distortion_coefficients"]; d.IsDefined())
     set_distortion(c.K, yaml_matrix(d, "distortion_coefficients", path), "distortion_coefficients", path);
@@ -161,8 +164,9 @@ CameraFile read_yaml(std::string text, const std::string& path) {
   if (root["camera_matrix"].IsDefined()) return read_calibration_yaml(root, path);
   for (const char* key : {"K", "k"})
     if (root[key].IsDefined()) return read_camera_info(root, key, path);
-  fail(path, "no camera found: expected Camera.fx ... (ORB-SLAM), camera_matrix (OpenCV or ROS calibration YAML), "
-             "K (ROS camera_info) or, in JSON, intrinsic_matrix (Open3D)");
+  fail(path,
+       "no camera found: expected Camera.fx ... (ORB-SLAM), camera_matrix (OpenCV or ROS calibration YAML), "
+       "K (ROS camera_info) or, in JSON, intrinsic_matrix (Open3D)");
 }
 
 CameraFile read_open3d(const std::string& text, const std::string& path) {
@@ -173,8 +177,9 @@ CameraFile read_open3d(const std::string& text, const std::string& path) {
     fail(path, std::string("not valid JSON: ") + e.what());
   }
   if (!j.is_object() || !j.contains("intrinsic_matrix"))
-    fail(path, "a JSON file without intrinsic_matrix (expected Open3D's PinholeCameraIntrinsic: width, height, "
-               "intrinsic_matrix)");
+    fail(path,
+         "a JSON file without intrinsic_matrix (expected Open3D's PinholeCameraIntrinsic: width, height, "
+         "intrinsic_matrix)");
   const nlohmann::json& m = j["intrinsic_matrix"];
   if (!m.is_array() || m.size() != 9)
     fail(path, "intrinsic_matrix is not a list of nine numbers (the 3x3 camera matrix, column-major)");
@@ -189,7 +194,8 @@ CameraFile read_open3d(const std::string& text, const std::string& path) {
   c.format = "Open3D JSON";
   c.K = intrinsics_from_matrix(k, "camera file '" + path + "', intrinsic_matrix (column-major)");
   for (const char* key : {"width", "height"})
-    if (!j.contains(key) || !j[key].is_number_integer() || j[key].get<long long>() < 1 || j[key].get<long long>() > 16384)
+    if (!j.contains(key) || !j[key].is_number_integer() || j[key].get<long long>() < 1 ||
+        j[key].get<long long>() > 16384)
       fail(path, std::string("has no ") + key + " in pixels (Open3D's PinholeCameraIntrinsic has width and height)");
   c.K.width = j["width"].get<int>(), c.K.height = j["height"].get<int>();
   c.has_size = true;
@@ -202,7 +208,8 @@ Intrinsics intrinsics_from_matrix(const double (&k)[9], const std::string& where
   auto bad = [&](const std::string& what) {
     return InputError(where + ": " + what + "; expected K = [fx 0 cx; 0 fy cy; 0 0 1]");
   };
-  if (k[6] != 0 || k[7] != 0 || k[8] != 1) throw bad("the bottom row is not 0 0 1 (a transposed or projection matrix?)");
+  if (k[6] != 0 || k[7] != 0 || k[8] != 1)
+    throw bad("the bottom row is not 0 0 1 (a transposed or projection matrix?)");
   if (k[3] != 0) throw bad("the second row starts with " + std::to_string(k[3]) + ", not 0");
   // Below one pixel a focal length is no camera (and 0 cannot be divided by).
   if (!(std::abs(k[0]) >= 1 && std::abs(k[4]) >= 1)) throw bad("a focal length fx or fy is zero or below one pixel");

@@ -14,9 +14,9 @@ namespace seamless {
 namespace {
 
 // Kinect v1 triangulation (depth_scale.hpp): one disparity step is dz = z^2 * kStepPerZ2.
-constexpr double kBaseline = 0.075;      // metres, IR projector to IR camera
-constexpr double kFocalIr = 580.0;       // pixels, IR camera at 640x480
-constexpr double kDisparityStep = 0.125;  // pixels
+constexpr double kBaseline = 0.075;                                     // metres, IR projector to IR camera
+constexpr double kFocalIr = 580.0;                                      // pixels, IR camera at 640x480
+constexpr double kDisparityStep = 0.125;                                // pixels
 constexpr double kStepPerZ2 = kDisparityStep / (kFocalIr * kBaseline);  // 1/m
 
 std::string fmt(double v, int decimals = 0) {
@@ -93,12 +93,13 @@ DepthScaleVerdict judge_depth_scale(const DepthQuantisation& q, double scale, co
   v.kind = wrong ? DepthScaleVerdict::wrong : DepthScaleVerdict::doubtful;
   v.likely_scale = near ? near->scale : std::round(q.kinect_scale);
   std::string steps = "the " + std::to_string(q.steps) + " steps between neighbouring depth values of '" + file +
-                      "' from " + fmt(q.lo / scale, 2) + " to " + fmt(q.hi / scale, 2) + " m (at that scale; median step " +
-                      fmt(q.median_gap) + " units) are a Kinect v1's disparity steps (dz = z^2 / (8 f b), b 7.5 cm, " +
-                      "f 580 px) at " + fmt(q.kinect_scale) + " units per metre";
+                      "' from " + fmt(q.lo / scale, 2) + " to " + fmt(q.hi / scale, 2) +
+                      " m (at that scale; median step " + fmt(q.median_gap) +
+                      " units) are a Kinect v1's disparity steps (dz = z^2 / (8 f b), b 7.5 cm, " + "f 580 px) at " +
+                      fmt(q.kinect_scale) + " units per metre";
   if (wrong) {
-    v.message = "input.depth_scale " + fmt(scale) + " contradicts the depth images: " + steps + ", " +
-                fmt(ratio, 2) + "x the configured scale and close to " + fmt(near->scale) + " (" + near->name +
+    v.message = "input.depth_scale " + fmt(scale) + " contradicts the depth images: " + steps + ", " + fmt(ratio, 2) +
+                "x the configured scale and close to " + fmt(near->scale) + " (" + near->name +
                 "): set input.depth_scale: " + fmt(near->scale) +
                 " (or input.check_depth_scale: false for a camera that is not a Kinect v1-type structured-light "
                 "sensor)";
@@ -119,15 +120,17 @@ void DepthScaleCheck::check(const Image<std::uint16_t>& raw, const std::string& 
     case DepthScaleVerdict::wrong: throw ConfigError(v.message);
     case DepthScaleVerdict::doubtful: spdlog::warn("{}", v.message); break;
     case DepthScaleVerdict::consistent:
-      spdlog::info("input.depth_scale {} agrees with the Kinect v1 quantisation steps of '{}' ({} steps suggest {:.0f})",
-                   scale_, file, q.steps, q.kinect_scale);
+      spdlog::info(
+          "input.depth_scale {} agrees with the Kinect v1 quantisation steps of '{}' ({} steps suggest {:.0f})", scale_,
+          file, q.steps, q.kinect_scale);
       break;
     case DepthScaleVerdict::not_measurable:
       if (frames_ < kMaxFrames) return;
-      spdlog::info("input.depth_scale {} could not be checked against quantisation steps: the first {} depth images "
-                   "show none (median step {:.0f} unit(s): a camera of finer steps, or filtered depth); the median "
-                   "depth is checked on every frame",
-                   scale_, frames_, q.median_gap);
+      spdlog::info(
+          "input.depth_scale {} could not be checked against quantisation steps: the first {} depth images "
+          "show none (median step {:.0f} unit(s): a camera of finer steps, or filtered depth); the median "
+          "depth is checked on every frame",
+          scale_, frames_, q.median_gap);
       break;
   }
   done_ = true;
@@ -152,10 +155,11 @@ double fillable_gap_fraction(const Image<float>& depth) {
 void hint_depth_gaps(const Image<float>& depth, const std::string& file) {
   const double f = fillable_gap_fraction(depth);
   if (f > kGapHint)
-    spdlog::warn("depth image '{}': {:.0f}% of the pixels are one-pixel gaps between two agreeing depths (depth "
-                 "registered to colour by forward projection); normals and fusion fail there, ICP may lose track: "
-                 "set input.fill_gaps: true",
-                 file, 100 * f);
+    spdlog::warn(
+        "depth image '{}': {:.0f}% of the pixels are one-pixel gaps between two agreeing depths (depth "
+        "registered to colour by forward projection); normals and fusion fail there, ICP may lose track: "
+        "set input.fill_gaps: true",
+        file, 100 * f);
 }
 
 float median_depth(const Image<float>& depth) {
@@ -172,9 +176,9 @@ void check_median_depth(const Image<float>& depth, double scale, const std::stri
   const float med = median_depth(depth);
   if (med > 0.f && (med < 0.2f || med > 10.f))
     throw InputError("depth image '" + file + "': median depth " + std::to_string(med) + " m with input.depth_scale " +
-                std::to_string(scale) + " is implausible for a depth camera (0.2-10 m); TUM uses 5000, " +
-                "millimetre depth (frame folders) 1000 (a scale of about " + std::to_string(scale * med / 2.0) +
-                " would put the median at 2 m)");
+                     std::to_string(scale) + " is implausible for a depth camera (0.2-10 m); TUM uses 5000, " +
+                     "millimetre depth (frame folders) 1000 (a scale of about " + std::to_string(scale * med / 2.0) +
+                     " would put the median at 2 m)");
 }
 
 }  // namespace seamless

@@ -25,13 +25,13 @@ namespace seamless {
 
 // What the raw values of one depth image say about their scale.
 struct DepthQuantisation {
-  bool informative = false;  // enough resolved steps (median gap >= kMinGap units, >= kMinSteps gaps)
-  double kinect_scale = 0;   // units per metre at which the steps are a Kinect v1's (median over steps)
-  std::int64_t steps = 0;    // gaps between neighbouring distinct values used
-  double median_gap = 0;     // in raw units
-  std::uint16_t lo = 0, hi = 0;  // raw values spanned (10th to 95th percentile of the valid pixels)
-  static constexpr int kMinGap = 3;      // a gap of 1-2 units is the PNG's rounding as much as the sensor's step
-  static constexpr int kMinSteps = 30;   // a median over fewer steps is noise
+  bool informative = false;             // enough resolved steps (median gap >= kMinGap units, >= kMinSteps gaps)
+  double kinect_scale = 0;              // units per metre at which the steps are a Kinect v1's (median over steps)
+  std::int64_t steps = 0;               // gaps between neighbouring distinct values used
+  double median_gap = 0;                // in raw units
+  std::uint16_t lo = 0, hi = 0;         // raw values spanned (10th to 95th percentile of the valid pixels)
+  static constexpr int kMinGap = 3;     // a gap of 1-2 units is the PNG's rounding as much as the sensor's step
+  static constexpr int kMinSteps = 30;  // a median over fewer steps is noise
 };
 
 // raw: a depth PNG's values; 0 and 65535 (7-Scenes) are "no reading".
@@ -39,8 +39,8 @@ DepthQuantisation depth_quantisation(const Image<std::uint16_t>& raw);
 
 struct DepthScaleVerdict {
   enum Kind { consistent, not_measurable, doubtful, wrong } kind = not_measurable;
-  double likely_scale = 0;   // wrong / doubtful: what the steps suggest (a common scale when one is near)
-  std::string message;       // wrong / doubtful: the explanation for the user (names input.depth_scale)
+  double likely_scale = 0;  // wrong / doubtful: what the steps suggest (a common scale when one is near)
+  std::string message;      // wrong / doubtful: the explanation for the user (names input.depth_scale)
 };
 
 // Compares `scale` (units per metre) with q. The verdict is

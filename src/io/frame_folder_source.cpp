@@ -60,8 +60,9 @@ std::string frame_name(std::int64_t number) {
 
 std::vector<FrameFolderEntry> list_frame_folder(const std::string& folder) {
   if (!fs::is_directory(folder))
-    throw InputError("input.path '" + folder + "' is not a folder (source: frames wants a folder of frame-NNNNNN.color.png, "
-                ".depth.png and .pose.txt files)");
+    throw InputError("input.path '" + folder +
+                     "' is not a folder (source: frames wants a folder of frame-NNNNNN.color.png, "
+                     ".depth.png and .pose.txt files)");
   std::map<std::int64_t, FrameFolderEntry> by_number;
   for (const fs::directory_entry& e : fs::directory_iterator(folder)) {
     const std::string name = e.path().filename().string();
@@ -74,8 +75,8 @@ std::vector<FrameFolderEntry> list_frame_folder(const std::string& folder) {
     f.number = number;
     if (colour) {
       if (!f.colour.empty())
-        throw InputError("frame folder '" + folder + "' has two colour images for frame " + std::to_string(number) + ": '" +
-                    f.colour + "' and '" + name + "'; keep one");
+        throw InputError("frame folder '" + folder + "' has two colour images for frame " + std::to_string(number) +
+                         ": '" + f.colour + "' and '" + name + "'; keep one");
       f.colour = name;
     } else {
       (kind == "depth.png" ? f.depth : f.pose) = name;
@@ -90,15 +91,16 @@ std::optional<SE3> read_pose_matrix(const std::string& path) {
   std::vector<double> v = read_numbers(path, "pose file");
   if (v.size() != 16)
     throw InputError("pose file '" + path + "' holds " + std::to_string(v.size()) +
-                " numbers; expected a 4x4 camera-to-world matrix, 16 numbers row by row");
+                     " numbers; expected a 4x4 camera-to-world matrix, 16 numbers row by row");
   for (double x : v)
     if (!std::isfinite(x)) return std::nullopt;  // the capture marks a lost pose this way
   // Exact comparison: every writer of these files prints the constant row as 0 0 0 1.
   if (v[12] != 0 || v[13] != 0 || v[14] != 0 || v[15] != 1)
-    throw InputError("pose file '" + path + "': the bottom row is " + std::to_string(v[12]) + " " + std::to_string(v[13]) +
-                " " + std::to_string(v[14]) + " " + std::to_string(v[15]) +
-                ", not 0 0 0 1 (a transposed matrix, translation in the last row?); expected a 4x4 camera-to-world "
-                "matrix row by row");
+    throw InputError(
+        "pose file '" + path + "': the bottom row is " + std::to_string(v[12]) + " " + std::to_string(v[13]) + " " +
+        std::to_string(v[14]) + " " + std::to_string(v[15]) +
+        ", not 0 0 0 1 (a transposed matrix, translation in the last row?); expected a 4x4 camera-to-world "
+        "matrix row by row");
   Eigen::Matrix3d R;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) R(r, c) = v[4 * r + c];
@@ -107,8 +109,8 @@ std::optional<SE3> read_pose_matrix(const std::string& path) {
   const double off = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (off > 1e-2 || R.determinant() < 0)
     throw InputError("pose file '" + path + "': the upper-left 3x3 is not a rotation (R^T R differs from I by " +
-                std::to_string(off) + ", det " + std::to_string(R.determinant()) +
-                "); expected a rigid camera-to-world matrix");
+                     std::to_string(off) + ", det " + std::to_string(R.determinant()) +
+                     "); expected a rigid camera-to-world matrix");
   Eigen::JacobiSVD<Eigen::Matrix3d> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);
   const Eigen::Matrix3d Rn = svd.matrixU() * svd.matrixV().transpose();  // det +1: checked above
   SE3 T;
@@ -123,10 +125,11 @@ vec3 read_gravity_direction(const std::string& path) {
   std::vector<double> v = read_numbers(path, "gravity file");
   if (v.size() != 3)
     throw InputError("gravity file '" + path + "' holds " + std::to_string(v.size()) +
-                " numbers; expected the direction of gravity in the poses' world frame, three numbers");
+                     " numbers; expected the direction of gravity in the poses' world frame, three numbers");
   const double n = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
   if (!(n > 1e-6) || !std::isfinite(n))
-    throw InputError("gravity file '" + path + "' holds a zero or non-finite vector; expected the direction of gravity");
+    throw InputError("gravity file '" + path +
+                     "' holds a zero or non-finite vector; expected the direction of gravity");
   return {static_cast<float>(v[0] / n), static_cast<float>(v[1] / n), static_cast<float>(v[2] / n)};
 }
 
@@ -143,18 +146,23 @@ FrameFolderSource::FrameFolderSource(const InputParams& params, bool pinned)
     const std::string problem =
         "frame folder '" + folder_ + "': frame " + std::to_string(f.number) + " has " +
         (f.depth.empty() ? "no depth image " + base + ".depth.png" : "no colour image " + base + ".color.png or .jpg") +
-        " (its files: " + f.colour + (f.colour.empty() ? "" : " ") + f.depth + (f.depth.empty() ? "" : " ") + f.pose + ")";
-    if (!params.skip_bad_frames) throw InputError(problem + "; add it, remove the frame's other files, or set input.skip_bad_frames: true");
+        " (its files: " + f.colour + (f.colour.empty() ? "" : " ") + f.depth + (f.depth.empty() ? "" : " ") + f.pose +
+        ")";
+    if (!params.skip_bad_frames)
+      throw InputError(problem + "; add it, remove the frame's other files, or set input.skip_bad_frames: true");
     ++skipped_;
     spdlog::warn("{}: skipped (input.skip_bad_frames)", problem);
   }
   if (frames_.empty())
-    throw InputError("frame folder '" + folder_ + "' has no frames (no frame-NNNNNN.color.png/.jpg with a frame-NNNNNN.depth.png)");
+    throw InputError("frame folder '" + folder_ +
+                     "' has no frames (no frame-NNNNNN.color.png/.jpg with a frame-NNNNNN.depth.png)");
   const std::size_t first = static_cast<std::size_t>(std::min<std::int64_t>(params.first_frame, frames_.size()));
   frames_.erase(frames_.begin(), frames_.begin() + first);
-  if (params.max_frames > 0 && frames_.size() > static_cast<std::size_t>(params.max_frames)) frames_.resize(params.max_frames);
+  if (params.max_frames > 0 && frames_.size() > static_cast<std::size_t>(params.max_frames))
+    frames_.resize(params.max_frames);
   if (frames_.empty())
-    throw InputError("input.first_frame " + std::to_string(params.first_frame) + " is past the end of '" + folder_ + "'");
+    throw InputError("input.first_frame " + std::to_string(params.first_frame) + " is past the end of '" + folder_ +
+                     "'");
 
   std::int64_t with_pose = 0, lost_pose = 0;
   for (const FrameFolderEntry& f : frames_) {
@@ -168,15 +176,16 @@ FrameFolderSource::FrameFolderSource(const InputParams& params, bool pinned)
       spdlog::warn("'{}' gives gravity in the poses' world frame, but no frame has a pose: gravity unused", g);
   }
 
-  const IntrinsicsChoice choice = resolve_intrinsics(params.intrinsics, folder_);  // logged (a warning for the generic set)
+  const IntrinsicsChoice choice =
+      resolve_intrinsics(params.intrinsics, folder_);  // logged (a warning for the generic set)
   K_ = choice.K, flip_x_ = choice.flip_x, flip_y_ = choice.flip_y;
-  spdlog::info("frame folder '{}': {} frames (numbers {}..{}), {} with a pose file{}{}, depth {} units per metre{}, "
-               "timestamps number / {} fps",
-               folder_, frames_.size(), frames_.front().number, frames_.back().number, with_pose,
-               lost_pose ? " (" + std::to_string(lost_pose) + " more marked lost)" : "",
-               gravity_ ? ", gravity from gravity-direction.txt" : "", scale_,
-               params.depth_scale > 0 ? " (input.depth_scale)" : " (the layout's millimetres; input.depth_scale 0)",
-               params.fps);
+  spdlog::info(
+      "frame folder '{}': {} frames (numbers {}..{}), {} with a pose file{}{}, depth {} units per metre{}, "
+      "timestamps number / {} fps",
+      folder_, frames_.size(), frames_.front().number, frames_.back().number, with_pose,
+      lost_pose ? " (" + std::to_string(lost_pose) + " more marked lost)" : "",
+      gravity_ ? ", gravity from gravity-direction.txt" : "", scale_,
+      params.depth_scale > 0 ? " (input.depth_scale)" : " (the layout's millimetres; input.depth_scale 0)", params.fps);
   scale_check_ = std::make_unique<DepthScaleCheck>(scale_, params.check_depth_scale);
 }
 
@@ -187,15 +196,17 @@ void FrameFolderSource::load_frame(std::size_t i, RgbdFrame& frame) {
   const fs::path dir(folder_);
   const std::string depth_path = (dir / f.depth).string(), colour_path = (dir / f.colour).string();
   Image<std::uint16_t> raw = read_png_u16(depth_path);
-  Image<uchar3> rgb = read_colour_image(colour_path);  // PNG or JPEG, by content
+  Image<uchar3> rgb = read_colour_image(colour_path);                    // PNG or JPEG, by content
   flip_image(raw, flip_x_, flip_y_), flip_image(rgb, flip_x_, flip_y_);  // a negative focal length
   if (raw.width() != K_.width || raw.height() != K_.height)
-    throw InputError("depth image '" + depth_path + "' is " + std::to_string(raw.width()) + "x" + std::to_string(raw.height()) +
-                " but input.intrinsics says " + std::to_string(K_.width) + "x" + std::to_string(K_.height));
+    throw InputError("depth image '" + depth_path + "' is " + std::to_string(raw.width()) + "x" +
+                     std::to_string(raw.height()) + " but input.intrinsics says " + std::to_string(K_.width) + "x" +
+                     std::to_string(K_.height));
   if (rgb.width() != raw.width() || rgb.height() != raw.height())
     throw InputError("colour image '" + colour_path + "' is " + std::to_string(rgb.width()) + "x" +
-                std::to_string(rgb.height()) + ", its depth image '" + depth_path + "' " + std::to_string(raw.width()) +
-                "x" + std::to_string(raw.height()) + " (the depth must be registered to the colour camera)");
+                     std::to_string(rgb.height()) + ", its depth image '" + depth_path + "' " +
+                     std::to_string(raw.width()) + "x" + std::to_string(raw.height()) +
+                     " (the depth must be registered to the colour camera)");
   reserve_frame_images(frame, raw.width(), raw.height(), pinned_);
   if (params_.fill_gaps && gap_scratch_.width() != raw.width())
     gap_scratch_ = Image<float>(raw.width(), raw.height(), Device::CPU);
@@ -229,7 +240,8 @@ bool FrameFolderSource::next(RgbdFrame& frame) {
       const bool scale_problem = std::string(e.what()).find("input.depth_scale") != std::string::npos;
       if (!params_.skip_bad_frames || scale_problem) throw;  // a wrong scale is not one bad frame
       ++skipped_;
-      spdlog::warn("skipping bad frame {} of '{}' ({} skipped so far): {}", frames_[i].number, folder_, skipped_, e.what());
+      spdlog::warn("skipping bad frame {} of '{}' ({} skipped so far): {}", frames_[i].number, folder_, skipped_,
+                   e.what());
     }
   }
   return false;

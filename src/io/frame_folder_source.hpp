@@ -65,7 +65,7 @@ class FrameFolderSource : public FrameSource {
   std::string folder_;
   Intrinsics K_;
   bool flip_x_ = false, flip_y_ = false;  // images flipped on reading (a negative focal length)
-  double scale_ = 1000.0;  // units per metre, input.depth_scale or the layout's millimetres
+  double scale_ = 1000.0;                 // units per metre, input.depth_scale or the layout's millimetres
   std::vector<FrameFolderEntry> frames_;
   std::vector<std::optional<SE3>> poses_;
   std::optional<vec3> gravity_;

@@ -13,7 +13,7 @@ namespace seamless {
 // Camera intrinsics: a named preset, `custom` with fx fy cx cy given here, or a camera file.
 struct IntrinsicsParams {
   std::string preset = "auto";
-  std::string file;  // a camera file (io/camera_file.hpp); wins over preset auto
+  std::string file;                                        // a camera file (io/camera_file.hpp); wins over preset auto
   float fx = 525.f, fy = 525.f, cx = 319.5f, cy = 239.5f;  // used when preset is custom
   int width = 640, height = 480;
 
@@ -39,7 +39,7 @@ struct IntrinsicsParams {
 
 // Kinect v1 sensor model of the synthetic room (kernels/io/render_room.hpp, docs/INPUT.md).
 struct SyntheticNoiseParams {
-  float sigma_disparity = 0.05f;     // pixels, Gaussian disparity noise on top of 1/8-pixel quantisation
+  float sigma_disparity = 0.05f;  // pixels, Gaussian disparity noise on top of 1/8-pixel quantisation
   float min_depth = 0.4f;
   float max_depth = 4.0f;
   float max_incidence_deg = 78.f;
@@ -47,7 +47,8 @@ struct SyntheticNoiseParams {
   bool projector_shadow = true;
 
   template <class V> void visit(V& v) {
-    v("sigma_disparity", sigma_disparity, "Gaussian disparity noise, pixels (Khoshelham & Elberink 2012)", Range{0.0, 5.0});
+    v("sigma_disparity", sigma_disparity, "Gaussian disparity noise, pixels (Khoshelham & Elberink 2012)",
+      Range{0.0, 5.0});
     v("min_depth", min_depth, "nearest measurable depth, metres", Range{0.0, 100.0});
     v("max_depth", max_depth, "farthest measurable depth, metres", Range{0.0, 100.0});
     v("max_incidence_deg", max_incidence_deg, "no depth beyond this angle between ray and surface normal, degrees",
@@ -62,11 +63,11 @@ struct SyntheticNoiseParams {
 // path's end (then gone, as if it left the room). Posed per frame by src/io/movers.cpp.
 struct MoverParams {
   std::string kind = "person";
-  std::vector<vec3> path;            // waypoints on the floor, room frame (x, y; z is ignored)
-  float speed = 1.0f;                // metres per second along the path
-  double start = 0.0;                // seconds: when it stands at the path's first point
-  float height = 1.75f;              // person: standing height, metres
-  float radius = 0.12f;              // ball: radius, metres
+  std::vector<vec3> path;  // waypoints on the floor, room frame (x, y; z is ignored)
+  float speed = 1.0f;      // metres per second along the path
+  double start = 0.0;      // seconds: when it stands at the path's first point
+  float height = 1.75f;    // person: standing height, metres
+  float radius = 0.12f;    // ball: radius, metres
 
   template <class V> void visit(V& v) {
     v("kind", kind, "person (torso, head, arms and legs swinging as it walks) or ball (rolling)",
@@ -87,20 +88,19 @@ struct SyntheticParams {
   int frames = 120;
   std::string trajectory = "orbit";
   double fps = 30.0;
-  float radius = 1.6f;               // orbit: horizontal distance to the desk centre, metres
-  float height = 1.35f;              // camera height above the floor, metres
-  float speed_deg = 15.f;            // orbit: degrees per second around the desk
-  float start_deg = -90.f;           // orbit: start angle (-90: in front of the desk, behind the chair)
-  float shake = 1.f;                 // scale of the hand-held wobble (0 = a perfectly smooth path)
+  float radius = 1.6f;      // orbit: horizontal distance to the desk centre, metres
+  float height = 1.35f;     // camera height above the floor, metres
+  float speed_deg = 15.f;   // orbit: degrees per second around the desk
+  float start_deg = -90.f;  // orbit: start angle (-90: in front of the desk, behind the chair)
+  float shake = 1.f;        // scale of the hand-held wobble (0 = a perfectly smooth path)
   SyntheticNoiseParams sensor;
-  std::vector<MoverParams> movers;   // people and balls moving through the room (ground-truth masks)
+  std::vector<MoverParams> movers;  // people and balls moving through the room (ground-truth masks)
 
   template <class V> void visit(V& v) {
     v("seed", seed, "random seed for the noise and the hand-held wobble");
     v("noise", noise, "add Kinect-like depth noise and dropouts (off: exact depth everywhere)");
     v("frames", frames, "number of frames to generate", Range{1, 1000000});
-    v("trajectory", trajectory, "camera path: orbit around the desk, or still (fixed pose)",
-      Choices{"orbit", "still"});
+    v("trajectory", trajectory, "camera path: orbit around the desk, or still (fixed pose)", Choices{"orbit", "still"});
     v("fps", fps, "frames per second (timestamps and motion speed)", Range{1.0, 1000.0});
     v("radius", radius, "orbit radius around the desk centre, metres", Range{0.5, 1.8});
     v("height", height, "camera height above the floor, metres (above the furniture)", Range{1.05, 2.3});
@@ -108,7 +108,8 @@ struct SyntheticParams {
     v("start_deg", start_deg, "orbit start angle, degrees", Range{-360.0, 360.0});
     v("shake", shake, "hand-held wobble scale (0 = smooth)", Range{0.0, 5.0});
     v("sensor", sensor, "Kinect v1 sensor model used when noise is on");
-    v("movers", movers, "people and balls that move through the room; `seamless record` writes their masks "
+    v("movers", movers,
+      "people and balls that move through the room; `seamless record` writes their masks "
       "(mask/) and capsules (movers.txt)");
   }
 };
@@ -129,17 +130,17 @@ struct KinectParams {
 
 struct InputParams {
   std::string source = "synthetic";
-  std::string path;                 // TUM folder (source: tum) or frame folder (source: frames)
-  double depth_scale = 0.0;         // units per metre; 0: the layout's own (TUM 5000, frames 1000)
-  bool check_depth_scale = true;    // compare depth_scale with the depth's Kinect quantisation
-  double fps = 30.0;                // frame folders: timestamp = frame number / fps
-  bool fill_gaps = false;           // close one-pixel gaps of forward-registered depth
+  std::string path;               // TUM folder (source: tum) or frame folder (source: frames)
+  double depth_scale = 0.0;       // units per metre; 0: the layout's own (TUM 5000, frames 1000)
+  bool check_depth_scale = true;  // compare depth_scale with the depth's Kinect quantisation
+  double fps = 30.0;              // frame folders: timestamp = frame number / fps
+  bool fill_gaps = false;         // close one-pixel gaps of forward-registered depth
   IntrinsicsParams intrinsics;
-  std::int64_t max_frames = 0;      // 0 = all
+  std::int64_t max_frames = 0;  // 0 = all
   std::int64_t first_frame = 0;
   bool skip_bad_frames = false;
-  bool undistort = true;            // remove lens distortion of presets that have it (freiburg1/2)
-  double max_gt_gap = 0.1;          // seconds: no ground truth across larger motion-capture gaps
+  bool undistort = true;             // remove lens distortion of presets that have it (freiburg1/2)
+  double max_gt_gap = 0.1;           // seconds: no ground truth across larger motion-capture gaps
   std::string association = "auto";  // TUM: pair rgb.txt/depth.txt by time (auto) or trust the folder's file
   double association_max_dt = 0.02;  // TUM's associate.py --max_difference, seconds
   double association_offset = 0.0;   // TUM's associate.py --offset: added to depth timestamps, seconds
@@ -176,7 +177,8 @@ struct InputParams {
       Choices{"auto", "file"});
     v("association_max_dt", association_max_dt, "auto association: largest rgb/depth timestamp difference, seconds",
       Range{0.0, 1.0});
-    v("association_offset", association_offset, "auto association: seconds added to depth timestamps", Range{-10.0, 10.0});
+    v("association_offset", association_offset, "auto association: seconds added to depth timestamps",
+      Range{-10.0, 10.0});
     v("synthetic", synthetic, "synthetic room settings (source: synthetic)");
     v("kinect", kinect, "live Kinect v1 settings (source: kinect)");
   }

@@ -15,8 +15,8 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "io/camera_file.hpp"
-#include "io/number_file.hpp"
 #include "io/input_params.hpp"
+#include "io/number_file.hpp"
 
 namespace seamless {
 namespace fs = std::filesystem;
@@ -47,10 +47,12 @@ void flip_negative_focal_lengths(IntrinsicsChoice& c) {
 // kinect_v1 is the ROS/OpenNI default the same page gives for uncalibrated Kinects.
 Intrinsics intrinsics_preset(const std::string& name) {
   if (name == "freiburg1") return make(517.3f, 516.5f, 318.6f, 255.3f, {0.2624f, -0.9531f, -0.0054f, 0.0026f, 1.1633f});
-  if (name == "freiburg2") return make(520.9f, 521.0f, 325.1f, 249.7f, {0.2312f, -0.7849f, -0.0033f, -0.0001f, 0.9172f});
+  if (name == "freiburg2")
+    return make(520.9f, 521.0f, 325.1f, 249.7f, {0.2312f, -0.7849f, -0.0033f, -0.0001f, 0.9172f});
   if (name == "freiburg3") return make(535.4f, 539.2f, 320.1f, 247.6f);
   if (name == "kinect_v1") return make(525.f, 525.f, 319.5f, 239.5f);
-  throw ConfigError("unknown intrinsics preset '" + name + "': use freiburg1, freiburg2, freiburg3, kinect_v1, custom or auto");
+  throw ConfigError("unknown intrinsics preset '" + name +
+                    "': use freiburg1, freiburg2, freiburg3, kinect_v1, custom or auto");
 }
 
 std::string camera_in_folder_name(const std::string& name) {
@@ -155,15 +157,16 @@ IntrinsicsChoice choose_intrinsics(const IntrinsicsParams& p, const std::string&
 IntrinsicsChoice resolve_intrinsics(const IntrinsicsParams& p, const std::string& folder) {
   IntrinsicsChoice c = choose_intrinsics(p, folder);
   if (c.flip_x || c.flip_y)
-    spdlog::info("intrinsics: {} has a negative focal length {}: every image is read with its {} flipped, which "
-                 "makes it an ordinary pinhole seeing the same 3D points (fx fy cx cy below are the flipped image's)",
-                 c.chosen, c.flip_y ? "fy" : "fx",
-                 c.flip_x && c.flip_y ? "columns and rows" : (c.flip_y ? "rows" : "columns"));
+    spdlog::info(
+        "intrinsics: {} has a negative focal length {}: every image is read with its {} flipped, which "
+        "makes it an ordinary pinhole seeing the same 3D points (fx fy cx cy below are the flipped image's)",
+        c.chosen, c.flip_y ? "fy" : "fx", c.flip_x && c.flip_y ? "columns and rows" : (c.flip_y ? "rows" : "columns"));
   if (c.generic)
-    spdlog::warn("intrinsics: {}: USING THE GENERIC KINECT v1 SET ({}), which can be off by several pixels for "
-                 "this camera; set input.intrinsics.preset (freiburg1, freiburg2, freiburg3, kinect_v1 or custom "
-                 "with fx fy cx cy) or put a calibration.txt in the folder",
-                 c.reason, describe_intrinsics(c.K));
+    spdlog::warn(
+        "intrinsics: {}: USING THE GENERIC KINECT v1 SET ({}), which can be off by several pixels for "
+        "this camera; set input.intrinsics.preset (freiburg1, freiburg2, freiburg3, kinect_v1 or custom "
+        "with fx fy cx cy) or put a calibration.txt in the folder",
+        c.reason, describe_intrinsics(c.K));
   else if (!folder.empty() || p.preset != "auto" || !p.file.empty())
     spdlog::info("intrinsics: {} ({}): {}", c.chosen, c.reason, describe_intrinsics(c.K));
   return c;
@@ -182,11 +185,10 @@ std::string find_intrinsics_matrix(const std::string& folder) {
 }
 
 Intrinsics read_intrinsics_matrix(const std::string& path) {
-  const std::vector<double> v =
-      read_numbers(path, "camera matrix file", "(expected a 3x3 matrix K, nine numbers)");
+  const std::vector<double> v = read_numbers(path, "camera matrix file", "(expected a 3x3 matrix K, nine numbers)");
   if (v.size() != 9)
     throw InputError("camera matrix file '" + path + "' holds " + std::to_string(v.size()) +
-                " numbers; expected a 3x3 matrix K = [fx 0 cx; 0 fy cy; 0 0 1], nine numbers");
+                     " numbers; expected a 3x3 matrix K = [fx 0 cx; 0 fy cy; 0 0 1], nine numbers");
   double k[9];
   std::copy(v.begin(), v.end(), k);
   return intrinsics_from_matrix(k, "camera matrix file '" + path + "'");
@@ -203,8 +205,8 @@ Intrinsics read_calibration(const std::string& path) {
     if (ss >> K.fx >> K.fy >> K.cx >> K.cy >> K.width >> K.height >> K.dist[0] >> K.dist[1] >> K.dist[2] >> K.dist[3] >>
         K.dist[4])
       return K;
-    throw InputError("malformed calibration file '" + path + "': expected 'fx fy cx cy width height d0 d1 d2 d3 d4', got '" +
-                line + "'");
+    throw InputError("malformed calibration file '" + path +
+                     "': expected 'fx fy cx cy width height d0 d1 d2 d3 d4', got '" + line + "'");
   }
   throw InputError("calibration file '" + path + "' has no calibration line");
 }

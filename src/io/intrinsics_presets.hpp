@@ -45,8 +45,7 @@ IntrinsicsChoice choose_intrinsics(const IntrinsicsParams& p, const std::string&
 IntrinsicsChoice resolve_intrinsics(const IntrinsicsParams& p, const std::string& folder = "");
 
 // Mirrors a host image's columns (flip_x) and rows (flip_y), as IntrinsicsChoice describes.
-template <class T>
-void flip_image(Image<T>& im, bool flip_x, bool flip_y) {
+template <class T> void flip_image(Image<T>& im, bool flip_x, bool flip_y) {
   T* d = im.buffer().data();
   const std::int64_t w = im.width(), h = im.height();
   if (flip_y)
@@ -63,7 +62,8 @@ std::string find_intrinsics_matrix(const std::string& folder);
 // A 3x3 camera matrix K = [fx s cx; 0 fy cy; 0 0 1], nine numbers (whitespace or commas between
 // them, '#' comments). Throws an InputError naming the file for another count, a bottom row that
 // is not 0 0 1, a non-zero second-row first entry, a focal length below one pixel in size or a
-// skew s (the kernels' pinhole has none). Negative focal lengths are kept (IntrinsicsChoice). width and height are left at their defaults (the file does not say).
+// skew s (the kernels' pinhole has none). Negative focal lengths are kept (IntrinsicsChoice). width and height are left
+// at their defaults (the file does not say).
 Intrinsics read_intrinsics_matrix(const std::string& path);
 
 // The TUM camera a folder name names: "freiburg1" for "rgbd_dataset_freiburg1_desk" or

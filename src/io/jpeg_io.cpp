@@ -70,7 +70,8 @@ Image<uchar3> read_jpeg_rgb(const std::string& path) {
   auto img = std::make_unique<Image<uchar3>>();
   if (setjmp(s->jb)) {
     jpeg_destroy_decompress(d.get());
-    throw InputError("JPEG file '" + path + "' is truncated, corrupt or not decodable as RGB (libjpeg: " + s->message + ")");
+    throw InputError("JPEG file '" + path + "' is truncated, corrupt or not decodable as RGB (libjpeg: " + s->message +
+                     ")");
   }
   jpeg_create_decompress(d.get());
   jpeg_stdio_src(d.get(), f.get());
@@ -147,8 +148,9 @@ Image<uchar3> read_colour_image(const std::string& path) {
     case ImageFormat::jpeg: return read_jpeg_rgb(path);
     case ImageFormat::unknown: break;
   }
-  throw InputError("colour image '" + path + "' is neither PNG nor JPEG (its first bytes are no PNG signature and no "
-              "JPEG start-of-image marker; empty, truncated or another format?)");
+  throw InputError("colour image '" + path +
+                   "' is neither PNG nor JPEG (its first bytes are no PNG signature and no "
+                   "JPEG start-of-image marker; empty, truncated or another format?)");
 }
 
 }  // namespace seamless

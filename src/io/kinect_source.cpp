@@ -35,8 +35,8 @@ KinectSource::KinectSource(const InputParams& params, bool pinned) : params_(par
                       "): a Kinect's images are not flipped; give its focal lengths as positive numbers");
   K_ = choice.K;
   if (K_.width != kW || K_.height != kH)
-    throw ConfigError("input.intrinsics width/height must be 640x480 for a Kinect v1 (got " + std::to_string(K_.width) + "x" +
-                std::to_string(K_.height) + ")");
+    throw ConfigError("input.intrinsics width/height must be 640x480 for a Kinect v1 (got " + std::to_string(K_.width) +
+                      "x" + std::to_string(K_.height) + ")");
   if (freenect_init(&ctx_, nullptr) < 0)
     throw InputError("libfreenect could not initialise (is libusb working? try running as root or add the udev rules)");
   freenect_set_log_level(ctx_, FREENECT_LOG_WARNING);
@@ -45,13 +45,15 @@ KinectSource::KinectSource(const InputParams& params, bool pinned) : params_(par
   int index = params.kinect.device_index;
   if (n <= 0 || index >= n) {
     close();
-    throw InputError("no Kinect v1 found at input.kinect.device_index " + std::to_string(index) + " (" + std::to_string(n) +
-                " connected): plug it in (with its power supply), check `lsusb` for 045e:02ae and the udev rules, "
-                "or use input.source: tum / synthetic");
+    throw InputError("no Kinect v1 found at input.kinect.device_index " + std::to_string(index) + " (" +
+                     std::to_string(n) +
+                     " connected): plug it in (with its power supply), check `lsusb` for 045e:02ae and the udev rules, "
+                     "or use input.source: tum / synthetic");
   }
   if (freenect_open_device(ctx_, &dev_, index) < 0) {
     close();
-    throw InputError("could not open Kinect " + std::to_string(index) + " (in use by another program, or no permission)");
+    throw InputError("could not open Kinect " + std::to_string(index) +
+                     " (in use by another program, or no permission)");
   }
   freenect_set_user(dev_, this);
   freenect_set_depth_callback(dev_, &KinectSource::on_depth);
@@ -148,8 +150,8 @@ void KinectSource::check_replay_is_millimetres(const std::vector<std::uint16_t>&
   }
   if (zeros == 0 && raw_invalid > 0)
     throw InputError(std::string("the fakenect recording in FAKENECT_PATH=") + std::getenv("FAKENECT_PATH") +
-                " holds raw 11-bit disparity (made by fakenect-record); seamless replays recordings of registered "
-                "millimetres written by write_fakenect_dump() (docs/INPUT.md)");
+                     " holds raw 11-bit disparity (made by fakenect-record); seamless replays recordings of registered "
+                     "millimetres written by write_fakenect_dump() (docs/INPUT.md)");
 }
 
 bool KinectSource::next(RgbdFrame& frame) {
@@ -159,7 +161,7 @@ bool KinectSource::next(RgbdFrame& frame) {
     auto timeout = std::chrono::duration<double>(params_.kinect.timeout_s);
     if (!ready_.wait_for(lock, timeout, [&] { return !queue_.empty() || ended_; }))
       throw InputError("no frame from the Kinect for " + std::to_string(params_.kinect.timeout_s) +
-                  " s (input.kinect.timeout_s): is it still connected and powered?");
+                       " s (input.kinect.timeout_s): is it still connected and powered?");
     if (queue_.empty()) {
       if (delivered_ == 0) throw InputError("the Kinect stopped before its first frame: " + end_reason_);
       return false;

@@ -22,15 +22,15 @@ std::unique_ptr<FrameSource> make_source(const InputParams& params, Device devic
 #if SEAMLESS_HAS_FREENECT
     return std::make_unique<KinectSource>(params, pinned);
 #else
-    throw ConfigError("input.source is kinect but this build has no libfreenect: apt-get install libfreenect-dev, reconfigure");
+    throw ConfigError(
+        "input.source is kinect but this build has no libfreenect: apt-get install libfreenect-dev, reconfigure");
 #endif
   }
   throw ConfigError("unknown input.source '" + params.source + "': use synthetic, tum, frames or kinect");
 }
 
 namespace {
-template <class T>
-void reserve_host_image(Image<T>& im, int w, int h, bool pinned) {
+template <class T> void reserve_host_image(Image<T>& im, int w, int h, bool pinned) {
   // Without a usable GPU, pinned_host falls back to ordinary memory: that fits as well.
   bool fits = im.width() == w && im.height() == h && im.device() == Device::CPU &&
               (!pinned || memory::is_pinned(im.buffer().data()) || !cuda_available());

@@ -49,7 +49,7 @@ void add_person(kernels::movers::Scene& s, int id, vec3 at, vec3 facing, float t
   const vec3 pelvis = at + up * hip_z;
   add(pelvis + up * 0.04f * H, at + up * (shoulder_z - 0.03f * H), 0.09f * H, shirt);  // torso
   add(at + up * 0.93f * H, at + up * 0.93f * H, 0.065f * H, skin);                     // head
-  for (int k = -1; k <= 1; k += 2) {                                                     // left, right
+  for (int k = -1; k <= 1; k += 2) {                                                   // left, right
     const vec3 hip = pelvis + side * (k * 0.055f * H);
     const float a = k * leg_swing, leg = hip_z - leg_r;  // the foot's sphere touches the floor at rest
     add(hip, hip + facing * (leg * std::sin(a)) - up * (leg * std::cos(a)), leg_r, trousers);

@@ -68,7 +68,8 @@ namespace {
 std::string set_transforms(png_structp png, int color_type, int bit_depth, Want want, const PngInfo& info) {
   bool gray = color_type == PNG_COLOR_TYPE_GRAY;
   if (want == Want::U16) {
-    if (!gray || bit_depth != 16) return "is " + describe(info) + ", expected 16-bit grayscale (e.g. a TUM depth image)";
+    if (!gray || bit_depth != 16)
+      return "is " + describe(info) + ", expected 16-bit grayscale (e.g. a TUM depth image)";
     if (std::endian::native == std::endian::little) png_set_swap(png);  // PNG stores big-endian
   } else if (want == Want::U8) {
     if (!gray || bit_depth != 8) return "is " + describe(info) + ", expected 8-bit grayscale";
@@ -122,8 +123,7 @@ void read_png(const std::string& path, Want want, State* s) {
   if (!s->format_problem.empty()) throw InputError("PNG file '" + path + "' " + s->format_problem);
 }
 
-template <class T>
-Image<T> to_image(const State& s, const std::string& path) {
+template <class T> Image<T> to_image(const State& s, const std::string& path) {
   std::size_t n = static_cast<std::size_t>(s.info.width) * s.info.height;
   if (s.pixels.size() != n * sizeof(T))
     throw InputError("PNG file '" + path + "': unexpected decoded size (internal error)");
@@ -144,8 +144,7 @@ void write_png(const std::string& path, int w, int h, int bit_depth, int color_t
     throw Error("cannot write PNG file '" + path + "' (libpng: " + s->libpng_message + ")");
   }
   s->rows.resize(h);
-  for (int y = 0; y < h; ++y)
-    s->rows[y] = const_cast<png_bytep>(static_cast<const png_byte*>(data) + row_bytes * y);
+  for (int y = 0; y < h; ++y) s->rows[y] = const_cast<png_bytep>(static_cast<const png_byte*>(data) + row_bytes * y);
   png_init_io(png, f.get());
   // Depth PNGs are written often (recording at 30 Hz): fast compression is the right trade-off.
   png_set_compression_level(png, 1);
@@ -159,8 +158,7 @@ void write_png(const std::string& path, int w, int h, int bit_depth, int color_t
   if (std::fflush(f.get()) != 0) throw Error("cannot write PNG file '" + path + "': " + std::strerror(errno));
 }
 
-template <class T>
-void check_host(const Image<T>& im, const std::string& path) {
+template <class T> void check_host(const Image<T>& im, const std::string& path) {
   if (im.device() != Device::CPU) throw Error("write_png: image for '" + path + "' must be a host image");
   if (im.width() <= 0 || im.height() <= 0) throw Error("write_png: image for '" + path + "' is empty");
 }

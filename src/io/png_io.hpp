@@ -11,8 +11,8 @@ namespace seamless {
 
 struct PngInfo {
   int width = 0, height = 0;
-  int bit_depth = 0;   // per channel
-  int channels = 0;    // 1 gray, 2 gray+alpha, 3 RGB, 4 RGBA (palette images report 3)
+  int bit_depth = 0;  // per channel
+  int channels = 0;   // 1 gray, 2 gray+alpha, 3 RGB, 4 RGBA (palette images report 3)
 };
 
 PngInfo png_info(const std::string& path);

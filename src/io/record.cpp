@@ -68,8 +68,9 @@ std::int64_t record(FrameSource& source, const std::string& out_dir, const Recor
       if (!movers_txt.is_open()) fs::create_directories(dir / "mask", ec);  // with the list, once
       write_png_u8((dir / "mask" / name).string(), f.mover_mask);
       if (!movers_txt.is_open())
-        movers_txt = open_list(dir / "movers.txt", "# movers (capsules) of the synthetic room, frame of groundtruth.txt\n" +
-                                                       origin + "# timestamp mover ax ay az bx by bz radius\n");
+        movers_txt =
+            open_list(dir / "movers.txt", "# movers (capsules) of the synthetic room, frame of groundtruth.txt\n" +
+                                              origin + "# timestamp mover ax ay az bx by bz radius\n");
       if (f.movers) movers_txt << movers_lines(f.timestamp, *f.movers) << std::flush;
     }
     // The lists name a frame only once both its images are written, and reach the disk with every

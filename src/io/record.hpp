@@ -9,8 +9,8 @@
 namespace seamless {
 
 struct RecordOptions {
-  std::int64_t max_frames = 0;   // 0 = until the source ends
-  double depth_scale = 5000.0;   // units per metre in the 16-bit depth PNGs (TUM: 5000)
+  std::int64_t max_frames = 0;  // 0 = until the source ends
+  double depth_scale = 5000.0;  // units per metre in the 16-bit depth PNGs (TUM: 5000)
 };
 
 // Creates out_dir (and rgb/, depth/) and writes rgb/<t>.png, depth/<t>.png, rgb.txt, depth.txt,

@@ -16,8 +16,9 @@ constexpr double kPi = 3.14159265358979323846;
 
 // Deterministic phase in [0, 2 pi) for wobble component k.
 double phase(std::uint64_t seed, int k) {
-  std::uint32_t h = kernels::hash32(static_cast<std::uint32_t>(seed) ^ kernels::hash32(static_cast<std::uint32_t>(k + 1) ^
-                                                                                       static_cast<std::uint32_t>(seed >> 32)));
+  std::uint32_t h =
+      kernels::hash32(static_cast<std::uint32_t>(seed) ^
+                      kernels::hash32(static_cast<std::uint32_t>(k + 1) ^ static_cast<std::uint32_t>(seed >> 32)));
   return 2 * kPi * (h / 4294967296.0);
 }
 
@@ -69,7 +70,8 @@ PathPoint path_point(const SyntheticParams& p, double t) {
 
 SE3 synthetic_camera_pose(const SyntheticParams& p, double t) {
   PathPoint q = path_point(p, t);
-  return look_at(fv(q.eye[0], q.eye[1], q.eye[2]), fv(q.target[0], q.target[1], q.target[2]), static_cast<float>(q.roll));
+  return look_at(fv(q.eye[0], q.eye[1], q.eye[2]), fv(q.target[0], q.target[1], q.target[2]),
+                 static_cast<float>(q.roll));
 }
 
 vec3 synthetic_accelerometer(const SyntheticParams& p, double t) {
@@ -123,8 +125,9 @@ void SyntheticSource::render(const SE3& T, std::uint32_t frame_number, const ker
   const bool with_mask = !p_.movers.empty();
   if (with_mask && mask_dev_.width() != K_.width) mask_dev_ = Image<std::uint8_t>(K_.width, K_.height, device_);
   with_exec(device_, [&]<class E>(const E& ex) {
-    kernels::RenderRoom<E>::render_room(ex, K_, T, noise, seed, frame_number, movers, scratch_.view(), depth_dev_.view(),
-                         rgb_dev_.view(), with_mask ? mask_dev_.view() : View2D<std::uint8_t>{});
+    kernels::RenderRoom<E>::render_room(ex, K_, T, noise, seed, frame_number, movers, scratch_.view(),
+                                        depth_dev_.view(), rgb_dev_.view(),
+                                        with_mask ? mask_dev_.view() : View2D<std::uint8_t>{});
     ex.synchronize();
   });
   depth.buffer().copy_from(depth_dev_.buffer());
@@ -133,7 +136,8 @@ void SyntheticSource::render(const SE3& T, std::uint32_t frame_number, const ker
     mask = Image<std::uint8_t>();
     return;
   }
-  if (mask.width() != K_.width || mask.height() != K_.height) mask = Image<std::uint8_t>(K_.width, K_.height, Device::CPU);
+  if (mask.width() != K_.width || mask.height() != K_.height)
+    mask = Image<std::uint8_t>(K_.width, K_.height, Device::CPU);
   mask.buffer().copy_from(mask_dev_.buffer());
 }
 

@@ -40,7 +40,6 @@ class SyntheticSource : public FrameSource {
               Image<float>& depth, Image<uchar3>& rgb, Image<std::uint8_t>& mask);
 
  public:
-
  private:
   SyntheticParams p_;
   Intrinsics K_;

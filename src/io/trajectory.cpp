@@ -66,14 +66,16 @@ Trajectory read_tum_trajectory(const std::string& path) {
     std::istringstream ss(line);
     TumPose p;
     if (!(ss >> p.timestamp >> p.t[0] >> p.t[1] >> p.t[2] >> p.q[0] >> p.q[1] >> p.q[2] >> p.q[3]))
-      throw InputError("malformed pose at " + where(path, n) + ": expected 'timestamp tx ty tz qx qy qz qw', got '" + line + "'");
+      throw InputError("malformed pose at " + where(path, n) + ": expected 'timestamp tx ty tz qx qy qz qw', got '" +
+                       line + "'");
     double norm = quat(p).norm();
     if (!(norm > 0.9 && norm < 1.1))
-      throw InputError("quaternion at " + where(path, n) + " has norm " + std::to_string(norm) + ", expected 1 (order is qx qy qz qw)");
+      throw InputError("quaternion at " + where(path, n) + " has norm " + std::to_string(norm) +
+                       ", expected 1 (order is qx qy qz qw)");
     set_quat(p, quat(p).normalized());
     if (!out.empty() && p.timestamp < out.back().timestamp)
       throw InputError("timestamps go backwards at " + where(path, n) + " (" + std::to_string(p.timestamp) + " after " +
-                  std::to_string(out.back().timestamp) + "): sort the file by time");
+                       std::to_string(out.back().timestamp) + "): sort the file by time");
     out.push_back(p);
   }
   return out;
@@ -128,7 +130,8 @@ void TrajectoryWriter::write(const TumPose& p) {
   // 6 decimals for time (microseconds, as TUM) and 7 significant digits beyond metres (0.1 um).
   int n = std::fprintf(f_, "%.6f %.7f %.7f %.7f %.9f %.9f %.9f %.9f\n", p.timestamp, p.t[0], p.t[1], p.t[2], p.q[0],
                        p.q[1], p.q[2], p.q[3]);
-  if (n < 0 || std::fflush(f_) != 0) throw Error("cannot write trajectory file '" + path_ + "': " + std::strerror(errno));
+  if (n < 0 || std::fflush(f_) != 0)
+    throw Error("cannot write trajectory file '" + path_ + "': " + std::strerror(errno));
 }
 
 }  // namespace seamless

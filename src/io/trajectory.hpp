@@ -18,7 +18,7 @@ struct TumPose {
   double t[3] = {0, 0, 0};     // tx ty tz, metres
   double q[4] = {0, 0, 0, 1};  // qx qy qz qw
 
-  SE3 se3() const;                                   // world_T_camera
+  SE3 se3() const;  // world_T_camera
   static TumPose from_se3(double timestamp, const SE3& world_T_camera);
 };
 

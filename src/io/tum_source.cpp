@@ -39,7 +39,7 @@ bool repeated(double prev, double t, const std::string& path, int n, const std::
 void check_order(double prev, double t, const std::string& path, int n) {
   if (t < prev)
     throw InputError("timestamps out of order at " + where(path, n) + " (" + std::to_string(t) + " after " +
-                std::to_string(prev) + "): TUM list files must be sorted by time");
+                     std::to_string(prev) + "): TUM list files must be sorted by time");
 }
 
 // associations.txt: `t_rgb rgb_file t_depth depth_file` (TUM's associate.py rgb.txt depth.txt);
@@ -54,8 +54,8 @@ std::vector<TumPair> read_associations(const std::string& path) {
     std::istringstream ss(line);
     TumPair p;
     if (!(ss >> p.rgb.timestamp >> p.rgb.file >> p.depth.timestamp >> p.depth.file))
-      throw InputError("malformed association at " + where(path, n) + ": expected 't_rgb rgb/x.png t_depth depth/y.png', got '" +
-                  line + "'");
+      throw InputError("malformed association at " + where(path, n) +
+                       ": expected 't_rgb rgb/x.png t_depth depth/y.png', got '" + line + "'");
     if (p.rgb.file.find("depth") != std::string::npos && p.depth.file.find("rgb") != std::string::npos)
       std::swap(p.rgb, p.depth);
     if (!out.empty() && repeated(out.back().rgb.timestamp, p.rgb.timestamp, path, n, line)) continue;
@@ -112,7 +112,7 @@ std::vector<TumPair> associate(const std::vector<TumListEntry>& rgb, const std::
   };
   std::vector<Candidate> cand;
   for (std::size_t r = 0; r < rgb.size(); ++r) {  // both lists are sorted: a window per rgb entry
-    const double t = rgb[r].timestamp - offset;      // the depth stamp that would match exactly
+    const double t = rgb[r].timestamp - offset;   // the depth stamp that would match exactly
     auto lo = std::lower_bound(depth.begin(), depth.end(), t - max_difference,
                                [](const TumListEntry& e, double v) { return e.timestamp < v; });
     for (auto it = lo; it != depth.end() && it->timestamp <= t + max_difference; ++it) {
@@ -128,7 +128,8 @@ std::vector<TumPair> associate(const std::vector<TumListEntry>& rgb, const std::
     used_r[c.r] = used_d[c.d] = 1;
     out.push_back({rgb[c.r], depth[c.d]});
   }
-  std::sort(out.begin(), out.end(), [](const TumPair& a, const TumPair& b) { return a.rgb.timestamp < b.rgb.timestamp; });
+  std::sort(out.begin(), out.end(),
+            [](const TumPair& a, const TumPair& b) { return a.rgb.timestamp < b.rgb.timestamp; });
   return out;
 }
 
@@ -154,22 +155,24 @@ std::vector<TumPair> tum_folder_pairs(const std::string& folder, const InputPara
   const std::string file = association_file(dir);
   if (params.association == "file") {
     if (file.empty())
-      throw InputError("input.association is 'file' but '" + folder + "' has neither associations.txt nor associate.txt: " +
-                  "set input.association: auto to pair rgb.txt and depth.txt by time");
+      throw InputError("input.association is 'file' but '" + folder +
+                       "' has neither associations.txt nor associate.txt: " +
+                       "set input.association: auto to pair rgb.txt and depth.txt by time");
     return read_associations(file);
   }
   const bool lists = fs::exists(dir / "rgb.txt") && fs::exists(dir / "depth.txt");
   if (!lists && !file.empty()) return read_associations(file);  // nothing to pair by time
-  std::vector<TumPair> pairs = associate(read_tum_list((dir / "rgb.txt").string()),
-                                         read_tum_list((dir / "depth.txt").string()), params.association_max_dt,
-                                         params.association_offset);
+  std::vector<TumPair> pairs =
+      associate(read_tum_list((dir / "rgb.txt").string()), read_tum_list((dir / "depth.txt").string()),
+                params.association_max_dt, params.association_offset);
   if (!file.empty()) {
     std::vector<TumPair> listed = read_associations(file);
     if (!same_pairs(listed, pairs))
-      spdlog::warn("'{}' lists {} rgb/depth pairs, pairing rgb.txt and depth.txt by time (within {} s) finds {}: "
-                   "using the pairs by time, TUM's convention (input.association: auto); set input.association: file "
-                   "to use the file instead",
-                   file, listed.size(), params.association_max_dt, pairs.size());
+      spdlog::warn(
+          "'{}' lists {} rgb/depth pairs, pairing rgb.txt and depth.txt by time (within {} s) finds {}: "
+          "using the pairs by time, TUM's convention (input.association: auto); set input.association: file "
+          "to use the file instead",
+          file, listed.size(), params.association_max_dt, pairs.size());
   }
   return pairs;
 }
@@ -184,13 +187,16 @@ TumSource::TumSource(const InputParams& params, bool pinned) : params_(params), 
   pairs_ = tum_folder_pairs(folder_, params);
   if (pairs_.empty())
     throw InputError("TUM folder '" + folder_ + "' has no rgb/depth pairs (input.association " + params.association +
-                ": no rgb/depth timestamps within input.association_max_dt " + std::to_string(params.association_max_dt) +
-                " s, or empty lists); check rgb.txt and depth.txt, or input.association_offset");
+                     ": no rgb/depth timestamps within input.association_max_dt " +
+                     std::to_string(params.association_max_dt) +
+                     " s, or empty lists); check rgb.txt and depth.txt, or input.association_offset");
   std::size_t first = static_cast<std::size_t>(std::min<std::int64_t>(params.first_frame, pairs_.size()));
   pairs_.erase(pairs_.begin(), pairs_.begin() + first);
-  if (params.max_frames > 0 && pairs_.size() > static_cast<std::size_t>(params.max_frames)) pairs_.resize(params.max_frames);
+  if (params.max_frames > 0 && pairs_.size() > static_cast<std::size_t>(params.max_frames))
+    pairs_.resize(params.max_frames);
   if (pairs_.empty())
-    throw InputError("input.first_frame " + std::to_string(params.first_frame) + " is past the end of '" + folder_ + "'");
+    throw InputError("input.first_frame " + std::to_string(params.first_frame) + " is past the end of '" + folder_ +
+                     "'");
   if (fs::exists(dir / "groundtruth.txt")) groundtruth_ = read_tum_trajectory((dir / "groundtruth.txt").string());
   if (fs::exists(dir / "accelerometer.txt")) accel_ = read_accelerometer((dir / "accelerometer.txt").string());
   scale_check_ = std::make_unique<DepthScaleCheck>(effective_depth_scale(params), params.check_depth_scale);
@@ -221,14 +227,16 @@ void TumSource::load_frame(const TumPair& pair, RgbdFrame& frame) {
   fs::path dir(folder_);
   std::string depth_path = (dir / pair.depth.file).string(), rgb_path = (dir / pair.rgb.file).string();
   Image<std::uint16_t> raw = read_png_u16(depth_path);
-  Image<uchar3> rgb = read_colour_image(rgb_path);  // PNG or JPEG, by content
+  Image<uchar3> rgb = read_colour_image(rgb_path);                       // PNG or JPEG, by content
   flip_image(raw, flip_x_, flip_y_), flip_image(rgb, flip_x_, flip_y_);  // a negative focal length
   if (raw.width() != K_.width || raw.height() != K_.height)
-    throw InputError("depth image '" + depth_path + "' is " + std::to_string(raw.width()) + "x" + std::to_string(raw.height()) +
-                " but input.intrinsics says " + std::to_string(K_.width) + "x" + std::to_string(K_.height));
+    throw InputError("depth image '" + depth_path + "' is " + std::to_string(raw.width()) + "x" +
+                     std::to_string(raw.height()) + " but input.intrinsics says " + std::to_string(K_.width) + "x" +
+                     std::to_string(K_.height));
   if (rgb.width() != raw.width() || rgb.height() != raw.height())
-    throw InputError("colour image '" + rgb_path + "' is " + std::to_string(rgb.width()) + "x" + std::to_string(rgb.height()) +
-                ", its depth image '" + depth_path + "' " + std::to_string(raw.width()) + "x" + std::to_string(raw.height()));
+    throw InputError("colour image '" + rgb_path + "' is " + std::to_string(rgb.width()) + "x" +
+                     std::to_string(rgb.height()) + ", its depth image '" + depth_path + "' " +
+                     std::to_string(raw.width()) + "x" + std::to_string(raw.height()));
   // Decoded straight into the frame's (reused, possibly page-locked) images; undistortion reads
   // from scratch images instead.
   Intrinsics K = intrinsics();

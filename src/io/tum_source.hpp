@@ -56,15 +56,15 @@ class TumSource : public FrameSource {
 
   InputParams params_;
   std::string folder_;
-  Intrinsics K_;  // as calibrated (with distortion)
+  Intrinsics K_;                          // as calibrated (with distortion)
   bool flip_x_ = false, flip_y_ = false;  // images flipped on reading (a negative focal length)
   std::vector<TumPair> pairs_;
   Trajectory groundtruth_;
-  std::vector<std::pair<double, vec3>> accel_;  // camera-frame specific force
-  Image<vec2> undistort_map_;                   // where each undistorted pixel comes from
-  Image<uchar3> rgb_scratch_;                   // undistortion's source
-  Image<float> scratch_;                        // depth before undistortion
-  Image<float> gap_scratch_;                    // input.fill_gaps: depth before its gaps are filled
+  std::vector<std::pair<double, vec3>> accel_;    // camera-frame specific force
+  Image<vec2> undistort_map_;                     // where each undistorted pixel comes from
+  Image<uchar3> rgb_scratch_;                     // undistortion's source
+  Image<float> scratch_;                          // depth before undistortion
+  Image<float> gap_scratch_;                      // input.fill_gaps: depth before its gaps are filled
   std::unique_ptr<DepthScaleCheck> scale_check_;  // depth_scale against the first frames' quantisation
   bool pinned_ = false;
   std::size_t next_ = 0;

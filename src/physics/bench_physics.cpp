@@ -55,7 +55,8 @@ PhysicsBenchCase rigid(Device dev, bool graph, const std::string& name, int bodi
   for (int b = 0; b < bodies; ++b) {
     SpawnParams c;
     c.kind = "rigid", c.size = {4 * d, 4 * d, 4 * d};
-    c.position = {(b % side - 0.5f * side) * 6 * d, 0.1f + 0.3f * (b / (side * side)), (b / side % side - 0.5f * side) * 6 * d};
+    c.position = {(b % side - 0.5f * side) * 6 * d, 0.1f + 0.3f * (b / (side * side)),
+                  (b / side % side - 0.5f * side) * 6 * d};
     s->spawn(c);
   }
   return make_case(name, std::to_string(bodies) + " rigid cubes of 4x4x4 particles, 2 iterations", s);

@@ -43,7 +43,9 @@ std::vector<vec4> voxel_sdf(const std::vector<int3>& cells, float d) {
   hi = hi + int3{1, 1, 1};
   int3 n = hi - lo + int3{1, 1, 1};
   std::vector<char> occ(static_cast<std::size_t>(n.x) * n.y * n.z, 0);
-  auto at = [&](int3 c) -> char& { return occ[(static_cast<std::size_t>(c.z - lo.z) * n.y + (c.y - lo.y)) * n.x + (c.x - lo.x)]; };
+  auto at = [&](int3 c) -> char& {
+    return occ[(static_cast<std::size_t>(c.z - lo.z) * n.y + (c.y - lo.y)) * n.x + (c.x - lo.x)];
+  };
   auto inside = [&](int3 c) {
     return c.x >= lo.x && c.y >= lo.y && c.z >= lo.z && c.x <= hi.x && c.y <= hi.y && c.z <= hi.z ? at(c) : 0;
   };
@@ -76,8 +78,8 @@ std::vector<vec4> voxel_sdf(const std::vector<int3>& cells, float d) {
 ParticleBatch rigid_from_cells(const std::vector<int3>& cells, const SpawnParams& s, const SolverParams& p) {
   if (cells.empty())
     throw ConfigError("spawn rigid: shape '" + s.shape + "' of size (" + std::to_string(s.size.x) + ", " +
-                std::to_string(s.size.y) + ", " + std::to_string(s.size.z) +
-                ") holds no particle of diameter " + std::to_string(p.particle_diameter) + "; make it larger");
+                      std::to_string(s.size.y) + ", " + std::to_string(s.size.z) + ") holds no particle of diameter " +
+                      std::to_string(p.particle_diameter) + "; make it larger");
   const float d = p.particle_diameter;
   ParticleBatch b;
   b.kind = ParticleBatch::kRigid;
@@ -248,8 +250,8 @@ void check_spawn_capacity(const std::vector<SpawnParams>& spawns, const SolverPa
     if (n > 0) total += n;
     if (total > p.max_particles)
       throw ConfigError("spawn[" + std::to_string(i) + "] (" + spawns[i].kind + ") brings the particle count to " +
-                  std::to_string(total) + ", over solver.max_particles = " + std::to_string(p.max_particles) +
-                  "; raise solver.max_particles or make the spawn entries smaller");
+                        std::to_string(total) + ", over solver.max_particles = " + std::to_string(p.max_particles) +
+                        "; raise solver.max_particles or make the spawn entries smaller");
   }
 }
 
@@ -301,7 +303,8 @@ ObjMesh read_obj(const std::string& path) {
       }
     }
   }
-  if (m.v.empty() || m.f.empty()) throw InputError("mesh file '" + path + "' has no triangles (expected OBJ 'v' and 'f' lines)");
+  if (m.v.empty() || m.f.empty())
+    throw InputError("mesh file '" + path + "' has no triangles (expected OBJ 'v' and 'f' lines)");
   const int nv = static_cast<int>(std::min<std::size_t>(m.v.size(), INT_MAX));
   for (std::size_t t = 0; t < m.f.size(); ++t)
     for (int i : {m.f[t].x, m.f[t].y, m.f[t].z})
@@ -320,8 +323,8 @@ std::vector<vec3> voxelize_obj(const std::string& path, float spacing, vec3 fit_
     hi = vmax(hi, p);
   }
   vec3 ext = hi - lo, mid = (lo + hi) * 0.5f;
-  float scale = std::min({fit_size.x / std::max(ext.x, 1e-9f), fit_size.y / std::max(ext.y, 1e-9f),
-                          fit_size.z / std::max(ext.z, 1e-9f)});
+  float scale = std::min(
+      {fit_size.x / std::max(ext.x, 1e-9f), fit_size.y / std::max(ext.y, 1e-9f), fit_size.z / std::max(ext.z, 1e-9f)});
   for (vec3& p : m.v) p = (p - mid) * scale;
   ext = ext * scale;
   int ny = static_cast<int>(ext.y / spacing) + 1, nz = static_cast<int>(ext.z / spacing) + 1;

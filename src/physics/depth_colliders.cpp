@@ -8,8 +8,8 @@
 
 namespace seamless {
 
-DepthSurface depth_surface(const std::vector<vec3>& camera_vertices, const std::vector<vec3>& camera_normals,
-                           int width, int height, const SE3& world_T_camera, const std::vector<std::uint8_t>& mask) {
+DepthSurface depth_surface(const std::vector<vec3>& camera_vertices, const std::vector<vec3>& camera_normals, int width,
+                           int height, const SE3& world_T_camera, const std::vector<std::uint8_t>& mask) {
   const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   if (camera_vertices.size() != n || camera_normals.size() != n || (!mask.empty() && mask.size() != n))
     throw Error("depth colliders: a " + std::to_string(width) + "x" + std::to_string(height) +
@@ -89,7 +89,8 @@ void MovingColliders::update(DepthSurface surface, double t) {
       const int j = grid.nearest(surface.points[i]);
       if (j < 0) continue;
       const vec3 n = last_.normals[static_cast<std::size_t>(j)];
-      velocity_[i] = n * (dot(n, surface.points[i] - last_.points[static_cast<std::size_t>(j)]) / static_cast<float>(dt));
+      velocity_[i] =
+          n * (dot(n, surface.points[i] - last_.points[static_cast<std::size_t>(j)]) / static_cast<float>(dt));
     }
   }
   last_ = std::move(surface);

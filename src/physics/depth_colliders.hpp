@@ -22,9 +22,8 @@ struct DepthSurface {
 // camera_vertices, camera_normals: vertex and normal maps (camera coordinates, row-major, z <= 0 =
 // no reading, the zero vector = no normal), width x height; mask: empty (every pixel) or one byte
 // per pixel (nonzero = use it).
-DepthSurface depth_surface(const std::vector<vec3>& camera_vertices, const std::vector<vec3>& camera_normals,
-                           int width, int height, const SE3& world_T_camera,
-                           const std::vector<std::uint8_t>& mask = {});
+DepthSurface depth_surface(const std::vector<vec3>& camera_vertices, const std::vector<vec3>& camera_normals, int width,
+                           int height, const SE3& world_T_camera, const std::vector<std::uint8_t>& mask = {});
 
 // Each surface point and, behind it along its ray, one more every `spacing` metres up to `thickness`.
 std::vector<vec3> thicken(const std::vector<vec3>& points, const std::vector<vec3>& rays, float spacing,

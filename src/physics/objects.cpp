@@ -65,8 +65,8 @@ std::shared_ptr<const BodyMesh> obj_body_mesh(const SpawnParams& s, const Solver
   vec3 lo = m->positions[0], hi = lo;
   for (vec3 v : m->positions) lo = vmin(lo, v), hi = vmax(hi, v);
   const vec3 ext = hi - lo, mid = (lo + hi) * 0.5f;
-  const float scale = std::min({s.size.x / std::max(ext.x, 1e-9f), s.size.y / std::max(ext.y, 1e-9f),
-                                s.size.z / std::max(ext.z, 1e-9f)});
+  const float scale = std::min(
+      {s.size.x / std::max(ext.x, 1e-9f), s.size.y / std::max(ext.y, 1e-9f), s.size.z / std::max(ext.z, 1e-9f)});
   vec3 mean{0.f, 0.f, 0.f};
   const std::vector<vec3> cells = voxelize_obj(s.mesh, p.particle_diameter, s.size);
   for (vec3 c : cells) mean += c;

@@ -36,9 +36,11 @@ ParticleState read_particles_ply(const std::string& path) {
     header += line + "\n";
     if (line.rfind("element vertex ", 0) == 0) n = std::stoll(line.substr(15));
   }
-  const char* expected = "property float x\nproperty float y\nproperty float z\nproperty float vx\nproperty float vy\n"
-                         "property float vz\nproperty uint phase\n";
-  if (n < 0 || header.find("format binary_little_endian") == std::string::npos || header.find(expected) == std::string::npos)
+  const char* expected =
+      "property float x\nproperty float y\nproperty float z\nproperty float vx\nproperty float vy\n"
+      "property float vz\nproperty uint phase\n";
+  if (n < 0 || header.find("format binary_little_endian") == std::string::npos ||
+      header.find(expected) == std::string::npos)
     throw Error("'" + path + "' is not a particle file of `seamless run` (binary PLY with x y z vx vy vz phase)");
   std::vector<char> buf(static_cast<std::size_t>(n) * 28);
   if (!in.read(buf.data(), static_cast<std::streamsize>(buf.size())))
@@ -88,7 +90,11 @@ SceneObjects read_objects(const std::string& path) {
   while (true) {
     std::string tag;
     std::istringstream ls;
-    try { ls = next("a record"); } catch (const Error&) { break; }
+    try {
+      ls = next("a record");
+    } catch (const Error&) {
+      break;
+    }
     ls >> tag;
     if (tag == "cloth_triangles") {
       std::int64_t n = -1;
@@ -102,7 +108,8 @@ SceneObjects read_objects(const std::string& path) {
       if (!sheet.triangles.empty()) o.cloths.push_back(std::move(sheet));
     } else if (tag == "body") {
       RigidBody b;
-      if (!(ls >> b.first >> b.count >> b.spawn) || b.first < 0 || b.count < 1) throw bad("body <first> <count> <spawn>");
+      if (!(ls >> b.first >> b.count >> b.spawn) || b.first < 0 || b.count < 1)
+        throw bad("body <first> <count> <spawn>");
       for (std::int64_t i = 0; i < b.count; ++i) {
         vec3 q{};
         if (!(next("a rest offset") >> q.x >> q.y >> q.z)) throw bad("three rest offset coordinates");

@@ -28,16 +28,14 @@ namespace {
 // spawned above the scene, within a metre or so of what the camera saw.
 constexpr float kScanMargin = 1.f;
 
-template <class T>
-void grow(Buffer<T>& b, std::int64_t cap, std::int64_t keep, Device d) {
+template <class T> void grow(Buffer<T>& b, std::int64_t cap, std::int64_t keep, Device d) {
   if (b.size() >= cap) return;
   Buffer<T> nb(cap, d);
   if (keep > 0) memory::copy(nb.data(), d, b.data(), d, sizeof(T) * static_cast<std::size_t>(keep));
   b = std::move(nb);
 }
 
-template <class T>
-void upload_at(Buffer<T>& b, std::int64_t offset, const std::vector<T>& v) {
+template <class T> void upload_at(Buffer<T>& b, std::int64_t offset, const std::vector<T>& v) {
   if (v.empty()) return;
   memory::copy(b.data() + offset, b.device(), v.data(), Device::CPU, sizeof(T) * v.size());
 }
@@ -77,7 +75,7 @@ struct ParticleState {
   Buffer<std::uint32_t> phase_id;
   Buffer<vec4> rsdf, sdf_at;
   Buffer<K::Packed> spk, spl, spd, svh, cnv;  // packed copies for the neighbour loops (sim_views.hpp)
-  Buffer<K::Packed> pair_w;              // CPU: kernel values per list entry (SimViews::pair_w)
+  Buffer<K::Packed> pair_w;                   // CPU: kernel values per list entry (SimViews::pair_w)
   // sort and sorted scratch
   Buffer<std::uint32_t> key, sphase;
   Buffer<int> order, rank, ncontacts;
@@ -134,7 +132,7 @@ struct ClothState {
   std::vector<float> edge_len, edge_k0, edge_limit0;
   std::vector<K::Quad> bends;
   std::vector<float> bend_rest, bend_k0;
-  std::vector<int3> tris;  // every sheet's, for the self-collision lists
+  std::vector<int3> tris;                // every sheet's, for the self-collision lists
   std::vector<std::int64_t> colour_off;  // stretch edges of colour c: [colour_off[c], colour_off[c + 1])
   bool strain_limited = false;
   Buffer<int> d_edge_a, d_edge_b, bend_off, bend_list, tri_off, tri_list;
@@ -239,7 +237,8 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
     float wdq = K::poly6(P.tensile_dq * P.tensile_dq * c.h * c.h, c.h);
     c.scorr_inv_wdq = wdq > 0.f ? 1.f / wdq : 0.f;
     c.unilateral = P.fluid_unilateral ? 1 : 0, c.solid_density_scale = P.solid_density_scale;
-    c.viscosity = P.viscosity, c.vorticity = P.vorticity, c.cohesion = P.cohesion, c.surface_tension = P.surface_tension;
+    c.viscosity = P.viscosity, c.vorticity = P.vorticity, c.cohesion = P.cohesion,
+    c.surface_tension = P.surface_tension;
     c.drag = P.drag, c.lift = P.lift, c.air_density = P.air_density, c.wind = P.wind;
     c.sleep_threshold = P.sleep_threshold;
     c.cloth_self_exclusion = 1.5f * d;
@@ -247,13 +246,17 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
     c.max_neighbors = P.max_neighbours, c.max_static_neighbors = P.max_static_neighbours;
     c.rotation_iterations = P.rotation_iterations;
     S.n = n;
-    S.x = x.data(), S.v = v.data(), S.w = w.data(), S.phase = phase.data(), S.slot_id = slot_id.data(), S.rest = rest.data();
+    S.x = x.data(), S.v = v.data(), S.w = w.data(), S.phase = phase.data(), S.slot_id = slot_id.data(),
+    S.rest = rest.data();
     S.rsdf = rsdf.data(), S.pred = pred.data();
     S.key = key.data(), S.order = order.data(), S.rank = rank.data();
     S.sx = sx.data(), S.sp = sp.data(), S.sp0 = sp0.data(), S.sv = sv.data(), S.tmp = tmp.data(), S.vtmp = vtmp.data();
-    S.sw = sw.data(), S.sphase = sphase.data(), S.lambda = lambda.data(), S.density = density.data(), S.h_rho = h_rho.data(), S.vort_len = vort_len.data();
-    S.ncontacts = ncontacts.data(), S.vort = vort.data(), S.cnormal = cnormal.data(), S.sdf_at = sdf_at.data(), S.scene_n = scene_n.data();
-    S.spk = spk.data(), S.spl = spl.data(), S.spd = spd.data(), S.svh = svh.data(), S.cnv = cnv.data(), S.pair_w = pair_w.data();
+    S.sw = sw.data(), S.sphase = sphase.data(), S.lambda = lambda.data(), S.density = density.data(),
+    S.h_rho = h_rho.data(), S.vort_len = vort_len.data();
+    S.ncontacts = ncontacts.data(), S.vort = vort.data(), S.cnormal = cnormal.data(), S.sdf_at = sdf_at.data(),
+    S.scene_n = scene_n.data();
+    S.spk = spk.data(), S.spl = spl.data(), S.spd = spd.data(), S.svh = svh.data(), S.cnv = cnv.data(),
+    S.pair_w = pair_w.data();
     S.grid = K::GridSpec::for_radius(c.search_radius, bits);
     S.cell_start = cell_start.data();
     S.nbr = nbr.data(), S.nnbr = nnbr.data(), S.snbr = snbr.data(), S.nsnbr = nsnbr.data(), S.nsolid = nsolid.data();
@@ -292,19 +295,15 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
     const void* before[2] = {cell_start.data(), snbr.data()};
     cell_start.reserve_discard(cells + 1, dev);
     if (static_count() > 0) snbr.reserve_discard(cap * (P.max_static_neighbours + 1), dev);
-    const bool temp_moved = graph.reserve_temp(n, [&]<class E>(const E& ex) {
-      return K::NeighbourGrid<E>::sort_cells_temp_bytes(ex, n, 3 * bits);
-    });
+    const bool temp_moved = graph.reserve_temp(
+        n, [&]<class E>(const E& ex) { return K::NeighbourGrid<E>::sort_cells_temp_bytes(ex, n, 3 * bits); });
     if (temp_moved) ++generation;
     if (before[0] != cell_start.data() || before[1] != snbr.data()) ++generation;
   }
 
   // Calls fn(executor): on CUDA, one that launches on the solver's own stream and sorts in its
   // own temp storage (so that a step can be captured as a graph).
-  template <class F>
-  void run(F&& fn) {
-    graph.run(std::forward<F>(fn));
-  }
+  template <class F> void run(F&& fn) { graph.run(std::forward<F>(fn)); }
 
   // k substeps of dt / k. On CUDA they run on the solver's stream, ordered after what the default
   // stream holds and before what it gets next (no host synchronisation), as one graph launch
@@ -321,8 +320,7 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
   }
 
   // Sort, grid and neighbour lists of the predicted positions (S.pred must be filled).
-  template <class Ex>
-  void build_neighbours(const Ex& ex, const K::SimViews& S) {
+  template <class Ex> void build_neighbours(const Ex& ex, const K::SimViews& S) {
     using Grid = K::NeighbourGrid<Ex>;
     Grid::sort_cells(ex, S.key, S.order, n, 3 * bits);
     Grid::reorder(ex, S);
@@ -358,8 +356,7 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
     });
   }
 
-  template <class Ex>
-  void solve_cloth(const Ex& ex, K::SimViews& S) {
+  template <class Ex> void solve_cloth(const Ex& ex, K::SimViews& S) {
     if (colour_off.size() > 1) K::Solids<Ex>::cloth_stretch(ex, S, colour_off.data(), colours());
     if (!bends.empty()) {
       K::Solids<Ex>::cloth_bend(ex, S);
@@ -370,9 +367,9 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
   int colours() const { return static_cast<int>(colour_off.size()) - 1; }
 
   // Strain limiting after the iterations (Provot 1995): Gauss-Seidel over the edge colours.
-  template <class Ex>
-  void limit_strain(const Ex& ex, const K::SimViews& S) {
-    if (colour_off.size() > 1) K::Solids<Ex>::cloth_strain_limit(ex, S, colour_off.data(), colours(), P.cloth_strain_passes);
+  template <class Ex> void limit_strain(const Ex& ex, const K::SimViews& S) {
+    if (colour_off.size() > 1)
+      K::Solids<Ex>::cloth_strain_limit(ex, S, colour_off.data(), colours(), P.cloth_strain_passes);
   }
 
   void upload_bodies(const std::vector<vec3>& c, const std::vector<vec4>& q) {
@@ -499,7 +496,8 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
       flags = K::phase::kRigid | static_cast<std::uint32_t>(body_start.size());
     }
     if (b.kind == ParticleBatch::kCloth)
-      flags = K::phase::kCloth | static_cast<std::uint32_t>(cloth_groups++) | (b.self_collide ? K::phase::kSelfCollide : 0u);
+      flags = K::phase::kCloth | static_cast<std::uint32_t>(cloth_groups++) |
+              (b.self_collide ? K::phase::kSelfCollide : 0u);
     upload_at(x, first, b.x), upload_at(v, first, b.v), upload_at(w, first, b.inv_mass);
     upload_at(phase, first, std::vector<std::uint32_t>(static_cast<std::size_t>(m), flags));
     std::vector<int> ids(static_cast<std::size_t>(m));
@@ -549,9 +547,10 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
         e.budget -= static_cast<double>(layer.size());
         if (n + layer.size() > P.max_particles) {
           if (emitter_dropped == 0)
-            spdlog::warn("emitter at ({:.2f}, {:.2f}, {:.2f}): solver.max_particles = {} reached at t = {:.3f} s; its "
-                         "further layers are dropped (the total is in the physics summary)",
-                         e.s.position.x, e.s.position.y, e.s.position.z, P.max_particles, time);
+            spdlog::warn(
+                "emitter at ({:.2f}, {:.2f}, {:.2f}): solver.max_particles = {} reached at t = {:.3f} s; its "
+                "further layers are dropped (the total is in the physics summary)",
+                e.s.position.x, e.s.position.y, e.s.position.z, P.max_particles, time);
           emitter_dropped += layer.size();
           continue;
         }
@@ -580,20 +579,22 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
     const float m = kScanMargin;
     for (vec3 p : x) {
       if (host_sdf.active() && kernels::scene_sdf(host_sdf, p).d < 0.f) ++solid;
-      if (scanned && (p.x < lo.x - m || p.y < lo.y - m || p.z < lo.z - m || p.x > hi.x + m || p.y > hi.y + m ||
-                      p.z > hi.z + m))
+      if (scanned &&
+          (p.x < lo.x - m || p.y < lo.y - m || p.z < lo.z - m || p.x > hi.x + m || p.y > hi.y + m || p.z > hi.z + m))
         ++far;
     }
     const std::string what = s.kind + " at (" + format_vec(s.position) + ")";
     if (solid > 0)
-      spdlog::warn("spawn {}: {} of {} particles start inside the scene's solid (in a wall or object, or outside the "
-                   "room); the first collision moves them to the nearest surface. Check the spawn position (world "
-                   "frame: README, Usage)",
-                   what, solid, x.size());
+      spdlog::warn(
+          "spawn {}: {} of {} particles start inside the scene's solid (in a wall or object, or outside the "
+          "room); the first collision moves them to the nearest surface. Check the spawn position (world "
+          "frame: README, Usage)",
+          what, solid, x.size());
     if (far > 0)
-      spdlog::warn("spawn {}: {} of {} particles start more than {} m outside the scanned scene (x {:.2f}..{:.2f}, y "
-                   "{:.2f}..{:.2f}, z {:.2f}..{:.2f}): there is nothing there for them to land on",
-                   what, far, x.size(), kScanMargin, lo.x, hi.x, lo.y, hi.y, lo.z, hi.z);
+      spdlog::warn(
+          "spawn {}: {} of {} particles start more than {} m outside the scanned scene (x {:.2f}..{:.2f}, y "
+          "{:.2f}..{:.2f}, z {:.2f}..{:.2f}): there is nothing there for them to land on",
+          what, far, x.size(), kScanMargin, lo.x, hi.x, lo.y, hi.y, lo.z, hi.z);
   }
 
   // An emitter puts out one layer each time its jet has moved one diameter: at most
@@ -602,10 +603,11 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
     const double layer = static_cast<double>(make_emitter_layer(s, P).size());
     const double most = layer * length(s.velocity) / P.particle_diameter;
     if (s.rate <= most * (1.0 + 1e-6)) return;
-    spdlog::warn("spawn emitter at ({}): rate {} particles/s is more than its jet carries ({} particles a layer, a "
-                 "layer per {} m travelled at {:.3g} m/s: {:.0f} particles/s); it emits {:.0f}/s. Raise velocity or "
-                 "nozzle_radius for more",
-                 format_vec(s.position), s.rate, layer, P.particle_diameter, length(s.velocity), most, most);
+    spdlog::warn(
+        "spawn emitter at ({}): rate {} particles/s is more than its jet carries ({} particles a layer, a "
+        "layer per {} m travelled at {:.3g} m/s: {:.0f} particles/s); it emits {:.0f}/s. Raise velocity or "
+        "nozzle_radius for more",
+        format_vec(s.position), s.rate, layer, P.particle_diameter, length(s.velocity), most, most);
   }
 
   static std::string format_vec(vec3 v) {
@@ -701,7 +703,8 @@ void ParticleSolver::set_scene_sdf_grid(const std::vector<float>& values, int3 d
                 " grid with a positive voxel size");
   impl_->sdf_grid = Buffer<float>::from_host(values, impl_->dev);
   ++impl_->generation;
-  impl_->sdf.grid = impl_->sdf_grid.data(), impl_->sdf.dims = dims, impl_->sdf.origin = origin, impl_->sdf.voxel = voxel;
+  impl_->sdf.grid = impl_->sdf_grid.data(), impl_->sdf.dims = dims, impl_->sdf.origin = origin,
+  impl_->sdf.voxel = voxel;
 }
 
 std::int64_t ParticleSolver::spawn(const SpawnParams& s) { return impl_->spawn(s, -1); }
@@ -756,13 +759,15 @@ SolverStats ParticleSolver::stats() const {
   s.max_neighbours_seen = c[2], s.max_static_neighbours_seen = c[3];
   if (I.n > 0) s.max_speed = std::sqrt(bits_float(c[4]));
   if (s.emitter_dropped > 0)
-    spdlog::warn("particle solver: emitters could not create {} particles (solver.max_particles = {} reached); raise "
-                 "solver.max_particles",
-                 s.emitter_dropped, I.P.max_particles);
+    spdlog::warn(
+        "particle solver: emitters could not create {} particles (solver.max_particles = {} reached); raise "
+        "solver.max_particles",
+        s.emitter_dropped, I.P.max_particles);
   if (s.neighbour_overflow > 0 || s.static_neighbour_overflow > 0)
-    spdlog::warn("particle solver: {} neighbour lists and {} scene lists exceeded the cap ({} / {}); raise "
-              "solver.max_neighbours / solver.max_static_neighbours",
-              s.neighbour_overflow, s.static_neighbour_overflow, I.P.max_neighbours, I.P.max_static_neighbours);
+    spdlog::warn(
+        "particle solver: {} neighbour lists and {} scene lists exceeded the cap ({} / {}); raise "
+        "solver.max_neighbours / solver.max_static_neighbours",
+        s.neighbour_overflow, s.static_neighbour_overflow, I.P.max_neighbours, I.P.max_static_neighbours);
   return s;
 }
 

@@ -32,7 +32,7 @@ struct SolverStats {
   std::int64_t rigid_bodies = 0, static_particles = 0;
   std::int64_t collider_particles = 0;  // this frame's kinematic colliders (set_collider_particles)
   int substeps = 1;
-  double time = 0.0;              // simulated seconds
+  double time = 0.0;  // simulated seconds
   std::int64_t steps = 0;
   // Neighbour lists over the cap (particles, summed over substeps since the start): each such
   // particle lost neighbours. Raise solver.max_neighbours if these are not zero.

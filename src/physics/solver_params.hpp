@@ -14,63 +14,62 @@ namespace seamless {
 enum class SceneCollision { particles, sdf };
 inline std::span<const EnumName<SceneCollision>> enum_names(SceneCollision) {
   static constexpr EnumName<SceneCollision> names[] = {{SceneCollision::particles, "particles"},
-                                           {SceneCollision::sdf, "sdf"}};
+                                                       {SceneCollision::sdf, "sdf"}};
   return names;
 }
 enum class DynamicColliders { none, depth, all };
 inline std::span<const EnumName<DynamicColliders>> enum_names(DynamicColliders) {
-  static constexpr EnumName<DynamicColliders> names[] = {{DynamicColliders::none, "none"},
-                                           {DynamicColliders::depth, "depth"},
-                                           {DynamicColliders::all, "all"}};
+  static constexpr EnumName<DynamicColliders> names[] = {
+      {DynamicColliders::none, "none"}, {DynamicColliders::depth, "depth"}, {DynamicColliders::all, "all"}};
   return names;
 }
 
 struct SolverParams {
-  float particle_diameter = 0.04f;      // metres; one radius for every particle (Macklin 2014)
-  float dt = 0.01f;                     // seconds per frame step
-  int iterations = 2;                   // constraint (Jacobi) iterations per substep
+  float particle_diameter = 0.04f;  // metres; one radius for every particle (Macklin 2014)
+  float dt = 0.01f;                 // seconds per frame step
+  int iterations = 2;               // constraint (Jacobi) iterations per substep
   int substeps = 1;
-  vec3 gravity{0.f, -9.81f, 0.f};       // world frame, m/s^2
+  vec3 gravity{0.f, -9.81f, 0.f};  // world frame, m/s^2
   std::int64_t max_particles = 1 << 20;
   float static_friction = 0.5f;
   float kinetic_friction = 0.3f;
   float restitution = 0.f;
-  float fluid_friction = 0.f;           // fluid on the scene and on solids; 0: fluids slip (Macklin 2014)
-  float rest_density = 1000.f;          // kg/m^3 (water)
-  float viscosity = 0.01f;              // XSPH coefficient c (Macklin & Mueller 2013, eq. 17)
-  float vorticity = 0.0001f;            // vorticity confinement epsilon (ibid., eq. 16)
-  float cohesion = 0.01f;               // Akinci 2013 cohesion gamma
-  float surface_tension = 0.01f;        // Akinci 2013 curvature term
+  float fluid_friction = 0.f;     // fluid on the scene and on solids; 0: fluids slip (Macklin 2014)
+  float rest_density = 1000.f;    // kg/m^3 (water)
+  float viscosity = 0.01f;        // XSPH coefficient c (Macklin & Mueller 2013, eq. 17)
+  float vorticity = 0.0001f;      // vorticity confinement epsilon (ibid., eq. 16)
+  float cohesion = 0.01f;         // Akinci 2013 cohesion gamma
+  float surface_tension = 0.01f;  // Akinci 2013 curvature term
   SceneCollision scene_collision = SceneCollision::particles;
-  float sleep_threshold = 0.f;          // m/s; 0 = never sleep
-  float max_speed = 4.f;                // m/s: speed limit; sets the substeps (docs/PHYSICS.md)
+  float sleep_threshold = 0.f;  // m/s; 0 = never sleep
+  float max_speed = 4.f;        // m/s: speed limit; sets the substeps (docs/PHYSICS.md)
   int max_neighbours = 64;
   // Solver details (docs/PHYSICS.md).
-  int stabilization_iterations = 1;     // Macklin 2014 section 4.4 pre-stabilisation passes
-  float relaxation = 1.f;               // SOR factor omega of averaged contacts (Macklin 2014 eq. 11)
-  float tunnel_fraction = 0.5f;         // substeps keep max_speed * dt_sub <= this * diameter
-  float fluid_smoothing = 2.f;          // PBF smoothing radius h in particle diameters
-  float fluid_relaxation = 0.01f;       // PBF epsilon as a fraction of the rest lattice's sum |grad C|^2
-  bool fluid_unilateral = true;         // density constraint only pushes apart (Macklin 2014 7.1)
-  float tensile_k = 0.f;                // PBF s_corr k (eq. 13); 0 = off
-  float tensile_dq = 0.2f;              // PBF s_corr delta q in units of h
-  float solid_density_scale = 1.f;      // weight of solid neighbours in fluid density
-  float drag = 0.f;                     // cloth drag coefficient C_D (Keckeisen 2004)
-  float lift = 0.f;                     // cloth lift coefficient C_L
-  float air_density = 1.2f;             // kg/m^3
-  vec3 wind{0.f, 0.f, 0.f};             // m/s
-  float cloth_relaxation = 2.f;         // cloth constraint averaging: k / max(1, degree / this)
-  int rotation_iterations = 8;          // Mueller 2016 rotation extraction steps per shape match
+  int stabilization_iterations = 1;  // Macklin 2014 section 4.4 pre-stabilisation passes
+  float relaxation = 1.f;            // SOR factor omega of averaged contacts (Macklin 2014 eq. 11)
+  float tunnel_fraction = 0.5f;      // substeps keep max_speed * dt_sub <= this * diameter
+  float fluid_smoothing = 2.f;       // PBF smoothing radius h in particle diameters
+  float fluid_relaxation = 0.01f;    // PBF epsilon as a fraction of the rest lattice's sum |grad C|^2
+  bool fluid_unilateral = true;      // density constraint only pushes apart (Macklin 2014 7.1)
+  float tensile_k = 0.f;             // PBF s_corr k (eq. 13); 0 = off
+  float tensile_dq = 0.2f;           // PBF s_corr delta q in units of h
+  float solid_density_scale = 1.f;   // weight of solid neighbours in fluid density
+  float drag = 0.f;                  // cloth drag coefficient C_D (Keckeisen 2004)
+  float lift = 0.f;                  // cloth lift coefficient C_L
+  float air_density = 1.2f;          // kg/m^3
+  vec3 wind{0.f, 0.f, 0.f};          // m/s
+  float cloth_relaxation = 2.f;      // cloth constraint averaging: k / max(1, degree / this)
+  int rotation_iterations = 8;       // Mueller 2016 rotation extraction steps per shape match
   int max_static_neighbours = 64;
-  int cloth_strain_passes = 4;          // strain-limiting passes over all edge colours per substep
-  float cloth_strain_omega = 1.5f;      // over-relaxation of strain limiting
+  int cloth_strain_passes = 4;               // strain-limiting passes over all edge colours per substep
+  float cloth_strain_omega = 1.5f;           // over-relaxation of strain limiting
   float cloth_strain_contact_weight = 0.3f;  // strain limiting: inverse-mass factor of particles on the scene
-  bool cuda_graph = true;               // CUDA: replay a step as one captured graph (docs/PHYSICS.md)
+  bool cuda_graph = true;                    // CUDA: replay a step as one captured graph (docs/PHYSICS.md)
   // Issue 22: the live depth camera's points as kinematic colliders each frame (people and moving
   // objects push the simulation): none, the dynamic pixels only (dynamic.enabled), or every pixel.
   DynamicColliders dynamic_colliders = DynamicColliders::none;
-  int collider_level = 2;               // pyramid level whose vertex map gives the points (2: 160x120)
-  float collider_thickness = 0.1f;      // metres of colliders behind each seen surface point, along its ray
+  int collider_level = 2;           // pyramid level whose vertex map gives the points (2: 160x120)
+  float collider_thickness = 0.1f;  // metres of colliders behind each seen surface point, along its ray
 
   template <class V> void visit(V& v) {
     v("particle_diameter", particle_diameter, "particle diameter, metres", Range{0.001, 1.0});
@@ -137,12 +136,12 @@ struct SolverParams {
 // on the surface seen at a pixel of a recorded frame. `on: none` and no pixel: `position` is used
 // as given (world metres). docs/PLACEMENT.md.
 struct PlaceParams {
-  std::string on = "none";            // support: the index-th largest horizontal surface that is not the floor
-  int index = 0;                      // 0 = largest
-  float above = 0.15f;                // metres above the surface (to the entry's centre)
-  std::vector<float> offset;          // [x, z]: metres from the surface's centre along world x and z
-  std::vector<int> pixel;             // [u, v]: the surface seen at this pixel of frame `frame`
-  int frame = 0;                      // input frame whose camera the pixel belongs to
+  std::string on = "none";    // support: the index-th largest horizontal surface that is not the floor
+  int index = 0;              // 0 = largest
+  float above = 0.15f;        // metres above the surface (to the entry's centre)
+  std::vector<float> offset;  // [x, z]: metres from the surface's centre along world x and z
+  std::vector<int> pixel;     // [u, v]: the surface seen at this pixel of frame `frame`
+  int frame = 0;              // input frame whose camera the pixel belongs to
 
   bool active() const { return on != "none" || !pixel.empty(); }
   template <class V> void visit(V& v) {
@@ -150,8 +149,10 @@ struct PlaceParams {
       Choices{"none", "support", "floor"});
     v("index", index, "which surface: 0 = largest, 1 = second largest, ...", Range{0, 1000});
     v("above", above, "height of the entry's centre above the surface, metres", Range{-10.0, 10.0});
-    v("offset", offset, "[x, z]: metres from the surface's centre along world x (right of the first camera) and z "
-      "(ahead of it); the point must lie on the surface", Range{-100.0, 100.0});
+    v("offset", offset,
+      "[x, z]: metres from the surface's centre along world x (right of the first camera) and z "
+      "(ahead of it); the point must lie on the surface",
+      Range{-100.0, 100.0});
     v("pixel", pixel, "[u, v]: place on the surface seen at this pixel of input frame `frame`", Range{0, 1e5});
     v("frame", frame, "input frame (0 = first) of the pixel pick", Range{0, 1e9});
   }
@@ -160,25 +161,25 @@ struct PlaceParams {
 // One thing to drop into the scene at time `time`. Which fields matter depends on `kind`.
 struct SpawnParams {
   std::string kind = "fluid_block";
-  float time = 0.f;                   // seconds of simulated time
-  vec3 position{0.f, 1.f, 0.f};       // world, metres (centre; emitter: nozzle)
-  PlaceParams place;                  // relative to the scan instead (resolved into position)
-  vec3 size{0.2f, 0.2f, 0.2f};        // metres (fluid_block, rigid box/sphere bounding box)
-  vec3 velocity{0.f, 0.f, 0.f};       // m/s (initial velocity; emitter: jet velocity)
-  float rate = 500.f;                 // emitter: particles per second
-  float duration = 0.f;               // emitter: seconds to run; 0 = until the end
-  float nozzle_radius = 0.05f;        // emitter, metres
-  int nx = 32, ny = 32;               // cloth grid
-  float spacing = 0.f;                // cloth particle spacing, metres; 0 = particle diameter
-  std::vector<int> pinned;            // cloth corners held fixed: 0..3 = (0,0) (nx-1,0) (0,ny-1) (nx-1,ny-1)
-  float stiffness = 1.f;              // cloth stretch stiffness (PBD k); rigid: shape matching stiffness
-  float bend_stiffness = 0.1f;        // cloth bending stiffness
-  float max_strain = 0.1f;            // cloth: largest relative edge length change (Provot 1995); 0 = no limit
-  bool self_collide = false;          // cloth collides with itself
-  std::string shape = "box";          // rigid
-  std::string mesh;                   // rigid, shape: mesh (OBJ/PLY path)
-  vec3 rotation{0.f, 0.f, 0.f};       // pose: Euler angles about x, y, z (applied in that order), degrees
-  float density = 1000.f;             // kg/m^3: particle mass = density * diameter^3 (fluid: solver.rest_density)
+  float time = 0.f;              // seconds of simulated time
+  vec3 position{0.f, 1.f, 0.f};  // world, metres (centre; emitter: nozzle)
+  PlaceParams place;             // relative to the scan instead (resolved into position)
+  vec3 size{0.2f, 0.2f, 0.2f};   // metres (fluid_block, rigid box/sphere bounding box)
+  vec3 velocity{0.f, 0.f, 0.f};  // m/s (initial velocity; emitter: jet velocity)
+  float rate = 500.f;            // emitter: particles per second
+  float duration = 0.f;          // emitter: seconds to run; 0 = until the end
+  float nozzle_radius = 0.05f;   // emitter, metres
+  int nx = 32, ny = 32;          // cloth grid
+  float spacing = 0.f;           // cloth particle spacing, metres; 0 = particle diameter
+  std::vector<int> pinned;       // cloth corners held fixed: 0..3 = (0,0) (nx-1,0) (0,ny-1) (nx-1,ny-1)
+  float stiffness = 1.f;         // cloth stretch stiffness (PBD k); rigid: shape matching stiffness
+  float bend_stiffness = 0.1f;   // cloth bending stiffness
+  float max_strain = 0.1f;       // cloth: largest relative edge length change (Provot 1995); 0 = no limit
+  bool self_collide = false;     // cloth collides with itself
+  std::string shape = "box";     // rigid
+  std::string mesh;              // rigid, shape: mesh (OBJ/PLY path)
+  vec3 rotation{0.f, 0.f, 0.f};  // pose: Euler angles about x, y, z (applied in that order), degrees
+  float density = 1000.f;        // kg/m^3: particle mass = density * diameter^3 (fluid: solver.rest_density)
 
   template <class V> void visit(V& v) {
     v("kind", kind, "what to spawn", Choices{"fluid_block", "emitter", "cloth", "rigid"});

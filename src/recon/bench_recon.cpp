@@ -6,8 +6,7 @@
 
 namespace seamless {
 
-ReconBench::ReconBench(const std::vector<ReconFrame>& frames, const Intrinsics& K, const VolumeParams& params,
-                       Device d)
+ReconBench::ReconBench(const std::vector<ReconFrame>& frames, const Intrinsics& K, const VolumeParams& params, Device d)
     : K_(K), device_(d), volume_(make_volume(params, d)), timer_(std::make_unique<StageTimer>(d)) {
   for (const ReconFrame& f : frames)
     frames_.push_back({f.depth.clone(d), f.rgb.width() ? f.rgb.clone(d) : Image<uchar3>{}, f.world_T_camera});

@@ -16,9 +16,9 @@
 namespace seamless {
 
 struct ReconFrame {
-  Image<float> depth;   // metres
-  Image<uchar3> rgb;    // may be empty
-  SE3 world_T_camera;   // ground truth or tracked
+  Image<float> depth;  // metres
+  Image<uchar3> rgb;   // may be empty
+  SE3 world_T_camera;  // ground truth or tracked
 };
 
 struct ReconBenchResult {

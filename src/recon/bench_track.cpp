@@ -64,13 +64,14 @@ std::vector<TrackBenchCase> make_track_bench(Device device, const std::string& d
   auto session = std::make_shared<TrackingSession>(p, device, (*frames)[0].intrinsics);
   session->process((*frames)[0]);  // the first frame only defines the world; later calls track
   auto i = std::make_shared<std::size_t>(1);
-  cases.push_back({"frame_640x480",
-                   [=] {
-                     session->process((*frames)[*i]);
-                     *i = *i % 2 + 1;  // alternate frames 1 and 2 around frame 0's model
-                   },
-                   "upload + preprocess + frame-to-model ICP (10/5/4, stopping at the default step thresholds) + fuse + "
-                   "raycast, 5 mm hash volume"});
+  cases.push_back(
+      {"frame_640x480",
+       [=] {
+         session->process((*frames)[*i]);
+         *i = *i % 2 + 1;  // alternate frames 1 and 2 around frame 0's model
+       },
+       "upload + preprocess + frame-to-model ICP (10/5/4, stopping at the default step thresholds) + fuse + "
+       "raycast, 5 mm hash volume"});
   return cases;
 }
 

@@ -32,8 +32,9 @@ void DenseVolume::integrate(const Image<float>& depth, const Image<uchar3>& rgb,
   Image<uchar3> ctmp;
   const Image<float>& dep = detail::on_device(depth, device_, dtmp);
   const Image<uchar3>& col = detail::on_device(rgb, device_, ctmp);
-  kernels::FrameInput in{dep.cview(), col.width() ? col.cview() : View2D<const uchar3>{}, K, world_T_camera,
-                         params_.min_depth, params_.max_depth};
+  kernels::FrameInput in{
+      dep.cview(),      col.width() ? col.cview() : View2D<const uchar3>{}, K, world_T_camera, params_.min_depth,
+      params_.max_depth};
   in.carve = carve_;
   if (timer) timer->begin("fuse");
   with_exec(device_, [&]<class E>(const E& ex) {
@@ -48,7 +49,8 @@ void DenseVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, Raycas
   kernels::RaycastOutput out{maps.depth.view(), maps.vertex.view(), maps.normal.view(), maps.color.view()};
   if (timer) timer->begin("raycast");
   with_exec(device_, [&]<class E>(const E& ex) {
-    kernels::TsdfRaycast<E, kernels::DenseAccess>::raycast(ex, device_view(), K, world_T_camera, params_.min_depth, params_.max_depth, out);
+    kernels::TsdfRaycast<E, kernels::DenseAccess>::raycast(ex, device_view(), K, world_T_camera, params_.min_depth,
+                                                           params_.max_depth, out);
   });
   if (timer) timer->end("raycast");
 }

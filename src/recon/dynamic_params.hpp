@@ -20,9 +20,9 @@ struct DynamicParams {
   // Free-space violation: a measurement more than this many volume.truncation widths in front of
   // the nearest model surface along its ray sees through space the model says is empty.
   float free_space_truncations = 3.f;
-  int search_radius = 2;     // pixels: projective association is a pixel or two off at depth edges
-  int support_radius = 1;    // pixels: the consistency window is (2r+1)^2
-  int min_support = 5;       // of the window's 9 pixels (r = 1): a majority
+  int search_radius = 2;          // pixels: projective association is a pixel or two off at depth edges
+  int support_radius = 1;         // pixels: the consistency window is (2r+1)^2
+  int min_support = 5;            // of the window's 9 pixels (r = 1): a majority
   float dilate_max_step = 0.05f;  // metres: the dilation never crosses a larger depth step
   // Free-space carving: a voxel more than this many truncation widths in front of the measured depth
   // (and of its 3x3 neighbours) is reset to free; 0: only the running average (KinectFusion).
@@ -51,8 +51,7 @@ struct DynamicParams {
       "frame's mask having it)",
       Range{1, 289});
     v("dilate_max_step", dilate_max_step,
-      "the mask grows by support_radius into neighbours whose depth differs by at most this, metres",
-      Range{0.0, 10.0});
+      "the mask grows by support_radius into neighbours whose depth differs by at most this, metres", Range{0.0, 10.0});
     v("carve_truncations", carve_truncations,
       "free-space carving: voxels this many truncation widths in front of the measurement are reset to free "
       "space; 0: off",

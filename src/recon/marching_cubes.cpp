@@ -77,12 +77,11 @@ const std::vector<std::int8_t>& marching_cubes_table() {
   return t;
 }
 
-template <class Acc>
-Mesh marching_cubes(Device d, const Acc& a, const Buffer<int3>& blocks, std::int64_t block_count) {
+template <class Acc> Mesh marching_cubes(Device d, const Acc& a, const Buffer<int3>& blocks, std::int64_t block_count) {
   Buffer<std::int8_t> table = Buffer<std::int8_t>::from_host(marching_cubes_table(), d);
   Mesh mesh;
   std::unordered_map<std::uint64_t, int> index;  // voxel edge -> vertex
-  constexpr std::int64_t kChunk = 8192;           // blocks per pass: bounds the scratch memory
+  constexpr std::int64_t kChunk = 8192;          // blocks per pass: bounds the scratch memory
   for (std::int64_t first = 0; first < block_count; first += kChunk) {
     std::int64_t nb = std::min(kChunk, block_count - first);
     View<const int3> chunk{blocks.data() + first, nb};
@@ -95,7 +94,8 @@ Mesh marching_cubes(Device d, const Acc& a, const Buffer<int3>& blocks, std::int
     Buffer<uchar3> col(3 * tris, d);
     Buffer<std::uint64_t> keys(3 * tris, d);
     with_exec(d, [&]<class E>(const E& ex) {
-      kernels::TsdfExtract<E, Acc>::mesh_emit(ex, a, chunk, table.data(), offsets.cview(), pos.view(), nrm.view(), col.view(), keys.view());
+      kernels::TsdfExtract<E, Acc>::mesh_emit(ex, a, chunk, table.data(), offsets.cview(), pos.view(), nrm.view(),
+                                              col.view(), keys.view());
     });
     auto hp = pos.to_host(), hn = nrm.to_host();
     auto hc = col.to_host();
@@ -115,7 +115,8 @@ Mesh marching_cubes(Device d, const Acc& a, const Buffer<int3>& blocks, std::int
   return mesh;
 }
 
-template Mesh marching_cubes<kernels::HashAccess>(Device, const kernels::HashAccess&, const Buffer<int3>&, std::int64_t);
+template Mesh marching_cubes<kernels::HashAccess>(Device, const kernels::HashAccess&, const Buffer<int3>&,
+                                                  std::int64_t);
 template Mesh marching_cubes<kernels::DenseAccess>(Device, const kernels::DenseAccess&, const Buffer<int3>&,
                                                    std::int64_t);
 

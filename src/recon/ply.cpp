@@ -101,7 +101,8 @@ Mesh read_ply(const std::string& path) {
       std::string t, name;
       ls >> t;
       if (t == "list") {
-        if (element != "face") throw InputError("PLY '" + path + "': a list property is supported in element face only");
+        if (element != "face")
+          throw InputError("PLY '" + path + "': a list property is supported in element face only");
         ls >> face_count >> face_index;
         if (type_size(face_count, path) != 1 || type_size(face_index, path) != 4)
           throw InputError("PLY '" + path + "': face lists must be 'list uchar int'");
@@ -139,7 +140,8 @@ Mesh read_ply(const std::string& path) {
   if (has_c) m.colors.resize(nv);
   std::vector<char> rec(stride);
   for (std::size_t i = 0; i < nv; ++i) {
-    if (!f.read(rec.data(), static_cast<std::streamsize>(stride))) throw InputError("PLY '" + path + "': truncated vertex data");
+    if (!f.read(rec.data(), static_cast<std::streamsize>(stride)))
+      throw InputError("PLY '" + path + "': truncated vertex data");
     std::size_t off = 0;
     for (const Prop& p : vprops) {
       const double d = read_value(p.type, rec.data() + off);
@@ -167,7 +169,8 @@ Mesh read_ply(const std::string& path) {
     std::uint8_t count = 0;
     f.read(reinterpret_cast<char*>(&count), 1);
     if (count != 3) throw InputError("PLY '" + path + "': face " + std::to_string(i) + " is not a triangle");
-    if (!f.read(reinterpret_cast<char*>(&m.triangles[i]), 12)) throw InputError("PLY '" + path + "': truncated face data");
+    if (!f.read(reinterpret_cast<char*>(&m.triangles[i]), 12))
+      throw InputError("PLY '" + path + "': truncated face data");
     for (int k : {m.triangles[i].x, m.triangles[i].y, m.triangles[i].z})
       if (k < 0 || static_cast<std::size_t>(k) >= nv)
         throw InputError("PLY '" + path + "': face " + std::to_string(i) + " refers to vertex " + std::to_string(k) +

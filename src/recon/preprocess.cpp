@@ -22,12 +22,13 @@ void FramePyramid::build(const Image<float>& raw, const Image<float>* intensity,
                 " but the intrinsics say " + std::to_string(l0.K.width) + "x" + std::to_string(l0.K.height));
   with_exec(device_, [&]<class E>(const E& ex) {
     if (p.bilateral)
-      kernels::Preprocess<E>::bilateral_filter(ex, raw.cview(), l0.depth.view(), p.sigma_space, p.sigma_depth, p.radius);
-    else
-      levels_[0].depth.buffer().copy_from(raw.buffer());
+      kernels::Preprocess<E>::bilateral_filter(ex, raw.cview(), l0.depth.view(), p.sigma_space, p.sigma_depth,
+                                               p.radius);
+    else levels_[0].depth.buffer().copy_from(raw.buffer());
     if (intensity) levels_[0].intensity.buffer().copy_from(intensity->buffer());
     for (std::size_t l = 1; l < levels_.size(); ++l) {
-      kernels::Preprocess<E>::pyr_down_depth(ex, levels_[l - 1].depth.cview(), levels_[l].depth.view(), p.pyramid_max_diff);
+      kernels::Preprocess<E>::pyr_down_depth(ex, levels_[l - 1].depth.cview(), levels_[l].depth.view(),
+                                             p.pyramid_max_diff);
       if (intensity)
         kernels::Preprocess<E>::pyr_down_intensity(ex, levels_[l - 1].intensity.cview(), levels_[l].intensity.view());
     }

@@ -6,9 +6,9 @@ namespace seamless {
 
 struct PreprocessParams {
   bool bilateral = true;
-  float sigma_space = 4.5f;   // pixels
-  float sigma_depth = 0.03f;  // metres
-  int radius = 3;             // window (2r+1)^2
+  float sigma_space = 4.5f;        // pixels
+  float sigma_depth = 0.03f;       // metres
+  int radius = 3;                  // window (2r+1)^2
   float pyramid_max_diff = 0.09f;  // 3 sigma_depth: averaging never bridges larger jumps
   float max_normal_edge = 0.1f;    // metres; longer neighbour edges are depth discontinuities
   int levels = 3;

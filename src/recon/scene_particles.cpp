@@ -21,8 +21,7 @@ struct Candidates {
 };
 
 // Concatenates per-chunk buffers into one of `total` elements on device d.
-template <class T>
-Buffer<T> concat(std::vector<Buffer<T>>& parts, std::int64_t total, Device d) {
+template <class T> Buffer<T> concat(std::vector<Buffer<T>>& parts, std::int64_t total, Device d) {
   Buffer<T> out(total, d);
   std::int64_t at = 0;
   for (auto& b : parts) {
@@ -47,14 +46,15 @@ Candidates candidates(Device d, const Acc& a, const Buffer<int3>& blocks, std::i
     View<const int3> part{blocks.data() + first, nb};
     Buffer<std::int32_t> offsets(nb * per_block, d);
     std::int64_t n = with_exec(d, [&]<class E>(const E& ex) {
-      return kernels::TsdfExtract<E, Acc>::scene_particle_count(ex, a, part, p.spacing, p.interior_depth, offsets.view());
+      return kernels::TsdfExtract<E, Acc>::scene_particle_count(ex, a, part, p.spacing, p.interior_depth,
+                                                                offsets.view());
     });
     if (n == 0) continue;
     Buffer<vec3> pos(n, d), nrm(n, d);
     Buffer<float> score(n, d);
     with_exec(d, [&]<class E>(const E& ex) {
-      kernels::TsdfExtract<E, Acc>::scene_particle_emit(ex, a, part, p.spacing, p.interior_depth, offsets.cview(), pos.view(), nrm.view(),
-                                   score.view());
+      kernels::TsdfExtract<E, Acc>::scene_particle_emit(ex, a, part, p.spacing, p.interior_depth, offsets.cview(),
+                                                        pos.view(), nrm.view(), score.view());
     });
     c.count += n;
     pos_parts.push_back(std::move(pos)), nrm_parts.push_back(std::move(nrm)), score_parts.push_back(std::move(score));
@@ -72,14 +72,14 @@ SceneParticles thin(Device d, const Candidates& c, float min_distance) {
   Buffer<std::uint64_t> keys(c.count, d);
   Buffer<std::int32_t> order(c.count, d), keep(c.count, d);
   with_exec(d, [&]<class E>(const E& ex) {
-    out.count = kernels::TsdfExtract<E>::scene_particle_thin(ex, c.positions.cview(), c.scores.cview(), min_distance, keys.view(),
-                                             order.view(), keep.view());
+    out.count = kernels::TsdfExtract<E>::scene_particle_thin(ex, c.positions.cview(), c.scores.cview(), min_distance,
+                                                             keys.view(), order.view(), keep.view());
   });
   out.positions = Buffer<vec3>(out.count, d);
   out.normals = Buffer<vec3>(out.count, d);
   with_exec(d, [&]<class E>(const E& ex) {
     kernels::TsdfExtract<E>::scene_particle_compact(ex, keep.cview(), out.count, c.positions.cview(), c.normals.cview(),
-                                    out.positions.view(), out.normals.view());
+                                                    out.positions.view(), out.normals.view());
   });
   return out;
 }
@@ -91,9 +91,10 @@ SceneParticles extract_scene_particles(Device d, const Acc& a, const Buffer<int3
                                        const SceneParticleParams& p) {
   if (!(p.spacing > 0.f)) throw Error("scene particles: spacing must be positive");
   if (p.interior_depth > a.geom.truncation)
-    spdlog::warn("scene particles: interior_depth {} m is deeper than the TSDF truncation {} m; the fill stops at the "
-                 "truncation (raise volume.truncation to fill deeper)",
-                 p.interior_depth, a.geom.truncation);
+    spdlog::warn(
+        "scene particles: interior_depth {} m is deeper than the TSDF truncation {} m; the fill stops at the "
+        "truncation (raise volume.truncation to fill deeper)",
+        p.interior_depth, a.geom.truncation);
   return thin(d, candidates(d, a, blocks, block_count, p), kSceneParticleMinDistance * p.spacing);
 }
 
@@ -110,13 +111,15 @@ std::vector<float> sample_sdf_grid(Device d, const Acc& a, vec3 origin, int3 dim
   if (dims.x <= 0 || dims.y <= 0 || dims.z <= 0 || !(voxel > 0.f))
     throw Error("SDF grid: dimensions and voxel size must be positive");
   Buffer<float> out(n, d);
-  with_exec(d, [&]<class E>(const E& ex) { kernels::TsdfExtract<E, Acc>::sample_sdf_grid(ex, a, origin, dims, voxel, unknown, out.view()); });
+  with_exec(d, [&]<class E>(const E& ex) {
+    kernels::TsdfExtract<E, Acc>::sample_sdf_grid(ex, a, origin, dims, voxel, unknown, out.view());
+  });
   return out.to_host();
 }
 
 template std::vector<float> sample_sdf_grid<kernels::HashAccess>(Device, const kernels::HashAccess&, vec3, int3, float,
-                                                                float);
+                                                                 float);
 template std::vector<float> sample_sdf_grid<kernels::DenseAccess>(Device, const kernels::DenseAccess&, vec3, int3,
-                                                                 float, float);
+                                                                  float, float);
 
 }  // namespace seamless

@@ -1,7 +1,7 @@
 // Static scene particles for the physics solver, taken from the fused TSDF (DESIGN "Physics").
 #pragma once
-#include <vector>
 #include <cstdint>
+#include <vector>
 
 #include "core/buffer.hpp"
 #include "core/math.hpp"
@@ -10,8 +10,8 @@
 namespace seamless {
 
 struct SceneParticleParams {
-  float spacing = 0.04f;        // the solver's particle diameter (dissertation: 4 m / 100)
-  float interior_depth = 0.f;   // also fill the solid this deep below the surface (<= truncation)
+  float spacing = 0.04f;       // the solver's particle diameter (dissertation: 4 m / 100)
+  float interior_depth = 0.f;  // also fill the solid this deep below the surface (<= truncation)
 
   template <class V> void visit(V& v) {
     v("spacing", spacing, "lattice spacing of the scene particles, metres (the particle diameter)", Range{0.001, 1.0});

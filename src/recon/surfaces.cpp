@@ -40,9 +40,9 @@ std::map<Key, Cell> bin_horizontal_pieces(const Mesh& mesh, vec3 up, const Surfa
     if (twice_area <= 0.f || dot(n, up) < cos_tilt * twice_area) continue;
     const vec3 m = (a + b + c) * (1.f / 3.f);
     const float h = dot(m, up), area = 0.5f * twice_area;
-    Cell& cell = cells[{static_cast<int>(std::floor(dot(m, e1) / p.cell)),
-                        static_cast<int>(std::floor(dot(m, e2) / p.cell)),
-                        static_cast<int>(std::floor(h / p.height_bin))}];
+    Cell& cell =
+        cells[{static_cast<int>(std::floor(dot(m, e1) / p.cell)), static_cast<int>(std::floor(dot(m, e2) / p.cell)),
+               static_cast<int>(std::floor(h / p.height_bin))}];
     cell.area += area, cell.area_h += area * h, cell.area_p += m * area;
     cell.lo = vmin(cell.lo, m), cell.hi = vmax(cell.hi, m);
   }
@@ -123,7 +123,7 @@ std::vector<HorizontalSurface> find_horizontal_surfaces(const Mesh& mesh, vec3 u
     const auto [i, j, k] = key;
     const float h = static_cast<float>(c.area_h / c.area);
     const int component = c.component;  // a lambda may not capture a structured binding before Clang 16
-    auto open = [&](int ci, int cj) {  // this column is the surface's and nothing stands on it
+    auto open = [&](int ci, int cj) {   // this column is the surface's and nothing stands on it
       auto o = owners.find({ci, cj});
       if (o == owners.end() || !o->second.count(component)) return false;
       auto col = columns.find({ci, cj});
@@ -149,8 +149,7 @@ std::vector<HorizontalSurface> find_horizontal_surfaces(const Mesh& mesh, vec3 u
   }
   for (int i = 0; i < n; ++i) s[i].open_radius = std::max(0, best[i].first) * p.cell;
   for (int i = 0; i < n; ++i) s[i].centre += up * (s[i].height - dot(s[i].centre, up));
-  s.erase(std::remove_if(s.begin(), s.end(), [&](const HorizontalSurface& x) { return x.area < p.min_area; }),
-          s.end());
+  s.erase(std::remove_if(s.begin(), s.end(), [&](const HorizontalSurface& x) { return x.area < p.min_area; }), s.end());
   std::sort(s.begin(), s.end(), [](const auto& a, const auto& b) { return a.area > b.area; });
 
   // The floor: the lowest large surface, if it lies far below the cameras (a room scanned from eye
@@ -160,14 +159,13 @@ std::vector<HorizontalSurface> find_horizontal_surfaces(const Mesh& mesh, vec3 u
   for (HorizontalSurface& x : s)
     if (x.area >= p.floor_min_area && (!lowest || x.height < lowest->height)) lowest = &x;
   if (lowest) {
-    const bool under_furniture = std::any_of(s.begin(), s.end(), [&](const HorizontalSurface& x) {
-      return x.height > lowest->height + p.furniture_rise;
-    });
+    const bool under_furniture = std::any_of(
+        s.begin(), s.end(), [&](const HorizontalSurface& x) { return x.height > lowest->height + p.furniture_rise; });
     float camera_h = 0.f;
     for (vec3 c : camera_positions) camera_h += dot(c, up);
     const float drop = camera_positions.empty() ? 1e9f : camera_h / camera_positions.size() - lowest->height;
-    lowest->floor = (drop >= p.floor_min_drop && !camera_positions.empty()) ||
-                    (under_furniture && drop >= 0.5f * p.floor_min_drop);
+    lowest->floor =
+        (drop >= p.floor_min_drop && !camera_positions.empty()) || (under_furniture && drop >= 0.5f * p.floor_min_drop);
   }
   return s;
 }

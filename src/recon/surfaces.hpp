@@ -11,10 +11,10 @@
 namespace seamless {
 
 struct HorizontalSurface {
-  float height = 0.f;       // metres along `up` (area-weighted mean of its pieces)
-  float area = 0.f;         // m^2 of upward-facing surface
-  vec3 centre{0, 0, 0};     // the surface's most open point (see find_horizontal_surfaces), world
-  float open_radius = 0.f;  // metres of free surface around the centre (at most SurfaceParams::open_radius)
+  float height = 0.f;             // metres along `up` (area-weighted mean of its pieces)
+  float area = 0.f;               // m^2 of upward-facing surface
+  vec3 centre{0, 0, 0};           // the surface's most open point (see find_horizontal_surfaces), world
+  float open_radius = 0.f;        // metres of free surface around the centre (at most SurfaceParams::open_radius)
   vec3 lo{0, 0, 0}, hi{0, 0, 0};  // world bounds of its pieces
   bool floor = false;
   std::vector<vec3> cells;  // the mean point of each of its grid cells (where it can be stood on)

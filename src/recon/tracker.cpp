@@ -40,9 +40,8 @@ const char* to_string(TrackStatus s) {
 // ---- ReferenceMaps ------------------------------------------------------------------------------
 
 void ReferenceMaps::resize(const Intrinsics& K, int levels, Device d, bool intensity) {
-  bool same = static_cast<int>(levels_.size()) == levels && !levels_.empty() &&
-              levels_[0].vertices.device() == d && levels_[0].K.width == K.width &&
-              levels_[0].K.height == K.height && has_intensity() == intensity;
+  bool same = static_cast<int>(levels_.size()) == levels && !levels_.empty() && levels_[0].vertices.device() == d &&
+              levels_[0].K.width == K.width && levels_[0].K.height == K.height && has_intensity() == intensity;
   if (!same) {
     levels_.clear();
     for (int l = 0; l < levels; ++l) {
@@ -80,12 +79,12 @@ void ReferenceMaps::set_from_raycast(const RaycastMaps& maps, const Intrinsics& 
   resize(K, levels, d, intensity);
   const SE3 camera_T_world = world_T_camera.inverse();
   with_exec(d, [&]<class E>(const E& ex) {
-    kernels::Icp<E>::transform_maps(ex, maps.vertex.cview(), maps.normal.cview(), camera_T_world, levels_[0].vertices.view(),
-                            levels_[0].normals.view());
+    kernels::Icp<E>::transform_maps(ex, maps.vertex.cview(), maps.normal.cview(), camera_T_world,
+                                    levels_[0].vertices.view(), levels_[0].normals.view());
     if (from_model) kernels::Rgbd<E>::rgb_to_intensity(ex, maps.color.cview(), levels_[0].intensity.view());
     for (int l = 1; l < levels; ++l) {
       kernels::Icp<E>::pyr_down_maps(ex, levels_[l - 1].vertices.cview(), levels_[l - 1].normals.cview(),
-                             levels_[l].vertices.view(), levels_[l].normals.view(), max_diff);
+                                     levels_[l].vertices.view(), levels_[l].normals.view(), max_diff);
       if (from_model)
         kernels::Preprocess<E>::pyr_down_intensity(ex, levels_[l - 1].intensity.cview(), levels_[l].intensity.view());
     }
@@ -137,12 +136,12 @@ SE3 orthonormalize(SE3 T) {
 
 Tracker::Tracker(const TrackerParams& params, Device device) : params_(params), device_(device) {
   if (params_.kind != "icp" && params_.kind != "rgbd")
-    throw ConfigError("tracker.kind '" + params_.kind + "' is not an ICP tracker (the Tracker class runs icp and rgbd)");
+    throw ConfigError("tracker.kind '" + params_.kind +
+                      "' is not an ICP tracker (the Tracker class runs icp and rgbd)");
 }
 
 bool Tracker::use_photometric(const FramePyramid& frame, const ReferenceMaps& ref) const {
-  return reads_intensity() && ref.has_intensity() &&
-         frame.level(0).intensity.width() > 0;
+  return reads_intensity() && ref.has_intensity() && frame.level(0).intensity.width() > 0;
 }
 
 bool Tracker::robust(const FramePyramid& frame, const ReferenceMaps& ref) const {
@@ -161,18 +160,24 @@ void Tracker::set_pose(const SE3& ref_T_cur) const {
 
 kernels::IcpSums* Tracker::sums_slot(int level) const {
   if (level >= kernels::kIcpMaxLevels)
-    throw ConfigError("the tracker handles at most " + std::to_string(kernels::kIcpMaxLevels) + " pyramid levels, not " +
-                std::to_string(level + 1) + " (preprocess.levels)");
+    throw ConfigError("the tracker handles at most " + std::to_string(kernels::kIcpMaxLevels) +
+                      " pyramid levels, not " + std::to_string(level + 1) + " (preprocess.levels)");
   return &state()->sums[level];
 }
 
 void Tracker::reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, int level, int steps) const {
   const PyramidLevel& cur = frame.level(level);
   const ReferenceLevel& rl = ref.level(level);
-  kernels::IcpLevel L{cur.vertices.cview(), cur.normals.cview(), rl.vertices.cview(), rl.normals.cview(), rl.K,
-                      SE3::identity(), params_.dist_threshold,
+  kernels::IcpLevel L{cur.vertices.cview(),
+                      cur.normals.cview(),
+                      rl.vertices.cview(),
+                      rl.normals.cview(),
+                      rl.K,
+                      SE3::identity(),
+                      params_.dist_threshold,
                       static_cast<float>(std::cos(params_.angle_threshold_deg * kPi / 180.0)),
-                      static_cast<float>(params_.stop_rotation_deg * kPi / 180.0), params_.stop_translation};
+                      static_cast<float>(params_.stop_rotation_deg * kPi / 180.0),
+                      params_.stop_translation};
   if (level < static_cast<int>(params_.pixel_stride.size())) L.stride = params_.pixel_stride[level];
   kernels::IcpState* st = state();
   kernels::IcpSums* out = sums_slot(level);
@@ -181,8 +186,13 @@ void Tracker::reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, i
       if (steps == 0) return kernels::Icp<E>::icp_reduce_into(ex, L, &st->pose, out);
       return kernels::Icp<E>::icp_level_steps(ex, L, &st->pose, out, steps);
     }
-    kernels::RgbdLevel R{L, cur.intensity.cview(), rl.intensity.cview(), 1.f, params_.photometric_weight,
-                         params_.max_intensity_diff, robust(frame, ref) ? params_.robust_dof : 0.f,
+    kernels::RgbdLevel R{L,
+                         cur.intensity.cview(),
+                         rl.intensity.cview(),
+                         1.f,
+                         params_.photometric_weight,
+                         params_.max_intensity_diff,
+                         robust(frame, ref) ? params_.robust_dof : 0.f,
                          params_.depth_noise == "depth_squared"};
     R.photometric_all_visible = params_.photometric_pixels == "visible";
     R.min_gradient = params_.min_gradient;
@@ -225,7 +235,7 @@ TrackResult Tracker::track(const FramePyramid& frame, const ReferenceMaps& ref,
   r.iterations = pose.steps;
   bool degenerate = false;
   if (levels > 0 && params_.iterations[0] > 0) {  // statistics of the finest level's last system
-    const kernels::IcpSums& s = st.sums[0];  // the last system summed (a done level stops there)
+    const kernels::IcpSums& s = st.sums[0];       // the last system summed (a done level stops there)
     IcpStep step = solve_icp_step(s);
     r.inliers = static_cast<std::int64_t>(s.inliers);
     r.inlier_ratio = s.valid > 0 ? s.inliers / s.valid : 0.0;
@@ -244,10 +254,8 @@ void Tracker::check_loss(TrackResult& r, const SE3& initial) const {
   r.translation_jump = length(delta.t);
   r.rotation_jump_deg = rotation_angle_deg(delta.R);
   if (r.status != TrackStatus::ok) return;
-  if (r.inlier_ratio < params_.min_inlier_ratio)
-    r.status = TrackStatus::too_few_inliers;
-  else if (!(r.condition <= params_.max_condition))
-    r.status = TrackStatus::degenerate;
+  if (r.inlier_ratio < params_.min_inlier_ratio) r.status = TrackStatus::too_few_inliers;
+  else if (!(r.condition <= params_.max_condition)) r.status = TrackStatus::degenerate;
   else if (r.translation_jump > params_.max_translation_jump || r.rotation_jump_deg > params_.max_rotation_jump_deg)
     r.status = TrackStatus::implausible_jump;
 }

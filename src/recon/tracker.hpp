@@ -75,12 +75,12 @@ const char* to_string(TrackStatus s);
 struct TrackResult {
   SE3 world_T_camera = SE3::identity();  // the estimate; the initial guess when the solve failed
   TrackStatus status = TrackStatus::no_reference;
-  double residual_rms = 0;     // sqrt(error / inliers) of the last finest-level iteration (metres for ICP)
-  double inlier_ratio = 0;     // finest level: correspondences / pixels with a vertex
+  double residual_rms = 0;  // sqrt(error / inliers) of the last finest-level iteration (metres for ICP)
+  double inlier_ratio = 0;  // finest level: correspondences / pixels with a vertex
   std::int64_t inliers = 0;
-  double condition = 0;        // eigenvalue ratio of the finest level's J^T J
-  int iterations = 0;          // Gauss-Newton steps taken, all levels
-  double translation_jump = 0; // metres between the initial guess and the estimate
+  double condition = 0;         // eigenvalue ratio of the finest level's J^T J
+  int iterations = 0;           // Gauss-Newton steps taken, all levels
+  double translation_jump = 0;  // metres between the initial guess and the estimate
   double rotation_jump_deg = 0;
   bool ok() const { return status == TrackStatus::ok; }
 };
@@ -121,7 +121,8 @@ class Tracker {
 };
 
 // One Gauss-Newton step on the host (tests, statistics): solves J^T J xi = -J^T r with the device
-// loop's Cholesky (kernels::solve_normal_equations) and reports the condition number of J^T J (largest / smallest eigenvalue; infinity when singular).
+// loop's Cholesky (kernels::solve_normal_equations) and reports the condition number of J^T J (largest / smallest
+// eigenvalue; infinity when singular).
 struct IcpStep {
   double xi[6] = {0, 0, 0, 0, 0, 0};  // omega (rad), upsilon (m)
   double condition = 0;

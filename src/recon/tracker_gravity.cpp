@@ -9,14 +9,14 @@
 namespace seamless {
 
 namespace {
-constexpr float kPlaneTol = 0.02f;        // metres: inlier distance (a few Kinect noise sigmas at 2 m)
-constexpr float kNormalCos = 0.9397f;     // cos 20 deg: inlier normal agreement
-constexpr float kUprightCos = 0.5f;       // cos 60 deg: candidate normals near the camera's up
+constexpr float kPlaneTol = 0.02f;     // metres: inlier distance (a few Kinect noise sigmas at 2 m)
+constexpr float kNormalCos = 0.9397f;  // cos 20 deg: inlier normal agreement
+constexpr float kUprightCos = 0.5f;    // cos 60 deg: candidate normals near the camera's up
 constexpr int kCandidates = 400;
 
 struct Plane {
-  vec3 n;  // unit, pointing up (towards the camera side)
-  float d; // n . x + d = 0
+  vec3 n;   // unit, pointing up (towards the camera side)
+  float d;  // n . x + d = 0
 };
 
 int count_inliers(const std::vector<vec3>& v, const std::vector<vec3>& n, const Plane& p) {

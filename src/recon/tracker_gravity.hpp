@@ -13,7 +13,7 @@
 namespace seamless {
 
 struct GravityEstimate {
-  vec3 down{0.f, 1.f, 0.f};  // unit vector along gravity in the camera frame it was estimated in
+  vec3 down{0.f, 1.f, 0.f};     // unit vector along gravity in the camera frame it was estimated in
   std::string source = "none";  // accelerometer | floor | fixed | none
   bool found = false;           // false: the source asked for had nothing; down is the camera's +y
   double support = 0;           // floor: fraction of the level's valid pixels on the plane

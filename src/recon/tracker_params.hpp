@@ -20,9 +20,9 @@ struct TrackerParams {
   // rotation that moves a point 1.7 m away by as much; an order of magnitude under the Kinect v1's
   // depth noise at 1 m (~1.4 mm, Khoshelham & Elberink 2012), so the pose it would still gain is far
   // below what the sensor resolves. 0 and 0: every level takes all its iterations.
-  float stop_translation = 1e-4f;         // metres per step
-  float stop_rotation_deg = 0.0034f;      // degrees per step (6e-5 rad)
-  float dist_threshold = 0.1f;            // metres
+  float stop_translation = 1e-4f;     // metres per step
+  float stop_rotation_deg = 0.0034f;  // degrees per step (6e-5 rad)
+  float dist_threshold = 0.1f;        // metres
   float angle_threshold_deg = 20.f;
   float photometric_weight = 0.1f;        // rgbd only: weight of the colour term vs geometry
   float min_inlier_ratio = 0.15f;         // see docs/TRACKING.md, "Tracking loss"
@@ -36,33 +36,32 @@ struct TrackerParams {
   // whitened by its own scale, estimated every step, with Student-t weights against outliers
   // (Kerl et al. 2013; docs/TRACKING.md, "RGB-D").
   std::string weighting = "fixed";
-  float robust_dof = 5.f;                 // degrees of freedom of the t-distribution (Kerl et al. 2013: 5)
-  std::string depth_noise = "uniform";    // robust: geometric noise uniform or ~ depth^2 (Kinect v1)
+  float robust_dof = 5.f;               // degrees of freedom of the t-distribution (Kerl et al. 2013: 5)
+  std::string depth_noise = "uniform";  // robust: geometric noise uniform or ~ depth^2 (Kinect v1)
   // rgbd: the pixels that get a photometric row (kernels/recon/rgbd.hpp, RgbdLevel): the geometric
   // inliers only, or every pixel that sees the reference surface (the normal test left to geometry).
   std::string photometric_pixels = "inliers";
-  float min_gradient = 0.f;               // rgbd: photometric rows only where |grad I| >= this (per pixel)
-  bool constant_velocity = false;         // start each frame from the last motion instead of the last pose
-  float max_translation_jump = 0.3f;      // metres per frame
-  float max_rotation_jump_deg = 30.f;     // degrees per frame
+  float min_gradient = 0.f;            // rgbd: photometric rows only where |grad I| >= this (per pixel)
+  bool constant_velocity = false;      // start each frame from the last motion instead of the last pose
+  float max_translation_jump = 0.3f;   // metres per frame
+  float max_rotation_jump_deg = 30.f;  // degrees per frame
   // Relocalisation: the first frame tracked after lost ones is accepted only when its pose is within
   // what a handheld camera can move in the time since the last good frame, and its residual against
   // the model is within relocalise_max_residual_ratio of the recent good frames' (docs/TRACKING.md,
   // "Relocalisation"). The speeds are above the fastest handheld motion of the TUM benchmark: its
   // freiburg1 sequences average at most 0.43 m/s (fr1/desk2) and 50 deg/s (fr1/rpy) (Sturm et al.
   // 2012, Table I), and fr1/rpy peaks at ~6 degrees in one 1/30 s frame (180 deg/s).
-  float relocalise_max_speed = 1.0f;                // m/s
-  float relocalise_max_angular_speed_deg = 180.f;   // deg/s
+  float relocalise_max_speed = 1.0f;               // m/s
+  float relocalise_max_angular_speed_deg = 180.f;  // deg/s
   float relocalise_max_residual_ratio = 2.0f;
   std::string gravity = "auto";
-  vec3 fixed_gravity{0.f, 1.f, 0.f};      // camera frame (y down), used when gravity: fixed
+  vec3 fixed_gravity{0.f, 1.f, 0.f};  // camera frame (y down), used when gravity: fixed
 
   template <class V> void visit(V& v) {
     v("kind", kind, "tracker; opencv_* and pcl_gicp are external libraries, always frame to frame",
       Choices{"icp", "rgbd", "ground_truth", "opencv_rgbd_odometry", "opencv_icp", "opencv_rgbd_icp", "opencv_fast_icp",
               "pcl_gicp"});
-    v("mode", mode, "align to the model raycast or to the previous frame",
-      Choices{"frame_to_model", "frame_to_frame"});
+    v("mode", mode, "align to the model raycast or to the previous frame", Choices{"frame_to_model", "frame_to_frame"});
     v("iterations", iterations, "ICP iterations per pyramid level, finest first", Range{0, 1000});
     v("pixel_stride", pixel_stride,
       "per pyramid level, finest first: track on every n-th pixel of every n-th row (a full-resolution "
@@ -95,8 +94,7 @@ struct TrackerParams {
       "every step, with t-distribution weights against outliers; photometric_weight then scales the whitened "
       "colour term)",
       Choices{"fixed", "robust"});
-    v("robust_dof", robust_dof, "rgbd weighting robust: degrees of freedom of the t-distribution",
-      Range{0.1, 1e6});
+    v("robust_dof", robust_dof, "rgbd weighting robust: degrees of freedom of the t-distribution", Range{0.1, 1e6});
     v("depth_noise", depth_noise,
       "rgbd weighting robust: the geometric residual's noise is uniform, or grows with depth squared "
       "(structured-light sensors such as the Kinect v1)",

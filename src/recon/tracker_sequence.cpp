@@ -45,7 +45,8 @@ TrackerInfo external_entry(std::string kind, std::string description, external::
   bool on = static_cast<bool>(make);
   return {std::move(kind), std::move(description), on, on ? "" : std::move(missing), std::move(make)};
 }
-const char* kOpenCvMissing = "OpenCV's rgbd contrib module is not in this build (apt-get install libopencv-contrib-dev, rebuild)";
+const char* kOpenCvMissing =
+    "OpenCV's rgbd contrib module is not in this build (apt-get install libopencv-contrib-dev, rebuild)";
 const char* kPclMissing = "PCL is not in this build (apt-get install libpcl-dev, rebuild)";
 }  // namespace
 
@@ -63,8 +64,8 @@ const std::vector<TrackerInfo>& tracker_registry() {
                      external::opencv_factory(OpenCvMethod::rgbd_icp), kOpenCvMissing),
       external_entry("opencv_fast_icp", "OpenCV contrib rgbd::FastICPOdometry (kinfu's ICP), frame to frame",
                      external::opencv_factory(OpenCvMethod::fast_icp), kOpenCvMissing),
-      external_entry("pcl_gicp", "PCL generalized ICP on a 2 cm voxel grid, frame to frame", external::pcl_gicp_factory(),
-                     kPclMissing),
+      external_entry("pcl_gicp", "PCL generalized ICP on a 2 cm voxel grid, frame to frame",
+                     external::pcl_gicp_factory(), kPclMissing),
   };
   return r;
 }
@@ -99,8 +100,7 @@ RgbdFrame host_copy(const RgbdFrame& f) {
 }
 }  // namespace
 
-TrackingSession::TrackingSession(const TrackSequenceParams& params, Device device, const Intrinsics& K,
-                                 Volume* volume)
+TrackingSession::TrackingSession(const TrackSequenceParams& params, Device device, const Intrinsics& K, Volume* volume)
     : p_(params), device_(device), K_(K), volume_(volume), pyr_(device, K, params.preprocess.levels),
       marks_(device, kMarks), colour_upload_(std::make_unique<ColourUpload>()) {
   const TrackerInfo& info = tracker_info(p_.tracker.kind);
@@ -186,11 +186,11 @@ void TrackingSession::find_dynamic(const ReferenceMaps& model, const SE3& world_
   in.search_radius = d.search_radius;
   with_exec(device_, [&]<class E>(const E& ex) {
     kernels::Dynamic<E>::classify_dynamic(ex, in, dyn_candidates_.view());
-    kernels::Dynamic<E>::filter_dynamic(ex, dyn_candidates_.cview(), dyn_prev_.cview(), l0.depth.cview(), d.support_radius,
-                            d.min_support, d.dilate_max_step, dyn_kept_.view(), dyn_mask_.view());
+    kernels::Dynamic<E>::filter_dynamic(ex, dyn_candidates_.cview(), dyn_prev_.cview(), l0.depth.cview(),
+                                        d.support_radius, d.min_support, d.dilate_max_step, dyn_kept_.view(),
+                                        dyn_mask_.view());
   });
 }
-
 
 TrackingSession::~TrackingSession() = default;
 
@@ -199,8 +199,8 @@ bool TrackingSession::uses_volume() const { return volume_ != nullptr; }
 void TrackingSession::upload(const RgbdFrame& frame) {
   if (frame.depth.width() != K_.width || frame.depth.height() != K_.height)
     throw InputError("frame " + std::to_string(frame.index) + " is " + std::to_string(frame.depth.width()) + "x" +
-                std::to_string(frame.depth.height()) + " but the source's intrinsics say " +
-                std::to_string(K_.width) + "x" + std::to_string(K_.height));
+                     std::to_string(frame.depth.height()) + " but the source's intrinsics say " +
+                     std::to_string(K_.width) + "x" + std::to_string(K_.height));
   // Persistent device images: one host-to-device copy a frame, no allocation. The copies are
   // asynchronous when the frame is in page-locked memory (what make_source gives a GPU pipeline);
   // process() waits for them before it returns, so the caller may then reuse the frame.
@@ -218,7 +218,8 @@ void TrackingSession::preprocess() {
   if (colour && p_.tracker.kind == "rgbd") {
     if (intensity_.width() != K_.width) intensity_ = Image<float>(K_.width, K_.height, device_);
     join_colour();
-    with_exec(device_, [&]<class E>(const E& ex) { kernels::Rgbd<E>::rgb_to_intensity(ex, rgb_.cview(), intensity_.view()); });
+    with_exec(device_,
+              [&]<class E>(const E& ex) { kernels::Rgbd<E>::rgb_to_intensity(ex, rgb_.cview(), intensity_.view()); });
     intensity = &intensity_;
   }
   pyr_.build(depth_, intensity, p_.preprocess);
@@ -277,7 +278,7 @@ void TrackingSession::first_frame(const RgbdFrame& frame, FrameRecord& rec) {
   gravity_ = estimate_gravity(p_.tracker, frame.accelerometer, pyr_);
   if (p_.tracker.gravity != "none" && !gravity_.found)
     spdlog::warn("tracker.gravity: {} gave no gravity direction; the world frame is the first camera's",
-              p_.tracker.gravity);
+                 p_.tracker.gravity);
   SE3 world_T_first = gravity_.found ? gravity_aligned_pose(gravity_.down) : SE3::identity();
   if (frame.ground_truth) world_T_gt_ = world_T_first * frame.ground_truth->inverse();
   rec.result.world_T_camera = world_T_first;
@@ -392,8 +393,7 @@ TrackResult TrackingSession::track_external(const RgbdFrame& frame) {
   std::optional<SE3> guess;
   if (lost_run_ > 0 && lost_run_ + 1 <= kMaxExtrapolatedFrames)
     guess = last_motion(lost_run_ + 1);  // where the last motion took it, then where it was (relocalise())
-  else if (p_.tracker.constant_velocity)
-    guess = last_motion(1);
+  else if (p_.tracker.constant_velocity) guess = last_motion(1);
   std::optional<external::OdometryEstimate> e = odometry_->prev_T_cur(last_good_frame_, frame, guess);
   if (!e && guess) {
     guess.reset();
@@ -411,8 +411,8 @@ TrackResult TrackingSession::track_external(const RgbdFrame& frame) {
   SE3 jump = (last_good_ * guess.value_or(SE3::identity())).inverse() * r.world_T_camera;
   r.translation_jump = length(jump.t);
   r.rotation_jump_deg = rotation_angle_deg(jump.R);
-  bool implausible = r.translation_jump > p_.tracker.max_translation_jump ||
-                     r.rotation_jump_deg > p_.tracker.max_rotation_jump_deg;
+  bool implausible =
+      r.translation_jump > p_.tracker.max_translation_jump || r.rotation_jump_deg > p_.tracker.max_rotation_jump_deg;
   r.status = implausible ? TrackStatus::implausible_jump : TrackStatus::ok;
   if (r.ok() && lost_run_ > 0) check_relocalisation(frame, r);
   return r;
@@ -564,9 +564,9 @@ TrackSequenceResult track_sequence(FrameSource& source, const TrackSequenceParam
   std::unique_ptr<TrajectoryWriter> writer;
   if (params.write_files) {
     std::filesystem::create_directories(out_dir);
-    writer = std::make_unique<TrajectoryWriter>(out_dir + "/trajectory.txt",
-                                                "camera trajectory (world_T_camera) by seamless, tracker " +
-                                                    params.tracker.kind + " " + params.tracker.mode);
+    writer = std::make_unique<TrajectoryWriter>(
+        out_dir + "/trajectory.txt",
+        "camera trajectory (world_T_camera) by seamless, tracker " + params.tracker.kind + " " + params.tracker.mode);
   }
   TrackSequenceResult out;
   RgbdFrame frame;
@@ -621,8 +621,7 @@ TrackSequenceResult track_sequence(FrameSource& source, const TrackSequenceParam
       if (n > 0)
         spdlog::error("the run stopped at frame {}: trajectory.txt and tracking_stats.csv hold frames 0-{} before it",
                       n, n - 1);
-      else
-        spdlog::error("the run stopped at frame 0, before any frame was tracked");
+      else spdlog::error("the run stopped at frame 0, before any frame was tracked");
     } else {
       spdlog::error("the run stopped at frame {}, after {} frames", n, n);
     }
@@ -637,8 +636,8 @@ TrackSequenceResult track_sequence(FrameSource& source, const TrackSequenceParam
   if (gt_writer) gt_writer->close();
   if (params.write_files) write_tracking_stats(out_dir + "/tracking_stats.csv", out.frames);
   spdlog::info("tracked {} frames with {} ({}), {} lost; median {:.2f} ms tracking, {:.2f} ms a frame",
-            out.frames.size(), params.tracker.kind, params.tracker.mode, out.lost_frames, out.median_track_ms,
-            out.median_frame_ms);
+               out.frames.size(), params.tracker.kind, params.tracker.mode, out.lost_frames, out.median_track_ms,
+               out.median_frame_ms);
   return out;
 }
 

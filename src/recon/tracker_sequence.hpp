@@ -59,8 +59,8 @@ struct TrackSequenceParams {
 struct FrameRecord {
   std::int64_t frame = 0;
   double timestamp = 0;
-  TrackResult result;          // result.world_T_camera is the pose written for this frame
-  bool fused = false;          // integrated into the volume (never when tracking was lost)
+  TrackResult result;  // result.world_T_camera is the pose written for this frame
+  bool fused = false;  // integrated into the volume (never when tracking was lost)
   // Times on the device's timeline (CUDA events; the host clock on the CPU): preprocess includes
   // the upload, fuse the raycast of the next reference view (the columns of tracking_stats.csv).
   double preprocess_ms = 0, track_ms = 0, fuse_ms = 0, frame_ms = 0;
@@ -155,15 +155,15 @@ class TrackingSession {
   SE3 last_good_ = SE3::identity(), prev_good_ = SE3::identity();
   SE3 world_T_gt_ = SE3::identity();  // ground_truth tracker: maps the source's poses into our world
   std::int64_t lost_ = 0;
-  std::int64_t lost_run_ = 0;     // consecutive lost frames just before this one: > 0 means relocalising
-  double last_good_time_ = 0;     // timestamp of the last good frame
-  double last_inlier_ratio_ = 0;  // of the last frame tracked (not the first), 0 before
+  std::int64_t lost_run_ = 0;           // consecutive lost frames just before this one: > 0 means relocalising
+  double last_good_time_ = 0;           // timestamp of the last good frame
+  double last_inlier_ratio_ = 0;        // of the last frame tracked (not the first), 0 before
   std::vector<double> good_residuals_;  // residual_rms of the last good tracked frames (at most 10)
 };
 
 struct TrackSequenceResult {
-  Trajectory trajectory;             // one pose per frame (a lost frame: the last good pose)
-  Trajectory ground_truth;           // the source's poses of the frames that have one, in the same world frame
+  Trajectory trajectory;    // one pose per frame (a lost frame: the last good pose)
+  Trajectory ground_truth;  // the source's poses of the frames that have one, in the same world frame
   std::vector<FrameRecord> frames;
   std::int64_t lost_frames = 0;
   GravityEstimate gravity;
@@ -193,7 +193,7 @@ struct TrackerInfo {
   std::string kind;
   std::string description;
   bool available;
-  std::string missing;                    // what to install when not available
+  std::string missing;                      // what to install when not available
   external::OdometryFactory make_external;  // external frame-to-frame trackers only
 };
 const std::vector<TrackerInfo>& tracker_registry();

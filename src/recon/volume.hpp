@@ -28,24 +28,24 @@ struct RaycastMaps {
 // Per-frame statistics (counts of the last integrate(), totals for the rest).
 struct VolumeStats {
   std::int64_t frames = 0;
-  std::int64_t allocated_blocks = 0;  // blocks holding voxels now
-  std::int64_t block_capacity = 0;    // blocks the pool can hold
-  std::int64_t hash_slots = 0;        // 0 for the dense grid
-  std::int64_t tombstones = 0;        // deleted hash slots awaiting the next rehash
-  double hash_fill = 0.0;             // (live + tombstones) / slots
-  std::int64_t inserted = 0;          // blocks allocated by the last frame
-  std::int64_t collisions = 0;        // of those, how many did not land in their home slot
-  std::int64_t failed_insertions = 0; // insertions of the last frame that failed even after retries
-  std::int64_t retries = 0;           // allocation passes repeated after growing (total)
-  std::int64_t visible_blocks = 0;    // blocks fused by the last frame
-  std::int64_t removed_blocks = 0;    // blocks freed as empty by the last frame
-  std::size_t bytes_per_block = 0;    // voxel payload of one 8^3 block
-  std::size_t voxel_bytes = 0;        // allocated_blocks * bytes_per_block
-  std::size_t device_bytes = 0;       // everything the volume holds on its device
-  std::int64_t host_blocks = 0;       // blocks streamed out to host memory (Niessner section 5)
-  std::size_t host_bytes = 0;         // their voxel payload
-  std::int64_t streamed_out = 0;      // blocks moved to the host, total
-  std::int64_t streamed_in = 0;       // blocks moved back to the device, total
+  std::int64_t allocated_blocks = 0;   // blocks holding voxels now
+  std::int64_t block_capacity = 0;     // blocks the pool can hold
+  std::int64_t hash_slots = 0;         // 0 for the dense grid
+  std::int64_t tombstones = 0;         // deleted hash slots awaiting the next rehash
+  double hash_fill = 0.0;              // (live + tombstones) / slots
+  std::int64_t inserted = 0;           // blocks allocated by the last frame
+  std::int64_t collisions = 0;         // of those, how many did not land in their home slot
+  std::int64_t failed_insertions = 0;  // insertions of the last frame that failed even after retries
+  std::int64_t retries = 0;            // allocation passes repeated after growing (total)
+  std::int64_t visible_blocks = 0;     // blocks fused by the last frame
+  std::int64_t removed_blocks = 0;     // blocks freed as empty by the last frame
+  std::size_t bytes_per_block = 0;     // voxel payload of one 8^3 block
+  std::size_t voxel_bytes = 0;         // allocated_blocks * bytes_per_block
+  std::size_t device_bytes = 0;        // everything the volume holds on its device
+  std::int64_t host_blocks = 0;        // blocks streamed out to host memory (Niessner section 5)
+  std::size_t host_bytes = 0;          // their voxel payload
+  std::int64_t streamed_out = 0;       // blocks moved to the host, total
+  std::int64_t streamed_in = 0;        // blocks moved back to the device, total
 };
 
 class Volume {
@@ -88,8 +88,7 @@ namespace detail {
 // Ensures maps hold K.width x K.height images on d.
 void resize_maps(RaycastMaps& maps, const Intrinsics& K, Device d);
 // The image itself when it is on d, else a copy there (held by tmp).
-template <class T>
-const Image<T>& on_device(const Image<T>& im, Device d, Image<T>& tmp) {
+template <class T> const Image<T>& on_device(const Image<T>& im, Device d, Image<T>& tmp) {
   if (im.device() == d || im.width() * im.height() == 0) return im;
   tmp = im.clone(d);
   return tmp;

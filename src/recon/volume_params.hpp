@@ -18,23 +18,23 @@ inline std::span<const EnumName<VolumeLayout>> enum_names(VolumeLayout) {
 
 struct VolumeParams {
   VolumeLayout layout = VolumeLayout::hash;
-  float voxel_size = 0.005f;         // metres
-  float truncation = 0.02f;          // metres (4 voxels at the default size)
-  float max_weight = 100.f;          // running-average weight cap (lets the model adapt)
+  float voxel_size = 0.005f;  // metres
+  float truncation = 0.02f;   // metres (4 voxels at the default size)
+  float max_weight = 100.f;   // running-average weight cap (lets the model adapt)
   std::int64_t hash_buckets = 1 << 20;
-  std::int64_t capacity = 1 << 18;   // 8^3-voxel blocks the pool can hold
-  int dense_resolution = 512;        // voxels per side of the dense cube
+  std::int64_t capacity = 1 << 18;         // 8^3-voxel blocks the pool can hold
+  int dense_resolution = 512;              // voxels per side of the dense cube
   vec3 dense_origin{-1.28f, -1.28f, 0.f};  // world position of the dense cube's min corner
-  float min_depth = 0.3f;            // Kinect v1 minimum range, metres
-  float max_depth = 4.0f;            // beyond this depth is too noisy to fuse
+  float min_depth = 0.3f;                  // Kinect v1 minimum range, metres
+  float max_depth = 4.0f;                  // beyond this depth is too noisy to fuse
   bool integrate_color = true;
   bool remove_empty_blocks = true;
-  bool grow_when_full = true;        // double the hash table / block pool instead of dropping blocks
-  int raycast_tile = 8;              // pixels per side of a ray-interval tile (Niessner 4.3); 0: none
-  int raycast_window = 128;          // blocks per side of the raycast's block-index window; 0: none
-  int occlusion_tile = 8;            // pixels per side of the depth tiles that cull occluded blocks; 0: none
-  float stream_radius = 0.f;         // blocks beyond this distance from the camera go to host memory; 0: off
-  float stream_step = 0.25f;         // camera travel (metres) between two streaming passes
+  bool grow_when_full = true;  // double the hash table / block pool instead of dropping blocks
+  int raycast_tile = 8;        // pixels per side of a ray-interval tile (Niessner 4.3); 0: none
+  int raycast_window = 128;    // blocks per side of the raycast's block-index window; 0: none
+  int occlusion_tile = 8;      // pixels per side of the depth tiles that cull occluded blocks; 0: none
+  float stream_radius = 0.f;   // blocks beyond this distance from the camera go to host memory; 0: off
+  float stream_step = 0.25f;   // camera travel (metres) between two streaming passes
 
   // Rules across keys, checked when a config is loaded (Experiment::validate) and by the volumes'
   // constructors (for code that builds a volume without a config).

@@ -18,7 +18,7 @@ using kernels::HashCounters;
 using kernels::kBlockVoxels;
 
 namespace {
-constexpr int kMaxProbe = 128;   // linear probing at <= 50% fill rarely probes past 20 slots
+constexpr int kMaxProbe = 128;  // linear probing at <= 50% fill rarely probes past 20 slots
 // Allocation passes after growing, per frame. Each growth at least doubles the pool or the table,
 // so this bound is never the one that stops growth: the pool's 2^30 blocks (grow_pool) come first.
 constexpr int kMaxGrowths = 40;
@@ -34,8 +34,7 @@ std::int64_t next_pow2(std::int64_t n) {
 }
 
 // Runs fn inside a timer stage when there is a timer.
-template <class F>
-void staged(StageTimer* timer, const char* stage, F&& fn) {
+template <class F> void staged(StageTimer* timer, const char* stage, F&& fn) {
   if (!timer) return fn();
   StageScope s(*timer, stage);
   fn();
@@ -80,8 +79,9 @@ void VoxelHashVolume::integrate(const Image<float>& depth, const Image<uchar3>& 
   Image<uchar3> ctmp;
   const Image<float>& dep = detail::on_device(depth, device_, dtmp);
   const Image<uchar3>& col = detail::on_device(rgb, device_, ctmp);
-  kernels::FrameInput in{dep.cview(), col.width() ? col.cview() : View2D<const uchar3>{}, K, world_T_camera,
-                         params_.min_depth, params_.max_depth};
+  kernels::FrameInput in{
+      dep.cview(),      col.width() ? col.cview() : View2D<const uchar3>{}, K, world_T_camera, params_.min_depth,
+      params_.max_depth};
   in.carve = carve_;
   if (params_.stream_radius > 0.f) staged(timer, "stream", [&] { maybe_stream(K, world_T_camera.t); });
   maybe_rehash(last_);
@@ -92,13 +92,13 @@ void VoxelHashVolume::integrate(const Image<float>& depth, const Image<uchar3>& 
   const View<std::int32_t> keep = params_.remove_empty_blocks ? keep_.view() : View<std::int32_t>{};
   with_exec(device_, [&]<class E>(const E& ex) {
     staged(timer, "fuse", [&] {
-      kernels::TsdfFusion<E>::fuse_hash_blocks(ex, table(), visible_.cview(), n, voxels_.data(), in, geom_, params_.max_weight,
-                                params_.integrate_color, keep, keep_below());
+      kernels::TsdfFusion<E>::fuse_hash_blocks(ex, table(), visible_.cview(), n, voxels_.data(), in, geom_,
+                                               params_.max_weight, params_.integrate_color, keep, keep_below());
     });
     if (params_.remove_empty_blocks)
       staged(timer, "remove_empty", [&] {
         kernels::TsdfFusion<E>::remove_unkept_blocks(ex, table(), visible_.cview(), n, keep_.cview(), voxels_.data(),
-                                      free_list_.view(), counters_.data());
+                                                     free_list_.view(), counters_.data());
       });
   });
   ++frames_;
@@ -122,7 +122,8 @@ void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTime
         kernels::TsdfFusion<E>::allocate_blocks(ex, table(), free_list_.cview(), counters_.data(), in, geom_, tiles);
       });
       staged(timer, "visible", [&] {
-        kernels::TsdfFusion<E>::find_visible_blocks(ex, table(), counters_.data(), in, geom_, visible_.view(), keep_.view(), tiles);
+        kernels::TsdfFusion<E>::find_visible_blocks(ex, table(), counters_.data(), in, geom_, visible_.view(),
+                                                    keep_.view(), tiles);
       });
     });
     last_ = read_counters();
@@ -139,13 +140,15 @@ void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTime
     ++retries_;
   }
   if (free_list_.size() != pool_before)
-    spdlog::warn("voxel hashing: block pool full in frame {}; grew it from {} to {} blocks (set volume.capacity: {} to "
-                 "avoid this pause)",
-                 frames_, pool_before, free_list_.size(), free_list_.size());
+    spdlog::warn(
+        "voxel hashing: block pool full in frame {}; grew it from {} to {} blocks (set volume.capacity: {} to "
+        "avoid this pause)",
+        frames_, pool_before, free_list_.size(), free_list_.size());
   if (keys_.size() != slots_before)
-    spdlog::warn("voxel hashing: hash table too crowded in frame {}; rehashed it from {} into {} slots (set "
-                 "volume.hash_buckets: {} to avoid this pause)",
-                 frames_, slots_before, keys_.size(), keys_.size());
+    spdlog::warn(
+        "voxel hashing: hash table too crowded in frame {}; rehashed it from {} into {} slots (set "
+        "volume.hash_buckets: {} to avoid this pause)",
+        frames_, slots_before, keys_.size(), keys_.size());
   if (failed_ > 0)  // volume.grow_when_full is off
     spdlog::warn(
         "voxel hashing: {} block insertion attempts failed in frame {} ({} found no hash slot within {} probes, "
@@ -167,9 +170,10 @@ void VoxelHashVolume::handle_failures(const HashCounters& c) {
     const std::int64_t live = blocks_in_use(free_list_.size(), c);
     // (No tombstones left, as after an in-place rehash, and still failing: a real cluster; grow.)
     const bool crowded = 4 * live > slots || c.tombstones == 0;
-    spdlog::debug("voxel hashing: {} insertions found no slot in a table of {} slots ({} blocks, {} tombstones); "
-                  "rehashing into {} slots",
-                  c.probe_failures, slots, live, c.tombstones, crowded ? 2 * slots : slots);
+    spdlog::debug(
+        "voxel hashing: {} insertions found no slot in a table of {} slots ({} blocks, {} tombstones); "
+        "rehashing into {} slots",
+        c.probe_failures, slots, live, c.tombstones, crowded ? 2 * slots : slots);
     rehash(crowded ? 2 * slots : slots);
   }
   if (c.pool_failures > 0) {
@@ -189,15 +193,19 @@ void VoxelHashVolume::maybe_rehash(const HashCounters& c, std::int64_t extra) {
   if (2 * (live + c.tombstones) <= slots) return;
   if (4 * live > slots && params_.grow_when_full) return rehash(next_pow2(4 * live));
   if (4 * live > slots)
-    spdlog::warn("voxel hashing: {} of {} hash slots hold blocks; insertions may start failing (set "
-                 "volume.hash_buckets: {} or volume.grow_when_full: true)",
-                 live, slots, 2 * slots);
+    spdlog::warn(
+        "voxel hashing: {} of {} hash slots hold blocks; insertions may start failing (set "
+        "volume.hash_buckets: {} or volume.grow_when_full: true)",
+        live, slots, 2 * slots);
   rehash(slots);
 }
 
 std::int64_t VoxelHashVolume::live_slots(Buffer<std::int32_t>& slots) const {
-  if (slots.size() < free_list_.size() || slots.device() != device_) slots = Buffer<std::int32_t>(free_list_.size(), device_);
-  return with_exec(device_, [&]<class E>(const E& ex) { return kernels::VoxelHash<E>::hash_live_slots(ex, table(), scratch_.view(), slots.view()); });
+  if (slots.size() < free_list_.size() || slots.device() != device_)
+    slots = Buffer<std::int32_t>(free_list_.size(), device_);
+  return with_exec(device_, [&]<class E>(const E& ex) {
+    return kernels::VoxelHash<E>::hash_live_slots(ex, table(), scratch_.view(), slots.view());
+  });
 }
 
 void VoxelHashVolume::rehash(std::int64_t new_slots) {
@@ -210,7 +218,8 @@ void VoxelHashVolume::rehash(std::int64_t new_slots) {
   Buffer<kernels::HashKey> keys(n, device_);
   Buffer<std::int32_t> values(n, device_), slot_out(n, device_), result(n, device_);
   with_exec(device_, [&]<class E>(const E& ex) {
-    kernels::VoxelHash<E>::hash_gather(ex, table(), View<const std::int32_t>{slots.data(), n}, keys.view(), values.view());
+    kernels::VoxelHash<E>::hash_gather(ex, table(), View<const std::int32_t>{slots.data(), n}, keys.view(),
+                                       values.view());
   });
   keys_ = Buffer<kernels::HashKey>(new_slots, device_);
   values_ = Buffer<std::int32_t>(new_slots, device_);
@@ -221,7 +230,8 @@ void VoxelHashVolume::rehash(std::int64_t new_slots) {
   counters_.copy_from_host(&c, 1);
   with_exec(device_, [&]<class E>(const E& ex) {
     kernels::VoxelHash<E>::hash_clear(ex, table());
-    kernels::VoxelHash<E>::hash_insert(ex, table(), keys.cview(), values.cview(), slot_out.view(), result.view(), counters_.data());
+    kernels::VoxelHash<E>::hash_insert(ex, table(), keys.cview(), values.cview(), slot_out.view(), result.view(),
+                                       counters_.data());
   });
   HashCounters after = read_counters();
   if (after.probe_failures > 0)
@@ -236,8 +246,9 @@ void VoxelHashVolume::rehash(std::int64_t new_slots) {
 void VoxelHashVolume::grow_pool(std::int64_t blocks) {
   const std::int64_t old = free_list_.size();
   if (blocks > (1ll << 30))
-    throw Error("voxel hashing: the block pool cannot grow beyond 2^30 blocks; raise volume.voxel_size or lower "
-                "volume.max_depth");
+    throw Error(
+        "voxel hashing: the block pool cannot grow beyond 2^30 blocks; raise volume.voxel_size or lower "
+        "volume.max_depth");
   Buffer<kernels::Voxel> voxels(blocks * kBlockVoxels, device_);
   voxels.zero();
   voxels.copy_from(voxels_);
@@ -249,7 +260,7 @@ void VoxelHashVolume::grow_pool(std::int64_t blocks) {
   keep_ = Buffer<std::int32_t>(blocks, device_);
   with_exec(device_, [&]<class E>(const E& ex) {
     kernels::VoxelHash<E>::pool_append(ex, free_list_.view(), counters_.data(), static_cast<std::int32_t>(old),
-                         static_cast<std::int32_t>(blocks - old));
+                                       static_cast<std::int32_t>(blocks - old));
   });
   params_.capacity = blocks;
 }
@@ -263,8 +274,8 @@ std::int64_t VoxelHashVolume::remove_empty_blocks() {
   with_exec(device_, [&]<class E>(const E& ex) {
     kernels::VoxelHash<E>::reset_frame_counters(ex, counters_.data());
     kernels::TsdfFusion<E>::mark_kept_blocks(ex, table(), listed, n, voxels_.data(), keep.view(), keep_below());
-    kernels::TsdfFusion<E>::remove_unkept_blocks(ex, table(), listed, n, keep.cview(), voxels_.data(), free_list_.view(),
-                                  counters_.data());
+    kernels::TsdfFusion<E>::remove_unkept_blocks(ex, table(), listed, n, keep.cview(), voxels_.data(),
+                                                 free_list_.view(), counters_.data());
   });
   last_ = read_counters();
   return last_.removed;
@@ -276,7 +287,8 @@ std::vector<int3> VoxelHashVolume::allocated_block_coords() const {
   Buffer<kernels::HashKey> keys(n, device_);
   Buffer<std::int32_t> values(n, device_);
   with_exec(device_, [&]<class E>(const E& ex) {
-    kernels::VoxelHash<E>::hash_gather(ex, table(), View<const std::int32_t>{slots.data(), n}, keys.view(), values.view());
+    kernels::VoxelHash<E>::hash_gather(ex, table(), View<const std::int32_t>{slots.data(), n}, keys.view(),
+                                       values.view());
   });
   std::vector<int3> out;
   for (kernels::HashKey k : keys.to_host()) out.push_back(kernels::unpack_block(k));
@@ -291,7 +303,8 @@ std::vector<VoxelHashVolume::HostBlock> VoxelHashVolume::download_blocks() const
   Buffer<std::int32_t> values(n, device_);
   Buffer<kernels::Voxel> vox(n * kBlockVoxels, device_);
   with_exec(device_, [&]<class E>(const E& ex) {
-    kernels::VoxelHash<E>::hash_gather(ex, table(), View<const std::int32_t>{slots.data(), n}, keys.view(), values.view());
+    kernels::VoxelHash<E>::hash_gather(ex, table(), View<const std::int32_t>{slots.data(), n}, keys.view(),
+                                       values.view());
     kernels::VoxelHash<E>::gather_blocks(ex, voxels_.data(), values.cview(), vox.view());
   });
   std::vector<kernels::HashKey> hk = keys.to_host();
@@ -338,20 +351,23 @@ void VoxelHashVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, Ra
   with_exec(device_, [&]<class E>(const E& ex) {
     staged(timer, "raycast", [&] {
       const kernels::BlockWindow w = raycast_window(world_T_camera);
-      if (iv.bits)  // one pass over the slots splats the intervals and fills the window
+      if (iv.bits)                            // one pass over the slots splats the intervals and fills the window
         staged(timer, "raycast_splat", [&] {  // part of "raycast"
           kernels::TsdfRaycast<E>::clear_ray_intervals(ex, iv, w);
-          kernels::TsdfRaycast<E>::splat_ray_intervals(ex, table(), geom_, K, world_T_camera, params_.min_depth, params_.max_depth,
-                                       iv, w);
+          kernels::TsdfRaycast<E>::splat_ray_intervals(ex, table(), geom_, K, world_T_camera, params_.min_depth,
+                                                       params_.max_depth, iv, w);
         });
       if (!w.index) {
-        kernels::TsdfRaycast<E, kernels::HashAccess>::raycast(ex, device_view(), K, world_T_camera, params_.min_depth, params_.max_depth, out, iv);
+        kernels::TsdfRaycast<E, kernels::HashAccess>::raycast(ex, device_view(), K, world_T_camera, params_.min_depth,
+                                                              params_.max_depth, out, iv);
         return;
       }
       if (!iv.bits)
-        staged(timer, "raycast_window", [&] { kernels::TsdfRaycast<E>::fill_block_window(ex, table(), w); });  // part of "raycast"
-      kernels::TsdfRaycast<E, kernels::HashAccess>::raycast(ex, kernels::WindowedHashAccess{device_view(), w}, K, world_T_camera, params_.min_depth,
-                       params_.max_depth, out, iv);
+        staged(timer, "raycast_window",
+               [&] { kernels::TsdfRaycast<E>::fill_block_window(ex, table(), w); });  // part of "raycast"
+      kernels::TsdfRaycast<E, kernels::HashAccess>::raycast(ex, kernels::WindowedHashAccess{device_view(), w}, K,
+                                                            world_T_camera, params_.min_depth, params_.max_depth, out,
+                                                            iv);
     });
   });
 }

@@ -99,7 +99,7 @@ class VoxelHashVolume final : public Volume {
   Buffer<std::int32_t> visible_;
   Buffer<std::int32_t> keep_;             // per visible block: 1 = has a voxel near a surface
   Buffer<std::int32_t> intervals_;        // ray-interval tiles (kernels::RayIntervals)
-  Buffer<std::int32_t> depth_tiles_;             // the frame's farthest reading per tile (kernels::DepthTiles)
+  Buffer<std::int32_t> depth_tiles_;      // the frame's farthest reading per tile (kernels::DepthTiles)
   Buffer<std::int32_t> window_;           // the raycast's block-index window (kernels::BlockWindow)
   mutable Buffer<std::int32_t> scratch_;  // one int per slot for scans
   kernels::HashCounters last_{};          // counters as read at the end of the last frame

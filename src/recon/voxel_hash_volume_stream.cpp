@@ -14,9 +14,9 @@
 
 namespace seamless {
 
+using kernels::HashCounters;
 using kernels::HashKey;
 using kernels::kBlockVoxels;
-using kernels::HashCounters;
 using kernels::Voxel;
 
 namespace {
@@ -42,10 +42,11 @@ void VoxelHashVolume::maybe_stream(const Intrinsics& K, const vec3& camera_posit
   const float need = reach + params_.stream_step;
   if (params_.stream_radius < need)
     throw ConfigError("volume.stream_radius (" + std::to_string(params_.stream_radius) +
-                " m) is too small: a frame of this camera touches blocks up to " + std::to_string(reach) +
-                " m away (max_depth + truncation at the image corner, plus a block), and the camera moves up to "
-                "volume.stream_step = " + std::to_string(params_.stream_step) +
-                " m between passes; set volume.stream_radius to at least " + std::to_string(need) + " m");
+                      " m) is too small: a frame of this camera touches blocks up to " + std::to_string(reach) +
+                      " m away (max_depth + truncation at the image corner, plus a block), and the camera moves up to "
+                      "volume.stream_step = " +
+                      std::to_string(params_.stream_step) + " m between passes; set volume.stream_radius to at least " +
+                      std::to_string(need) + " m");
   if (streamed_ && length(camera_position - stream_pos_) < params_.stream_step) return;
   stream(camera_position);
 }
@@ -88,8 +89,8 @@ void VoxelHashVolume::stream_out(const vec3& camera_position) {
   Buffer<std::int32_t> slots(free_list_.size(), device_);
   const float radius = params_.stream_radius / geom_.voxel_size;
   const std::int64_t n = with_exec(device_, [&]<class E>(const E& ex) {
-    return kernels::VoxelHash<E>::hash_slots_beyond(ex, table(), geom_.to_voxel(camera_position), radius, scratch_.view(),
-                                      slots.view());
+    return kernels::VoxelHash<E>::hash_slots_beyond(ex, table(), geom_.to_voxel(camera_position), radius,
+                                                    scratch_.view(), slots.view());
   });
   if (n == 0) return;
   const View<const std::int32_t> listed{slots.data(), n};
@@ -100,8 +101,8 @@ void VoxelHashVolume::stream_out(const vec3& camera_position) {
   with_exec(device_, [&]<class E>(const E& ex) {
     kernels::VoxelHash<E>::hash_gather(ex, table(), listed, keys.view(), blocks.view());
     kernels::VoxelHash<E>::gather_blocks(ex, voxels_.data(), blocks.cview(), staging.view());
-    kernels::TsdfFusion<E>::remove_unkept_blocks(ex, table(), listed, n, View<const std::int32_t>{keep_.data(), n}, voxels_.data(),
-                                  free_list_.view(), counters_.data());
+    kernels::TsdfFusion<E>::remove_unkept_blocks(ex, table(), listed, n, View<const std::int32_t>{keep_.data(), n},
+                                                 voxels_.data(), free_list_.view(), counters_.data());
   });
   const std::vector<HashKey> hk = keys.to_host();
   const std::vector<Voxel> hv = staging.to_host();
@@ -129,7 +130,8 @@ void VoxelHashVolume::take_from_host(const vec3& camera_position, bool all, std:
   for (auto it = host_.begin(); it != host_.end();) {
     HostChunk& c = it->second;
     const int3 cc = kernels::unpack_block(it->first);
-    const vec3 centre = geom_.to_world(vec3{cc.x + 0.5f, cc.y + 0.5f, cc.z + 0.5f} * float(kernels::kBlockSide << kChunkShift));
+    const vec3 centre =
+        geom_.to_world(vec3{cc.x + 0.5f, cc.y + 0.5f, cc.z + 0.5f} * float(kernels::kBlockSide << kChunkShift));
     if (!all && length(centre - camera_position) > chunk_reach) {
       ++it;
       continue;
@@ -162,8 +164,10 @@ void VoxelHashVolume::upload(std::vector<HashKey>& keys, std::vector<Voxel>& vox
   if (free_blocks < n && params_.grow_when_full) {
     std::int64_t cap = free_list_.size();
     while (cap - (free_list_.size() - free_blocks) < n) cap *= 2;
-    spdlog::warn("voxel hashing: streaming {} blocks back needs a pool of {} blocks (set volume.capacity: {} to avoid "
-                 "this pause)", n, cap, cap);
+    spdlog::warn(
+        "voxel hashing: streaming {} blocks back needs a pool of {} blocks (set volume.capacity: {} to avoid "
+        "this pause)",
+        n, cap, cap);
     grow_pool(cap);
     c = read_counters();
   }
@@ -174,8 +178,8 @@ void VoxelHashVolume::upload(std::vector<HashKey>& keys, std::vector<Voxel>& vox
   Buffer<std::int32_t> blocks(fit, device_);
   with_exec(device_, [&]<class E>(const E& ex) {
     kernels::VoxelHash<E>::reset_frame_counters(ex, counters_.data());
-    kernels::VoxelHash<E>::insert_with_blocks(ex, table(), free_list_.cview(), counters_.data(), View<const HashKey>{dkeys.data(), fit},
-                                blocks.view());
+    kernels::VoxelHash<E>::insert_with_blocks(ex, table(), free_list_.cview(), counters_.data(),
+                                              View<const HashKey>{dkeys.data(), fit}, blocks.view());
     kernels::VoxelHash<E>::scatter_blocks(ex, voxels_.data(), blocks.cview(), dvox.cview());
   });
   const std::vector<std::int32_t> got = blocks.to_host();
@@ -195,9 +199,10 @@ void VoxelHashVolume::upload(std::vector<HashKey>& keys, std::vector<Voxel>& vox
   put_on_host(back_keys.data(), back_vox.data(), static_cast<std::int64_t>(back_keys.size()));
   streamed_in_ += n - static_cast<std::int64_t>(back_keys.size());
   if (!back_keys.empty())
-    spdlog::warn("voxel hashing: {} streamed blocks did not fit on the device and stay in host memory (set "
-                 "volume.capacity >= {} and volume.hash_buckets >= {}, or volume.grow_when_full: true)",
-                 back_keys.size(), 2 * free_list_.size(), 2 * keys_.size());
+    spdlog::warn(
+        "voxel hashing: {} streamed blocks did not fit on the device and stay in host memory (set "
+        "volume.capacity >= {} and volume.hash_buckets >= {}, or volume.grow_when_full: true)",
+        back_keys.size(), 2 * free_list_.size(), 2 * keys_.size());
 }
 
 }  // namespace seamless

@@ -9,8 +9,8 @@
 
 #include "core/buffer.hpp"
 #include "core/device.hpp"
-#include "kernels/physics/particle_math.hpp"
 #include "core/geometry.hpp"
+#include "kernels/physics/particle_math.hpp"
 #include "seamless/build_config.hpp"
 #if SEAMLESS_HAS_CUDA
 #include "render/cuda_interop.hpp"
@@ -92,7 +92,8 @@ RenderParams unoptimised_render_settings() {
   return p;
 }
 
-RenderBenchResult bench_render(int width, int height, std::int64_t particles, int frames, const RenderParams& settings) {
+RenderBenchResult bench_render(int width, int height, std::int64_t particles, int frames,
+                               const RenderParams& settings) {
   RenderParams p = settings;
   p.width = width, p.height = height;
   p.stage_images = false;

@@ -7,7 +7,6 @@ namespace {
 constexpr float kDegToRad = 3.14159265358979f / 180.f;
 }  // namespace
 
-
 RenderCamera RenderCamera::from_fov(float fov_y_deg, int width, int height, float znear, float zfar) {
   RenderCamera c;
   const float f = 0.5f * static_cast<float>(height) / std::tan(0.5f * fov_y_deg * kDegToRad);
@@ -21,8 +20,8 @@ RenderCamera RenderCamera::from_fov(float fov_y_deg, int width, int height, floa
   return c;
 }
 
-RenderCamera RenderCamera::look_at(vec3 eye, vec3 target, vec3 up, float fov_y_deg, int width, int height,
-                                   float znear, float zfar) {
+RenderCamera RenderCamera::look_at(vec3 eye, vec3 target, vec3 up, float fov_y_deg, int width, int height, float znear,
+                                   float zfar) {
   RenderCamera c = from_fov(fov_y_deg, width, height, znear, zfar);
   vec3 z = normalize(target - eye);
   vec3 x = normalize(cross(z, up));  // right = forward x up for y down (x right, y down, z forward)

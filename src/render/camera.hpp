@@ -2,8 +2,8 @@
 // z forward) with a pose, so that the Kinect view projects with the sensor's exact intrinsics
 // and any free camera is the same model with intrinsics made from a field of view.
 #pragma once
-#include <vector>
 #include <array>
+#include <vector>
 
 #include "core/camera.hpp"
 #include "core/math.hpp"
@@ -13,7 +13,7 @@ namespace seamless {
 using Mat4 = std::array<float, 16>;  // column-major, as OpenGL takes it
 
 struct RenderCamera {
-  Intrinsics K;                         // pixels of the framebuffer (see scaled_to)
+  Intrinsics K;  // pixels of the framebuffer (see scaled_to)
   SE3 world_T_camera = SE3::identity();
   float znear = 0.05f, zfar = 30.f;
 

@@ -69,8 +69,9 @@ EGLContext create_context(EGLDisplay d) {
     cfg = EGL_NO_CONFIG_KHR;
   }
   for (int minor : {5, 3, 1}) {
-    const EGLint attr[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, minor,
-                           EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+    const EGLint attr[] = {
+        EGL_CONTEXT_MAJOR_VERSION,           4,       EGL_CONTEXT_MINOR_VERSION, minor, EGL_CONTEXT_OPENGL_PROFILE_MASK,
+        EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
     EGLContext c = eglCreateContext(d, cfg, EGL_NO_CONTEXT, attr);
     if (c != EGL_NO_CONTEXT) return c;
   }
@@ -125,8 +126,7 @@ HeadlessContext::~HeadlessContext() {
 }
 
 void HeadlessContext::make_current() {
-  if (!eglMakeCurrent(impl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, impl_->context))
-  {
+  if (!eglMakeCurrent(impl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, impl_->context)) {
     char code[16];
     std::snprintf(code, sizeof code, "0x%04X", static_cast<unsigned>(eglGetError()));
     throw Error(std::string("render: eglMakeCurrent failed (EGL error ") + code +

@@ -1,9 +1,9 @@
 #include "render/headless_output.hpp"
 
+#include <unistd.h>
 #include <cstdlib>
 #include <filesystem>
 #include <sstream>
-#include <unistd.h>
 
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -73,8 +73,8 @@ void HeadlessOutput::add(const Image<uchar3>& frame) {
   if (p_.video && !pipe_ && !video_failed_) open_video(frame.width(), frame.height());
   if (pipe_) {
     if (frame.width() != w_ || frame.height() != h_)
-      throw Error("render.video: frame size changed from " + std::to_string(w_) + "x" + std::to_string(h_) +
-                  " to " + std::to_string(frame.width()) + "x" + std::to_string(frame.height()));
+      throw Error("render.video: frame size changed from " + std::to_string(w_) + "x" + std::to_string(h_) + " to " +
+                  std::to_string(frame.width()) + "x" + std::to_string(frame.height()));
     const std::vector<uchar3> px = frame.to_host();
     if (std::fwrite(px.data(), sizeof(uchar3), px.size(), pipe_) != px.size())
       throw Error("render.video: ffmpeg stopped accepting frames (writing " + video_path() + ")");
@@ -94,7 +94,8 @@ void HeadlessOutput::finish() {
   if (!pipe_) return;
   const int rc = pclose(pipe_);
   pipe_ = nullptr;
-  if (rc != 0) throw Error("render.video: ffmpeg failed (exit status " + std::to_string(rc) + ") writing " + video_path());
+  if (rc != 0)
+    throw Error("render.video: ffmpeg failed (exit status " + std::to_string(rc) + ") writing " + video_path());
 }
 
 }  // namespace seamless

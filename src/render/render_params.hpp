@@ -12,7 +12,7 @@ namespace seamless {
 enum class FluidFilter { narrow_range, bilateral };
 inline std::span<const EnumName<FluidFilter>> enum_names(FluidFilter) {
   static constexpr EnumName<FluidFilter> names[] = {{FluidFilter::narrow_range, "narrow_range"},
-                                           {FluidFilter::bilateral, "bilateral"}};
+                                                    {FluidFilter::bilateral, "bilateral"}};
   return names;
 }
 enum class FluidSplat { compute, raster };
@@ -25,22 +25,22 @@ struct RenderParams {
   std::string mode = "none";
   int width = 1280;
   int height = 720;
-  std::string view = "mesh";          // mesh: coloured scene mesh; kinect: live RGB with depth occlusion
+  std::string view = "mesh";  // mesh: coloured scene mesh; kinect: live RGB with depth occlusion
   // fixed: the mesh view from behind and above the first camera, the Kinect view from the first
   // frame; recorded: output frame k is recorded frame k seen from its tracked pose, the simulation
   // advancing by the recording's frame interval (scan_then_simulate replays the recording after the scan).
   std::string camera = "fixed";
-  int replay_start = 0;               // recorded, scan_then_simulate: first input frame of the replay
+  int replay_start = 0;  // recorded, scan_then_simulate: first input frame of the replay
   // recorded, mesh view: magnify the recorded camera about pixel zoom_at (default the centre), so
   // that a figure can frame an object that the recording saw from afar (a chair across the room).
   float zoom = 1.f;
   std::vector<float> zoom_at;
-  std::string fluid = "ssfr";         // screen-space fluid rendering (van der Laan 2009) or raw particles
+  std::string fluid = "ssfr";  // screen-space fluid rendering (van der Laan 2009) or raw particles
   bool write_frames = false;
   bool video = false;
   bool stage_images = false;
   // Camera of the mesh view (the Kinect view uses the sensor's intrinsics and tracked pose).
-  float fov_y = 60.f;                 // degrees, vertical
+  float fov_y = 60.f;  // degrees, vertical
   // Where the fixed mesh-view camera stands and what it looks at (world metres, [x, y, z]); empty:
   // behind and above the first scanning camera, looking at the scanned mesh's centre. A camera that
   // sees only what the scan saw shows no empty background (the demo frames the desk this way).
@@ -48,11 +48,11 @@ struct RenderParams {
   // The fixed mesh-view camera turns by this many degrees about the vertical through the target
   // between the first and the last frame of a run (parallax that shows depth); 0: it stays.
   float orbit_deg = 0.f;
-  float znear = 0.05f, zfar = 30.f;   // metres
-  int fps = 30;                       // video frame rate
+  float znear = 0.05f, zfar = 30.f;  // metres
+  int fps = 30;                      // video frame rate
   // What is drawn (the window toggles these with keys 1-5).
   bool show_scene = true, show_fluid = true, show_rigid = true, show_cloth = true;
-  bool show_particles = false;        // every dynamic particle as a sphere impostor (debug view)
+  bool show_particles = false;  // every dynamic particle as a sphere impostor (debug view)
   // Shading.
   vec3 background{0.12f, 0.13f, 0.15f};  // clear colour of the mesh view, linear 0..1
   vec3 light_dir{0.3f, -1.f, 0.4f};      // direction the light travels, world coordinates
@@ -61,9 +61,9 @@ struct RenderParams {
   // Shadows of the virtual objects on the real scene and on each other (docs/RENDERING.md, pass
   // shadow): a shadow map along light_dir over the dynamic objects' bounds.
   bool shadows = true;
-  float shadow_strength = 0.5f;          // share of a real surface's light that light_dir brings (darkening)
-  int shadow_map_size = 2048;            // texels per side
-  float light_angle = 10.f;              // the light's angular diameter, degrees: penumbra growth
+  float shadow_strength = 0.5f;  // share of a real surface's light that light_dir brings (darkening)
+  int shadow_map_size = 2048;    // texels per side
+  float light_angle = 10.f;      // the light's angular diameter, degrees: penumbra growth
   vec3 rigid_color{0.85f, 0.3f, 0.2f};
   vec3 cloth_color{0.9f, 0.75f, 0.3f};
   // Screen-space fluid rendering (van der Laan, Green, Sainz 2009).
@@ -71,28 +71,30 @@ struct RenderParams {
   // particles sit about one diameter apart, and on a cubic lattice seen face-on the gaps between
   // four touching spheres close only above sqrt(2) (the gap centre is sqrt(2) r from each).
   float fluid_radius_scale = 1.5f;
-  FluidFilter fluid_filter = FluidFilter::narrow_range;  // depth smoothing: narrow_range (Truong & Yuksel 2018) or bilateral
-  int filter_iterations = 1;          // separable filter passes (x then y) over the depth
-  int filter_max_taps = 12;           // taps per side at most: wider kernels sample every k-th pixel
-  float filter_size = 3.f;            // filter half-width in particle radii (world), projected per pixel
-  int filter_max_px = 24;             // ... but at most this many pixels
-  float filter_depth_sigma = 1.f;     // range sigma of the bilateral filter, in particle radii
-  vec3 absorption{25.f, 8.f, 3.5f};   // Beer-Lambert coefficients per colour channel, 1/m (tinted water)
-  float ior = 1.33f;                  // refractive index (water): Snell's law bends the view into the fluid
-  float fresnel_f0 = 0.02f;           // reflectance at normal incidence (water: ((1-1.33)/(1+1.33))^2)
-  float fluid_roughness = 0.05f;      // GGX alpha of the fluid surface: size of the light's highlight
-  float light_intensity = 0.6f;       // radiance light_dir alone gives a white diffuse surface facing it (0..1 = black..white)
-  int cube_size = 256;                // cube map face size for reflections in the mesh view
+  FluidFilter fluid_filter =
+      FluidFilter::narrow_range;     // depth smoothing: narrow_range (Truong & Yuksel 2018) or bilateral
+  int filter_iterations = 1;         // separable filter passes (x then y) over the depth
+  int filter_max_taps = 12;          // taps per side at most: wider kernels sample every k-th pixel
+  float filter_size = 3.f;           // filter half-width in particle radii (world), projected per pixel
+  int filter_max_px = 24;            // ... but at most this many pixels
+  float filter_depth_sigma = 1.f;    // range sigma of the bilateral filter, in particle radii
+  vec3 absorption{25.f, 8.f, 3.5f};  // Beer-Lambert coefficients per colour channel, 1/m (tinted water)
+  float ior = 1.33f;                 // refractive index (water): Snell's law bends the view into the fluid
+  float fresnel_f0 = 0.02f;          // reflectance at normal incidence (water: ((1-1.33)/(1+1.33))^2)
+  float fluid_roughness = 0.05f;     // GGX alpha of the fluid surface: size of the light's highlight
+  float light_intensity =
+      0.6f;             // radiance light_dir alone gives a white diffuse surface facing it (0..1 = black..white)
+  int cube_size = 256;  // cube map face size for reflections in the mesh view
   // Cost of the fluid passes (docs/RENDERING.md, section Speed).
   // compute: sphere depth and thickness as compute splats (GL 4.3; atomics into integer images)
   // and the full-screen passes as compute shaders; raster: point sprites and full-screen
   // triangles. Compute is the default because GH100 (H100/H200) keeps raster units on only a few
   // of its SMs; a context below GL 4.3 falls back to raster.
   FluidSplat fluid_splat = FluidSplat::compute;
-  int thickness_downsample = 2;       // thickness pass and its blur at 1/this resolution (1, 2 or 4), bilinear up
-  bool depth_prepass = true;          // hardware depth test of the sprites against the scene depth (early-Z)
-  float max_point_size = 64.f;        // sprite size limit, pixels: nearer spheres are cut to this square
-  bool cuda_interop = true;           // CUDA runs: copy particles device to device into GL (no host trip)
+  int thickness_downsample = 2;  // thickness pass and its blur at 1/this resolution (1, 2 or 4), bilinear up
+  bool depth_prepass = true;     // hardware depth test of the sprites against the scene depth (early-Z)
+  float max_point_size = 64.f;   // sprite size limit, pixels: nearer spheres are cut to this square
+  bool cuda_interop = true;      // CUDA runs: copy particles device to device into GL (no host trip)
 
   template <class V> void visit(V& v) {
     v("mode", mode, "window, headless (PNGs) or no rendering", Choices{"window", "headless", "none"});
@@ -107,19 +109,24 @@ struct RenderParams {
       Range{0, 1e9});
     v("zoom", zoom, "camera recorded, view mesh: magnify the recorded camera this many times about zoom_at",
       Range{1.0, 20.0});
-    v("zoom_at", zoom_at, "[u, v]: input image pixel that zoom centres on (empty: the image centre)",
-      Range{-1e5, 1e5});
+    v("zoom_at", zoom_at, "[u, v]: input image pixel that zoom centres on (empty: the image centre)", Range{-1e5, 1e5});
     v("fluid", fluid, "fluid drawing", Choices{"ssfr", "particles"});
     v("write_frames", write_frames, "write each rendered frame as PNG into the output folder");
     v("video", video, "encode the frames into a video (needs ffmpeg)");
     v("stage_images", stage_images, "also write the intermediate SSFR stages (depth, blur, thickness)");
     v("fov_y", fov_y, "vertical field of view of the mesh view camera, degrees", Range{5.0, 170.0});
-    v("eye", eye, "[x, y, z]: position of the fixed mesh view camera, world metres; empty: behind and above the "
-      "first scanning camera", Range{-1e4, 1e4});
-    v("target", target, "[x, y, z]: point the fixed mesh view camera looks at, world metres; empty: the scanned "
-      "mesh's centre", Range{-1e4, 1e4});
-    v("orbit_deg", orbit_deg, "the fixed mesh view camera turns this many degrees about the vertical through its "
-      "target from the first frame to the last; 0: it stays", Range{-360.0, 360.0});
+    v("eye", eye,
+      "[x, y, z]: position of the fixed mesh view camera, world metres; empty: behind and above the "
+      "first scanning camera",
+      Range{-1e4, 1e4});
+    v("target", target,
+      "[x, y, z]: point the fixed mesh view camera looks at, world metres; empty: the scanned "
+      "mesh's centre",
+      Range{-1e4, 1e4});
+    v("orbit_deg", orbit_deg,
+      "the fixed mesh view camera turns this many degrees about the vertical through its "
+      "target from the first frame to the last; 0: it stays",
+      Range{-360.0, 360.0});
     v("znear", znear, "near clipping distance, metres", Range{1e-4, 10.0});
     v("zfar", zfar, "far clipping distance, metres", Range{0.1, 1e5});
     v("fps", fps, "frame rate of the encoded video", Range{1, 240});
@@ -154,7 +161,8 @@ struct RenderParams {
     v("fluid_roughness", fluid_roughness, "fluid surface roughness (GGX alpha): spread of the light's highlight",
       Range{0.01, 1.0});
     v("light_intensity", light_intensity,
-      "light_dir's radiance on a white diffuse surface facing it (1 = white): strength of highlights", Range{0.0, 100.0});
+      "light_dir's radiance on a white diffuse surface facing it (1 = white): strength of highlights",
+      Range{0.0, 100.0});
     v("cube_size", cube_size, "reflection cube map face size, pixels", Range{16, 4096});
     v("fluid_splat", fluid_splat, "fluid passes: compute shaders (GL 4.3: splats, screen passes) or raster sprites");
     v("thickness_downsample", thickness_downsample, "fluid thickness at 1/this resolution (1, 2 or 4)", Range{1, 4});

@@ -4,9 +4,9 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "core/geometry.hpp"
 #include "core/log.hpp"
 #include "kernels/physics/particle_math.hpp"
-#include "core/geometry.hpp"
 #include "render/renderer_impl.hpp"
 
 namespace seamless {
@@ -34,7 +34,10 @@ void Renderer::Impl::build_programs() {
   auto vs = [](std::vector<std::string> f) { return ShaderStage{GL_VERTEX_SHADER, std::move(f)}; };
   auto fs = [](std::vector<std::string> f) { return ShaderStage{GL_FRAGMENT_SHADER, std::move(f)}; };
   const std::vector<std::string> sphere_fs = {"camera.glsl", "sphere_hit.glsl"};
-  auto with = [](std::vector<std::string> a, const char* f) { a.push_back(f); return a; };
+  auto with = [](std::vector<std::string> a, const char* f) {
+    a.push_back(f);
+    return a;
+  };
   // Surfaces that receive the virtual objects' shadows (shadow.glsl).
   const std::vector<std::string> receiver = {"color.glsl", "shadow.glsl", "mesh.frag"};
   mesh_prog = Program("mesh", {vs({"mesh.vert"}), fs(receiver)});
@@ -160,14 +163,15 @@ void Renderer::Impl::draw_scene(const RenderCamera& cam) {
 void Renderer::Impl::upload_particles(const DrawList& list) {
   const auto n = static_cast<std::int64_t>(list.positions.size());
   if (!list.phases.empty() && static_cast<std::int64_t>(list.phases.size()) != n)
-    throw Error("render: DrawList has " + std::to_string(n) + " positions but " +
-                std::to_string(list.phases.size()) + " phases; give one phase per particle (or none: all fluid)");
+    throw Error("render: DrawList has " + std::to_string(n) + " positions but " + std::to_string(list.phases.size()) +
+                " phases; give one phase per particle (or none: all fluid)");
   if (n > part_capacity) {
     part_capacity = std::max<std::int64_t>(n, 2 * part_capacity);
     glBindBuffer(GL_ARRAY_BUFFER, part_pos);
     glBufferData(GL_ARRAY_BUFFER, part_capacity * static_cast<GLsizeiptr>(sizeof(vec3)), nullptr, GL_STREAM_DRAW);
     glBindBuffer(GL_ARRAY_BUFFER, part_phase);
-    glBufferData(GL_ARRAY_BUFFER, part_capacity * static_cast<GLsizeiptr>(sizeof(std::uint32_t)), nullptr, GL_STREAM_DRAW);
+    glBufferData(GL_ARRAY_BUFFER, part_capacity * static_cast<GLsizeiptr>(sizeof(std::uint32_t)), nullptr,
+                 GL_STREAM_DRAW);
   }
   fluid_count = list.phases.empty() ? n : 0;
   for (std::uint32_t ph : list.phases) fluid_count += kernels::phase::is(ph, kernels::phase::kFluid) ? 1 : 0;
@@ -246,7 +250,8 @@ void Renderer::Impl::upload_cloth(const std::vector<int3>& tris, std::int64_t n)
   }
   glBindVertexArray(cloth_vao);
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, cloth_idx);
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(tris.size() * sizeof(int3)), tris.data(), GL_STATIC_DRAW);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(tris.size() * sizeof(int3)), tris.data(),
+               GL_STATIC_DRAW);
   glBindVertexArray(0);
   glBindBuffer(GL_TEXTURE_BUFFER, cloth_ring_off);
   glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(off.size() * sizeof(int)), off.data(), GL_STATIC_DRAW);

@@ -24,7 +24,6 @@
 
 namespace seamless {
 
-
 // An intermediate image of the fluid renderer, made viewable (depth as grey, normals as colour).
 struct StageImage {
   std::string name;  // "1_depth", "2_depth_filtered", "3_normals", "4_thickness", ...

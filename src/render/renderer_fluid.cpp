@@ -13,10 +13,9 @@ namespace {
 // GL cube map faces +X, -X, +Y, -Y, +Z, -Z as cameras (x right, y down, z forward): the face's
 // s coordinate grows along camera x and its t coordinate against camera y (GL 4.5 spec, table
 // 8.19: e.g. +X has s_c = -r_z, t_c = -r_y), so rendering with these fills the face as sampled.
-constexpr float kFaceAxes[6][3][3] = {
-    {{0, 0, -1}, {0, 1, 0}, {1, 0, 0}},  {{0, 0, 1}, {0, 1, 0}, {-1, 0, 0}},
-    {{1, 0, 0}, {0, 0, -1}, {0, 1, 0}},  {{1, 0, 0}, {0, 0, 1}, {0, -1, 0}},
-    {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}},   {{-1, 0, 0}, {0, 1, 0}, {0, 0, -1}}};
+constexpr float kFaceAxes[6][3][3] = {{{0, 0, -1}, {0, 1, 0}, {1, 0, 0}}, {{0, 0, 1}, {0, 1, 0}, {-1, 0, 0}},
+                                      {{1, 0, 0}, {0, 0, -1}, {0, 1, 0}}, {{1, 0, 0}, {0, 0, 1}, {0, -1, 0}},
+                                      {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}},  {{-1, 0, 0}, {0, 1, 0}, {0, 0, -1}}};
 
 RenderCamera face_camera(int face, vec3 centre, int size, float znear, float zfar) {
   RenderCamera c = RenderCamera::from_fov(90.f, size, size, znear, zfar);
@@ -29,7 +28,8 @@ RenderCamera face_camera(int face, vec3 centre, int size, float znear, float zfa
 std::vector<uchar3> flip_rows(const std::vector<uchar3>& v, int w, int h) {
   std::vector<uchar3> out(v.size());
   for (int y = 0; y < h; ++y)
-    std::copy_n(v.begin() + static_cast<std::ptrdiff_t>(y) * w, w, out.begin() + static_cast<std::ptrdiff_t>(h - 1 - y) * w);
+    std::copy_n(v.begin() + static_cast<std::ptrdiff_t>(y) * w, w,
+                out.begin() + static_cast<std::ptrdiff_t>(h - 1 - y) * w);
   return out;
 }
 
@@ -256,9 +256,10 @@ void Renderer::Impl::composite_pass(const RenderCamera& cam) {
   // the surface reflects.
   const vec3 env = p.view == "kinect" && has_kinect ? kin_mean : srgb_to_linear(p.background);
   glUniform3f(cp.loc("u_env"), env.x, env.y, env.z);
-  const std::vector<float> R = {cam.world_T_camera.R.m[0][0], cam.world_T_camera.R.m[1][0], cam.world_T_camera.R.m[2][0],
-                                cam.world_T_camera.R.m[0][1], cam.world_T_camera.R.m[1][1], cam.world_T_camera.R.m[2][1],
-                                cam.world_T_camera.R.m[0][2], cam.world_T_camera.R.m[1][2], cam.world_T_camera.R.m[2][2]};
+  const std::vector<float> R = {
+      cam.world_T_camera.R.m[0][0], cam.world_T_camera.R.m[1][0], cam.world_T_camera.R.m[2][0],
+      cam.world_T_camera.R.m[0][1], cam.world_T_camera.R.m[1][1], cam.world_T_camera.R.m[2][1],
+      cam.world_T_camera.R.m[0][2], cam.world_T_camera.R.m[1][2], cam.world_T_camera.R.m[2][2]};
   glUniformMatrix3fv(cp.loc("u_world_R_eye"), 1, GL_FALSE, R.data());
   glUniform3f(cp.loc("u_absorption"), p.absorption.x, p.absorption.y, p.absorption.z);
   glUniform1f(cp.loc("u_ior"), p.ior);
@@ -280,7 +281,8 @@ bool Renderer::Impl::draw_fluid(std::int64_t n, float radius, const RenderCamera
   const float sphere_r = radius * p.fluid_radius_scale;
   fluid_depth_pass(n, sphere_r, cam);
   timer.mark("fluid_depth");
-  if (p.stage_images) stages.push_back({"1_depth", float_to_grey(read_float(fluid_depth_fbo, 0, GL_RED, 1, w, h), w, h)});
+  if (p.stage_images)
+    stages.push_back({"1_depth", float_to_grey(read_float(fluid_depth_fbo, 0, GL_RED, 1, w, h), w, h)});
   fluid_thickness_pass(n, sphere_r, cam);
   timer.mark("fluid_thickness");
   fluid_filter_passes(radius, cam);
@@ -297,7 +299,8 @@ bool Renderer::Impl::draw_fluid(std::int64_t n, float radius, const RenderCamera
 void Renderer::Impl::capture_stages() {
   stages.push_back({"2_depth_filtered", float_to_grey(read_float(fluid_filter_fbo[0], 0, GL_RED, 1, w, h), w, h)});
   stages.push_back({"3_normals", normals_to_rgb(read_float(normal_fbo, 0, GL_RGBA, 4, w, h), w, h)});
-  stages.push_back({"4_thickness", upsample_nearest(float_to_grey(read_float(thick_fbo[0], 0, GL_RED, 1, tw, th), tw, th), w, h)});
+  stages.push_back(
+      {"4_thickness", upsample_nearest(float_to_grey(read_float(thick_fbo[0], 0, GL_RED, 1, tw, th), tw, th), w, h)});
   stages.push_back({"5_reflection", read_rgb8(final_fbo, 1, w, h)});
   stages.push_back({"6_refraction", read_rgb8(final_fbo, 2, w, h)});
   stages.push_back({"7_composite", read_rgb8(final_fbo, 0, w, h)});

@@ -15,15 +15,19 @@
 namespace seamless {
 
 // Move-only owner of one GL name; Del is the glDelete* function for it.
-template <void (*Del)(GLuint)>
-class GlName {
+template <void (*Del)(GLuint)> class GlName {
  public:
   GlName() = default;
   explicit GlName(GLuint id) : id_(id) {}
-  ~GlName() { if (id_) Del(id_); }
+  ~GlName() {
+    if (id_) Del(id_);
+  }
   GlName(GlName&& o) noexcept : id_(std::exchange(o.id_, 0u)) {}
   GlName& operator=(GlName&& o) noexcept {
-    if (this != &o) { if (id_) Del(id_); id_ = std::exchange(o.id_, 0u); }
+    if (this != &o) {
+      if (id_) Del(id_);
+      id_ = std::exchange(o.id_, 0u);
+    }
     return *this;
   }
   GLuint get() const { return id_; }
@@ -140,16 +144,16 @@ struct Renderer::Impl {
   // shaders and glClearTexImage (GL 4.4 or ARB_clear_texture).
   bool has_shadow = false;
   Program shadow_bounds_prog, shadow_splat_prog, shadow_resolve_prog, shadow_mesh_prog, shadow_cloth_prog;
-  Texture light_bounds;                   // 6 x 1 R32I: casters' bounds in the light frame (shadow.glsl)
-  Texture shadow_depth, shadow_map;       // rasterised casters' depth, the opaque map
-  Texture shadow_bits, shadow_thick;      // fluid splat: front depth bits, fixed-point path in fluid
-  Texture shadow_fluid;                   // RG32F: fluid front depth and path, in the splat's grid
-  bool fluid_shadow_live = false;         // this frame's fluid transmits into the map
-  float list_sphere_r = 0.f;              // this frame's fluid sphere radius (its splat level)
+  Texture light_bounds;               // 6 x 1 R32I: casters' bounds in the light frame (shadow.glsl)
+  Texture shadow_depth, shadow_map;   // rasterised casters' depth, the opaque map
+  Texture shadow_bits, shadow_thick;  // fluid splat: front depth bits, fixed-point path in fluid
+  Texture shadow_fluid;               // RG32F: fluid front depth and path, in the splat's grid
+  bool fluid_shadow_live = false;     // this frame's fluid transmits into the map
+  float list_sphere_r = 0.f;          // this frame's fluid sphere radius (its splat level)
   Framebuffer shadow_fbo;
   int shadow_size = 0;
-  mat3 light_R = mat3::identity();        // world -> light frame
-  bool shadow_live = false;               // this frame's receivers read a map
+  mat3 light_R = mat3::identity();  // world -> light frame
+  bool shadow_live = false;         // this frame's receivers read a map
 
   std::vector<StageImage> stages;
   std::vector<RenderTiming> timings;

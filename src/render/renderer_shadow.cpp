@@ -26,9 +26,9 @@ constexpr int kShadowMapUnit = 6, kLightBoundsUnit = 7, kFluidShadowUnit = 8;  /
 // 2^20 units per metre, at most half a unit of rounding per sphere on a ray (0.5 um), and 4096 m
 // of path before the uint32 wraps, far beyond any light path through the fluid.
 constexpr float kFixedPerMetre = 1048576.f;
-constexpr GLuint kBoundsGroup = 256;                     // local_size_x of shadow_bounds.comp
-constexpr GLuint kBoundsGroupsMax = 256;                 // grid-stride: few atomics on 6 texels
-constexpr GLuint kSplatGroup = 64;                       // splat.glsl
+constexpr GLuint kBoundsGroup = 256;      // local_size_x of shadow_bounds.comp
+constexpr GLuint kBoundsGroupsMax = 256;  // grid-stride: few atomics on 6 texels
+constexpr GLuint kSplatGroup = 64;        // splat.glsl
 constexpr GLuint kScreenGroup = 8;
 
 // shadow.glsl's order_int: ints ordered like the floats, for atomic min / max of signed values.
@@ -56,19 +56,24 @@ std::vector<float> cols(const mat3& R) {  // column-major for glUniformMatrix3fv
 void Renderer::Impl::build_shadow_programs() {
   has_shadow = has_compute && (epoxy_gl_version() >= 44 || epoxy_has_gl_extension("GL_ARB_clear_texture"));
   if (!has_shadow) {
-    if (p.shadows) spdlog::info("render: OpenGL {} has no compute shaders or glClearTexImage; no shadows", epoxy_gl_version() / 10.0);
+    if (p.shadows)
+      spdlog::info("render: OpenGL {} has no compute shaders or glClearTexImage; no shadows",
+                   epoxy_gl_version() / 10.0);
     return;
   }
   auto cs = [](std::vector<std::string> f) { return ShaderStage{GL_COMPUTE_SHADER, std::move(f)}; };
   shadow_bounds_prog = Program("shadow bounds", {cs({"color.glsl", "shadow.glsl", "shadow_bounds.comp"})});
-  shadow_splat_prog = Program(
-      "shadow splat", {cs({"camera.glsl", "sphere_hit.glsl", "splat.glsl", "color.glsl", "shadow.glsl", "shadow_splat.comp"})});
+  shadow_splat_prog =
+      Program("shadow splat",
+              {cs({"camera.glsl", "sphere_hit.glsl", "splat.glsl", "color.glsl", "shadow.glsl", "shadow_splat.comp"})});
   shadow_resolve_prog = Program("shadow resolve", {cs({"color.glsl", "shadow.glsl", "shadow_resolve.comp"})});
   const ShaderStage depth_only{GL_FRAGMENT_SHADER, {"shadow_caster.frag"}};
-  shadow_mesh_prog = Program("shadow mesh casters",
-                             {ShaderStage{GL_VERTEX_SHADER, {"shadow_caster.glsl", "shadow.glsl", "mesh.vert"}}, depth_only});
-  shadow_cloth_prog = Program("shadow cloth casters",
-                              {ShaderStage{GL_VERTEX_SHADER, {"shadow_caster.glsl", "shadow.glsl", "cloth.vert"}}, depth_only});
+  shadow_mesh_prog =
+      Program("shadow mesh casters",
+              {ShaderStage{GL_VERTEX_SHADER, {"shadow_caster.glsl", "shadow.glsl", "mesh.vert"}}, depth_only});
+  shadow_cloth_prog =
+      Program("shadow cloth casters",
+              {ShaderStage{GL_VERTEX_SHADER, {"shadow_caster.glsl", "shadow.glsl", "cloth.vert"}}, depth_only});
   light_bounds = make_texture_2d(GL_R32I, 6, 1);
 }
 
@@ -176,8 +181,8 @@ void Renderer::Impl::shadow_pass(const DrawList& list, std::int64_t n) {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, part_pos);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, part_phase);
     glBindImageTexture(0, light_bounds, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32I);
-    const GLuint groups = static_cast<GLuint>(
-        std::clamp<std::int64_t>((n + kBoundsGroup - 1) / kBoundsGroup, 1, kBoundsGroupsMax));
+    const GLuint groups =
+        static_cast<GLuint>(std::clamp<std::int64_t>((n + kBoundsGroup - 1) / kBoundsGroup, 1, kBoundsGroupsMax));
     glDispatchCompute(groups, 1, 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
   }
@@ -249,7 +254,8 @@ void Renderer::Impl::shadow_pass(const DrawList& list, std::int64_t n) {
   glBindImageTexture(1, shadow_thick, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
   glBindImageTexture(2, shadow_map, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
   glBindImageTexture(3, shadow_fluid, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RG32F);
-  const auto tiles = static_cast<GLuint>((shadow_size + static_cast<int>(kScreenGroup) - 1) / static_cast<int>(kScreenGroup));
+  const auto tiles =
+      static_cast<GLuint>((shadow_size + static_cast<int>(kScreenGroup) - 1) / static_cast<int>(kScreenGroup));
   glDispatchCompute(tiles, tiles, 1);
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
   glBindTexture(GL_TEXTURE_2D, 0);

@@ -12,8 +12,8 @@
 namespace seamless {
 namespace {
 
-constexpr GLuint kSplatGroup = 64;         // local_size_x of splat.glsl
-constexpr GLuint kResolveGroup = 8;        // local_size_x/y of ssfr_resolve.comp and screen.glsl
+constexpr GLuint kSplatGroup = 64;           // local_size_x of splat.glsl
+constexpr GLuint kResolveGroup = 8;          // local_size_x/y of ssfr_resolve.comp and screen.glsl
 constexpr GLuint kEmptyDepth = 0xffffffffu;  // "no fluid" in the depth-bits image: above every depth
 
 // Fixed-point thickness: units per metre of path in fluid. Each chord is rounded to the nearest

@@ -43,8 +43,7 @@ std::string map_shader_log(const std::string& log, const std::vector<std::string
     out += log.substr(last, static_cast<std::size_t>(m.position()) - last);
     if (file >= 0 && file < static_cast<long>(files.size()))
       out += files[static_cast<std::size_t>(file)] + ":" + std::to_string(line % kLinesPerFile);
-    else
-      out += m.str();
+    else out += m.str();
     last = static_cast<std::size_t>(m.position() + m.length());
   }
   return out + log.substr(last);
@@ -97,8 +96,7 @@ GLuint compile(const std::string& program, GLenum type, const Sources& src) {
 
 }  // namespace
 
-Program Program::from_sources(const std::string& name,
-                              const std::vector<std::pair<unsigned, Sources>>& stages) {
+Program Program::from_sources(const std::string& name, const std::vector<std::pair<unsigned, Sources>>& stages) {
   Program p;
   p.id_ = glCreateProgram();
   std::vector<GLuint> shaders;

@@ -23,8 +23,9 @@ class Program {
   // Compiles and links; `name` labels the program in error messages.
   Program(const std::string& name, const std::vector<ShaderStage>& stages);
   // Same from literal sources (name -> text), for tests of the error path.
-  static Program from_sources(const std::string& name,
-                              const std::vector<std::pair<unsigned, std::vector<std::pair<std::string, std::string>>>>& stages);
+  static Program from_sources(
+      const std::string& name,
+      const std::vector<std::pair<unsigned, std::vector<std::pair<std::string, std::string>>>>& stages);
   ~Program();
   Program(Program&& o) noexcept;
   Program& operator=(Program&& o) noexcept;

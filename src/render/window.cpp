@@ -115,7 +115,8 @@ void draw_timing_bars(const std::vector<RenderTiming>& t, int fb_w) {
   glDisable(GL_SCISSOR_TEST);
 }
 
-std::string title_with_timings(const std::string& title, const std::vector<RenderTiming>& t, double frame_ms, bool paused) {
+std::string title_with_timings(const std::string& title, const std::vector<RenderTiming>& t, double frame_ms,
+                               bool paused) {
   std::string s = title + (paused ? "  [paused]" : "");
   char b[64];
   std::snprintf(b, sizeof b, "  %.1f ms/frame |", frame_ms);

@@ -18,11 +18,11 @@ namespace seamless {
 class Renderer;
 
 struct WindowCallbacks {
-  std::function<void()> step;                       // advance the simulation one frame
-  std::function<DrawList()> draw_list;              // what to draw now
-  std::function<void()> spawn_next;                 // the next configured object (key G)
-  std::function<void(Renderer&)> before_draw;       // e.g. set_kinect_view with the newest frame
-  std::function<void(Renderer&)> on_start;          // e.g. set_scene_mesh
+  std::function<void()> step;                  // advance the simulation one frame
+  std::function<DrawList()> draw_list;         // what to draw now
+  std::function<void()> spawn_next;            // the next configured object (key G)
+  std::function<void(Renderer&)> before_draw;  // e.g. set_kinect_view with the newest frame
+  std::function<void(Renderer&)> on_start;     // e.g. set_scene_mesh
   // Keys pressed before frame `frame` (GLFW key codes), handled as if typed: for scripted runs
   // and tests (a display server delivers no events to an unattended window).
   std::function<std::vector<int>(int frame)> scripted_keys;

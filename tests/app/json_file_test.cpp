@@ -31,19 +31,25 @@ TEST(JsonFile, KeepsInsertionOrderAndIndentsOneMemberPerLine) {
 }
 
 TEST(JsonFile, NumbersRoundTripAndNonFiniteBecomeNull) {
-  const Json j = Json::array({0.1, 1e-9, 0.02f, std::nan(""), std::numeric_limits<double>::infinity(),
-                              std::int64_t{-7}, std::size_t{18446744073709551615ull}});
+  const Json j = Json::array({0.1, 1e-9, 0.02f, std::nan(""), std::numeric_limits<double>::infinity(), std::int64_t{-7},
+                              std::size_t{18446744073709551615ull}});
   // Shortest forms that read back as the same double (0.02f widened to double is not 0.02);
   // NaN and infinity have no JSON form.
   EXPECT_EQ(j.dump(), "[0.1,1e-09,0.019999999552965164,null,null,-7,18446744073709551615]");
-  EXPECT_EQ(app::json_text(j), "[\n  0.1,\n  1e-09,\n  0.019999999552965164,\n  null,\n  null,\n  -7,\n"
-                               "  18446744073709551615\n]\n");
+  EXPECT_EQ(app::json_text(j),
+            "[\n  0.1,\n  1e-09,\n  0.019999999552965164,\n  null,\n  null,\n  -7,\n"
+            "  18446744073709551615\n]\n");
   EXPECT_EQ(Json::parse("[0.019999999552965164]")[0].get<double>(), static_cast<double>(0.02f));
 }
 
 TEST(JsonFile, InvalidUtf8IsReplacedNotFatal) {
   // A Latin-1 file name ("Nie\xdfner"): replaced by U+FFFD so the document stays valid UTF-8.
-  const Json j = {{"path", "Nie\xdf" "ner"}, {"ok", "Nie\xc3\x9f" "ner"}};
+  const Json j = {{"path",
+                   "Nie\xdf"
+                   "ner"},
+                  {"ok",
+                   "Nie\xc3\x9f"
+                   "ner"}};
   EXPECT_EQ(app::json_text(j), "{\n  \"path\": \"Nie\xef\xbf\xbdner\",\n  \"ok\": \"Nie\xc3\x9fner\"\n}\n");
 }
 

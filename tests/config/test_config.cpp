@@ -53,7 +53,8 @@ spawn:
   - {kind: cloth, pinned: [0, 3], nx: 5}
   - kind: rigid
     position: [1, 2, 3]
-)", {}, "t.yaml");
+)",
+                                  {}, "t.yaml");
   EXPECT_EQ(e.name, "my run: 2");
   EXPECT_EQ(e.frames, 12345678901LL);
   EXPECT_EQ(e.input.synthetic.seed, 18446744073709551615ULL);

@@ -89,8 +89,8 @@ TEST(ConfigEnums, EveryEnumFieldRoundTripsItsNamesAndRejectsOthers) {
   EnumWalker walker{"", &found};
   e.visit(walker);
   // The enums made so far (issue 19); a new one is checked here without being listed.
-  for (const char* path : {"volume.layout", "solver.scene_collision", "solver.dynamic_colliders",
-                           "render.fluid_filter", "render.fluid_splat"})
+  for (const char* path : {"volume.layout", "solver.scene_collision", "solver.dynamic_colliders", "render.fluid_filter",
+                           "render.fluid_splat"})
     EXPECT_NE(std::find(found.begin(), found.end(), path), found.end()) << path;
 }
 

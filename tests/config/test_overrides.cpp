@@ -38,8 +38,8 @@ TEST(ConfigOverride, NestedKeyAppearsInTheEffectiveConfig) {
 }
 
 TEST(ConfigOverride, ValuesAreYamlFlowNodes) {
-  Experiment e = parse_experiment(kBase, {"solver.gravity=[0,0,-9.81]", "tracker.iterations=[4, 2]", "name=a b"},
-                                  "base.yaml");
+  Experiment e =
+      parse_experiment(kBase, {"solver.gravity=[0,0,-9.81]", "tracker.iterations=[4, 2]", "name=a b"}, "base.yaml");
   EXPECT_EQ(e.solver.gravity.z, -9.81f);
   EXPECT_EQ(e.tracker.iterations, (std::vector<int>{4, 2}));
   EXPECT_EQ(e.name, "a b");
@@ -84,7 +84,8 @@ TEST(ConfigOverride, BadValuesNameTheOption) {
   EXPECT_THAT(error_of(kBase, {"spawn=[{kind: rigid, sise: [1,1,1]}]"}),
               HasSubstr("(from --set spawn=[{kind: rigid, sise: [1,1,1]}]): spawn.0.sise: unknown key"));
   // A problem in the file is still reported at its position when overrides are present.
-  EXPECT_THAT(error_of("volume: {layot: hash}\n", {"volume.voxel_size=0.01"}), HasSubstr("base.yaml:1:10: volume.layot"));
+  EXPECT_THAT(error_of("volume: {layot: hash}\n", {"volume.voxel_size=0.01"}),
+              HasSubstr("base.yaml:1:10: volume.layot"));
 }
 
 TEST(ConfigOverride, MalformedOptions) {
@@ -111,7 +112,8 @@ TEST(ConfigOverride, UnusableOptionIsListedWithTheFilesProblems) {
   EXPECT_THAT(msg, HasSubstr("bad.yaml:4:11: volume.layout"));
   EXPECT_THAT(msg, HasSubstr("bad.yaml:6:3: tracker.kindd: unknown key"));
   EXPECT_THAT(msg, HasSubstr("(from --set name.first=x): 'name' is a value"));
-  EXPECT_THAT(msg, HasSubstr("--set expects key.path=value (e.g. --set volume.voxel_size=0.01), got 'volume.voxel_size'"));
+  EXPECT_THAT(msg,
+              HasSubstr("--set expects key.path=value (e.g. --set volume.voxel_size=0.01), got 'volume.voxel_size'"));
   EXPECT_THAT(msg, HasSubstr("(from --set solver.dt=fast): solver.dt: expected a number"));
 }
 

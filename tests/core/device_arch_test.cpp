@@ -29,7 +29,7 @@ TEST(CudaArch, RealVirtualAndArchSpecificEntries) {
   EXPECT_EQ(cuda_arch_match("86-virtual", 8, 0), CudaArchMatch::none);  // PTX runs only forward
   EXPECT_EQ(cuda_arch_match("80;86", 8, 9), CudaArchMatch::machine_code);
   EXPECT_EQ(cuda_arch_match("90a", 9, 0), CudaArchMatch::machine_code);
-  EXPECT_EQ(cuda_arch_match("90a", 10, 0), CudaArchMatch::none);  // arch-specific: no PTX, no other card
+  EXPECT_EQ(cuda_arch_match("90a", 10, 0), CudaArchMatch::none);    // arch-specific: no PTX, no other card
   EXPECT_EQ(cuda_arch_match("86", 9, 0), CudaArchMatch::ptx_only);  // another major: PTX only
   EXPECT_EQ(cuda_arch_match("native", 9, 0), CudaArchMatch::unknown);
   EXPECT_EQ(cuda_arch_match("", 9, 0), CudaArchMatch::unknown);

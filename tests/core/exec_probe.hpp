@@ -46,8 +46,7 @@ struct RoundsLog {
   int rounds_run = 0;
   double sums[16][40] = {};
 };
-template <Executor Exec>
-struct ExecProbe {
+template <Executor Exec> struct ExecProbe {
   static void square(const Exec& ex, View<const float> in, View<float> out);
 
   static Moments moments(const Exec& ex, View<const float> in);
@@ -55,7 +54,8 @@ struct ExecProbe {
   // The same sum left on the device in *out (transform_reduce_into).
   static void moments_into(const Exec& ex, View<const float> in, Moments* out);
 
-  static void doubling_rounds(const Exec& ex, View<const float> in, int rounds, double stop_above, RoundSums* out, RoundsLog* log);
+  static void doubling_rounds(const Exec& ex, View<const float> in, int rounds, double stop_above, RoundSums* out,
+                              RoundsLog* log);
 
   static std::uint32_t scan(const Exec& ex, View<const std::uint32_t> in, View<std::uint32_t> out);
 

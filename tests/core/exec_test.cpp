@@ -108,7 +108,8 @@ TEST_P(ExecTest, ExclusiveScanAndTotal) {
   auto h = random_keys(77777, 9, 1);
   auto in = Buffer<std::uint32_t>::from_host(h, dev());
   Buffer<std::uint32_t> out(in.size(), dev());
-  auto total = with_exec(dev(), [&]<class E>(const E& ex) { return probe::ExecProbe<E>::scan(ex, in.cview(), out.view()); });
+  auto total =
+      with_exec(dev(), [&]<class E>(const E& ex) { return probe::ExecProbe<E>::scan(ex, in.cview(), out.view()); });
   std::vector<std::uint32_t> expect(h.size());
   std::exclusive_scan(h.begin(), h.end(), expect.begin(), 0u);
   EXPECT_EQ(out.to_host(), expect);

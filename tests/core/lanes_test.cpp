@@ -81,7 +81,8 @@ TEST_P(LanesTest, GroupedCompactionKeepsTheSerialOrder) {
       auto vals = Buffer<float>::from_host(l.vals, dev());
       Buffer<int> kept(n * kCap, dev()), nkept(n, dev());
       with_exec(dev(), [&]<class E>(const E& ex) {
-        probe::LanesProbe<E>::grouped_compact(ex, counts.data(), vals.data(), n, kCap, max_lanes, kept.data(), nkept.data());
+        probe::LanesProbe<E>::grouped_compact(ex, counts.data(), vals.data(), n, kCap, max_lanes, kept.data(),
+                                              nkept.data());
       });
       auto rk = kept.to_host();
       auto rn = nkept.to_host();

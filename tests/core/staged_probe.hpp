@@ -7,8 +7,7 @@
 
 namespace seamless::probe {
 
-template <Executor Exec>
-struct StagedProbe {
+template <Executor Exec> struct StagedProbe {
   // Red-black Gauss-Seidel on a ring of m floats x (m even), phase after phase: phase p relaxes
   // the elements i = 2 j + p % 2, j in [begin[p], end[p]) (j < m / 2), toward the mean of their
   // two neighbours, which are of the other parity (so one phase's writes never race):

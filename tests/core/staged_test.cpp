@@ -46,8 +46,8 @@ Result run(Device d, const Case& c, const std::vector<std::int64_t>& begin, cons
   auto dw = Buffer<float>::from_host(w, d);
   auto pad = Buffer<float>::from_host(std::vector<float>(c.pad_n, 1.f), d);
   with_exec(d, [&]<class E>(const E& ex) {
-    probe::StagedProbe<E>::relax_ring(ex, x.data(), visits.data(), dw.data(), pad.data(), c.pad_n, c.m, c.phases, begin.data(),
-                      end.data(), staged);
+    probe::StagedProbe<E>::relax_ring(ex, x.data(), visits.data(), dw.data(), pad.data(), c.pad_n, c.m, c.phases,
+                                      begin.data(), end.data(), staged);
     ex.synchronize();
   });
   return {x.to_host(), visits.to_host()};
@@ -55,11 +55,11 @@ Result run(Device d, const Case& c, const std::vector<std::int64_t>& begin, cons
 
 TEST_P(StagedPhasesTest, PhasesSeeEachOtherAndStagingChangesNoBit) {
   const Case cases[] = {
-      {3000, 1500, 7, 24},         // one block, all staged
-      {3000, 1500, 7, 40},         // two launches of phases, each staging
-      {3000, 1500, 200000, 24},    // the pad (800 KB) is skipped, x, visits and w staged
-      {100000, 1000, 7, 24},       // x, visits, w (400 KB each) too large: only the pad staged
-      {6000, 3000, 7, 12},         // phases of up to 3000 elements: a launch each
+      {3000, 1500, 7, 24},       // one block, all staged
+      {3000, 1500, 7, 40},       // two launches of phases, each staging
+      {3000, 1500, 200000, 24},  // the pad (800 KB) is skipped, x, visits and w staged
+      {100000, 1000, 7, 24},     // x, visits, w (400 KB each) too large: only the pad staged
+      {6000, 3000, 7, 12},       // phases of up to 3000 elements: a launch each
   };
   for (const Case& c : cases) {
     std::mt19937 rng(static_cast<unsigned>(c.m + c.pad_n + c.phases));
@@ -88,8 +88,8 @@ TEST_P(StagedPhasesTest, PhasesSeeEachOtherAndStagingChangesNoBit) {
 
     const Result s = run(dev(), c, begin, end, x0, w, true);
     const Result u = run(dev(), c, begin, end, x0, w, false);
-    const std::string what = "m " + std::to_string(c.m) + " pad " + std::to_string(c.pad_n) + " phases " +
-                             std::to_string(c.phases);
+    const std::string what =
+        "m " + std::to_string(c.m) + " pad " + std::to_string(c.pad_n) + " phases " + std::to_string(c.phases);
     EXPECT_EQ(s.visits, hv) << what;
     EXPECT_EQ(u.visits, hv) << what;
     ASSERT_EQ(s.x.size(), u.x.size());

@@ -13,8 +13,11 @@ namespace {
 TumPose pose(double t, double x, double y, double z, double yaw = 0) {
   TumPose p;
   p.timestamp = t;
-  p.t[0] = x; p.t[1] = y; p.t[2] = z;
-  p.q[2] = std::sin(yaw / 2); p.q[3] = std::cos(yaw / 2);  // rotation about z
+  p.t[0] = x;
+  p.t[1] = y;
+  p.t[2] = z;
+  p.q[2] = std::sin(yaw / 2);
+  p.q[3] = std::cos(yaw / 2);  // rotation about z
   return p;
 }
 

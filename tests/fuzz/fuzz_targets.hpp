@@ -8,6 +8,7 @@
 #include <cctype>
 
 #include "config/config.hpp"
+#include "fuzz_util.hpp"
 #include "io/frame_folder_source.hpp"
 #include "io/jpeg_io.hpp"
 #include "io/png_io.hpp"
@@ -15,7 +16,6 @@
 #include "io/tum_source.hpp"
 #include "physics/builders.hpp"
 #include "recon/ply.hpp"
-#include "fuzz_util.hpp"
 
 namespace seamless::fuzz {
 
@@ -30,10 +30,8 @@ inline void config(const std::uint8_t* data, std::size_t size) {
   while (!in.empty()) {
     std::size_t end = in.find('\n');
     std::string_view line = in.substr(0, end);
-    if (line.substr(0, 6) == "--set ")
-      sets.emplace_back(line.substr(6));
-    else
-      yaml.append(line).append("\n");
+    if (line.substr(0, 6) == "--set ") sets.emplace_back(line.substr(6));
+    else yaml.append(line).append("\n");
     in.remove_prefix(end == std::string_view::npos ? in.size() : end + 1);
   }
   expect_error_or_success([&] {
@@ -49,7 +47,7 @@ inline void config(const std::uint8_t* data, std::size_t size) {
 // TumSource reads them all (pairing, intrinsics, ground truth, accelerometer) without decoding an
 // image; metadata() then looks up every pair's ground truth and accelerometer sample.
 inline void tum(const std::uint8_t* data, std::size_t size) {
-  static const char* names[] = {"rgb.txt",          "depth.txt",        "groundtruth.txt",
+  static const char* names[] = {"rgb.txt",           "depth.txt",        "groundtruth.txt",
                                 "accelerometer.txt", "associations.txt", "calibration.txt"};
   std::vector<std::string_view> p = parts(data, size, 6);
   const std::string dir = fresh_folder("tum");
@@ -68,8 +66,7 @@ inline void tum(const std::uint8_t* data, std::size_t size) {
   expect_error_or_success([&] {
     Trajectory t = read_tum_trajectory(dir + "/groundtruth.txt");
     if (!t.empty())
-      for (double dt : {-1.0, 0.0, 0.005, 0.5})
-        (void)interpolate_pose(t, t.front().timestamp + dt);
+      for (double dt : {-1.0, 0.0, 0.005, 0.5}) (void)interpolate_pose(t, t.front().timestamp + dt);
   });
 }
 

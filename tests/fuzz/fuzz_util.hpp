@@ -24,7 +24,10 @@ inline const std::filesystem::path& scratch() {
     spdlog::set_level(spdlog::level::off);
     std::string tmpl = (std::filesystem::temp_directory_path() / "seamless_fuzz_XXXXXX").string();
     if (!mkdtemp(tmpl.data())) std::abort();
-    std::atexit([] { std::error_code ec; std::filesystem::remove_all(scratch(), ec); });
+    std::atexit([] {
+      std::error_code ec;
+      std::filesystem::remove_all(scratch(), ec);
+    });
     return std::filesystem::path(tmpl);
   }();
   return dir;
@@ -71,8 +74,7 @@ struct Violation : std::logic_error {
 // Runs f; a seamless::Error (bad input, with a message) is the expected outcome of most inputs.
 // Anything else escapes and libFuzzer reports it as a crash: a reader must never let a std::
 // exception of its parsing (std::stoi's invalid_argument, say) or a crash through.
-template <class F>
-void expect_error_or_success(F&& f) {
+template <class F> void expect_error_or_success(F&& f) {
   try {
     f();
   } catch (const seamless::Error&) {

@@ -70,7 +70,6 @@ std::string read_all(const InputParams& p, std::int64_t* frames = nullptr, std::
   }
 }
 
-
 }  // namespace
 
 TEST(BadInput, MissingListFile) {

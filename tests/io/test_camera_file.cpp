@@ -197,17 +197,19 @@ TEST(CameraFile, Open3dJsonIsColumnMajor) {
   TmpDir dir("camfile_o3d");
   // o3d.io.write_pinhole_camera_intrinsic of PinholeCameraIntrinsic(640, 480, 525, 526, 319.5, 239.5):
   // column-major, so cx and cy are the 7th and 8th numbers.
-  const std::string path = write(dir, "intrinsic.json",
-                                 "{\n\t\"height\" : 480,\n\t\"intrinsic_matrix\" : \n\t[\n\t\t525.0,\n\t\t0.0,\n\t\t0.0,"
-                                 "\n\t\t0.0,\n\t\t526.0,\n\t\t0.0,\n\t\t319.5,\n\t\t239.5,\n\t\t1.0\n\t],\n\t\"width\" : 640\n}");
+  const std::string path =
+      write(dir, "intrinsic.json",
+            "{\n\t\"height\" : 480,\n\t\"intrinsic_matrix\" : \n\t[\n\t\t525.0,\n\t\t0.0,\n\t\t0.0,"
+            "\n\t\t0.0,\n\t\t526.0,\n\t\t0.0,\n\t\t319.5,\n\t\t239.5,\n\t\t1.0\n\t],\n\t\"width\" : 640\n}");
   const CameraFile c = read_camera_file(path);
   EXPECT_EQ(c.format, "Open3D JSON");
   expect_pinhole(c.K, 525.f, 526.f, 319.5f, 239.5f);
   EXPECT_EQ(c.K.width, 640);
   EXPECT_EQ(c.K.height, 480);
   // The same numbers read row-major would put cx in the bottom row: refused, not misread.
-  const std::string row = write(dir, "row.json",
-                                "{\"width\": 640, \"height\": 480, \"intrinsic_matrix\": [525, 0, 319.5, 0, 526, 239.5, 0, 0, 1]}");
+  const std::string row =
+      write(dir, "row.json",
+            "{\"width\": 640, \"height\": 480, \"intrinsic_matrix\": [525, 0, 319.5, 0, 526, 239.5, 0, 0, 1]}");
   EXPECT_MENTIONS(error_of(row), "bottom row is not 0 0 1");
 }
 
@@ -230,11 +232,13 @@ TEST(CameraFile, ErrorsNameTheFileAndWhatIsMissing) {
   p = write(dir, "broken.json", "{\"width\": 640,");
   EXPECT_MENTIONS(error_of(p), "not valid JSON");
   p = write(dir, "cv.yml",
-            "%YAML:1.0\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   data: [ 500., 0., 320., 0., 500., 240. ]\n");
+            "%YAML:1.0\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   data: [ 500., 0., 320., "
+            "0., 500., 240. ]\n");
   EXPECT_MENTIONS(error_of(p), "camera_matrix says 3x3 but holds 6 numbers");
   p = write(dir, "k4.yaml", "K: [500, 0, 320, 0, 500, 240, 0, 0, 1]\nD: [0.1, 0, 0, 0, 0, 0.3, 0, 0]\n");
   EXPECT_MENTIONS(error_of(p), "coefficient 6 is not zero");
-  p = write(dir, "fish.yaml", "K: [500, 0, 320, 0, 500, 240, 0, 0, 1]\ndistortion_model: equidistant\nD: [0.1, 0, 0, 0]\n");
+  p = write(dir, "fish.yaml",
+            "K: [500, 0, 320, 0, 500, 240, 0, 0, 1]\ndistortion_model: equidistant\nD: [0.1, 0, 0, 0]\n");
   EXPECT_MENTIONS(error_of(p), "distortion_model is 'equidistant'");
   p = write(dir, "nan.yaml", "K: [500, 0, 320, 0, fivehundred, 240, 0, 0, 1]\n");
   EXPECT_MENTIONS(error_of(p), "K[4] is 'fivehundred', not a number");
@@ -267,7 +271,7 @@ TEST(CameraFile, NegativeFocalLengthIsAFlippedImageOfTheSameCamera) {
   expect_pinhole(c.K, 481.2f, 480.f, 319.5f, 479.f - 239.5f);
   const double fx = 481.2, fy = -480.0, cx = 319.5, cy = 239.5;
   for (const vec3 P : {vec3{0.3f, 0.2f, 2.f}, vec3{-0.5f, -0.4f, 1.5f}, vec3{0.f, 0.7f, 3.f}}) {
-    const double u = fx * P.x / P.z + cx, v = fy * P.y / P.z + cy;  // the file's camera
+    const double u = fx * P.x / P.z + cx, v = fy * P.y / P.z + cy;                               // the file's camera
     const vec3 back = c.K.unproject(static_cast<float>(u), static_cast<float>(479.0 - v), P.z);  // flipped row
     // float arithmetic on pixel values of a few hundred: about 1e-7 relative, far below 1e-5 m.
     EXPECT_NEAR(back.x, P.x, 1e-5f);
@@ -298,8 +302,9 @@ TEST(CameraFile, FrameFolderWithNegativeFocalLengthSeesTheSamePoint) {
   p.source = "frames";
   p.path = dir.str();
   p.check_depth_scale = false;  // a flat wall says nothing about the depth unit
-  p.intrinsics.file = write(dir, "camera.json",
-                            "{\"width\": 64, \"height\": 48, \"intrinsic_matrix\": [60, 0, 0, 0, -60, 0, 31.5, 23.5, 1]}");
+  p.intrinsics.file =
+      write(dir, "camera.json",
+            "{\"width\": 64, \"height\": 48, \"intrinsic_matrix\": [60, 0, 0, 0, -60, 0, 31.5, 23.5, 1]}");
   FrameFolderSource src(p);
   RgbdFrame f;
   ASSERT_TRUE(src.next(f));

@@ -11,8 +11,8 @@
 #include "io/input_params.hpp"
 #include "io/png_io.hpp"
 #include "io/tum_source.hpp"
-#include "tmp_dir.hpp"
 #include "kernels/io/render_room.hpp"
+#include "tmp_dir.hpp"
 
 using namespace seamless;
 namespace fs = std::filesystem;

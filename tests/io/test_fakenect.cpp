@@ -55,7 +55,8 @@ TEST(Fakenect, ReplayedFramesEqualTheSyntheticOnes) {
     auto za = a.depth.to_host(), zb = b.depth.to_host();
     for (std::size_t i = 0; i < za.size(); ++i) ASSERT_NEAR(za[i], zb[i], 0.5e-3f + 0.1e-3f + 1e-6f) << k << " " << i;
     auto ca = a.rgb.to_host(), cb = b.rgb.to_host();
-    for (std::size_t i = 0; i < ca.size(); ++i) ASSERT_TRUE(ca[i].x == cb[i].x && ca[i].y == cb[i].y && ca[i].z == cb[i].z);
+    for (std::size_t i = 0; i < ca.size(); ++i)
+      ASSERT_TRUE(ca[i].x == cb[i].x && ca[i].y == cb[i].y && ca[i].z == cb[i].z);
     // Accelerometer: raw counts of g/819 (half a count of rounding), 6 digits in accelerometer.txt.
     ASSERT_TRUE(b.accelerometer);
     const float count = 9.80665f / 819;
@@ -79,9 +80,15 @@ TEST(Fakenect, DumpFormatIsWhatFakenectParses) {
     unsigned stamp;
     ASSERT_EQ(std::sscanf(l.c_str(), "%c-%lf-%u-", &type, &t, &stamp), 3) << l;  // fakenect's own parse
     auto size = std::filesystem::file_size(dir.path / "dump" / l);
-    if (type == 'd') { EXPECT_EQ(size, std::string("P5 640 480 65535\n").size() + 640 * 480 * 2); }
-    if (type == 'r') { EXPECT_EQ(size, std::string("P6 640 480 255\n").size() + 640 * 480 * 3); }
-    if (type == 'a') { EXPECT_EQ(size, 12u); }  // sizeof(freenect_raw_tilt_state), checked by fakenect
+    if (type == 'd') {
+      EXPECT_EQ(size, std::string("P5 640 480 65535\n").size() + 640 * 480 * 2);
+    }
+    if (type == 'r') {
+      EXPECT_EQ(size, std::string("P6 640 480 255\n").size() + 640 * 480 * 3);
+    }
+    if (type == 'a') {
+      EXPECT_EQ(size, 12u);
+    }  // sizeof(freenect_raw_tilt_state), checked by fakenect
   }
 }
 
@@ -96,7 +103,8 @@ TEST(Fakenect, NoKinectIsAClearError) {
     FAIL() << "expected an error";
   } catch (const Error& e) {
     std::string m = e.what();
-    EXPECT_TRUE(m.find("no Kinect v1 found") != std::string::npos || m.find("could not initialise") != std::string::npos)
+    EXPECT_TRUE(m.find("no Kinect v1 found") != std::string::npos ||
+                m.find("could not initialise") != std::string::npos)
         << m;
   }
 }

@@ -65,10 +65,8 @@ struct Fixture {
     write_png_u16(dir / name(n, "depth.png"), d);
   }
   void colour(int n, const char* kind = "color.png") const {
-    if (std::string(kind).find("jpg") != std::string::npos)
-      write_jpeg_rgb(dir / name(n, kind), colour_image(n), 100);
-    else
-      write_png_rgb(dir / name(n, kind), colour_image(n));
+    if (std::string(kind).find("jpg") != std::string::npos) write_jpeg_rgb(dir / name(n, kind), colour_image(n), 100);
+    else write_png_rgb(dir / name(n, kind), colour_image(n));
   }
   void pose(int n, const std::string& text) const { std::ofstream(dir / name(n, "pose.txt")) << text; }
   void frame(int n) const {

@@ -101,7 +101,8 @@ TEST(Jpeg, FormatIsToldByContentNotByName) {
 TEST(Jpeg, BrokenFilesAreErrorsNamingTheFile) {
   TmpDir dir("jpeg_broken");
   Image<uchar3> im(64, 64, Device::CPU);
-  for (int i = 0; i < 64 * 64; ++i) im.buffer().data()[i] = {std::uint8_t(i * 7), std::uint8_t(i * 13), std::uint8_t(i)};
+  for (int i = 0; i < 64 * 64; ++i)
+    im.buffer().data()[i] = {std::uint8_t(i * 7), std::uint8_t(i * 13), std::uint8_t(i)};
   const std::string whole = dir / "whole.jpg", cut = dir / "cut.jpg";
   write_jpeg_rgb(whole, im, 90);
   // Half the file: libjpeg pads the missing rows with grey and warns; that must not pass as data.

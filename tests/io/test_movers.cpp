@@ -67,7 +67,8 @@ TEST(Movers, PosedPersonStandsOnTheFloorAndLeavesAtThePathsEnd) {
   float lowest = 1e9f, highest = -1e9f;
   for (int i = 0; i < 6; ++i) {
     EXPECT_EQ(s.c[i].mover, 1);
-    for (vec3 e : {s.c[i].a, s.c[i].b}) lowest = std::min(lowest, e.z - s.c[i].r), highest = std::max(highest, e.z + s.c[i].r);
+    for (vec3 e : {s.c[i].a, s.c[i].b})
+      lowest = std::min(lowest, e.z - s.c[i].r), highest = std::max(highest, e.z + s.c[i].r);
   }
   EXPECT_NEAR(lowest, 0.f, 1e-5f);
   EXPECT_NEAR(highest, 0.93f * 1.75f + 0.065f * 1.75f, 1e-5f);
@@ -128,7 +129,7 @@ TEST(Movers, RenderedMaskAndDepthAgreeWithTheCapsules) {
         ASSERT_NEAR(kernels::room::room_sdf(p), 0.f, 1e-3f) << x << "," << y;
       }
     }
-  EXPECT_GT(by_id[1], 1000);  // the person fills a good part of the view
+  EXPECT_GT(by_id[1], 1000);    // the person fills a good part of the view
   EXPECT_GT(masked, by_id[1]);  // and the ball is seen too
 }
 

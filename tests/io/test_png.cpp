@@ -12,16 +12,14 @@ using namespace seamless;
 
 namespace {
 
-template <class T, class F>
-Image<T> make_image(int w, int h, F value) {
+template <class T, class F> Image<T> make_image(int w, int h, F value) {
   std::vector<T> v(static_cast<std::size_t>(w) * h);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) v[y * w + x] = value(x, y);
   return Image<T>::from_host(v, w, h, Device::CPU);
 }
 
-template <class F>
-void expect_error_containing(F fn, const std::string& needle) {
+template <class F> void expect_error_containing(F fn, const std::string& needle) {
   try {
     fn();
     FAIL() << "expected seamless::Error containing '" << needle << "'";
@@ -35,7 +33,8 @@ void expect_error_containing(F fn, const std::string& needle) {
 TEST(Png, RoundTripU16KeepsEveryValue) {
   TmpDir dir("png16");
   // Values spanning the whole 16-bit range, including bytes that would swap visibly.
-  auto im = make_image<std::uint16_t>(37, 11, [](int x, int y) { return static_cast<std::uint16_t>(x * 1771 + y * 313 + 1); });
+  auto im = make_image<std::uint16_t>(37, 11,
+                                      [](int x, int y) { return static_cast<std::uint16_t>(x * 1771 + y * 313 + 1); });
   write_png_u16(dir / "a.png", im);
   PngInfo info = png_info(dir / "a.png");
   EXPECT_EQ(info.width, 37);
@@ -49,7 +48,8 @@ TEST(Png, RoundTripU8AndRgb) {
   TmpDir dir("png8");
   auto g = make_image<std::uint8_t>(20, 9, [](int x, int y) { return static_cast<std::uint8_t>(x * 13 + y * 7); });
   auto c = make_image<uchar3>(20, 9, [](int x, int y) {
-    return uchar3{static_cast<std::uint8_t>(x * 12), static_cast<std::uint8_t>(y * 28), static_cast<std::uint8_t>(x ^ y)};
+    return uchar3{static_cast<std::uint8_t>(x * 12), static_cast<std::uint8_t>(y * 28),
+                  static_cast<std::uint8_t>(x ^ y)};
   });
   write_png_u8(dir / "g.png", g);
   write_png_rgb(dir / "c.png", c);

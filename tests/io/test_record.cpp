@@ -20,7 +20,8 @@ TEST(Record, SyntheticRoomRoundTripsThroughATumFolder) {
   p.synthetic.sensor.sigma_disparity = 0.3f;
   SyntheticSource src(p);
   ASSERT_EQ(record(src, dir.str()), 4);
-  for (const char* f : {"rgb.txt", "depth.txt", "associations.txt", "groundtruth.txt", "accelerometer.txt", "calibration.txt"})
+  for (const char* f :
+       {"rgb.txt", "depth.txt", "associations.txt", "groundtruth.txt", "accelerometer.txt", "calibration.txt"})
     EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
 
   InputParams q;
@@ -39,7 +40,8 @@ TEST(Record, SyntheticRoomRoundTripsThroughATumFolder) {
     auto da = a.depth.to_host(), db = b.depth.to_host();
     for (std::size_t i = 0; i < da.size(); ++i) ASSERT_NEAR(da[i], db[i], 1e-4f + 1e-6f * da[i]) << i;
     auto ca = a.rgb.to_host(), cb = b.rgb.to_host();
-    for (std::size_t i = 0; i < ca.size(); ++i) ASSERT_TRUE(ca[i].x == cb[i].x && ca[i].y == cb[i].y && ca[i].z == cb[i].z);
+    for (std::size_t i = 0; i < ca.size(); ++i)
+      ASSERT_TRUE(ca[i].x == cb[i].x && ca[i].y == cb[i].y && ca[i].z == cb[i].z);
     // Poses: 7 decimals of metres, 9 of the quaternion.
     ASSERT_TRUE(b.ground_truth);
     EXPECT_LT(length(a.ground_truth->t - b.ground_truth->t), 1e-6f);

@@ -18,7 +18,7 @@ namespace {
 
 std::string data_dir(const std::string& name) { return std::string(SEAMLESS_TEST_DATA) + "/" + name; }
 
-#define REQUIRE_DATA(dir)                                                                         \
+#define REQUIRE_DATA(dir) \
   if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << "test data folder " << dir << " is absent"
 
 InputParams tum_params(const std::string& dir) {
@@ -97,14 +97,15 @@ TEST(TumReader, GroundTruthInterpolatedAtFrameTimes) {
     ++with_gt;
     // The interpolated position lies on the segment between the bracketing mocap samples (100 Hz,
     // so they are < 0.1 s apart); distance to the segment is float rounding only.
-    auto it = std::lower_bound(gt.begin(), gt.end(), f.timestamp, [](const TumPose& p, double t) { return p.timestamp < t; });
+    auto it =
+        std::lower_bound(gt.begin(), gt.end(), f.timestamp, [](const TumPose& p, double t) { return p.timestamp < t; });
     ASSERT_NE(it, gt.begin());
     const TumPose &a = *(it - 1), &b = *it;
     double s = (f.timestamp - a.timestamp) / (b.timestamp - a.timestamp);
     for (int k = 0; k < 3; ++k) {
       double expect = a.t[k] + s * (b.t[k] - a.t[k]);
-      EXPECT_NEAR(f.ground_truth->t.x * (k == 0) + f.ground_truth->t.y * (k == 1) + f.ground_truth->t.z * (k == 2), expect,
-                  1e-6 * std::max(1.0, std::fabs(expect)));
+      EXPECT_NEAR(f.ground_truth->t.x * (k == 0) + f.ground_truth->t.y * (k == 1) + f.ground_truth->t.z * (k == 2),
+                  expect, 1e-6 * std::max(1.0, std::fabs(expect)));
     }
     // Rotation: the angle to each bracketing sample is at most the angle between them (slerp).
     SE3 A = a.se3(), B = b.se3();
@@ -155,7 +156,9 @@ TEST(TumReader, NineFrameDeskPairsAllNineByTime) {
   std::int64_t n = 0;
   RgbdFrame f;
   while (src.next(f)) {
-    if (n == 0) { EXPECT_DOUBLE_EQ(f.timestamp, 1305031453.359684); }
+    if (n == 0) {
+      EXPECT_DOUBLE_EQ(f.timestamp, 1305031453.359684);
+    }
     EXPECT_TRUE(f.ground_truth);
     EXPECT_FALSE(f.accelerometer);  // no accelerometer.txt in this folder
     EXPECT_EQ(f.depth.width(), 640);

@@ -15,7 +15,9 @@ namespace {
 std::vector<float> fill(const std::vector<float>& d, int w, int h, Device dev = Device::CPU) {
   auto in = Image<float>::from_host(d, w, h, dev);
   Image<float> out(w, h, dev);
-  with_exec(dev, [&]<class E>(const E& ex) { kernels::FillGaps<E>::fill_depth_gaps(ex, in.cview(), out.view(), kernels::kFillGapsMaxRelDiff); });
+  with_exec(dev, [&]<class E>(const E& ex) {
+    kernels::FillGaps<E>::fill_depth_gaps(ex, in.cview(), out.view(), kernels::kFillGapsMaxRelDiff);
+  });
   return out.to_host();
 }
 }  // namespace

@@ -53,7 +53,7 @@ Maps vertex_normal_maps(Device dev, const std::vector<float>& depth, const Intri
 
 TEST(Preprocess, PlaneNormalsAreExact) {
   const vec3 n = normalize(vec3{0.3f, -0.5f, -1.f});  // faces the camera (negative z)
-  const float d = -1.5f;                               // dot(n, p) = d with p.z > 0
+  const float d = -1.5f;                              // dot(n, p) = d with p.z > 0
   auto depth = plane_depth(kK, n, d);
   auto m = vertex_normal_maps(Device::CPU, depth, kK, 0.1f);
   // Forward differences on a plane span the plane exactly; the only error is float rounding of
@@ -82,7 +82,7 @@ TEST(Preprocess, SphereNormalsMatchAnalytic) {
       if (std::fabs(length(p - c) - r) > 1e-3f) continue;  // wall or silhouette pixel
       vec3 truth = normalize(p - c);
       if (-dot(truth, normalize(p)) < 0.5f) continue;  // grazing: pixel footprint > 2x
-      if (length(got) == 0.f) continue;                  // a neighbour fell on the wall
+      if (length(got) == 0.f) continue;                // a neighbour fell on the wall
       // The forward-difference normal is that of the chord plane through p and its two
       // neighbours. At 1.2 m a pixel spans ~2.3 mm, up to ~4.6 mm at 60 degrees incidence; on a
       // sphere of radius 0.3 m the chord normal tilts by at most about edge / r = 0.016 rad.
@@ -118,8 +118,8 @@ TEST(Preprocess, BilateralKeepsPlanesAndEdges) {
 
 TEST(Preprocess, PyramidAveragesWithoutBridgingEdges) {
   // 4x2 -> 2x1: left block {1.0, 1.02, 1.04, hole}, right block {3.0, 3.0, 3.0, 3.1}.
-  std::vector<float> d = {1.0f, 1.02f, 3.0f, 3.0f,   //
-                          1.04f, 0.0f, 3.0f, 3.1f};
+  std::vector<float> d = {1.0f,  1.02f, 3.0f, 3.0f,  //
+                          1.04f, 0.0f,  3.0f, 3.1f};
   auto in = Image<float>::from_host(d, 4, 2, Device::CPU);
   Image<float> out(2, 1, Device::CPU);
   kernels::Preprocess<CpuExec>::pyr_down_depth(CpuExec{}, in.cview(), out.view(), 0.1f);

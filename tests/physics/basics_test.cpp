@@ -53,7 +53,7 @@ TEST(PhysicsFreeFall, EqualsSymplecticEuler) {
 TEST(PhysicsMomentum, ConservedWithoutExternalForces) {
   SolverParams p;
   p.gravity = {0.f, 0.f, 0.f};
-  p.vorticity = 0.f;  // confinement adds energy by design and is not a pairwise force
+  p.vorticity = 0.f;   // confinement adds energy by design and is not a pairwise force
   p.max_speed = 20.f;  // the speed limit is a (deliberate) external impulse: keep it out of reach
   ParticleSolver s(p, Device::CPU);
   SpawnParams a;

@@ -78,9 +78,10 @@ DrapeRun drape(float height = 0.2f) {
     if (std::fabs(x.x) < half && std::fabs(x.z) < half && x.y > 2 * half) ++r.on_top;
     if (x.y < 0.5f * d + 0.01f) ++r.on_floor;
   }
-  std::printf("cloth on box from %.2f m: max edge strain %.6f (at rest %.6f), closest centre to the box %.4g m (radius %.3g), "
-              "lowest %.4g m, %d particles over the top, %d on the floor\n",
-              height, r.worst_strain, r.final_strain, r.deepest, 0.5f * d, r.lowest, r.on_top, r.on_floor);
+  std::printf(
+      "cloth on box from %.2f m: max edge strain %.6f (at rest %.6f), closest centre to the box %.4g m (radius %.3g), "
+      "lowest %.4g m, %d particles over the top, %d on the floor\n",
+      height, r.worst_strain, r.final_strain, r.deepest, 0.5f * d, r.lowest, r.on_top, r.on_floor);
   return r;
 }
 

@@ -63,7 +63,8 @@ TEST(DepthColliders, PointsLieOnTheSeenSurfaceAndBehindIt) {
   s.count = 1;
   s.c[0] = {{0.f, 0.2f, 0.f}, {0.f, 1.2f, 0.f}, 0.15f, 1, {1, 1, 1}};
   const std::vector<vec3> v = view_of(s).v;
-  const std::size_t seen = static_cast<std::size_t>(std::count_if(v.begin(), v.end(), [](vec3 p) { return p.z > 0.f; }));
+  const std::size_t seen =
+      static_cast<std::size_t>(std::count_if(v.begin(), v.end(), [](vec3 p) { return p.z > 0.f; }));
   ASSERT_GT(seen, 500u);  // ~19 x 84 pixels: 0.3 m x 1.3 m at 2 m, 65 pixels a metre
   const float spacing = 0.04f;
   const DepthSurface surf = surface_of(s);
@@ -149,8 +150,10 @@ Walk walk_through_cube(bool interpolate) {
     for (const vec3& x : solver.download_state().x) w.worst = std::min(w.worst, mv::distance(s, x));
   }
   w.pushed = solver.rigid_frames()[0].centre.x - x0;
-  std::printf("%s colliders: cube pushed %.3f m, fastest particle %.2f m/s, deepest particle centre %.4f m inside "
-              "the torso\n", interpolate ? "moving" : "jumping", w.pushed, w.vmax, -w.worst);
+  std::printf(
+      "%s colliders: cube pushed %.3f m, fastest particle %.2f m/s, deepest particle centre %.4f m inside "
+      "the torso\n",
+      interpolate ? "moving" : "jumping", w.pushed, w.vmax, -w.worst);
   return w;
 }
 
@@ -170,12 +173,11 @@ TEST(DepthColliders, WalkingTorsoPushesACubeAndNothingEndsInsideIt) {
   EXPECT_LT(moving.vmax, jumping.vmax);
 }
 
-
 struct Pour {
-  float worst = 1e30f;   // smallest distance of a particle centre from the torso's surface, any step
-  float nearest = 1e30f; // the same, but only of particles above the torso's axis end (landed on it)
+  float worst = 1e30f;          // smallest distance of a particle centre from the torso's surface, any step
+  float nearest = 1e30f;        // the same, but only of particles above the torso's axis end (landed on it)
   int on_floor = 0, total = 0;  // fluid particles at the end within three diameters of the floor
-  float highest = 0.f;   // highest particle at the end, metres
+  float highest = 0.f;          // highest particle at the end, metres
 };
 
 // A person standing still (a torso capsule of radius 0.15 m from 0.2 to 1.2 m) under a 16 cm block
@@ -216,9 +218,10 @@ Pour pour_on_person(bool with_colliders) {
     out.on_floor += x.y < 3 * d;
     out.highest = std::max(out.highest, x.y);
   }
-  std::printf("%s: deepest particle centre %.4f m inside the torso, nearest above its head %.4f m, %d of %d on the "
-              "floor, highest %.3f m\n", with_colliders ? "colliders" : "no colliders", -out.worst, out.nearest,
-              out.on_floor, out.total, out.highest);
+  std::printf(
+      "%s: deepest particle centre %.4f m inside the torso, nearest above its head %.4f m, %d of %d on the "
+      "floor, highest %.3f m\n",
+      with_colliders ? "colliders" : "no colliders", -out.worst, out.nearest, out.on_floor, out.total, out.highest);
   return out;
 }
 

@@ -33,10 +33,9 @@ std::vector<vec3> desk_particles(float d) {
   return out;
 }
 
-// A jet (nozzle radius 10 cm: discs of 21 particles, 2 m/s down, 1000 particles/s for 1.5 s) falls 0.2 m onto the desk top
-// 0.15 m from its front edge (y = 0.25 m), beside the objects on the desk; 3 s simulated. The floor
-// is the room's floor plane (a half-space SDF at z = 0; the desk is only particles).
-// Expected from the geometry:
+// A jet (nozzle radius 10 cm: discs of 21 particles, 2 m/s down, 1000 particles/s for 1.5 s) falls 0.2 m onto the desk
+// top 0.15 m from its front edge (y = 0.25 m), beside the objects on the desk; 3 s simulated. The floor is the room's
+// floor plane (a half-space SDF at z = 0; the desk is only particles). Expected from the geometry:
 // - pooling: fluid at rest on the top sits on the scene layer at z = 0.73: directly above a scene
 //   particle at 0.73 + d = 0.77 (desk top + radius), over the gap between four at
 //   0.73 + 0.71 d = 0.758; so the first layer lies in [0.75, 0.75 + 2r] over the desk's footprint;
@@ -76,9 +75,10 @@ TEST(PhysicsDesk, FluidPouredOnDeskPoolsAndFlowsOffTheEdge) {
     if (over && x.z >= R::kDeskTopZ && x.z <= R::kDeskTopZ + 2 * r) ++pooled;
     if (!over && x.z < 2 * d) ++off;
   }
-  std::printf("desk: %d fluid particles, %d pooled on the top, %d on the floor beyond the edge, %d samples "
-              "inside the desk, %zu scene particles\n",
-              total, pooled, off, inside, desk.size());
+  std::printf(
+      "desk: %d fluid particles, %d pooled on the top, %d on the floor beyond the edge, %d samples "
+      "inside the desk, %zu scene particles\n",
+      total, pooled, off, inside, desk.size());
   EXPECT_EQ(inside, 0);
   EXPECT_GT(pooled, 50);
   EXPECT_GT(off, 50);

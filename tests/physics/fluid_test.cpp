@@ -62,17 +62,18 @@ RestResult fluid_at_rest(int iterations, int W) {
 // Thresholds from the issue (4 iterations): mean interior density error <= 2 %, max <= 5 %.
 TEST(PhysicsFluid, AtRestInBoxKeepsDensity) {
   RestResult r = fluid_at_rest(4, 8);
-  std::printf("fluid at rest, 4 iterations: interior %d, mean |rho/rho0 - 1| %.4f, max %.4f\n", r.interior,
-              r.mean_err, r.max_err);
+  std::printf("fluid at rest, 4 iterations: interior %d, mean |rho/rho0 - 1| %.4f, max %.4f\n", r.interior, r.mean_err,
+              r.max_err);
   ASSERT_GT(r.interior, 100);
   EXPECT_LE(r.mean_err, 0.02);
   EXPECT_LE(r.max_err, 0.05);
   EXPECT_EQ(r.escaped, 0) << "e.g. at " << r.escaped_at.x << " " << r.escaped_at.y << " " << r.escaped_at.z;
   // The dissertation's 2 iterations: reported only (docs/PHYSICS.md).
   RestResult r2 = fluid_at_rest(2, 8);
-  std::printf("fluid at rest, 2 iterations: interior %d, mean |rho/rho0 - 1| %.4f, max %.4f, %d left the box "
-              "(e.g. at %.3f %.3f %.3f)\n", r2.interior, r2.mean_err, r2.max_err, r2.escaped, r2.escaped_at.x,
-              r2.escaped_at.y, r2.escaped_at.z);
+  std::printf(
+      "fluid at rest, 2 iterations: interior %d, mean |rho/rho0 - 1| %.4f, max %.4f, %d left the box "
+      "(e.g. at %.3f %.3f %.3f)\n",
+      r2.interior, r2.mean_err, r2.max_err, r2.escaped, r2.escaped_at.x, r2.escaped_at.y, r2.escaped_at.z);
 }
 
 // Martin & Moyce 1952 (plate 2, water column of width a, height 2a): surge front x/a against
@@ -121,7 +122,6 @@ TEST(PhysicsFluid, DamBreakFollowsMartinMoyce) {
   }
   EXPECT_EQ(checked, 11);
 }
-
 
 // The CPU's SIMD tiles (8 particles a vector, kernels/physics/simd.hpp) do the scalar loops'
 // float operations in the scalar order, lane by lane, so the states must be equal bit for bit.

@@ -79,7 +79,8 @@ TEST(PhysicsGrid, CellStartsCountKeysBelowEachCell) {
   std::vector<std::uint32_t> keys = {0, 0, 3, 40, 40, 41, 100, 511, 511};
   const std::int64_t cells = 512;
   std::vector<int> start(cells + 1, -1);
-  kernels::NeighbourGrid<CpuExec>::cell_starts(CpuExec{}, keys.data(), static_cast<std::int64_t>(keys.size()), start.data(), cells);
+  kernels::NeighbourGrid<CpuExec>::cell_starts(CpuExec{}, keys.data(), static_cast<std::int64_t>(keys.size()),
+                                               start.data(), cells);
   for (std::int64_t k = 0; k <= cells; ++k) {
     auto below = std::lower_bound(keys.begin(), keys.end(), static_cast<std::uint32_t>(k)) - keys.begin();
     ASSERT_EQ(start[k], below) << "cell " << k;

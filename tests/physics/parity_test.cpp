@@ -77,7 +77,8 @@ TEST(PhysicsParity, CpuAndCudaAgreeWithFluidFriction) {
 // (fewer substeps here).
 ParticleState run_block(Device dev, bool with_solids) {
   SolverParams p;
-  p.max_particles = 74 * 74 * 74 + (with_solids ? 4096 : 0);  // 405,224 fluid: over the one-lane threshold of GPUs up to ~200 SMs
+  p.max_particles =
+      74 * 74 * 74 + (with_solids ? 4096 : 0);  // 405,224 fluid: over the one-lane threshold of GPUs up to ~200 SMs
   ParticleSolver s(p, dev);
   const float d = p.particle_diameter;
   kernels::SceneSdf box;
@@ -106,7 +107,8 @@ void expect_block_parity(bool with_solids) {
   ASSERT_GT(a.x.size(), 400000u);
   float worst = 0.f;
   for (std::size_t i = 0; i < a.x.size(); ++i) worst = std::max(worst, length(a.x[i] - b.x[i]));
-  std::printf("parity (one lane%s): largest CPU/CUDA position difference %.3g m\n", with_solids ? ", solids" : "", worst);
+  std::printf("parity (one lane%s): largest CPU/CUDA position difference %.3g m\n", with_solids ? ", solids" : "",
+              worst);
   EXPECT_LT(worst, 1e-4f);
   if (!with_solids) return;
   // The solids' paths ran only if a solid particle was within the fluid's smoothing radius h =
@@ -146,8 +148,9 @@ TEST(PhysicsParity, CudaGraphReplayEqualsDirectLaunches) {
   ASSERT_EQ(g.state.x.size(), d.state.x.size());
   std::size_t differ = 0;
   for (std::size_t i = 0; i < g.state.x.size(); ++i)
-    differ += g.state.x[i].x != d.state.x[i].x || g.state.x[i].y != d.state.x[i].y || g.state.x[i].z != d.state.x[i].z ||
-              g.state.v[i].x != d.state.v[i].x || g.state.v[i].y != d.state.v[i].y || g.state.v[i].z != d.state.v[i].z;
+    differ += g.state.x[i].x != d.state.x[i].x || g.state.x[i].y != d.state.x[i].y ||
+              g.state.x[i].z != d.state.x[i].z || g.state.v[i].x != d.state.v[i].x ||
+              g.state.v[i].y != d.state.v[i].y || g.state.v[i].z != d.state.v[i].z;
   EXPECT_EQ(differ, 0u);
   EXPECT_EQ(g.stats.max_speed, d.stats.max_speed);
   EXPECT_EQ(g.stats.max_neighbours_seen, d.stats.max_neighbours_seen);

@@ -27,7 +27,8 @@ inline std::vector<vec3> static_box(vec3 lo, vec3 hi, float d) {
   for (int k = 0; k <= nz; ++k)
     for (int j = 0; j <= ny; ++j)
       for (int i = 0; i <= nx; ++i)
-        if (j == 0 || i == 0 || i == nx || k == 0 || k == nz) out.push_back(lo + vec3{float(i), float(j), float(k)} * d);
+        if (j == 0 || i == 0 || i == nx || k == 0 || k == nz)
+          out.push_back(lo + vec3{float(i), float(j), float(k)} * d);
   return out;
 }
 

@@ -80,8 +80,8 @@ Masks run_on(Device d, const Scene& v) {
     in.model_normals = mn.cview();
     in.ref_T_cur = SE3::identity();
     kernels::Dynamic<E>::classify_dynamic(ex, in, cand.view());
-    kernels::Dynamic<E>::filter_dynamic(ex, cand.cview(), View2D<const std::uint8_t>{}, depth.cview(), 1, 5, 0.05f, kept.view(),
-                            mask.view());
+    kernels::Dynamic<E>::filter_dynamic(ex, cand.cview(), View2D<const std::uint8_t>{}, depth.cview(), 1, 5, 0.05f,
+                                        kept.view(), mask.view());
     kernels::Dynamic<E>::mask_vertices(ex, mask.cview(), 1, fv.view(), fn.view());
     kernels::Dynamic<E>::mask_depth(ex, mask.cview(), depth.view());
     out.count = kernels::Dynamic<E>::count_dynamic(ex, mask.cview());
@@ -140,7 +140,8 @@ TEST(DynamicKernels, Parity) {
   const Scene v = render_view();
   const Masks c = run_on(Device::CPU, v), g = run_on(Device::CUDA, v);
   std::int64_t diff = 0;
-  for (std::size_t k = 0; k < c.mask.size(); ++k) diff += (c.mask[k] != g.mask[k]) + (c.candidates[k] != g.candidates[k]);
+  for (std::size_t k = 0; k < c.mask.size(); ++k)
+    diff += (c.mask[k] != g.mask[k]) + (c.candidates[k] != g.candidates[k]);
   EXPECT_LE(diff, static_cast<std::int64_t>(c.mask.size() / 1000));
   EXPECT_NEAR(static_cast<double>(c.count), static_cast<double>(g.count), c.mask.size() / 1000.0);
 }

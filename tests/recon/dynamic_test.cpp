@@ -17,10 +17,10 @@
 
 #include "core/exec.hpp"
 #include "eval/trajectory_eval.hpp"
-#include "kernels/scene/synthetic_room.hpp"
 #include "io/movers.hpp"
 #include "io/synthetic_source.hpp"
 #include "kernels/recon/dynamic.hpp"
+#include "kernels/scene/synthetic_room.hpp"
 #include "recon/tracker_sequence.hpp"
 #include "recon/volume.hpp"
 
@@ -74,7 +74,7 @@ TrackSequenceParams params(bool dynamic, const std::string& tracker) {
 }
 
 struct Outcome {
-  double ate_m = 0;             // ATE RMSE after se3 alignment (seamless eval's)
+  double ate_m = 0;  // ATE RMSE after se3 alignment (seamless eval's)
   double min_iou = 1, mean_iou = 0;
   int iou_frames = 0;
   std::int64_t ghost_vertices = 0;  // mesh vertices inside the person's swept volume
@@ -168,8 +168,9 @@ TEST(Dynamic, SlowPersonWalkingThroughTheRoom) {
                 empty = run(scene(false), false);
   std::printf("%s, %dx%d\n", device_name(device()), 640 / downscale(), 480 / downscale());
   std::printf("ground-truth poses, dynamic off: ghost %lld vertices\n", static_cast<long long>(off.ghost_vertices));
-  std::printf("ground-truth poses, dynamic on:  ghost %lld vertices, IoU min %.3f mean %.3f over %d frames, masked %.2f%%\n",
-              static_cast<long long>(on.ghost_vertices), on.min_iou, on.mean_iou, on.iou_frames, 100 * on.mean_fraction);
+  std::printf(
+      "ground-truth poses, dynamic on:  ghost %lld vertices, IoU min %.3f mean %.3f over %d frames, masked %.2f%%\n",
+      static_cast<long long>(on.ghost_vertices), on.min_iou, on.mean_iou, on.iou_frames, 100 * on.mean_fraction);
   std::printf("icp, dynamic off: ATE %.2f cm\nicp, dynamic on:  ATE %.2f cm, IoU min %.3f mean %.3f\n",
               100 * tracked_off.ate_m, 100 * tracked_on.ate_m, tracked_on.min_iou, tracked_on.mean_iou);
   std::printf("icp, no person:   ATE %.2f cm\n", 100 * empty.ate_m);

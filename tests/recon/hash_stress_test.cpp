@@ -52,8 +52,9 @@ void check(const Workload& w, const StressResult& r) {
   }
   for (HashKey k : w.unique) ASSERT_EQ(inserted1[k], 1) << "each key inserted exactly once";
   for (std::size_t j = 0; j < w.unique.size(); ++j) {
-    if (j % 2 == 0) { ASSERT_EQ(r.erase_slot[j], slot_of[w.unique[j]]) << "erase found the key"; }
-    else ASSERT_EQ(r.lookup_slot[j], slot_of[w.unique[j]]) << "lookup during deletes lost a key";
+    if (j % 2 == 0) {
+      ASSERT_EQ(r.erase_slot[j], slot_of[w.unique[j]]) << "erase found the key";
+    } else ASSERT_EQ(r.lookup_slot[j], slot_of[w.unique[j]]) << "lookup during deletes lost a key";
   }
   std::map<HashKey, std::int32_t> slot3;
   for (std::size_t i = 0; i < w.ops.size(); ++i) {
@@ -65,7 +66,9 @@ void check(const Workload& w, const StressResult& r) {
   for (std::size_t j = 0; j < w.unique.size(); ++j) {
     HashKey k = w.unique[j];
     ASSERT_EQ(inserted3[k], j % 2 == 0 ? 1 : 0) << "erased keys come back once, kept keys are found";
-    if (j % 2) { ASSERT_EQ(slot3[k], slot_of[k]); }
+    if (j % 2) {
+      ASSERT_EQ(slot3[k], slot_of[k]);
+    }
   }
   // The table holds exactly the key set: nothing lost, nothing twice.
   std::vector<HashKey> live;

@@ -63,7 +63,8 @@ class ReplaySource : public FrameSource {
 // The ground-truth poses of the synthetic sequence (what the frames were rendered from).
 Trajectory ground_truth(int frames) {
   Trajectory gt;
-  for (int i = 0; i < frames; ++i) gt.push_back(TumPose::from_se3(rendered()[i].timestamp, *rendered()[i].ground_truth));
+  for (int i = 0; i < frames; ++i)
+    gt.push_back(TumPose::from_se3(rendered()[i].timestamp, *rendered()[i].ground_truth));
   return gt;
 }
 

@@ -36,11 +36,11 @@ void add_ramp(Mesh& m, float x0, float z0, float deg) {
 
 Mesh room() {
   Mesh m;
-  add_rect(m, -1.f, 1.f, -1.f, 1.f, 0.f);          // floor, 4 m^2
-  add_rect(m, -0.5f, 0.5f, 0.2f, 0.8f, 0.75f);     // desk top, 0.6 m^2, centre (0, 0.75, 0.5)
+  add_rect(m, -1.f, 1.f, -1.f, 1.f, 0.f);              // floor, 4 m^2
+  add_rect(m, -0.5f, 0.5f, 0.2f, 0.8f, 0.75f);         // desk top, 0.6 m^2, centre (0, 0.75, 0.5)
   add_rect(m, -0.5f, 0.5f, 0.2f, 0.8f, 0.72f, false);  // its underside: faces down
-  add_rect(m, 0.1f, 0.4f, 0.3f, 0.6f, 0.95f);      // a box on the desk, 0.09 m^2
-  add_ramp(m, -1.f, -1.6f, 30.f);                  // 30 degrees: not horizontal
+  add_rect(m, 0.1f, 0.4f, 0.3f, 0.6f, 0.95f);          // a box on the desk, 0.09 m^2
+  add_ramp(m, -1.f, -1.6f, 30.f);                      // 30 degrees: not horizontal
   return m;
 }
 

@@ -64,7 +64,8 @@ std::vector<SynthFrame> synthetic_frames(int count, bool noise, bool intensity, 
     if (intensity) {
       std::vector<uchar3> rgb = f.frame.rgb.to_host();
       std::vector<float> g(rgb.size());
-      for (std::size_t i = 0; i < rgb.size(); ++i) g[i] = (0.299f * rgb[i].x + 0.587f * rgb[i].y + 0.114f * rgb[i].z) / 255.f;
+      for (std::size_t i = 0; i < rgb.size(); ++i)
+        g[i] = (0.299f * rgb[i].x + 0.587f * rgb[i].y + 0.114f * rgb[i].z) / 255.f;
       if (edit_intensity) edit_intensity(static_cast<int>(out.size()), g, depth.width());
       inten = Image<float>::from_host(g, depth.width(), depth.height(), d);
     }
@@ -91,8 +92,8 @@ TEST(IcpStep, SolvesAKnownLinearSystem) {
   for (int i = 0; i < 50; ++i) {
     vec3 a{std::sin(i * 1.3f), std::cos(i * 0.7f), std::sin(i * 2.1f + 1)};
     vec3 b{std::cos(i * 0.9f + 2), std::sin(i * 1.7f), std::cos(i * 0.4f)};
-    double Jx = a.x * xi_true[0] + a.y * xi_true[1] + a.z * xi_true[2] + b.x * xi_true[3] + b.y * xi_true[4] +
-                b.z * xi_true[5];
+    double Jx =
+        a.x * xi_true[0] + a.y * xi_true[1] + a.z * xi_true[2] + b.x * xi_true[3] + b.y * xi_true[4] + b.z * xi_true[5];
     kernels::add_row(s, a, b, static_cast<float>(-Jx), 1.f);
   }
   IcpStep step = solve_icp_step(s);
@@ -388,7 +389,8 @@ std::vector<BorderFrame> border_frames(int count, int border) {
         }
     Image<uchar3> im = Image<uchar3>::from_host(rgb, w, h, Device::CPU);
     Image<float> inten(w, h, Device::CPU);
-    with_exec(Device::CPU, [&]<class E>(const E& ex) { kernels::Rgbd<E>::rgb_to_intensity(ex, im.cview(), inten.view()); });
+    with_exec(Device::CPU,
+              [&]<class E>(const E& ex) { kernels::Rgbd<E>::rgb_to_intensity(ex, im.cview(), inten.view()); });
     BorderFrame b{*f.ground_truth, std::make_unique<FramePyramid>(Device::CPU, src.intrinsics(), 3),
                   std::make_unique<FramePyramid>(Device::CPU, src.intrinsics(), 3)};
     b.full->build(full_depth, nullptr, PreprocessParams{});
@@ -476,7 +478,8 @@ TEST(Gravity, AccelerometerAndFloorMatchGroundTruth) {
   const SyntheticParams sp = test::synthetic_input(1).synthetic;
   const double h = 0.01, t0 = fr.timestamp;
   vec3 a = (synthetic_camera_pose(sp, t0 + h).t - synthetic_camera_pose(sp, t0).t * 2.f +
-            synthetic_camera_pose(sp, t0 - h).t) / static_cast<float>(h * h);
+            synthetic_camera_pose(sp, t0 - h).t) /
+           static_cast<float>(h * h);
   double bound = std::asin(std::min(1.0, length(a) / 9.80665)) * 180.0 / kPi;
   EXPECT_LT(angle_between_deg(acc.down, truth), bound + 0.05);
   GravityEstimate floor = estimate_gravity(tp, std::nullopt, *f[0].pyr);

@@ -69,7 +69,8 @@ kernels::IcpSums reduce_on(Device d, const std::vector<RgbdFrame>& f, int level,
 Image<float> host_intensity(const RgbdFrame& f, Device d) {
   std::vector<uchar3> rgb = f.rgb.to_host();
   std::vector<float> g(rgb.size());
-  for (std::size_t i = 0; i < rgb.size(); ++i) g[i] = (0.299f * rgb[i].x + 0.587f * rgb[i].y + 0.114f * rgb[i].z) / 255.f;
+  for (std::size_t i = 0; i < rgb.size(); ++i)
+    g[i] = (0.299f * rgb[i].x + 0.587f * rgb[i].y + 0.114f * rgb[i].z) / 255.f;
   return Image<float>::from_host(g, f.rgb.width(), f.rgb.height(), d);
 }
 

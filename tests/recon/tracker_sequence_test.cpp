@@ -8,8 +8,8 @@
 #include <fstream>
 #include <string>
 
-#include "io/synthetic_source.hpp"
 #include "core/error.hpp"
+#include "io/synthetic_source.hpp"
 #include "recon/refine/refine.hpp"
 #include "tracker_test_util.hpp"
 
@@ -152,9 +152,9 @@ TEST(TrackSequence, UnavailableTrackerSaysSo) {
 }
 
 // The tracker section of configs/tum_fr1.yaml before issue 24 (it is frame to frame now: see
-// docs/TRACKING.md, "Issue 24", and ctest compare_trackers_fr1_rpy): RGB-D frame-to-model with robust self-balancing weights, the Kinect's depth-squared noise, a colour row for every
-// visible pixel and the last frame's image as the photometric reference, a constant-velocity
-// prediction, photometric weight 1. Volume at 1 cm (see default_params).
+// docs/TRACKING.md, "Issue 24", and ctest compare_trackers_fr1_rpy): RGB-D frame-to-model with robust self-balancing
+// weights, the Kinect's depth-squared noise, a colour row for every visible pixel and the last frame's image as the
+// photometric reference, a constant-velocity prediction, photometric weight 1. Volume at 1 cm (see default_params).
 TrackSequenceParams best_tum_params() {
   TrackSequenceParams p = default_params("frame_to_model");
   p.tracker.kind = "rgbd";
@@ -182,12 +182,12 @@ TEST(TrackSequence, TumFreiburg1RpyBestTrackerTracksEveryFrame) {
 }
 
 // Issue 5 asks ATE RMSE <= 3 cm here. The tracker alone measures 2.5 cm at 5 mm (session 4: robust
-// weights, depth-squared noise, colour on every visible pixel; 3.3 cm before them; frame-to-frame RGB-D 3.1 cm, geometric ICP much worse: on these frames the Kinect depth shows about 25 % less rotation
-// between frames than the ground truth and the colour do, see docs/TRACKING.md). Our best tracker
-// is therefore the tracker followed by the Ceres refinement (the refine section of
-// configs/tum_fr1.yaml: a keyframe every 5 frames, so that consecutive keyframes of this fast
-// rotation stay within the 30 degrees a pair may differ; docs/TRACKING.md, "Ceres refinement", has
-// the sensitivity to the keyframe spacing). Needs Ceres (libceres-dev).
+// weights, depth-squared noise, colour on every visible pixel; 3.3 cm before them; frame-to-frame RGB-D 3.1 cm,
+// geometric ICP much worse: on these frames the Kinect depth shows about 25 % less rotation between frames than the
+// ground truth and the colour do, see docs/TRACKING.md). Our best tracker is therefore the tracker followed by the
+// Ceres refinement (the refine section of configs/tum_fr1.yaml: a keyframe every 5 frames, so that consecutive
+// keyframes of this fast rotation stay within the 30 degrees a pair may differ; docs/TRACKING.md, "Ceres refinement",
+// has the sensitivity to the keyframe spacing). Needs Ceres (libceres-dev).
 TEST(TrackSequence, TumFreiburg1RpyBestTrackerWithinThreeCentimetres) {
   const std::string dir = test::tum_rpy_dir();
   if (!std::filesystem::exists(dir)) GTEST_SKIP() << dir << " is absent (shared test data)";

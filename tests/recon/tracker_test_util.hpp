@@ -21,7 +21,6 @@ inline InputParams synthetic_input(int frames, bool noise = true) {
   return p;
 }
 
-
 inline std::string tum_rpy_dir() { return std::string(SEAMLESS_TEST_DATA) + "/tum_fr1_rpy_000-149"; }
 
 inline InputParams tum_input(const std::string& dir) {

@@ -9,9 +9,9 @@
 #include "core/buffer.hpp"
 #include "core/device.hpp"
 #include "core/error.hpp"
-#include "recon/voxel_hash_volume.hpp"
 #include "io/frame_source.hpp"
 #include "io/input_params.hpp"
+#include "recon/voxel_hash_volume.hpp"
 #include "tsdf_scene.hpp"
 
 namespace seamless {

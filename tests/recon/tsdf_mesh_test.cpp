@@ -2,14 +2,14 @@
 // seams, and the PLY round trip.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <algorithm>
 #include <map>
-#include <tuple>
 #include <set>
 #include <string>
+#include <tuple>
 
 #include "core/error.hpp"
 
@@ -60,7 +60,9 @@ TEST(TsdfMesh, VerticesLieOnTheAnalyticSurface) {
     ++evaluated;
     EXPECT_LE(std::fabs(s.sdf(p)), tol) << "vertex " << p.x << " " << p.y << " " << p.z;
     // Normals from the TSDF gradient: within ~0.1 rad (see the raycast test).
-    EXPECT_GT(dot(m.normals[i], n), 0.995f) << p.x << " " << p.y << " " << p.z << " n " << m.normals[i].x << " " << m.normals[i].y << " " << m.normals[i].z << " true " << n.x << " " << n.y << " " << n.z;
+    EXPECT_GT(dot(m.normals[i], n), 0.995f)
+        << p.x << " " << p.y << " " << p.z << " n " << m.normals[i].x << " " << m.normals[i].y << " " << m.normals[i].z
+        << " true " << n.x << " " << n.y << " " << n.z;
   }
   EXPECT_GT(evaluated, int(m.positions.size() * 8 / 10));
   // Colour fused from the normal encoding: a wall vertex is (127, 127, 0).
@@ -189,8 +191,7 @@ std::string ply_file(const std::string& name, const std::string& header, const s
   std::fclose(f);
   return path;
 }
-template <class T>
-std::string le(T v) {  // the little-endian bytes of v (this machine is little-endian: x86-64)
+template <class T> std::string le(T v) {  // the little-endian bytes of v (this machine is little-endian: x86-64)
   return std::string(reinterpret_cast<const char*>(&v), sizeof v);
 }
 std::string face(int a, int b, int c) { return std::string(1, '\3') + le(a) + le(b) + le(c); }
@@ -200,7 +201,8 @@ TEST(PlyReader, ReadsEveryScalarType) {
       "element vertex 3\nproperty double x\nproperty short y\nproperty int z\nproperty ushort ny\n"
       "element face 1\nproperty list uchar int vertex_indices\n";
   std::string data;
-  for (int i = 0; i < 3; ++i) data += le(1.5 + i) + le<std::int16_t>(-2 - i) + le<std::int32_t>(70000 + i) + le<std::uint16_t>(1);
+  for (int i = 0; i < 3; ++i)
+    data += le(1.5 + i) + le<std::int16_t>(-2 - i) + le<std::int32_t>(70000 + i) + le<std::uint16_t>(1);
   const Mesh m = read_ply(ply_file("types.ply", header, data + face(0, 1, 2)));
   ASSERT_EQ(m.positions.size(), 3u);
   EXPECT_EQ(m.positions[2].x, 3.5f);

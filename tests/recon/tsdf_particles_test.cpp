@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "io/synthetic_source.hpp"
-#include "kernels/scene/synthetic_room.hpp"
 #include "kernels/recon/voxel_hash.hpp"
+#include "kernels/scene/synthetic_room.hpp"
 #include "recon/voxel_hash_volume.hpp"
 #include "tsdf_scene.hpp"
 
@@ -71,8 +71,7 @@ bool unfused(const std::vector<SE3>& poses, const Intrinsics& K, float mu, Depth
 // voxel is a corner of the sample's cell, within a voxel diagonal of it. So such a particle has an
 // unfused voxel within 1 + sqrt(3) < 3 voxels: the voxels (at g * voxel, the hash volume's origin
 // is 0) within 3 of the particle's nearest are probed.
-template <class Unfused>
-bool next_to_unfused(vec3 p, float voxel, Unfused unfused_at) {
+template <class Unfused> bool next_to_unfused(vec3 p, float voxel, Unfused unfused_at) {
   const int3 c{int(std::lround(p.x / voxel)), int(std::lround(p.y / voxel)), int(std::lround(p.z / voxel))};
   for (int i = -3; i <= 3; ++i)
     for (int j = -3; j <= 3; ++j)
@@ -92,8 +91,9 @@ TEST(TsdfParticles, LieOnTheSurfaceWithinHalfASpacing) {
   const BoxViews views(s);
   const float voxel = test::small_volume_params().voxel_size;
   auto unfused_at = [&](vec3 q) {
-    return unfused(views.poses, views.K, 0.04f,
-                   [&](std::size_t k, int u, int v) { return views.depth[k][v * views.K.width + u]; }, q);
+    return unfused(
+        views.poses, views.K, 0.04f, [&](std::size_t k, int u, int v) { return views.depth[k][v * views.K.width + u]; },
+        q);
   };
   int front = 0, closing = 0;
   for (std::int64_t i = 0; i < sp.count; ++i) {
@@ -117,7 +117,7 @@ TEST(TsdfParticles, LieOnTheSurfaceWithinHalfASpacing) {
     EXPECT_GE(on_lattice, 2) << p.x << " " << p.y << " " << p.z;
     if (std::fabs(p.z - s.box_lo.z) < 0.011f && std::fabs(p.x) < 0.17f && std::fabs(p.y) < 0.07f) {
       ++front;
-      EXPECT_GT(-nrm[i].z, 0.99f);  // the front face looks at the camera
+      EXPECT_GT(-nrm[i].z, 0.99f);          // the front face looks at the camera
       EXPECT_NEAR(p.z, s.box_lo.z, 1e-4f);  // on the face: the head-on TSDF is exact (rounding)
     }
   }
@@ -139,8 +139,9 @@ TEST(TsdfParticles, InteriorFillReachesTheRequestedDepth) {
   const BoxViews views(s);
   const float voxel = test::small_volume_params().voxel_size;
   auto unfused_at = [&](vec3 q) {
-    return unfused(views.poses, views.K, 0.04f,
-                   [&](std::size_t k, int u, int v) { return views.depth[k][v * views.K.width + u]; }, q);
+    return unfused(
+        views.poses, views.K, 0.04f, [&](std::size_t k, int u, int v) { return views.depth[k][v * views.K.width + u]; },
+        q);
   };
   float deepest = 0.f;
   for (vec3 p : pos) {
@@ -317,7 +318,8 @@ int holes(const RoomScan& r, int axis, float side, float level, vec2 lo, vec2 hi
       for (int k = 0; k < 8 && clear; ++k) {  // and 2 s around it (no edge, nothing standing on it)
         float a = 6.2831853f * k / 8.f;
         float w3[3];
-        w3[axis] = level + 0.25f * s * side, w3[u] = q3[u] + 2.f * s * std::cos(a), w3[v] = q3[v] + 2.f * s * std::sin(a);
+        w3[axis] = level + 0.25f * s * side, w3[u] = q3[u] + 2.f * s * std::cos(a),
+        w3[v] = q3[v] + 2.f * s * std::sin(a);
         clear = std::fabs(room_sdf({w3[0], w3[1], w3[2]}) - 0.25f * s) < 1e-4f;
       }
       if (!clear || !seen_by_all(r, q)) continue;
@@ -376,7 +378,8 @@ TEST(TsdfParticlesRoom, ParticlesLieOnTheRoomWithinHalfASpacingWhereSeen) {
     const SE3& T = r.poses[k];
     const vec3 ray = normalize(T.R * r.K.unproject(float(u), float(v), 1.f));
     const R::Hit h = R::room_raycast(T.t - kShift, ray);
-    return h.t > 0.f && h.t * dot(ray, T.R * vec3{0.f, 0.f, 1.f}) <= 4.f ? h.t * dot(ray, T.R * vec3{0.f, 0.f, 1.f}) : 0.f;
+    return h.t > 0.f && h.t * dot(ray, T.R * vec3{0.f, 0.f, 1.f}) <= 4.f ? h.t * dot(ray, T.R * vec3{0.f, 0.f, 1.f})
+                                                                         : 0.f;
   };
   auto unfused_at = [&](vec3 q) { return unfused(r.poses, r.K, 0.04f, depth_at, q); };
   int closing = 0;
@@ -391,13 +394,14 @@ TEST(TsdfParticlesRoom, ParticlesLieOnTheRoomWithinHalfASpacingWhereSeen) {
     EXPECT_LE(std::fabs(d), loose) << p.x << " " << p.y << " " << p.z;
     if (!seen_by_all(r, p - R::room_sdf_grad(p - kShift) * d)) continue;
     ++seen;
-    if (std::fabs(d) > 0.5f * s && ++far <= 10) ADD_FAILURE() << "particle " << p.x << " " << p.y << " " << p.z << " at " << d;
+    if (std::fabs(d) > 0.5f * s && ++far <= 10)
+      ADD_FAILURE() << "particle " << p.x << " " << p.y << " " << p.z << " at " << d;
   }
   EXPECT_EQ(far, 0);
   EXPECT_GT(seen, static_cast<int>(r.particles.size() / 4));  // not vacuous: much of the room was seen by all
   EXPECT_GT(closing, 0);  // the orbit's 15 degrees leave the backs of the objects unseen
-  std::printf("room: %zu particles, %d on surfaces seen by every view, %d closing unfused space\n",
-              r.particles.size(), seen, closing);
+  std::printf("room: %zu particles, %d on surfaces seen by every view, %d closing unfused space\n", r.particles.size(),
+              seen, closing);
 }
 
 // The thinning's promise: no two particles closer than kSceneParticleMinDistance spacings, so that
@@ -408,7 +412,8 @@ TEST(TsdfParticlesRoom, NoTwoParticlesCloserThanHalfASpacing) {
   const float r = kSceneParticleMinDistance * kRoomSpacing;
   float closest = 1e9f;
   for (std::size_t i = 0; i < p.size(); ++i)
-    for (std::size_t j = i + 1; j < p.size() && p[j].x - p[i].x < r; ++j) closest = std::min(closest, length(p[j] - p[i]));
+    for (std::size_t j = i + 1; j < p.size() && p[j].x - p[i].x < r; ++j)
+      closest = std::min(closest, length(p[j] - p[i]));
   EXPECT_GE(closest, r * (1.f - 1e-5f));
 }
 

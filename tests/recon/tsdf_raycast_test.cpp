@@ -71,7 +71,9 @@ void expect_same_surfaces(const RaycastMaps& plain, const RaycastMaps& tiled, co
     // none, in both maps alike.
     const bool none_p = length2(np[i]) == 0.f, none_t = length2(nt[i]) == 0.f;
     EXPECT_EQ(none_p, none_t) << what << " pixel " << i;
-    if (!none_p && !none_t) { EXPECT_GT(dot(np[i], nt[i]), 0.99f) << what << " pixel " << i; }
+    if (!none_p && !none_t) {
+      EXPECT_GT(dot(np[i], nt[i]), 0.99f) << what << " pixel " << i;
+    }
   }
   EXPECT_EQ(hit_mismatch, 0) << what;
   EXPECT_LE(not_identical, hits / 50) << what;
@@ -128,10 +130,13 @@ TEST(TsdfRaycastWindow, SameMapsWithAndWithoutTheWindow) {
       int hits = 0;
       for (std::size_t i = 0; i < da.size(); ++i) {
         ASSERT_EQ(da[i], db[i]) << "window " << side << " pixel " << i;
-        ASSERT_TRUE(va[i].x == vb[i].x && va[i].y == vb[i].y && va[i].z == vb[i].z) << "window " << side << " pixel " << i;
+        ASSERT_TRUE(va[i].x == vb[i].x && va[i].y == vb[i].y && va[i].z == vb[i].z)
+            << "window " << side << " pixel " << i;
         hits += da[i] > 0.f;
       }
-      if (v == 0) { EXPECT_GT(hits, static_cast<int>(da.size()) / 4) << "the first view must see the model"; }
+      if (v == 0) {
+        EXPECT_GT(hits, static_cast<int>(da.size()) / 4) << "the first view must see the model";
+      }
     }
   }
 }

@@ -79,7 +79,8 @@ struct Scene {
   }
 
   // Camera-z depth (metres, 0 = nothing) as a pinhole camera at world_T_camera sees the scene.
-  std::vector<float> render(const Intrinsics& K, const SE3& world_T_camera, std::vector<vec3>* normals = nullptr) const {
+  std::vector<float> render(const Intrinsics& K, const SE3& world_T_camera,
+                            std::vector<vec3>* normals = nullptr) const {
     std::vector<float> depth(static_cast<std::size_t>(K.width) * K.height, 0.f);
     if (normals) normals->assign(depth.size(), vec3{0.f, 0.f, 0.f});
     for (int y = 0; y < K.height; ++y)
@@ -137,7 +138,9 @@ inline void expect_same_blocks(const std::vector<VoxelHashVolume::HostBlock>& a,
     for (int k = 0; k < kernels::kBlockVoxels; ++k) {
       ASSERT_EQ(a[i].voxels[k].weight, b[i].voxels[k].weight);
       ASSERT_NEAR(a[i].voxels[k].sdf, b[i].voxels[k].sdf, 1e-5f);
-      if (colour) { ASSERT_NEAR(a[i].voxels[k].color.x, b[i].voxels[k].color.x, 1); }
+      if (colour) {
+        ASSERT_NEAR(a[i].voxels[k].color.x, b[i].voxels[k].color.x, 1);
+      }
     }
   }
 }

@@ -33,14 +33,13 @@ TEST(VolumeBench, ReportsEveryStageOfEveryFrame) {
   ReconBenchResult r = bench_recon(bench_frames(5), kK, bench_params(), Device::CPU, 2);
   EXPECT_EQ(r.frames, 3);
   std::map<std::string, double> m(r.median_ms.begin(), r.median_ms.end());
-  for (const char* stage :
-       {"allocate", "visible", "fuse", "remove_empty", "raycast", "raycast_splat", "frame"}) {
+  for (const char* stage : {"allocate", "visible", "fuse", "remove_empty", "raycast", "raycast_splat", "frame"}) {
     ASSERT_TRUE(m.count(stage)) << stage;
     EXPECT_GT(m[stage], 0.0) << stage;
   }
   EXPECT_LE(m["fuse"], m["frame"]);
   EXPECT_LE(m["raycast_splat"], m["raycast"]);  // a part of it
-  EXPECT_FALSE(m.count("raycast_window"));  // with ray intervals the splat fills the window
+  EXPECT_FALSE(m.count("raycast_window"));      // with ray intervals the splat fills the window
   EXPECT_EQ(r.rows.size(), 3u * 7u);
   EXPECT_GT(r.stats.allocated_blocks, 0);
 }

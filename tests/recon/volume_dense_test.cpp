@@ -11,7 +11,7 @@ namespace {
 
 TEST(VolumeDense, MatchesTheHashedVolume) {
   VolumeParams p = test::small_volume_params();
-  p.max_depth = 4.f;  // the default: this test never limited it
+  p.max_depth = 4.f;                        // the default: this test never limited it
   p.dense_resolution = 128;                 // 1.28 m cube
   p.dense_origin = {-0.64f, -0.64f, 0.8f};  // holds the sphere and the wall's centre
   test::Scene s;

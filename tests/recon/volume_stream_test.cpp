@@ -106,13 +106,15 @@ TEST(VolumeStream, EachBlockIsOnExactlyOneSide) {
     vec3 c = (vec3{float(b.x), float(b.y), float(b.z)} * 8.f + vec3{3.5f, 3.5f, 3.5f}) * 0.01f;
     bool near = length(c - p) <= 4.5f;
     expect_device += near;
-    EXPECT_EQ(near, std::binary_search(on_device.begin(), on_device.end(), b, [](int3 a, int3 b) {
-                return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
-              })) << "block " << b.x << " " << b.y << " " << b.z;
+    EXPECT_EQ(near,
+              std::binary_search(on_device.begin(), on_device.end(), b,
+                                 [](int3 a, int3 b) { return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z); }))
+        << "block " << b.x << " " << b.y << " " << b.z;
   }
   ASSERT_GT(expect_device, 0);
   ASSERT_LT(expect_device, static_cast<std::int64_t>(all.size()));
-  EXPECT_EQ(vol.stats().host_blocks + static_cast<std::int64_t>(on_device.size()), static_cast<std::int64_t>(all.size()));
+  EXPECT_EQ(vol.stats().host_blocks + static_cast<std::int64_t>(on_device.size()),
+            static_cast<std::int64_t>(all.size()));
   vol.stream_in_all();
   EXPECT_EQ(vol.allocated_block_coords(), all);
 }

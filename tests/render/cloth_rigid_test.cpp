@@ -51,8 +51,8 @@ TEST(RenderCloth, BothFacesAreLit) {
     Sheet s(9, flip);
     Pixels img(r.render(s.list(), camera(K)));
     const uchar3 c = img.at(80, 60);
-    EXPECT_LE(max_diff(c, uchar3{200, 150, 50}), 2) << (flip ? "back" : "front") << " face: " << int(c.x) << " "
-                                                      << int(c.y) << " " << int(c.z);
+    EXPECT_LE(max_diff(c, uchar3{200, 150, 50}), 2)
+        << (flip ? "back" : "front") << " face: " << int(c.x) << " " << int(c.y) << " " << int(c.z);
   }
 }
 
@@ -152,7 +152,7 @@ TEST(RenderRigid, DrawListFromTheSolversObjects) {
   }
   st.x.push_back({0.f, 0.f, 0.f}), st.phase.push_back(kernels::phase::kCloth);
   auto mesh = std::make_shared<BodyMesh>();
-  objects.bodies = {{10, 1, 0, {vec3{0.f, 0.f, 0.f}}, mesh}, box};  // the first is not in the frames
+  objects.bodies = {{10, 1, 0, {vec3{0.f, 0.f, 0.f}}, mesh}, box};      // the first is not in the frames
   objects.cloths.push_back({0, 0, 1, {int3{0, 1, 3}, int3{0, 1, 4}}});  // id 4: not spawned yet
   RigidFrame f;
   f.centre = c;

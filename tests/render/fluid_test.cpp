@@ -37,12 +37,12 @@ RenderParams fluid_params() {
 }
 
 // The union of the spheres' projections is inside the box of the particles' projected centres
-// grown by the largest projected radius f r / (z - r) (r: the enlarged radius of the SSFR passes) (a sphere's silhouette lies within its
-// bounding square in the image). Pixels two beyond that box must be untouched background: the
-// depth filter and the shading never write where no sphere was. Pixels inside the projection of
-// the block's front face shrunk by a radius are covered by spheres and must differ from the
-// background: thickness > 0 there attenuates the refracted background (Beer-Lambert, red
-// coefficient 6/m over at least one diameter: at least 1 - exp(-0.24) = 21 % of 230).
+// grown by the largest projected radius f r / (z - r) (r: the enlarged radius of the SSFR passes) (a sphere's
+// silhouette lies within its bounding square in the image). Pixels two beyond that box must be untouched background:
+// the depth filter and the shading never write where no sphere was. Pixels inside the projection of the block's front
+// face shrunk by a radius are covered by spheres and must differ from the background: thickness > 0 there attenuates
+// the refracted background (Beer-Lambert, red coefficient 6/m over at least one diameter: at least 1 - exp(-0.24) = 21
+// % of 230).
 TEST(RenderFluid, FluidPixelsExactlyWhereTheFluidProjects) {
   SEAMLESS_REQUIRE_EGL();
   const Intrinsics K = intrinsics(150.f, 79.5f, 59.5f, 160, 120);
@@ -104,8 +104,8 @@ TEST(RenderFluid, StageImagesAreWrittenAndNotEmpty) {
   std::filesystem::remove_all(dir);
   HeadlessOutput out(dir, p);
   out.add(r);
-  const std::vector<std::string> names = {"1_depth", "2_depth_filtered", "3_normals", "4_thickness",
-                                          "5_reflection", "6_refraction", "7_composite"};
+  const std::vector<std::string> names = {"1_depth",      "2_depth_filtered", "3_normals",  "4_thickness",
+                                          "5_reflection", "6_refraction",     "7_composite"};
   ASSERT_EQ(r.stage_images().size(), names.size());
   for (std::size_t i = 0; i < names.size(); ++i) {
     EXPECT_EQ(r.stage_images()[i].name, names[i]);

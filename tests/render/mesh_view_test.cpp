@@ -70,7 +70,8 @@ TEST(RenderMeshView, FreeCamera) {
     return worst;
   };
   float lo_u = 1e9f, hi_u = -1e9f, lo_v = 1e9f, hi_v = -1e9f;
-  for (vec2 c : q) lo_u = std::min(lo_u, c.x), hi_u = std::max(hi_u, c.x), lo_v = std::min(lo_v, c.y), hi_v = std::max(hi_v, c.y);
+  for (vec2 c : q)
+    lo_u = std::min(lo_u, c.x), hi_u = std::max(hi_u, c.x), lo_v = std::min(lo_v, c.y), hi_v = std::max(hi_v, c.y);
   int inside = 0;
   for (int v = 0; v < H; ++v)
     for (int u = 0; u < W; ++u) {

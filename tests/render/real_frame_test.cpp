@@ -28,9 +28,9 @@ namespace {
 const char* const kFolder = "tum_fr1_rpy_000-149";
 constexpr int kFrame = 130;
 
-#define REQUIRE_REAL_FRAME()                                                                     \
-  SEAMLESS_REQUIRE_EGL();                                                                        \
-  if (!std::filesystem::is_directory(std::string(SEAMLESS_TEST_DATA) + "/" + kFolder))           \
+#define REQUIRE_REAL_FRAME()                                                           \
+  SEAMLESS_REQUIRE_EGL();                                                              \
+  if (!std::filesystem::is_directory(std::string(SEAMLESS_TEST_DATA) + "/" + kFolder)) \
   GTEST_SKIP() << "test data folder " << SEAMLESS_TEST_DATA << "/" << kFolder << " is absent"
 
 // The frame and the desk plane (unit normal n towards the camera, tangents t1 (image right) and
@@ -55,7 +55,9 @@ struct RealFrame {
   int w() const { return f.intrinsics.width; }
   int h() const { return f.intrinsics.height; }
   float depth(int u, int v) const { return depth_host[static_cast<std::size_t>(v) * w() + u]; }
-  vec3 point(int u, int v) const { return f.intrinsics.unproject(static_cast<float>(u), static_cast<float>(v), depth(u, v)); }
+  vec3 point(int u, int v) const {
+    return f.intrinsics.unproject(static_cast<float>(u), static_cast<float>(v), depth(u, v));
+  }
   // Where pixel (u, v)'s ray meets the desk plane.
   vec3 on_plane(float u, float v) const {
     const vec3 ray = f.intrinsics.unproject(u, v, 1.f);
@@ -132,7 +134,7 @@ RenderParams kinect_params(const RealFrame& s) {
 // A cube of half size `half` resting on the desk below pixel (u, v), turned by `yaw` about n.
 RigidDraw cube_on_desk(const RealFrame& s, float u, float v, float half, float yaw) {
   RigidDraw r;
-  const vec3 a = s.t1 * std::cos(yaw) + s.t2 * std::sin(yaw), b = cross(s.n, a);  // b = n x a
+  const vec3 a = s.t1 * std::cos(yaw) + s.t2 * std::sin(yaw), b = cross(s.n, a);   // b = n x a
   r.world_T_body.R = {{{a.x, s.n.x, b.x}, {a.y, s.n.y, b.y}, {a.z, s.n.z, b.z}}};  // columns a, n, b
   r.world_T_body.t = s.on_plane(u, v) + s.n * half;
   r.half_extents = {half, half, half};
@@ -262,8 +264,8 @@ TEST(RenderLooks, CubeShadowOnTheRealDesk) {
         ++umbra;
         const float want = (1.f - 0.9f * k) * luminance(off);
         const float level = luminance(on) - luminance(uchar3{static_cast<std::uint8_t>(std::max(on.x - 1, 0)),
-                                                               static_cast<std::uint8_t>(std::max(on.y - 1, 0)),
-                                                               static_cast<std::uint8_t>(std::max(on.z - 1, 0))});
+                                                             static_cast<std::uint8_t>(std::max(on.y - 1, 0)),
+                                                             static_cast<std::uint8_t>(std::max(on.z - 1, 0))});
         EXPECT_LE(luminance(on), want + level) << "not in shadow at " << u << "," << v;
         // Within 1 cm of the cube's footprint on the desk: the contact region.
         const vec3 qb = fr.cube.world_T_body.inverse() * P;
@@ -376,9 +378,10 @@ TEST(RenderLooks, WaterOnTheRealDesk) {
   const vec3 a = p.absorption;
   const uchar3 tinted{srgb8(std::exp(-0.03f * a.x)), srgb8(std::exp(-0.03f * a.y)), srgb8(std::exp(-0.03f * a.z))};
   const float expected = delta_e(tinted, uchar3{255, 255, 255});
-  std::printf("%zu particles; disc pixels %d, visibly changed %.1f %%; thick pixels %d: mean delta E %.1f "
-              "(Beer-Lambert over 3 cm on white: %.1f)\n",
-              puddle.x.size(), disc, 100.0 * disc_seen / std::max(disc, 1), thick, mean_de, expected);
+  std::printf(
+      "%zu particles; disc pixels %d, visibly changed %.1f %%; thick pixels %d: mean delta E %.1f "
+      "(Beer-Lambert over 3 cm on white: %.1f)\n",
+      puddle.x.size(), disc, 100.0 * disc_seen / std::max(disc, 1), thick, mean_de, expected);
   EXPECT_GE(puddle.x.size(), 200u);
   EXPECT_GT(disc, 5000);
   EXPECT_GE(disc_seen, 0.9 * disc) << "specks: the fluid leaves the particles' discs unchanged";

@@ -13,11 +13,11 @@
 namespace seamless::test {
 
 // GTEST_SKIP unless a headless EGL context can be created (Mesa in CI).
-#define SEAMLESS_REQUIRE_EGL()                                                                 \
-  do {                                                                                         \
-    std::string why_;                                                                          \
-    if (!::seamless::HeadlessContext::available(&why_))                                        \
-      GTEST_SKIP() << "no EGL display could be created here: " << why_;                        \
+#define SEAMLESS_REQUIRE_EGL()                                          \
+  do {                                                                  \
+    std::string why_;                                                   \
+    if (!::seamless::HeadlessContext::available(&why_))                 \
+      GTEST_SKIP() << "no EGL display could be created here: " << why_; \
   } while (0)
 
 struct Pixels {

@@ -70,7 +70,7 @@ TEST(RenderShadow, MeshViewFloorUnderACube) {
   for (int v = 0; v < on.h; ++v)
     for (int u = 0; u < on.w; ++u) {
       if (!same(off.at(u, v), bg.at(u, v))) continue;  // the cube
-      if (!same(bg.at(u, v), floor_colour)) continue;   // beyond the floor (the unlit floor is its colour)
+      if (!same(bg.at(u, v), floor_colour)) continue;  // beyond the floor (the unlit floor is its colour)
       const vec3 q = floor_point(cam, u, v);
       const float m = std::max(std::abs(q.x), std::abs(q.z));
       const uchar3 c = on.at(u, v);

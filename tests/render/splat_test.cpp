@@ -25,7 +25,8 @@ struct Block {
     for (int k = 0; k < 6; ++k)
       for (int jj = 0; jj < 6; ++jj)
         for (int i = 0; i < 6; ++i)
-          x.push_back(vec3{(i - 2.5f) * 2 * r + j(rng), (jj - 2.5f) * 2 * r + j(rng), kWallZ + (k - 2.5f) * 2 * r + j(rng)});
+          x.push_back(
+              vec3{(i - 2.5f) * 2 * r + j(rng), (jj - 2.5f) * 2 * r + j(rng), kWallZ + (k - 2.5f) * 2 * r + j(rng)});
     ph.assign(x.size(), kernels::phase::kFluid);
   }
   DrawList list() const {
@@ -67,7 +68,8 @@ std::vector<int> chord_counts(const Block& b, const Intrinsics& K) {
     const float half = K.fx * rs / (c.z - rs) + 1.f;
     for (int y = 0; y < K.height; ++y)
       for (int x = 0; x < K.width; ++x)
-        if (std::abs(q.x - x) <= half && std::abs(q.y - (K.height - 1 - y)) <= half) ++n[static_cast<std::size_t>(y) * K.width + x];
+        if (std::abs(q.x - x) <= half && std::abs(q.y - (K.height - 1 - y)) <= half)
+          ++n[static_cast<std::size_t>(y) * K.width + x];
   }
   return n;
 }
@@ -76,7 +78,8 @@ std::vector<int> chord_counts(const Block& b, const Intrinsics& K) {
 int most_within(const std::vector<int>& n, int w, int h, int x, int y, int reach) {
   int m = 0;
   for (int v = std::max(0, y - reach); v <= std::min(h - 1, y + reach); ++v)
-    for (int u = std::max(0, x - reach); u <= std::min(w - 1, x + reach); ++u) m = std::max(m, n[static_cast<std::size_t>(v) * w + u]);
+    for (int u = std::max(0, x - reach); u <= std::min(w - 1, x + reach); ++u)
+      m = std::max(m, n[static_cast<std::size_t>(v) * w + u]);
   return m;
 }
 
@@ -126,8 +129,8 @@ TEST(RenderSplat, ComputeDepthMatchesRaster) {
       EXPECT_NEAR(c, a, depth_tol(a)) << "at " << x << "," << y;
       EXPECT_LT(a, kWallZ) << "fluid behind the wall at " << x << "," << y;
     }
-  EXPECT_GT(both, 2000);                // the block covers about 60 x 60 pixels, partly cut by the wall
-  EXPECT_LT(silhouette, both / 50);     // differences are rare rim pixels, not a shifted image
+  EXPECT_GT(both, 2000);             // the block covers about 60 x 60 pixels, partly cut by the wall
+  EXPECT_LT(silhouette, both / 50);  // differences are rare rim pixels, not a shifted image
 }
 
 // Thickness tolerance per pixel: the splat rounds each chord to 2^-20 m (0.5 * 2^-20 each); the
@@ -207,14 +210,16 @@ TEST(RenderSplat, ComputeScreenPassesGiveTheRasterFrame) {
   const Block b;
   RenderParams p;
   p.znear = kNear;
-  const Drawn a = draw_with(p, b, K, 2.5f, FluidSplat::raster), c = draw_with(p, b, K, 2.5f, FluidSplat::compute);  // wall behind
+  const Drawn a = draw_with(p, b, K, 2.5f, FluidSplat::raster),
+              c = draw_with(p, b, K, 2.5f, FluidSplat::compute);  // wall behind
   if (!c.compute) GTEST_SKIP() << "no GL 4.3 compute here";
   const Pixels ras(a.frame), cmp(c.frame);
   const auto &ras_d = a.fluid.depth, &cmp_d = c.fluid.depth;
   auto same_depth_near = [&](int x, int y) {  // (x, y): window texel
     for (int v = std::max(0, y - 2); v <= std::min(K.height - 1, y + 2); ++v)
       for (int u = std::max(0, x - 2); u <= std::min(K.width - 1, x + 2); ++u)
-        if (ras_d[static_cast<std::size_t>(v) * K.width + u] != cmp_d[static_cast<std::size_t>(v) * K.width + u]) return false;
+        if (ras_d[static_cast<std::size_t>(v) * K.width + u] != cmp_d[static_cast<std::size_t>(v) * K.width + u])
+          return false;
     return true;
   };
   int fluid = 0, compared = 0;

@@ -28,7 +28,10 @@ namespace {
 class VirtualDisplay {
  public:
   VirtualDisplay() {
-    if (std::getenv("DISPLAY")) { ok_ = true; return; }
+    if (std::getenv("DISPLAY")) {
+      ok_ = true;
+      return;
+    }
     for (int n = 97; n < 130 && !ok_; ++n) {
       const std::string sock = "/tmp/.X11-unix/X" + std::to_string(n), lock = "/tmp/.X" + std::to_string(n) + "-lock";
       if (std::filesystem::exists(sock) || std::filesystem::exists(lock)) continue;
@@ -50,7 +53,7 @@ class VirtualDisplay {
       if (exited) {
         pid_ = -1;
         if (WIFEXITED(status) && WEXITSTATUS(status) == 127) return;  // no Xvfb installed
-        continue;                                                      // display taken: next one
+        continue;                                                     // display taken: next one
       }
       ok_ = std::filesystem::exists(sock);
       if (ok_) {

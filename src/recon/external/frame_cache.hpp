@@ -9,12 +9,10 @@
 
 namespace seamless::external {
 
-template <class T>
-class TwoFrameCache {
+template <class T> class TwoFrameCache {
  public:
   // The prepared form of `f`, made by make(f) when it is not one of the two kept.
-  template <class Make>
-  const T& get(const RgbdFrame& f, Make&& make) {
+  template <class Make> const T& get(const RgbdFrame& f, Make&& make) {
     ++tick_;
     for (Entry& e : entries_)
       if (e.used != 0 && e.index == f.index && e.timestamp == f.timestamp) {

@@ -19,9 +19,7 @@ namespace seamless::external {
 
 namespace {
 
-cv::Mat camera_matrix(const Intrinsics& K) {
-  return (cv::Mat_<float>(3, 3) << K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1);
-}
+cv::Mat camera_matrix(const Intrinsics& K) { return (cv::Mat_<float>(3, 3) << K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1); }
 
 cv::Ptr<cv::rgbd::Odometry> make_cv_odometry(OpenCvMethod m, const Intrinsics& K) {
   cv::Mat cam = camera_matrix(K);

@@ -24,8 +24,8 @@ namespace {
 
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 
-constexpr float kMaxDepth = 4.f;            // metres
-constexpr float kVoxel = 0.02f;             // metres
+constexpr float kMaxDepth = 4.f;             // metres
+constexpr float kVoxel = 0.02f;              // metres
 constexpr double kMaxCorrespondence = 0.25;  // metres
 constexpr int kMaxIterations = 50;
 

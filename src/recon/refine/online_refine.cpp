@@ -127,7 +127,8 @@ void OnlineRefiner::add_keyframe(Item& it) {
     refined_.push_back(it.odometry);
   } else {
     // Its first estimate: the previous keyframe's refined pose and the odometry since.
-    refined_.push_back(to_se3(compose(from_se3(refined_[j - 1]), compose(inverse(kf_[j - 1].odometry), kf_[j].odometry))));
+    refined_.push_back(
+        to_se3(compose(from_se3(refined_[j - 1]), compose(inverse(kf_[j - 1].odometry), kf_[j].odometry))));
     Tracker tracker(pair_tracker_params(p_), Device::CPU);
     const int level = finest_level(p_, kf_[j].pyr->levels());
     Graph& g = *graph_;
@@ -273,21 +274,23 @@ void write_online_stats(const std::string& path, const OnlineRefineStats& s) {
 Trajectory online_refine_finish(OnlineCorrector& c, const std::string& out_dir, bool write_files) {
   Trajectory final_traj = c.finish();
   const OnlineRefineStats s = c.stats();
-  spdlog::info("online refinement: {} keyframes, {} pair edges ({} loop candidates, {} rejected), {} solves, {} "
-               "corrections applied while tracking; tracking thread {:.3f} ms a frame median ({:.3f} ms max); "
-               "background {:.2f} s a keyframe median ({:.2f} s max), Ceres {:.4f} s a solve median ({:.4f} s max); "
-               "{:.1f} s after the last frame for the keyframes still queued",
-               s.keyframes, s.pair_edges, s.candidate_pairs, s.rejected_pairs, s.solves, s.corrections,
-               median_of(s.handover_ms), max_of(s.handover_ms), median_of(s.keyframe_s), max_of(s.keyframe_s),
-               median_of(s.solve_s), max_of(s.solve_s), s.final_wait_s);
+  spdlog::info(
+      "online refinement: {} keyframes, {} pair edges ({} loop candidates, {} rejected), {} solves, {} "
+      "corrections applied while tracking; tracking thread {:.3f} ms a frame median ({:.3f} ms max); "
+      "background {:.2f} s a keyframe median ({:.2f} s max), Ceres {:.4f} s a solve median ({:.4f} s max); "
+      "{:.1f} s after the last frame for the keyframes still queued",
+      s.keyframes, s.pair_edges, s.candidate_pairs, s.rejected_pairs, s.solves, s.corrections, median_of(s.handover_ms),
+      max_of(s.handover_ms), median_of(s.keyframe_s), max_of(s.keyframe_s), median_of(s.solve_s), max_of(s.solve_s),
+      s.final_wait_s);
   if (write_files) {
     const std::string traj = out_dir + "/trajectory.txt";
     if (std::filesystem::exists(traj)) std::filesystem::rename(traj, out_dir + "/trajectory_live.txt");
     write_tum_trajectory(out_dir + "/trajectory_odometry.txt", c.odometry());
     write_tum_trajectory(traj, final_traj);
     write_online_stats(out_dir + "/online_refine_stats.csv", s);
-    spdlog::info("online refinement: trajectory.txt is the final graph's trajectory, trajectory_live.txt the poses "
-                 "as tracked and fused (corrected while the run went), trajectory_odometry.txt the uncorrected chain");
+    spdlog::info(
+        "online refinement: trajectory.txt is the final graph's trajectory, trajectory_live.txt the poses "
+        "as tracked and fused (corrected while the run went), trajectory_odometry.txt the uncorrected chain");
   }
   return final_traj;
 }

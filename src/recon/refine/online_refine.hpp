@@ -32,21 +32,21 @@ struct Graph;
 // A solved graph as the tracking thread sees it: every keyframe in it, with the odometry pose it
 // was handed over with and its refined pose (world_T_camera).
 struct OnlineSolution {
-  std::int64_t version = 0;               // 1 for the first solve, +1 per solve
-  std::vector<std::int64_t> frames;       // keyframe frame indices, in order
+  std::int64_t version = 0;          // 1 for the first solve, +1 per solve
+  std::vector<std::int64_t> frames;  // keyframe frame indices, in order
   std::vector<SE3> odometry, refined;
 };
 
 struct OnlineRefineStats {
-  std::int64_t keyframes = 0;        // handed over
-  std::int64_t solves = 0;           // Ceres solves done in the background
+  std::int64_t keyframes = 0;  // handed over
+  std::int64_t solves = 0;     // Ceres solves done in the background
   std::int64_t candidate_pairs = 0, pair_edges = 0, rejected_pairs = 0, odometry_edges = 0;
-  std::int64_t corrections = 0;      // solutions the tracking thread applied
+  std::int64_t corrections = 0;                         // solutions the tracking thread applied
   double max_correction_m = 0, max_correction_deg = 0;  // largest keyframe correction of the last solve
-  std::vector<double> handover_ms;   // tracking thread, every frame: keyframe test, copy, queue, poll
-  std::vector<double> keyframe_s;    // background, per keyframe: pyramid, pair alignments, Ceres solve
-  std::vector<double> solve_s;       // ... of which the Ceres solve
-  double final_wait_s = 0;           // after the last frame: until every keyframe was in a solve
+  std::vector<double> handover_ms;  // tracking thread, every frame: keyframe test, copy, queue, poll
+  std::vector<double> keyframe_s;   // background, per keyframe: pyramid, pair alignments, Ceres solve
+  std::vector<double> solve_s;      // ... of which the Ceres solve
+  double final_wait_s = 0;          // after the last frame: until every keyframe was in a solve
 };
 
 // The background worker: a queue of keyframes in, the latest solution out. Runs on the CPU (Ceres

@@ -81,8 +81,8 @@ void require_refine(const RefineParams& params) {
 std::vector<std::int64_t> select_keyframes(const Trajectory& odometry, const RefineParams& p,
                                            const std::vector<bool>& tracked) {
   if (!tracked.empty() && tracked.size() != odometry.size())
-    throw Error("refine: " + std::to_string(tracked.size()) + " tracking flags for " +
-                std::to_string(odometry.size()) + " poses");
+    throw Error("refine: " + std::to_string(tracked.size()) + " tracking flags for " + std::to_string(odometry.size()) +
+                " poses");
   std::vector<std::int64_t> kf;
   for (std::size_t i = 0; i < odometry.size(); ++i) {
     if (!is_tracked(tracked, i)) continue;  // a lost frame carries the last good pose, not its own
@@ -127,8 +127,8 @@ std::unique_ptr<FramePyramid> build_pyramid(const RgbdFrame& f, const Intrinsics
 namespace {
 // Reads the whole source (its frames are the trajectory's, in order) and keeps the keyframes.
 std::vector<KeyframeData> load_keyframes(FrameSource& source, const Trajectory& odometry,
-                                         const std::vector<std::int64_t>& kf, const PreprocessParams& pre,
-                                         bool colour, Device d) {
+                                         const std::vector<std::int64_t>& kf, const PreprocessParams& pre, bool colour,
+                                         Device d) {
   std::vector<KeyframeData> out;
   const Intrinsics K = source.intrinsics();
   RgbdFrame f;
@@ -144,8 +144,8 @@ std::vector<KeyframeData> load_keyframes(FrameSource& source, const Trajectory& 
   }
   if (n != total)
     throw InputError("refine: the source '" + source.name() + "' gave " + std::to_string(n) +
-                " frames but the trajectory has " + std::to_string(total) +
-                " poses; refine the trajectory of exactly these frames (same input, same frames setting)");
+                     " frames but the trajectory has " + std::to_string(total) +
+                     " poses; refine the trajectory of exactly these frames (same input, same frames setting)");
   return out;
 }
 
@@ -213,14 +213,10 @@ PairResult align_pair(const Tracker& tracker, const KeyframeData& a, const Keyfr
   out.inlier_ratio = s.valid > 0 ? s.inliers / s.valid : 0.0;
   IcpStep step = solve_icp_step(s);
   auto [deg, m] = distance(z_odo, out.z);
-  if (r.status == TrackStatus::degenerate || !step.solved || step.condition > 1e6)
-    out.why = "degenerate";
-  else if (out.inlier_ratio < p.min_pair_inlier_ratio)
-    out.why = "inliers";
-  else if (m > p.max_pair_correction || deg > p.max_pair_correction_deg)
-    out.why = "correction";
-  else
-    out.ok = true;
+  if (r.status == TrackStatus::degenerate || !step.solved || step.condition > 1e6) out.why = "degenerate";
+  else if (out.inlier_ratio < p.min_pair_inlier_ratio) out.why = "inliers";
+  else if (m > p.max_pair_correction || deg > p.max_pair_correction_deg) out.why = "correction";
+  else out.ok = true;
   if (out.ok) out.info = information(s, p);
   return out;
 }
@@ -256,8 +252,8 @@ void add_odometry_edge(Graph& g, const Tracker& tracker, const KeyframeData& a, 
   ++g.stats.odometry_edges;
 }
 
-void add_pair_edge(Graph& g, const Tracker& tracker, const KeyframeData& a, const KeyframeData& b,
-                   ReferenceMaps& ref_a, int i, int j, const RefineParams& p, int level) {
+void add_pair_edge(Graph& g, const Tracker& tracker, const KeyframeData& a, const KeyframeData& b, ReferenceMaps& ref_a,
+                   int i, int j, const RefineParams& p, int level) {
   PairResult r = align_pair(tracker, a, b, ref_a, p, level);
   if (!r.ok) {
     ++g.stats.rejected_pairs;
@@ -323,7 +319,7 @@ Trajectory apply_corrections(const Trajectory& odometry, const std::vector<Keyfr
       return refine_detail::compose(refined[k], refine_detail::compose(refine_detail::inverse(kf[k].odometry), odo));
     };
     Pose p;
-    if (b == 0) p = via(0);                       // before the first keyframe
+    if (b == 0) p = via(0);                           // before the first keyframe
     else if (b == kf.size()) p = via(kf.size() - 1);  // after the last
     else if (kf[b].frame == static_cast<std::int64_t>(f)) p = refined[b];
     else {
@@ -356,8 +352,9 @@ RefineResult refine_trajectory(FrameSource& source, const Trajectory& odometry, 
   r.keyframes = select_keyframes(odometry, params, tracked);
   r.stats.keyframes = static_cast<std::int64_t>(r.keyframes.size());
   if (r.keyframes.size() < 2)
-    return no_op(odometry, r, "fewer than two keyframes (" + std::to_string(odometry.size()) +
-                                  " frames, refine.keyframe_every " + std::to_string(params.keyframe_every) + ")");
+    return no_op(odometry, r,
+                 "fewer than two keyframes (" + std::to_string(odometry.size()) + " frames, refine.keyframe_every " +
+                     std::to_string(params.keyframe_every) + ")");
   if (!refine_available())
     throw ConfigError("refine: this build has no Ceres; install libceres-dev (scripts/packages.txt) and reconfigure");
   std::vector<KeyframeData> kf =
@@ -371,8 +368,9 @@ RefineResult refine_trajectory(FrameSource& source, const Trajectory& odometry, 
   r.stats.rejected_pairs = counts.rejected_pairs;
   r.stats.odometry_edges = counts.odometry_edges;
   if (r.stats.pair_edges == 0)
-    return no_op(odometry, r, "no keyframe pair could be aligned (no overlap within refine.max_pair_* and "
-                              "refine.min_overlap, or every alignment was rejected)");
+    return no_op(odometry, r,
+                 "no keyframe pair could be aligned (no overlap within refine.max_pair_* and "
+                 "refine.min_overlap, or every alignment was rejected)");
   std::vector<Pose> initial;
   for (const KeyframeData& k : kf) initial.push_back(k.odometry);
   refine_detail::GraphSolution sol = refine_detail::solve_pose_graph(initial, g.edges, params);
@@ -389,18 +387,21 @@ RefineResult refine_trajectory(FrameSource& source, const Trajectory& odometry, 
   r.stats.message = sol.message;
   r.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const RefineStats& s = r.stats;
-  spdlog::info("refine: {} keyframes, {} pair edges ({} loop candidates, {} rejected), {} odometry edges; Ceres {} "
-               "iterations, cost {:.4g} -> {:.4g}; largest keyframe correction {:.1f} mm / {:.2f} deg; {:.1f} s "
-               "({:.1f} s reading and preprocessing the keyframes, {:.1f} s aligning pairs)",
-               s.keyframes, s.pair_edges, s.candidate_pairs, s.rejected_pairs, s.odometry_edges, s.iterations,
-               s.initial_cost, s.final_cost, s.max_correction_m * 1e3, s.max_correction_deg, s.seconds, t_load, t_graph);
+  spdlog::info(
+      "refine: {} keyframes, {} pair edges ({} loop candidates, {} rejected), {} odometry edges; Ceres {} "
+      "iterations, cost {:.4g} -> {:.4g}; largest keyframe correction {:.1f} mm / {:.2f} deg; {:.1f} s "
+      "({:.1f} s reading and preprocessing the keyframes, {:.1f} s aligning pairs)",
+      s.keyframes, s.pair_edges, s.candidate_pairs, s.rejected_pairs, s.odometry_edges, s.iterations, s.initial_cost,
+      s.final_cost, s.max_correction_m * 1e3, s.max_correction_deg, s.seconds, t_load, t_graph);
   return r;
 }
 
 void write_refine_stats(const std::string& path, const RefineStats& s) {
   std::FILE* f = std::fopen(partial_path(path).c_str(), "w");
-  if (!f) throw Error("cannot write refinement statistics '" + path + "': check that the folder exists and is writable");
-  std::fprintf(f, "key,value\nframes,%lld\nkeyframes,%lld\ncandidate_pairs,%lld\npair_edges,%lld\n"
+  if (!f)
+    throw Error("cannot write refinement statistics '" + path + "': check that the folder exists and is writable");
+  std::fprintf(f,
+               "key,value\nframes,%lld\nkeyframes,%lld\ncandidate_pairs,%lld\npair_edges,%lld\n"
                "rejected_pairs,%lld\nodometry_edges,%lld\niterations,%d\ninitial_cost,%.9g\nfinal_cost,%.9g\n"
                "converged,%d\nmax_correction_m,%.6f\nmax_correction_deg,%.4f\nseconds,%.3f\nmessage,\"%s\"\n",
                static_cast<long long>(s.frames), static_cast<long long>(s.keyframes),

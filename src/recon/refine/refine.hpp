@@ -23,21 +23,21 @@ namespace seamless {
 struct RefineStats {
   std::int64_t frames = 0;
   std::int64_t keyframes = 0;
-  std::int64_t candidate_pairs = 0;   // non-consecutive pairs that passed the pose and overlap tests
-  std::int64_t pair_edges = 0;        // aligned pairs kept as edges (consecutive ones included)
-  std::int64_t rejected_pairs = 0;    // aligned but rejected (inliers, correction, degenerate)
+  std::int64_t candidate_pairs = 0;  // non-consecutive pairs that passed the pose and overlap tests
+  std::int64_t pair_edges = 0;       // aligned pairs kept as edges (consecutive ones included)
+  std::int64_t rejected_pairs = 0;   // aligned but rejected (inliers, correction, degenerate)
   std::int64_t odometry_edges = 0;
-  int iterations = 0;                 // Ceres iterations
+  int iterations = 0;  // Ceres iterations
   double initial_cost = 0, final_cost = 0;
-  bool converged = false;             // Ceres reported convergence
-  double max_correction_m = 0;        // largest change of a keyframe position
-  double max_correction_deg = 0;      // largest change of a keyframe orientation
-  double seconds = 0;                 // wall time of the whole stage
-  std::string message;                // Ceres' one-line report, or why nothing was done
+  bool converged = false;         // Ceres reported convergence
+  double max_correction_m = 0;    // largest change of a keyframe position
+  double max_correction_deg = 0;  // largest change of a keyframe orientation
+  double seconds = 0;             // wall time of the whole stage
+  std::string message;            // Ceres' one-line report, or why nothing was done
 };
 
 struct RefineResult {
-  Trajectory trajectory;              // one pose per input pose (refined, or the input when a no-op)
+  Trajectory trajectory;                // one pose per input pose (refined, or the input when a no-op)
   std::vector<std::int64_t> keyframes;  // indices into the trajectory
   RefineStats stats;
 };

@@ -32,16 +32,15 @@ struct EdgeCost {
   Eigen::Vector3d tz;
   Eigen::Matrix<double, 6, 6> sqrt_info;
 
-  template <class T>
-  bool operator()(const T* qi_, const T* ti_, const T* qj_, const T* tj_, T* res) const {
+  template <class T> bool operator()(const T* qi_, const T* ti_, const T* qj_, const T* tj_, T* res) const {
     Eigen::Map<const Eigen::Quaternion<T>> qi(qi_), qj(qj_);
     Eigen::Map<const Eigen::Matrix<T, 3, 1>> ti(ti_), tj(tj_);
     const Eigen::Quaternion<T> qi_inv = qi.conjugate();
-    const Eigen::Quaternion<T> qe = qi_inv * qj;          // E = T_i^-1 T_j
+    const Eigen::Quaternion<T> qe = qi_inv * qj;  // E = T_i^-1 T_j
     const Eigen::Matrix<T, 3, 1> te = qi_inv * (tj - ti);
     const Eigen::Quaternion<T> qd = qe * qz_inv.cast<T>();  // D = E Z^-1
     const Eigen::Matrix<T, 3, 1> td = te - qd * tz.cast<T>();
-    const T s = qd.w() < T(0) ? T(-2) : T(2);              // q and -q are the same rotation
+    const T s = qd.w() < T(0) ? T(-2) : T(2);  // q and -q are the same rotation
     Eigen::Matrix<T, 6, 1> e;
     e << s * qd.x(), s * qd.y(), s * qd.z(), td.x(), td.y(), td.z();
     Eigen::Map<Eigen::Matrix<T, 6, 1>> r(res);
@@ -95,8 +94,7 @@ GraphSolution solve_pose_graph(const std::vector<Pose>& initial, const std::vect
   opt.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
   ceres::Solve(opt, &problem, &summary);
-  if (!summary.IsSolutionUsable())
-    throw Error("refine: Ceres found no usable solution: " + summary.message);
+  if (!summary.IsSolutionUsable()) throw Error("refine: Ceres found no usable solution: " + summary.message);
   out.iterations = static_cast<int>(summary.iterations.size()) - 1;  // the first entry is the initial state
   out.initial_cost = summary.initial_cost;
   out.final_cost = summary.final_cost;

@@ -28,10 +28,10 @@ Pose inverse(const Pose& a);
 Pose blend(const Pose& a, const Pose& b, double alpha);
 
 struct Edge {
-  int i = 0, j = 0;                    // keyframe indices (positions in the node vector)
-  Pose z;                              // measured i_T_j
-  Eigen::Matrix<double, 6, 6> info;    // Lambda, symmetric positive definite
-  bool robust = false;                 // loop edge: robust loss
+  int i = 0, j = 0;                  // keyframe indices (positions in the node vector)
+  Pose z;                            // measured i_T_j
+  Eigen::Matrix<double, 6, 6> info;  // Lambda, symmetric positive definite
+  bool robust = false;               // loop edge: robust loss
   bool odometry = false;
 };
 

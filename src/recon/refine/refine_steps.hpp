@@ -56,8 +56,8 @@ struct Graph {
 // unless rejected; a loop edge, robust, when j > i + 1).
 void add_odometry_edge(Graph& g, const Tracker& tracker, const KeyframeData& a, const KeyframeData& b,
                        const ReferenceMaps& ref_a, int i, const RefineParams& p, int level);
-void add_pair_edge(Graph& g, const Tracker& tracker, const KeyframeData& a, const KeyframeData& b,
-                   ReferenceMaps& ref_a, int i, int j, const RefineParams& p, int level);
+void add_pair_edge(Graph& g, const Tracker& tracker, const KeyframeData& a, const KeyframeData& b, ReferenceMaps& ref_a,
+                   int i, int j, const RefineParams& p, int level);
 // The max_pairs_per_keyframe most overlapping of (overlap, keyframe) candidates.
 std::vector<int> best_partners(std::vector<std::pair<double, int>> cand, const RefineParams& p);
 

@@ -29,7 +29,9 @@ int main() {
   Image<vec3> vertices(64, 48, Device::CPU);
   Intrinsics small = K;
   small.cx = 32, small.cy = 24;
-  with_exec(Device::CPU, [&]<class E>(const E& ex) { kernels::Preprocess<E>::depth_to_vertices(ex, depth.cview(), small, vertices.view()); });
+  with_exec(Device::CPU, [&]<class E>(const E& ex) {
+    kernels::Preprocess<E>::depth_to_vertices(ex, depth.cview(), small, vertices.view());
+  });
   const vec3 v = vertices.to_host()[24 * 64 + 32];
   check(v.z == 2.0f && std::fabs(v.x) < 1e-6f && std::fabs(v.y) < 1e-6f, "kernels: depth_to_vertices on the CPU");
 
