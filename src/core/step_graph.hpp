@@ -13,6 +13,7 @@
 #include "core/buffer.hpp"
 #include "core/device.hpp"
 #include "core/exec.hpp"
+#include "seamless/build_config.hpp"
 
 namespace seamless {
 
