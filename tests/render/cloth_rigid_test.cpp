@@ -90,16 +90,18 @@ TEST(RenderRigid, BoxCoversItsProjection) {
   const Intrinsics K = intrinsics(100.f, 79.5f, 59.5f, 160, 120);
   Renderer r(rigid_params(), K.width, K.height);
   DrawList l;
-  l.rigids.push_back(RigidDraw{SE3{mat3::identity(), {0.f, 0.f, 2.f}}, {0.2f, 0.1f, 0.1f}});
+  l.rigids.push_back(RigidDraw{SE3{mat3::identity(), {0.f, 0.f, 2.f}}, {0.2f, 0.1f, 0.1f}, nullptr});
   Pixels img(r.render(l, camera(K)));
   const float u0 = 100.f * -0.2f / 1.9f + 79.5f, u1 = 100.f * 0.2f / 1.9f + 79.5f;
   const float v0 = 100.f * -0.1f / 1.9f + 59.5f, v1 = 100.f * 0.1f / 1.9f + 59.5f;
   for (int v = 0; v < img.h; ++v)
     for (int u = 0; u < img.w; ++u) {
-      if (u > u0 + 1 && u < u1 - 1 && v > v0 + 1 && v < v1 - 1)
+      if (u > u0 + 1 && u < u1 - 1 && v > v0 + 1 && v < v1 - 1) {
         EXPECT_LE(max_diff(img.at(u, v), uchar3{180, 60, 40}), 2) << u << "," << v;
-      if (u < u0 - 1 || u > u1 + 1 || v < v0 - 1 || v > v1 + 1)
+      }
+      if (u < u0 - 1 || u > u1 + 1 || v < v0 - 1 || v > v1 + 1) {
         EXPECT_TRUE(same(img.at(u, v), uchar3{0, 0, 0})) << u << "," << v;
+      }
     }
 }
 
@@ -128,8 +130,9 @@ TEST(RenderRigid, BodyMeshMovesWithItsFrame) {
           EXPECT_LE(max_diff(img.at(u, v), uchar3{180, 60, 40}), 2) << u << "," << v;
           ++inside;
         }
-        if (u < u0 - 1 || u > u1 + 1 || v < v0 - 1 || v > v1 + 1)
+        if (u < u0 - 1 || u > u1 + 1 || v < v0 - 1 || v > v1 + 1) {
           EXPECT_TRUE(same(img.at(u, v), uchar3{0, 0, 0})) << u << "," << v << " (a box drawn instead?)";
+        }
       }
     EXPECT_GT(inside, 100);  // 10 x 20 pixels less the margins
   }

@@ -79,8 +79,9 @@ TEST(RenderMeshView, FreeCamera) {
         EXPECT_TRUE(same(img.at(u, v), green)) << u << "," << v;
         ++inside;
       }
-      if (u < lo_u - 1 || u > hi_u + 1 || v < lo_v - 1 || v > hi_v + 1)
+      if (u < lo_u - 1 || u > hi_u + 1 || v < lo_v - 1 || v > hi_v + 1) {
         EXPECT_TRUE(same(img.at(u, v), uchar3{0, 0, 0})) << u << "," << v;
+      }
     }
   EXPECT_GT(inside, 500);
 }
