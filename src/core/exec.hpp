@@ -191,7 +191,7 @@ struct CudaExec {
   template <class F> void for_each_phases(int phases, const std::int64_t* begin, const std::int64_t* end, F fn) const;
   // Where for_each_phases runs the sweep in one block, the arrays that fit (in argument order)
   // live in the block's dynamic shared memory for the sweep: a phase then reads and writes them
-  // without a round trip to L2 (a phase of a small cloth was ~3 us, mostly such round trips).
+  // without a round trip to L2 (most of a small cloth's phase is such round trips: docs/PERFORMANCE.md).
   template <class F, class... T>
   void for_each_phases_staged(int phases, const std::int64_t* begin, const std::int64_t* end, F fn,
                               Staged<T>... arrays) const;

@@ -120,7 +120,8 @@ template <int kQ> __device__ __forceinline__ void warp_reduce_scatter(float (&v)
 // where a block reduction of the struct took thousands (docs/PERFORMANCE.md, session 6). At least
 // 2 blocks per multiprocessor: the RGB-D term's pixel function and the double-precision solve
 // would otherwise take 175 registers, one block of 8 warps per SM, too few to hide the pixels'
-// gathers (0.371 -> 0.306 ms with the bound, a few spilled bytes; ICP fits in 126 either way).
+// gathers (faster with the bound despite a few spilled bytes, docs/PERFORMANCE.md; ICP fits in 126
+// registers either way).
 template <int kThreads, class T, class F, class G>
 __global__ void __launch_bounds__(kThreads, 2)
     transform_reduce_rounds_kernel(std::int64_t n, int rounds, F fn, float* partial, int* stop, T* out, G then) {
