@@ -61,6 +61,26 @@ template <Executor Exec> struct Dynamic {
   // old surface away.
   static void classify_dynamic(const Exec& ex, DynamicInput in, View2D<std::uint8_t> candidates);
 
+  // Movers move: a candidate whose surface has stayed in place is static. Each candidate carries
+  // an age, the consecutive frames it has been a candidate, and an anchor, the depth (in this
+  // frame's camera) of where its surface was when the age began. Its point, taken into the previous
+  // frame's camera (prev_T_cur), lands on a pixel there; the oldest candidate within search_radius
+  // of it whose anchor, seen from this camera, lies within the residual threshold of the
+  // measurement passes on its age (plus one) and anchor; with none, the age starts at 1 at the
+  // measured depth (so a surface that creeps along its ray a little each frame starts over once it
+  // is a threshold away). The window bridges the pixels that a noisy classification leaves out of
+  // a region from one frame to the next (a lone pixel chain would rarely survive 30 frames of
+  // them); ages spread from one surface into a neighbouring one at its depth by at most
+  // search_radius pixels a frame. A candidate
+  // older than static_after frames (0: never) is cleared. That ends two loops the mask would
+  // otherwise keep forever, since masked pixels are never fused: a static surface first seen in
+  // front of one seen before (a chair's seat after the floor beneath it was seen from the side),
+  // and a person who stopped (as in ReFusion, Palazzolo et al. 2019, a mover at rest joins the
+  // map). Non-candidates get age 0 and anchor 0.
+  static void age_dynamic(const Exec& ex, DynamicInput in, View2D<const float> prev_anchor,
+                          View2D<const std::uint8_t> prev_age, SE3 prev_T_cur, int static_after,
+                          View2D<std::uint8_t> candidates, View2D<std::uint8_t> age, View2D<float> anchor);
+
   // Region and temporal consistency: a candidate stays dynamic when at least min_support of the
   // (2r+1)^2 candidates around it (itself included) are candidates, or when the previous frame kept
   // it (its `kept`, not its grown mask; prev may be empty: data == nullptr); then the kept pixels

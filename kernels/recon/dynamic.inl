@@ -48,6 +48,43 @@ void Dynamic<Exec>::classify_dynamic(const Exec& ex, DynamicInput in, View2D<std
 }
 
 template <Executor Exec>
+void Dynamic<Exec>::age_dynamic(const Exec& ex, DynamicInput in, View2D<const float> prev_anchor,
+                                View2D<const std::uint8_t> prev_age, SE3 prev_T_cur, int static_after,
+                                View2D<std::uint8_t> candidates, View2D<std::uint8_t> age, View2D<float> anchor) {
+  const int w = in.depth.width;
+  const bool has_prev = prev_age.data != nullptr && prev_anchor.data != nullptr;
+  const SE3 cur_T_prev = prev_T_cur.inverse();
+  ex.for_each(in.depth.count(), [=] SEAMLESS_HD(std::int64_t i) {
+    const int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
+    if (!candidates(x, y)) {
+      age(x, y) = 0;
+      anchor(x, y) = 0.f;
+      return;
+    }
+    const float d = in.depth(x, y);
+    int a = 1;
+    float z = d;
+    const vec3 p = prev_T_cur * in.K.unproject(static_cast<float>(x), static_cast<float>(y), d);
+    if (has_prev && p.z > 0.f) {
+      const vec2 uv = in.K.project(p);
+      const int u0 = static_cast<int>(floorf(uv.x + 0.5f)), v0 = static_cast<int>(floorf(uv.y + 0.5f));
+      const float threshold = dynamic_threshold(in, d);
+      for (int dy = -in.search_radius; dy <= in.search_radius; ++dy)
+        for (int dx = -in.search_radius; dx <= in.search_radius; ++dx) {
+          const int u = u0 + dx, v = v0 + dy;
+          if (!prev_age.inside(u, v) || prev_age(u, v) == 0 || !(prev_anchor(u, v) > 0.f)) continue;
+          // Where that pixel's surface was when its age began, seen from this camera.
+          const vec3 q = cur_T_prev * in.K.unproject(static_cast<float>(u), static_cast<float>(v), prev_anchor(u, v));
+          if (fabsf(q.z - d) <= threshold && prev_age(u, v) + 1 > a) a = prev_age(u, v) + 1, z = q.z;
+        }
+    }
+    age(x, y) = static_cast<std::uint8_t>(a < 255 ? a : 255);
+    anchor(x, y) = z;
+    if (static_after > 0 && a > static_after) candidates(x, y) = 0;
+  });
+}
+
+template <Executor Exec>
 void Dynamic<Exec>::filter_dynamic(const Exec& ex, View2D<const std::uint8_t> candidates,
                                    View2D<const std::uint8_t> prev, View2D<const float> depth, int radius,
                                    int min_support, float max_step, View2D<std::uint8_t> kept,

@@ -27,6 +27,12 @@ struct DynamicParams {
   // Free-space carving: a voxel more than this many truncation widths in front of the measured depth
   // (and of its 3x3 neighbours) is reset to free; 0: only the running average (KinectFusion).
   float carve_truncations = 3.f;
+  // Movers move: a candidate pixel whose surface has stayed in place (the same point, within the
+  // residual threshold) for more than this many consecutive frames is static (1 s at 30 fps: a
+  // person walking past covers a point with the same part of their body for well under that,
+  // e.g. a 0.3 m torso at 0.8 m/s for 0.4 s). It becomes part of the map: a surface first seen in
+  // front of one seen before, or a person who stopped. 0: never.
+  int static_after_frames = 30;
   bool write_masks = false;  // dynamic_mask/<frame>.png (255 = dynamic) into the run's folder
 
   template <class V> void visit(V& v) {
@@ -56,6 +62,10 @@ struct DynamicParams {
       "free-space carving: voxels this many truncation widths in front of the measurement are reset to free "
       "space; 0: off",
       Range{0.0, 100.0});
+    v("static_after_frames", static_after_frames,
+      "a dynamic pixel whose surface has stayed in place for more than this many consecutive frames is static "
+      "(a person who stopped, a surface first seen in front of one seen before); 0: never",
+      Range{0, 250});
     v("write_masks", write_masks, "write each frame's mask as dynamic_mask/<frame>.png (255 = dynamic)");
   }
 };

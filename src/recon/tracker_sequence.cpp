@@ -167,9 +167,13 @@ const ReferenceMaps* TrackingSession::mask_before_tracking() {
 void TrackingSession::find_dynamic(const ReferenceMaps& model, const SE3& world_T_camera) {
   const DynamicParams& d = p_.dynamic;
   if (dyn_mask_.width() != K_.width) {
-    for (Image<std::uint8_t>* im : {&dyn_candidates_, &dyn_kept_, &dyn_mask_, &dyn_prev_})
+    for (Image<std::uint8_t>* im : {&dyn_candidates_, &dyn_kept_, &dyn_mask_, &dyn_prev_, &dyn_age_, &dyn_prev_age_})
       *im = Image<std::uint8_t>(K_.width, K_.height, device_);
-    dyn_prev_.buffer().zero();  // no previous frame: no temporal support
+    dyn_prev_.buffer().zero();      // no previous frame: no temporal support
+    dyn_prev_age_.buffer().zero();  // and no candidate has an age yet
+    dyn_anchor_ = Image<float>(K_.width, K_.height, device_);
+    dyn_prev_anchor_ = Image<float>(K_.width, K_.height, device_);
+    dyn_prev_anchor_.buffer().zero();
   }
   const PyramidLevel& l0 = pyr_.level(0);
   const ReferenceLevel& m = model.level(0);
@@ -186,6 +190,9 @@ void TrackingSession::find_dynamic(const ReferenceMaps& model, const SE3& world_
   in.search_radius = d.search_radius;
   with_exec(device_, [&]<class E>(const E& ex) {
     kernels::Dynamic<E>::classify_dynamic(ex, in, dyn_candidates_.view());
+    kernels::Dynamic<E>::age_dynamic(ex, in, dyn_prev_anchor_.cview(), dyn_prev_age_.cview(),
+                                     dyn_prev_pose_.inverse() * world_T_camera, d.static_after_frames,
+                                     dyn_candidates_.view(), dyn_age_.view(), dyn_anchor_.view());
     kernels::Dynamic<E>::filter_dynamic(ex, dyn_candidates_.cview(), dyn_prev_.cview(), l0.depth.cview(),
                                         d.support_radius, d.min_support, d.dilate_max_step, dyn_kept_.view(),
                                         dyn_mask_.view());
@@ -455,6 +462,9 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
     // grown border reaches static neighbours at the mover's depth, which are then never fused and,
     // from the mask, would support themselves frame after frame (a line left on the desk's edge).
     dyn_prev_.buffer().copy_from(dyn_kept_.buffer());
+    dyn_prev_age_.buffer().copy_from(dyn_age_.buffer());
+    dyn_prev_anchor_.buffer().copy_from(dyn_anchor_.buffer());
+    dyn_prev_pose_ = rec.result.world_T_camera;
   } else if (p_.dynamic.enabled) {
     rec.dynamic_fraction = 0;  // the first frame, or a lost one: nothing masked, nothing fused
   }

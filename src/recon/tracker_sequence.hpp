@@ -143,6 +143,11 @@ class TrackingSession {
   ReferenceMaps dyn_ref_;  // frame-to-frame tracking: the model raycast the mask compares with
   RaycastMaps dyn_maps_;
   Image<std::uint8_t> dyn_candidates_, dyn_kept_, dyn_mask_, dyn_prev_;
+  // The candidates' ages and anchors (kernels::Dynamic::age_dynamic): this frame's, and the
+  // previous frame's with its pose.
+  Image<std::uint8_t> dyn_age_, dyn_prev_age_;
+  Image<float> dyn_anchor_, dyn_prev_anchor_;
+  SE3 dyn_prev_pose_ = SE3::identity();
   Image<vec3> kept_vertices_, kept_normals_;  // params.keep_unmasked_level before masking
   bool kept_ = false;                         // they hold this frame's level
   Image<float> depth_, intensity_;

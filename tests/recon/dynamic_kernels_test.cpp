@@ -145,3 +145,103 @@ TEST(DynamicKernels, Parity) {
   EXPECT_LE(diff, static_cast<std::int64_t>(c.mask.size() / 1000));
   EXPECT_NEAR(static_cast<double>(c.count), static_cast<double>(g.count), c.mask.size() / 1000.0);
 }
+
+namespace {
+
+// age_dynamic over a sequence of frames: a 64x48 camera, every pixel a candidate on a wall facing
+// it at depth(frame) metres, the camera moved sideways by shift(frame) metres (x, world = the first
+// camera's frame). Returns each frame's ages and the candidates left.
+struct Aged {
+  std::vector<std::vector<std::uint8_t>> age, candidates;
+};
+template <class Depth, class Shift>
+Aged age_sequence(Device d, int frames, int static_after, Depth depth_of, Shift shift_of) {
+  Intrinsics K;
+  K.fx = K.fy = 52.5f, K.cx = 31.5f, K.cy = 23.5f, K.width = 64, K.height = 48;
+  Image<float> depth(K.width, K.height, d), anchor(K.width, K.height, d), prev_anchor(K.width, K.height, d);
+  Image<std::uint8_t> cand(K.width, K.height, d), age(K.width, K.height, d), prev_age(K.width, K.height, d);
+  prev_anchor.buffer().zero();
+  prev_age.buffer().zero();
+  Aged out;
+  SE3 world_T_prev = SE3::identity();
+  for (int f = 0; f < frames; ++f) {
+    const SE3 world_T_cur{mat3::identity(), {shift_of(f), 0.f, 0.f}};
+    // The wall at z = depth_of(f) in the world: seen from a camera moved along x, at the same depth.
+    const std::vector<float> z(K.width * K.height, depth_of(f));
+    const std::vector<std::uint8_t> ones(K.width * K.height, 1);
+    depth.buffer().copy_from_host(z.data(), depth.buffer().size());
+    cand.buffer().copy_from_host(ones.data(), cand.buffer().size());
+    kernels::DynamicInput in;
+    in.depth = depth.cview();
+    in.K = K;
+    in.disparity_step_per_baseline = 0.f;  // no quantisation: the threshold is max(3 cm, 3 sigma(z))
+    with_exec(d, [&]<class E>(const E& ex) {
+      kernels::Dynamic<E>::age_dynamic(ex, in, prev_anchor.cview(), prev_age.cview(),
+                                       world_T_prev.inverse() * world_T_cur, static_after, cand.view(), age.view(),
+                                       anchor.view());
+    });
+    prev_age.buffer().copy_from(age.buffer());
+    prev_anchor.buffer().copy_from(anchor.buffer());
+    world_T_prev = world_T_cur;
+    out.age.push_back(age.to_host());
+    out.candidates.push_back(cand.to_host());
+  }
+  return out;
+}
+
+int count(const std::vector<std::uint8_t>& v) {
+  int n = 0;
+  for (std::uint8_t b : v) n += b != 0;
+  return n;
+}
+
+}  // namespace
+
+// A surface that stays in place ages by one a frame, also seen from a camera that moves (2 cm a
+// frame sideways at 2 m, fx 52.5: its points land 0.525 px to the side in the previous frame,
+// the nearest pixel one column over), and is cleared once older than static_after. The pixels
+// that come into view at the border take the age of their neighbours within search_radius (2)
+// at the same depth: the whole wall ages together.
+TEST(DynamicKernels, AStillSurfaceAgesAndBecomesStatic) {
+  const Aged a = age_sequence(
+      Device::CPU, 8, 5, [](int) { return 2.f; }, [](int f) { return 0.02f * f; });
+  for (int f = 0; f < 8; ++f) {
+    int wrong_age = 0;
+    for (std::uint8_t g : a.age[f]) wrong_age += g != f + 1;
+    EXPECT_EQ(wrong_age, 0) << "frame " << f;
+    // Frame 5 is the first with age 6 > 5.
+    EXPECT_EQ(count(a.candidates[f]), f < 5 ? 64 * 48 : 0) << "frame " << f;
+  }
+}
+
+// A surface moving along the ray by more than the residual threshold each frame (4.5 cm a frame;
+// the threshold is 3 cm up to 2.58 m, where 3 sigma = 3 * 0.0015 z^2 passes it) restarts every
+// frame; one creeping by 1.2 cm a frame is a threshold from its anchor after at most three frames
+// and restarts then: with static_after 4 neither is ever cleared.
+TEST(DynamicKernels, AMovingSurfaceNeverBecomesStatic) {
+  const Aged fast = age_sequence(
+      Device::CPU, 12, 4, [](int f) { return 2.f + 0.045f * f; }, [](int) { return 0.f; });
+  const Aged creep = age_sequence(
+      Device::CPU, 12, 4, [](int f) { return 2.f + 0.012f * f; }, [](int) { return 0.f; });
+  for (int f = 0; f < 12; ++f) {
+    EXPECT_EQ(count(fast.candidates[f]), 64 * 48) << "frame " << f;
+    EXPECT_EQ(fast.age[f][0], 1) << "frame " << f;
+    EXPECT_EQ(count(creep.candidates[f]), 64 * 48) << "frame " << f;
+    EXPECT_LE(creep.age[f][0], 3) << "frame " << f;
+  }
+}
+
+// CUDA against the CPU on the moving camera's sequence: ages are integer decisions on a threshold
+// of float depths computed the same way; allow 0.1% of pixels (fused multiply-adds at a threshold).
+TEST(DynamicKernels, AgeParity) {
+  if (!cuda_available()) GTEST_SKIP() << "no CUDA device";
+  auto depth = [](int f) { return 2.f + 0.01f * f; };
+  auto shift = [](int f) { return 0.02f * f; };
+  const Aged c = age_sequence(Device::CPU, 8, 5, depth, shift), g = age_sequence(Device::CUDA, 8, 5, depth, shift);
+  for (int f = 0; f < 8; ++f) {
+    int diff = 0;
+    for (std::size_t k = 0; k < c.age[f].size(); ++k)
+      diff += (c.age[f][k] != g.age[f][k]) + (c.candidates[f][k] != g.candidates[f][k]);
+    EXPECT_LE(diff, 4) << "frame " << f;
+  }
+}
