@@ -1,7 +1,7 @@
 #include "physics/builders.hpp"
 
+#include <tiny_obj_loader.h>
 #include <algorithm>
-#include <charconv>
 #include <climits>
 #include <cmath>
 #include <fstream>
@@ -257,61 +257,80 @@ void check_spawn_capacity(const std::vector<SpawnParams>& spawns, const SolverPa
 
 namespace {
 
-// One vertex reference of an OBJ face ("7", "7/1", "-2//3") as a 0-based index: 1-based, or
-// negative, counted back from the last vertex defined so far (`defined`). A positive index is
-// checked against all the file's vertices once they are read.
-long long obj_index(const std::string& tok, std::size_t defined, const std::string& where) {
-  const std::string num = tok.substr(0, tok.find('/'));
-  long long i = 0;
-  const auto [end, ec] = std::from_chars(num.data(), num.data() + num.size(), i);
-  if (num.empty() || ec != std::errc() || end != num.data() + num.size() || i == 0)
-    throw InputError(where + ": face vertex '" + tok + "' is not a vertex number (1, 2, ... or -1, -2, ...)");
-  if (i > 0) return i - 1;
-  if (-i > static_cast<long long>(defined))
-    throw InputError(where + ": face vertex " + tok + " counts back past the " + std::to_string(defined) +
-                     " vertices defined before it");
-  return static_cast<long long>(defined) + i;
+// tinyobjloader's warnings and errors as one line: each message ends in a newline (a few in "\n.").
+std::string one_line(const std::string& text) {
+  std::string out;
+  std::istringstream lines(text);
+  for (std::string l; std::getline(lines, l);)
+    if (l.find_first_not_of(" .") != std::string::npos) out += (out.empty() ? "" : "; ") + l;
+  return out;
+}
+
+// The triangles of one tinyobjloader mesh, each polygon as a fan around its first vertex.
+// `face` counts the file's faces (of three vertices or more) for the messages: the library checks
+// indices only once the file is read and names its last line, so our messages name the face.
+void add_fans(const tinyobj::mesh_t& mesh, int nv, const std::string& where, std::size_t& face,
+              std::vector<int3>& out) {
+  // The library counts a face's vertices in a byte: a face of 256 or more vertices comes back
+  // with a wrong count, and the counts no longer add up to the indices.
+  std::size_t total = 0;
+  for (const unsigned char n : mesh.num_face_vertices) total += n;
+  if (total != mesh.indices.size())
+    throw InputError(where + ": a face has 256 vertices or more, more than tinyobjloader can read");
+  std::size_t at = 0;
+  for (const unsigned char n : mesh.num_face_vertices) {
+    ++face;
+    std::vector<int> idx;
+    for (std::size_t k = at; k < at + n; ++k) {
+      const int i = mesh.indices[k].vertex_index;
+      // A negative index counts back from the vertices defined before the face; the library
+      // resolves it, so one that counted back too far arrives below 0.
+      if (i < 0)
+        throw InputError(where + ": face " + std::to_string(face) +
+                         " has a negative vertex number that counts back past the first vertex");
+      if (i >= nv)
+        throw InputError(where + ": face " + std::to_string(face) + ": face vertex " + std::to_string(i + 1LL) +
+                         " does not exist (the file has " + std::to_string(nv) + " vertices)");
+      idx.push_back(i);
+    }
+    for (std::size_t k = 2; k < idx.size(); ++k) out.push_back({idx[0], idx[k - 1], idx[k]});
+    at += n;
+  }
 }
 
 }  // namespace
 
 ObjMesh read_obj(const std::string& path) {
+  const std::string where = "mesh file '" + path + "'";
   std::ifstream in(path);
-  if (!in) throw InputError("cannot open mesh file '" + path + "' (spawn rigid, shape: mesh); check the path");
+  if (!in) throw InputError("cannot open " + where + " (spawn rigid, shape: mesh); check the path");
+  tinyobj::attrib_t attrib;
+  std::vector<tinyobj::shape_t> shapes;
+  std::vector<tinyobj::material_t> materials;
+  std::string warn, err;
+  // No material reader: a body needs only the triangles, and an 'mtllib' line must not make the
+  // reader open other files. The library does not triangulate (it would split quads along their
+  // shorter diagonal and ear-clip larger polygons): the fans below are what ObjMesh promises.
+  if (!tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &in, nullptr, /*triangulate=*/false,
+                        /*default_vcols_fallback=*/false))
+    throw InputError(where + " is not an OBJ file tinyobjloader can read: " +
+                     (err.empty() && warn.empty() ? "it gives no reason" : one_line(err + warn)));
+
   ObjMesh m;
-  std::vector<int> face_line;  // the line of each triangle, for the index check below
-  std::string line;
-  for (int n = 1; std::getline(in, line); ++n) {
-    const std::string where = "mesh file '" + path + "' line " + std::to_string(n);
-    std::istringstream ls(line);
-    std::string tag;
-    ls >> tag;
-    if (tag == "v") {
-      vec3 p{};
-      if (!(ls >> p.x >> p.y >> p.z) || !std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-        throw InputError(where + ": a vertex needs three finite numbers ('v x y z'), got '" + line + "'");
-      m.v.push_back(p);
-    } else if (tag == "f") {
-      std::vector<long long> idx;
-      std::string tok;
-      while (ls >> tok) idx.push_back(obj_index(tok, m.v.size(), where));
-      for (std::size_t k = 2; k < idx.size(); ++k) {
-        m.f.push_back({static_cast<int>(std::min<long long>(idx[0], INT_MAX)),
-                       static_cast<int>(std::min<long long>(idx[k - 1], INT_MAX)),
-                       static_cast<int>(std::min<long long>(idx[k], INT_MAX))});
-        face_line.push_back(n);
-      }
-    }
+  if (attrib.vertices.size() / 3 > static_cast<std::size_t>(INT_MAX))
+    throw InputError(where + " has more vertices than an int can count");
+  for (std::size_t i = 0; i + 2 < attrib.vertices.size(); i += 3) {
+    const vec3 p{attrib.vertices[i], attrib.vertices[i + 1], attrib.vertices[i + 2]};
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      throw InputError(where + ": vertex " + std::to_string(i / 3 + 1) + " is not a finite point (" +
+                       std::to_string(p.x) + ", " + std::to_string(p.y) + ", " + std::to_string(p.z) + ")");
+    m.v.push_back(p);
   }
+  std::size_t face = 0;
+  for (const tinyobj::shape_t& s : shapes) add_fans(s.mesh, static_cast<int>(m.v.size()), where, face, m.f);
   if (m.v.empty() || m.f.empty())
-    throw InputError("mesh file '" + path + "' has no triangles (expected OBJ 'v' and 'f' lines)");
-  const int nv = static_cast<int>(std::min<std::size_t>(m.v.size(), INT_MAX));
-  for (std::size_t t = 0; t < m.f.size(); ++t)
-    for (int i : {m.f[t].x, m.f[t].y, m.f[t].z})
-      if (i >= nv)
-        throw InputError("mesh file '" + path + "' line " + std::to_string(face_line[t]) + ": face vertex " +
-                         std::to_string(static_cast<long long>(i) + 1) + " does not exist (the file has " +
-                         std::to_string(m.v.size()) + " vertices)");
+    throw InputError(where + " has no triangles (expected OBJ 'v' and 'f' lines" +
+                     (warn.empty() ? "" : "; tinyobjloader: " + one_line(warn)) + ")");
   return m;
 }
 

@@ -60,10 +60,13 @@ struct ObjMesh {
   std::vector<vec3> v;
   std::vector<int3> f;
 };
-// The OBJ reader of the project (rigid bodies' `shape: mesh`): 'v' and 'f' lines, the rest
-// ignored. Throws seamless::InputError naming the file and line of what it cannot read (a missing
-// file, a vertex without three finite numbers, a face vertex that is not a vertex number or does
-// not exist) or when there are no triangles.
+// The OBJ reader of the project (rigid bodies' `shape: mesh`), through tinyobjloader (Debian's
+// libtinyobjloader-dev): the vertices and faces of every object and group; normals, texture
+// coordinates and materials are not used ('mtllib' files are not opened). Like the library, it
+// reads a missing or unreadable vertex coordinate as 0 and a face vertex by its leading digits.
+// Throws seamless::InputError naming the file and the problem (with the library's message and,
+// where it tells one, the line): a missing file, a face vertex 0 or not a number, one that does
+// not exist or counts back past the first vertex, a vertex that is not finite, no triangles.
 ObjMesh read_obj(const std::string& path);
 
 // Voxelises a closed triangle mesh (OBJ) on a grid of the given spacing: the centres inside by

@@ -195,8 +195,9 @@ TEST(PhysicsFriction, CubeOnIncline) {
 }
 
 // The OBJ reader of rigid mesh bodies (issue 20: fuzzing found std::stoi's exception escape and
-// face indices past the vertices read out of bounds). A valid file with every kind of face
-// reference gives a solid; each bad file is an InputError naming the file, line and problem.
+// face indices past the vertices read out of bounds; issue 19: tinyobjloader reads the file). A
+// valid file with every kind of face reference gives a solid; each bad file is an InputError
+// naming the file and the problem (and the line, where tinyobjloader tells it).
 std::string write_obj(const std::string& name, const std::string& text) {
   const std::string path = std::string(SEAMLESS_BUILD_DIR) + "/" + name;
   std::FILE* f = std::fopen(path.c_str(), "w");
@@ -205,11 +206,27 @@ std::string write_obj(const std::string& name, const std::string& text) {
   return path;
 }
 
+bool same(int3 a, int3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+
 TEST(ObjReader, FaceReferencesOfEveryKindMakeAClosedCube) {
-  // A unit cube: quads of 1-based, "i/t", "i//n" and negative (relative) references.
+  // A unit cube: quads of 1-based "i", "i/t", "i//n", "i/t/n" and negative (relative) references.
   const std::string cube =
-      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 1\n"
-      "f 1 3 4 2\nf 5/1 6/1 8/1 7/1\nf 1//1 2//1 6//1 5//1\nf -6 -5 -1 -2\nf 1 5 7 3\nf 2 4 8 6\n";
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 1\nvt 0 0\nvn 0 0 1\n"
+      "f 1 3 4 2\nf 5/1 6/1 8/1 7/1\nf 1//1 2//1 6//1 5//1\nf -6 -5 -1 -2\nf 1/1/1 5/1/1 7/1/1 3/1/1\nf 2 4 8 6\n";
+  // The triangles are fans around each quad's first vertex, 0-based: "f 1 3 4 2" gives (0 2 3)
+  // and (0 3 1); "f -6 -5 -1 -2", after 8 vertices, is "f 3 4 8 7": (2 3 7) and (2 7 6);
+  // "f 1/1/1 5/1/1 7/1/1 3/1/1" starts with (0 4 6).
+  const ObjMesh m = read_obj(write_obj("cube.obj", cube));
+  ASSERT_EQ(m.v.size(), 8u);
+  ASSERT_EQ(m.f.size(), 12u);
+  EXPECT_TRUE(same(m.f[0], {0, 2, 3}));
+  EXPECT_TRUE(same(m.f[1], {0, 3, 1}));
+  EXPECT_TRUE(same(m.f[6], {2, 3, 7}));
+  EXPECT_TRUE(same(m.f[7], {2, 7, 6}));
+  EXPECT_TRUE(same(m.f[8], {0, 4, 6}));
+  EXPECT_EQ(m.v[7].x, 1.f);
+  EXPECT_EQ(m.v[7].y, 1.f);
+  EXPECT_EQ(m.v[7].z, 1.f);
   // Fitted into 0.5 m at 0.05 m: the cube spans [-0.25, 0.25] on each axis and the cell centres
   // are multiples of 0.05. Every centre strictly inside (|coordinate| <= 0.2: 9 x 9 x 9) is
   // filled; those on the faces (+-0.25) may or may not be (ray parity on a face): 729 to 1331.
@@ -225,16 +242,24 @@ TEST(ObjReader, FaceReferencesOfEveryKindMakeAClosedCube) {
 
 TEST(ObjReader, BadFilesSayWhatAndWhere) {
   const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  std::string face300 = "f";  // 300 vertices: tinyobjloader keeps a face's vertex count in a byte
+  for (int k = 0; k < 100; ++k) face300 += " 1 2 3";
+  // The messages of tinyobjloader (a face vertex 0 or not a number stops it, with the line) and
+  // of our checks of what it read (it resolves indices without checking them, so these name the
+  // face, counting the file's faces). It takes a vertex coordinate it cannot read as 0 and a face
+  // vertex by its leading digits (atoi), so "v 0 0" and "f 1 2 3x" are read, not rejected.
   struct Case {
     std::string text, message;
   } cases[] = {
-      {tri + "f 1 2 x\n", "line 4: face vertex 'x' is not a vertex number"},
-      {tri + "f 1 2 99999999999999999999\n", "is not a vertex number"},
-      {tri + "f 1 2 0\n", "face vertex '0' is not a vertex number"},
-      {tri + "f 1 2 4\n", "line 4: face vertex 4 does not exist (the file has 3 vertices)"},
-      {tri + "f -1 -2 -4\n", "line 4: face vertex -4 counts back past the 3 vertices"},
-      {"v 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "line 1: a vertex needs three finite numbers"},
+      {tri + "f 1 2 x\n", "face index. line 4"},
+      {tri + "f 1 2 0\n", "face index. line 4"},
+      {tri + "f 1 2 4\n", "face 1: face vertex 4 does not exist (the file has 3 vertices)"},
+      {tri + "f 1 2 3\nf 3 2 1\nf 1 2 5\n# end\n", "face 3: face vertex 5 does not exist (the file has 3 vertices)"},
+      {tri + "f -1 -2 -4\n", "face 1 has a negative vertex number that counts back past the first vertex"},
+      {"v 0 0 1e999\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "vertex 1 is not a finite point"},
       {tri, "has no triangles"},
+      {tri + face300 + "\n", "a face has 256 vertices or more, more than tinyobjloader can read"},
+      {tri + "f 1 2\n", "has no triangles (expected OBJ 'v' and 'f' lines; tinyobjloader: Degenerated face found)"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.text);
@@ -245,6 +270,13 @@ TEST(ObjReader, BadFilesSayWhatAndWhere) {
       EXPECT_NE(std::string(e.what()).find(c.message), std::string::npos) << e.what();
       EXPECT_NE(std::string(e.what()).find("bad.obj"), std::string::npos) << e.what();
     }
+  }
+  try {
+    read_obj(std::string(SEAMLESS_BUILD_DIR) + "/no-such-mesh.obj");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot open mesh file '"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("no-such-mesh.obj"), std::string::npos) << e.what();
   }
 }
 
