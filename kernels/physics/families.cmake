@@ -1,6 +1,6 @@
 # kernels/physics: the unified particle solver (Macklin et al. 2014), see docs/PHYSICS.md and
 # kernels/physics/solver.hpp (the passes in order).
-foreach(family grid contacts fluid solids integration)
+foreach(family grid contacts fluid solids integration depth_colliders)
   seamless_kernel_family(physics/${family})
 endforeach()
 # The CPU's SIMD tiles (never compiled by nvcc).

@@ -60,7 +60,7 @@ void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
       kernels::SceneSdf sdf{};
       sdf.synthetic_room = 1;
       ctx.experiment().solver.gravity = kernels::room::gravity();  // the room's world is z up
-      simulate(ctx, {}, &sdf);
+      simulate(ctx, nullptr, &sdf);
       return ctx.exit_code();
     };
   });

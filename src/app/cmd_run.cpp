@@ -170,11 +170,12 @@ int run(const CommonOptions& o) {
   const SceneBounds bounds = scene_bounds(scan_result.mesh, ps.up, floor_surface);
   summary.floor_height = bounds.floor;
   summary.surfaces = ps.surfaces;
-  if (grid) points.clear();  // collide with the TSDF instead of scene particles
   Replay replay{&traj, e.render.replay_start};
   const bool replaying = e.render.camera == "recorded" && renderer;
-  SimulationResult sim = simulate(ctx, points, floor ? &*floor : nullptr, renderer.get(), grid ? &*grid : nullptr,
-                                  replaying ? &replay : nullptr);
+  // The scene particles go to the solver on the volume's device (the host copy above is for the
+  // PLY and the placement); with solver.scene_collision: sdf the TSDF replaces them.
+  SimulationResult sim = simulate(ctx, grid ? nullptr : &scene, floor ? &*floor : nullptr, renderer.get(),
+                                  grid ? &*grid : nullptr, replaying ? &replay : nullptr);
   summary.physics = sim.stats;
   summary.escaped = count_escaped(sim.state, bounds, e.solver.particle_diameter);
   log_escaped(*summary.escaped, sim.state.x.size());

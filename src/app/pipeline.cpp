@@ -257,11 +257,12 @@ class SimulationLoop : public FrameLoop {
 
 }  // namespace
 
-SimulationResult simulate(RunContext& ctx, const std::vector<vec3>& scene_particles, const kernels::SceneSdf* sdf,
+SimulationResult simulate(RunContext& ctx, const SceneParticles* scene_particles, const kernels::SceneSdf* sdf,
                           RunRenderer* renderer, const SdfGrid* grid, const Replay* replay) {
   const Experiment& e = ctx.experiment();
   ParticleSolver solver(e.solver, ctx.device());
-  if (!scene_particles.empty()) solver.add_static_particles(scene_particles);
+  const std::int64_t n_scene = scene_particles ? scene_particles->count : 0;
+  if (n_scene > 0) solver.add_static_particles(scene_particles->positions, n_scene);
   if (sdf) solver.set_scene_sdf(*sdf);
   if (grid) solver.set_scene_sdf_grid(grid->values, grid->dims, grid->origin, grid->voxel);
   solver.schedule(e.spawn);  // checks the particle budget up front
@@ -270,11 +271,11 @@ SimulationResult simulate(RunContext& ctx, const std::vector<vec3>& scene_partic
     spdlog::info(
         "replaying input frames {}..{} from their tracked poses, simulating in the recording's time "
         "(at least {:.2f} s) in steps of {} s on {} scene particles{}{}",
-        replay->start, replay->trajectory->size() - 1, e.duration, e.solver.dt, scene_particles.size(),
+        replay->start, replay->trajectory->size() - 1, e.duration, e.solver.dt, n_scene,
         sdf ? ", analytic SDF primitives" : "", grid ? ", the TSDF sampled on a grid" : "");
   else
     spdlog::info("simulating {:.2f} s in {} steps of {} s on {} scene particles{}{}", e.duration, loop.steps(),
-                 e.solver.dt, scene_particles.size(), sdf ? ", analytic SDF primitives" : "",
+                 e.solver.dt, n_scene, sdf ? ", analytic SDF primitives" : "",
                  grid ? ", the TSDF sampled on a grid" : "");
   if (renderer) renderer->run(loop);
   else
@@ -328,7 +329,7 @@ class LiveLoop : public FrameLoop {
           "solver.dynamic_colliders: depth with dynamic.enabled false: no pixel is dynamic, so nothing "
           "from the camera collides");
     if (e_.solver.dynamic_colliders != DynamicColliders::none)
-      colliders_.emplace(e_.solver.particle_diameter, e_.solver.collider_thickness, e_.solver.max_speed);
+      colliders_.emplace(e_.solver.particle_diameter, e_.solver.collider_thickness, e_.solver.max_speed, ctx.device());
   }
 
   bool advance() override {
@@ -355,7 +356,7 @@ class LiveLoop : public FrameLoop {
       while (time_ + (steps + 0.5) * e_.solver.dt <= target) ++steps;
       if (colliders_ && rec.result.ok()) update_colliders(rec.result.world_T_camera, time_ + steps * e_.solver.dt);
       for (int k = 0; k < steps; ++k) {
-        if (colliders_) solver_.set_collider_particles(colliders_->at(time_ + e_.solver.dt));
+        if (colliders_) solver_.set_collider_particles(colliders_->points(), colliders_->at(time_ + e_.solver.dt));
         solver_.step();  // spawns what is due first
         time_ += e_.solver.dt;
       }
@@ -422,39 +423,24 @@ class LiveLoop : public FrameLoop {
  private:
   void extract_scene() {
     StageScope s(ctx_.timer(), "extract");
-    SceneParticles scene = volume_->extract_scene_particles(sp_);
-    points_ = scene.positions.to_host();
-    points_.resize(static_cast<std::size_t>(scene.count));
+    scene_ = volume_->extract_scene_particles(sp_);
+    points_stale_ = true;  // downloaded only when a placement asks (place_live)
     solver_.clear_static_particles();
-    solver_.add_static_particles(points_);
+    solver_.add_static_particles(scene_.positions, scene_.count);
   }
 
   // solver.dynamic_colliders: this frame's depth points as the solver's kinematic colliders
   // (physics/depth_colliders.hpp), spaced by the pyramid level's pixels, thickened by one particle
-  // diameter per layer.
+  // diameter per layer; depth: only the pixels the dynamic mask marks (a level pixel when any of
+  // the full-resolution pixels it averages is). On the run's device, from the tracker's maps to
+  // the solver (DeviceColliders).
   // frame_time: the simulation time this frame's steps end at; the steps between the last frame
   // and this one move the colliders with their estimated velocities (MovingColliders).
   void update_colliders(const SE3& world_T_camera, double frame_time) {
     StageScope s(ctx_.timer(), "colliders");
     const auto [vertices, normals] = session_.unmasked_level();
-    const int w = vertices->width(), h = vertices->height();
-    std::vector<std::uint8_t> mask;  // empty: every pixel (dynamic_colliders: all)
-    if (e_.solver.dynamic_colliders == DynamicColliders::depth) mask = block_any(session_.dynamic_mask(), w, h);
-    colliders_->update(depth_surface(vertices->to_host(), normals->to_host(), w, h, world_T_camera, mask), frame_time);
-  }
-
-  // The full-resolution dynamic mask at a pyramid level's w x h: a level pixel is dynamic when
-  // any of the full-resolution pixels it averages is.
-  static std::vector<std::uint8_t> block_any(const Image<std::uint8_t>& full, int w, int h) {
-    std::vector<std::uint8_t> out(static_cast<std::size_t>(w) * h, 0);
-    if (full.width() == 0) return out;  // no mask yet (the first frame): nothing is dynamic
-    const std::vector<std::uint8_t> m = full.to_host();
-    const int W = full.width(), H = full.height(), sx = W / w, sy = H / h;
-    for (int y = 0; y < H; ++y)
-      for (int x = 0; x < W; ++x)
-        if (m[static_cast<std::size_t>(y) * W + x] && x / sx < w && y / sy < h)
-          out[static_cast<std::size_t>(y / sy) * w + x / sx] = 1;
-    return out;
+    const bool masked = e_.solver.dynamic_colliders == DynamicColliders::depth;  // else every pixel
+    colliders_->update(*vertices, *normals, world_T_camera, masked ? &session_.dynamic_mask() : nullptr, frame_time);
   }
 
   // summary.json of a live run: as scan_then_simulate's, with the scene as it was at the end.
@@ -495,6 +481,11 @@ class LiveLoop : public FrameLoop {
     ps.up = -normalize(e_.solver.gravity);
     ps.mesh = &mesh;
     ps.surfaces = find_horizontal_surfaces(mesh, ps.up, {pose.t});
+    if (points_stale_) {
+      points_ = scene_.positions.to_host();
+      points_.resize(static_cast<std::size_t>(scene_.count));
+      points_stale_ = false;
+    }
     ps.scene_points = &points_;
     ps.volume = volume_.get();
     ps.trajectory = &poses_;
@@ -529,8 +520,10 @@ class LiveLoop : public FrameLoop {
   double time_ = 0.0;
   SE3 pose_ = SE3::identity();                  // this frame's tracked pose (placements made while it steps)
   std::optional<double> t0_;                    // timestamp of the first fused frame
-  std::optional<MovingColliders> colliders_;    // solver.dynamic_colliders
-  std::vector<vec3> points_;                    // the scene particles of the last extraction
+  std::optional<DeviceColliders> colliders_;    // solver.dynamic_colliders
+  SceneParticles scene_;                        // the scene particles of the last extraction (device)
+  std::vector<vec3> points_;                    // their host copy, for placement
+  bool points_stale_ = false;                   // points_ is not scene_'s copy yet
   Trajectory poses_;                            // tracked so far (pixel placements)
   Trajectory groundtruth_;                      // the source's ground-truth poses of the same frames, where it has them
   std::vector<SpawnParams> spawns_ = e_.spawn;  // with the live placements resolved

@@ -8,6 +8,7 @@
 #include "kernels/physics/scene_sdf.hpp"
 #include "physics/particle_solver.hpp"
 #include "recon/refine/online_refine.hpp"
+#include "recon/scene_particles.hpp"
 #include "recon/tracker_sequence.hpp"
 #include "recon/volume.hpp"
 
@@ -62,7 +63,8 @@ struct SimulationResult {
 // With a renderer, draws a frame every 1 / (render.fps * solver.dt) steps; with a replay, one
 // frame per replayed input frame (then the simulation lasts as long as the replay, at least
 // experiment.duration: a recording shorter than that plays forward and back).
-SimulationResult simulate(RunContext& ctx, const std::vector<vec3>& scene_particles, const kernels::SceneSdf* sdf,
+// scene_particles: null for none; handed to the solver on their device (no host copy).
+SimulationResult simulate(RunContext& ctx, const SceneParticles* scene_particles, const kernels::SceneSdf* sdf,
                           RunRenderer* renderer = nullptr, const SdfGrid* grid = nullptr,
                           const Replay* replay = nullptr);
 

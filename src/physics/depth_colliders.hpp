@@ -9,6 +9,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/buffer.hpp"
+#include "core/device.hpp"
 #include "core/math.hpp"
 
 namespace seamless {
@@ -53,6 +55,43 @@ class MovingColliders {
   float spacing_, thickness_, max_speed_;
   DepthSurface last_;
   std::vector<vec3> velocity_;  // one per point of last_
+  double time_ = 0.0;
+  bool have_ = false;
+};
+
+// MovingColliders on a device, from the maps the tracker leaves there (live mode): the level's mask
+// (block_any of the full-resolution dynamic mask), the seen surface, the velocities and the
+// thickened colliders are kernels (kernels/physics/depth_colliders.hpp) and the colliders go to the
+// solver as a device buffer (ParticleSolver::set_collider_particles), so no map passes through the
+// host. The same points, velocities and colliders as depth_surface + MovingColliders (on the CPU
+// bit for bit): the velocity's nearest-point search is one independent query per point, through a
+// grid of the previous frame's points sorted by cell.
+class DeviceColliders {
+ public:
+  DeviceColliders(float spacing, float thickness, float max_speed, Device d);
+  // A new frame, seen at simulation time t: vertex and normal maps (camera coordinates, as
+  // depth_surface takes them) on the device; full_mask: null for every pixel, else the
+  // full-resolution dynamic mask (a pixel of the maps is used when any full-resolution pixel it
+  // averages is nonzero; an empty image: none is).
+  void update(const Image<vec3>& camera_vertices, const Image<vec3>& camera_normals, const SE3& world_T_camera,
+              const Image<std::uint8_t>* full_mask, double t);
+  // The colliders at time t (MovingColliders::at) in points()[0, count), count returned.
+  std::int64_t at(double t);
+  const Buffer<vec3>& points() const { return out_; }
+  // This frame's surface points and their velocities (first size() of each; tests).
+  std::int64_t size() const { return count_; }
+  const Buffer<vec3>& surface_points() const { return points_; }
+  const Buffer<vec3>& velocities() const { return velocity_; }
+
+ private:
+  void estimate_velocities(double dt);
+  float spacing_, thickness_, max_speed_;
+  Device dev_;
+  Buffer<vec3> points_, rays_, normals_, last_points_, last_rays_, last_normals_, velocity_, out_;
+  Buffer<std::uint8_t> level_mask_;
+  Buffer<int> used_, offset_, idx_, start_;
+  Buffer<std::uint32_t> keys_;
+  std::int64_t count_ = 0, last_count_ = 0;
   double time_ = 0.0;
   bool have_ = false;
 };

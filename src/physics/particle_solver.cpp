@@ -99,11 +99,17 @@ struct FluidState {
 };
 
 // The static scene the contacts meet: scene particles in their own grid, the scene SDF.
-// collider_host: this frame's kinematic colliders (set_collider_particles), kept after the
-// scene's points in the same static grid.
+// static_points: the first n_static hold the scene's particles (add_static_particles);
+// collider_points: the first n_colliders this frame's kinematic colliders (set_collider_particles),
+// kept after the scene's points in the same static grid. Both on the solver's device, so that
+// points handed over on the device never pass through the host.
 struct StaticScene {
-  std::vector<vec3> static_host, collider_host;
-  std::int64_t static_count() const { return static_cast<std::int64_t>(static_host.size() + collider_host.size()); }
+  Buffer<vec3> static_points, collider_points;
+  std::int64_t n_static = 0, n_colliders = 0;
+  std::int64_t static_count() const { return n_static + n_colliders; }
+  // The scene particles' bounds (report_placement), found when first asked after a change.
+  vec3 static_lo{}, static_hi{};
+  bool static_bounds_known = false;
   Buffer<vec3> stat;
   Buffer<int> scell_start;
   K::GridSpec sgrid{};
@@ -573,9 +579,9 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
     kernels::SceneSdf host_sdf = sdf;
     host_sdf.grid = nullptr;  // the sampled TSDF lives on the device; the primitives and the room suffice
     std::int64_t solid = 0, far = 0;
-    const bool scanned = !static_host.empty();
-    vec3 lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
-    for (vec3 p : static_host) lo = vmin(lo, p), hi = vmax(hi, p);
+    const bool scanned = n_static > 0;
+    if (scanned) find_static_bounds();
+    const vec3 lo = static_lo, hi = static_hi;
     const float m = kScanMargin;
     for (vec3 p : x) {
       if (host_sdf.active() && kernels::scene_sdf(host_sdf, p).d < 0.f) ++solid;
@@ -638,6 +644,39 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
     throw ConfigError("spawn: unknown kind '" + s.kind + "' (expected fluid_block, emitter, cloth or rigid)");
   }
 
+  // The scene particles' bounding box: one download of them, on the first spawn after they changed
+  // (a spawn's placement report is rare; the steps never need it).
+  void find_static_bounds() {
+    if (static_bounds_known) return;
+    static_lo = {1e30f, 1e30f, 1e30f}, static_hi = {-1e30f, -1e30f, -1e30f};
+    std::vector<vec3> pts(static_cast<std::size_t>(n_static));
+    memory::copy(pts.data(), Device::CPU, static_points.data(), dev, sizeof(vec3) * pts.size());
+    for (vec3 p : pts) static_lo = vmin(static_lo, p), static_hi = vmax(static_hi, p);
+    static_bounds_known = true;
+  }
+
+  // Appends n points at src (on device src_dev) to the scene particles, in order.
+  void append_static(const vec3* src, Device src_dev, std::int64_t n) {
+    if (n <= 0) return;
+    Buffer<vec3> grown(n_static + n, dev);
+    memory::copy(grown.data(), dev, static_points.data(), dev, sizeof(vec3) * static_cast<std::size_t>(n_static));
+    memory::copy(grown.data() + n_static, dev, src, src_dev, sizeof(vec3) * static_cast<std::size_t>(n));
+    static_points = std::move(grown);
+    n_static += n;
+    static_bounds_known = false;
+    rebuild_static();
+  }
+
+  // Replaces the colliders by the n points at src (on device src_dev).
+  void replace_colliders(const vec3* src, Device src_dev, std::int64_t n) {
+    if (n == 0 && n_colliders == 0) return;
+    collider_points.reserve_discard(n, dev);
+    memory::copy(collider_points.data(), dev, src, src_dev, sizeof(vec3) * static_cast<std::size_t>(n));
+    n_colliders = n;
+    ++generation;
+    rebuild_static();
+  }
+
   void rebuild_static() {
     ++generation;
     const std::int64_t ns = static_count();
@@ -645,9 +684,11 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
     int sb = grid_bits(ns);
     sgrid = K::GridSpec::for_radius(std::max(P.fluid_smoothing * P.particle_diameter, 1.5f * P.particle_diameter), sb);
     std::int64_t cells = std::int64_t{1} << (3 * sb);
-    std::vector<vec3> all = static_host;
-    all.insert(all.end(), collider_host.begin(), collider_host.end());
-    Buffer<vec3> raw = Buffer<vec3>::from_host(all, dev);
+    // The scene's points, then the colliders' (device to device).
+    Buffer<vec3> raw(ns, dev);
+    memory::copy(raw.data(), dev, static_points.data(), dev, sizeof(vec3) * static_cast<std::size_t>(n_static));
+    memory::copy(raw.data() + n_static, dev, collider_points.data(), dev,
+                 sizeof(vec3) * static_cast<std::size_t>(n_colliders));
     Buffer<std::uint32_t> keys(ns, dev);
     Buffer<int> idx(ns, dev);
     stat = Buffer<vec3>(ns, dev);
@@ -667,23 +708,40 @@ ParticleSolver::ParticleSolver(const SolverParams& params, Device device)
     : impl_(std::make_unique<Impl>(params, device)) {}
 ParticleSolver::~ParticleSolver() = default;
 
+namespace {
+
+// The first `count` elements of `points`, checked (a count over the buffer's size is a caller's bug).
+void check_count(const char* what, const Buffer<vec3>& points, std::int64_t count) {
+  if (count < 0 || count > points.size())
+    throw Error(std::string(what) + ": " + std::to_string(count) + " points asked of a buffer of " +
+                std::to_string(points.size()));
+}
+
+}  // namespace
+
 void ParticleSolver::add_static_particles(const std::vector<vec3>& points) {
-  if (points.empty()) return;
-  impl_->static_host.insert(impl_->static_host.end(), points.begin(), points.end());
-  impl_->rebuild_static();
+  impl_->append_static(points.data(), Device::CPU, static_cast<std::int64_t>(points.size()));
+}
+
+void ParticleSolver::add_static_particles(const Buffer<vec3>& points, std::int64_t count) {
+  check_count("add_static_particles", points, count);
+  impl_->append_static(points.data(), points.device(), count);
 }
 
 void ParticleSolver::clear_static_particles() {
-  impl_->static_host.clear();
+  impl_->n_static = 0;
+  impl_->static_bounds_known = false;
   ++impl_->generation;
-  if (!impl_->collider_host.empty()) impl_->rebuild_static();
+  if (impl_->n_colliders > 0) impl_->rebuild_static();
 }
 
 void ParticleSolver::set_collider_particles(const std::vector<vec3>& points) {
-  if (points.empty() && impl_->collider_host.empty()) return;
-  impl_->collider_host = points;
-  ++impl_->generation;
-  impl_->rebuild_static();
+  impl_->replace_colliders(points.data(), Device::CPU, static_cast<std::int64_t>(points.size()));
+}
+
+void ParticleSolver::set_collider_particles(const Buffer<vec3>& points, std::int64_t count) {
+  check_count("set_collider_particles", points, count);
+  impl_->replace_colliders(points.data(), points.device(), count);
 }
 
 void ParticleSolver::set_scene_sdf(const kernels::SceneSdf& sdf) {
@@ -748,8 +806,8 @@ SolverStats ParticleSolver::stats() const {
   SolverStats s;
   s.particles = I.n, s.fluid_particles = I.n_fluid, s.cloth_particles = I.n_cloth, s.rigid_particles = I.n_rigid;
   s.rigid_bodies = static_cast<std::int64_t>(I.body_start.size());
-  s.static_particles = static_cast<std::int64_t>(I.static_host.size());
-  s.collider_particles = static_cast<std::int64_t>(I.collider_host.size());
+  s.static_particles = I.n_static;
+  s.collider_particles = I.n_colliders;
   s.substeps = substeps();
   s.time = I.time, s.steps = I.steps, s.emitter_dropped = I.emitter_dropped;
   // One small read: the counters the kernels keep on the device (overflow, longest lists, the

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "core/buffer.hpp"
 #include "core/device.hpp"
 #include "core/geometry.hpp"
 #include "core/math.hpp"
@@ -49,13 +50,18 @@ class ParticleSolver {
   ParticleSolver(const ParticleSolver&) = delete;
   ParticleSolver& operator=(const ParticleSolver&) = delete;
 
-  // Static scene particles (appended to those already there); they never move.
+  // Static scene particles (appended to those already there, in order); they never move.
   void add_static_particles(const std::vector<vec3>& points);
+  // The same from the first `count` points of a buffer on any device (the scene particles that
+  // Volume::extract_scene_particles leaves on the volume's device), copied device to device.
+  void add_static_particles(const Buffer<vec3>& points, std::int64_t count);
   void clear_static_particles();
   // This frame's kinematic colliders (solver.dynamic_colliders: points from the depth camera,
   // physics/depth_colliders.hpp), replacing the last frame's: they collide as scene particles do,
   // infinitely heavy, so whatever they move into is pushed out of them.
   void set_collider_particles(const std::vector<vec3>& points);
+  // The same from the first `count` points of a buffer on any device, copied device to device.
+  void set_collider_particles(const Buffer<vec3>& points, std::int64_t count);
   // Collide against an SDF as well (analytic primitives and/or the synthetic room).
   void set_scene_sdf(const kernels::SceneSdf& sdf);
   // Collide against a dense sampled SDF (x fastest), e.g. resampled from the TSDF.

@@ -1,0 +1,3 @@
+#include "core/exec_cpu.hpp"
+#include "kernels/physics/depth_colliders.inl"
+template struct seamless::kernels::DepthColliders<seamless::CpuExec>;
