@@ -33,7 +33,7 @@ void make_folder(const TmpDir& dir) {
 
 InputParams tum(const TmpDir& dir, bool skip = false) {
   InputParams p;
-  p.source = "tum";
+  p.source = InputSource::tum;
   p.path = dir.str();
   p.skip_bad_frames = skip;
   return p;
@@ -84,7 +84,7 @@ TEST(BadInput, MissingListFile) {
 
 TEST(BadInput, MissingFolder) {
   InputParams p;
-  p.source = "tum";
+  p.source = InputSource::tum;
   p.path = "/nonexistent/rgbd_dataset_freiburg1_xyz";
   EXPECT_MENTIONS(read_all(p), "/nonexistent/rgbd_dataset_freiburg1_xyz");
 }

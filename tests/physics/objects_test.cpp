@@ -13,7 +13,7 @@ namespace {
 
 SpawnParams rigid_at(float time, const char* shape) {
   SpawnParams s;
-  s.kind = "rigid", s.shape = shape, s.time = time;
+  s.kind = SpawnKind::rigid, s.shape = shape, s.time = time;
   s.size = {0.1f, 0.1f, 0.1f};
   s.position = {0.f, 1.f, 0.f};
   return s;
@@ -27,7 +27,7 @@ TEST(SolverObjects, ScheduleOrderSpawnIndexAndRest) {
   p.particle_diameter = 0.05f, p.dt = 0.01f, p.gravity = {0.f, 0.f, 0.f};
   ParticleSolver s(p, Device::CPU);
   SpawnParams cloth;
-  cloth.kind = "cloth", cloth.nx = 3, cloth.ny = 2, cloth.time = 0.005f, cloth.position = {1.f, 1.f, 0.f};
+  cloth.kind = SpawnKind::cloth, cloth.nx = 3, cloth.ny = 2, cloth.time = 0.005f, cloth.position = {1.f, 1.f, 0.f};
   // 0.02 s falls in the third step (starts 0, 0.01, 0.02): spawned then; 0.015 in the third too.
   s.schedule({rigid_at(0.02f, "box"), cloth, rigid_at(0.f, "sphere"), rigid_at(0.015f, "box")});
   s.step();

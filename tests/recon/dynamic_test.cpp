@@ -39,7 +39,7 @@ int downscale() { return device() == Device::CUDA ? 1 : 2; }
 // configs/dynamic_person.yaml's scene at a quarter of the Kinect's resolution.
 InputParams scene(bool with_movers) {
   InputParams in;
-  in.source = "synthetic";
+  in.source = InputSource::synthetic;
   in.synthetic.frames = kFrames;
   in.synthetic.fps = kFps;
   in.synthetic.speed_deg = 15.f;
@@ -50,10 +50,12 @@ InputParams scene(bool with_movers) {
   in.intrinsics.width = 640 / k, in.intrinsics.height = 480 / k;
   if (with_movers) {
     MoverParams person;
-    person.kind = "person", person.path = {{-1.3f, 1.15f, 0.f}, {1.8f, 1.15f, 0.f}}, person.speed = kPersonSpeed;
+    person.kind = MoverKind::person, person.path = {{-1.3f, 1.15f, 0.f}, {1.8f, 1.15f, 0.f}},
+    person.speed = kPersonSpeed;
     person.start = 10 / kFps;
     MoverParams ball;
-    ball.kind = "ball", ball.path = {{1.5f, 1.7f, 0.f}, {-1.2f, 1.7f, 0.f}}, ball.speed = 0.4f, ball.start = 0.5;
+    ball.kind = MoverKind::ball, ball.path = {{1.5f, 1.7f, 0.f}, {-1.2f, 1.7f, 0.f}}, ball.speed = 0.4f,
+    ball.start = 0.5;
     ball.radius = 0.15f;
     in.synthetic.movers = {person, ball};
   }

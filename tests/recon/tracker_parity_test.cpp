@@ -79,10 +79,10 @@ Image<float> host_intensity(const RgbdFrame& f, Device d) {
 TrackerParams visible_rgbd() {
   TrackerParams tp;
   tp.kind = "rgbd";
-  tp.weighting = "robust";
+  tp.weighting = RgbdWeighting::robust;
   tp.photometric_weight = 1.f;
-  tp.photometric_pixels = "visible";
-  tp.depth_noise = "depth_squared";
+  tp.photometric_pixels = PhotometricPixels::visible;
+  tp.depth_noise = DepthNoiseModel::depth_squared;
   return tp;
 }
 
