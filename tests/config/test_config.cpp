@@ -64,10 +64,10 @@ spawn:
   EXPECT_EQ(e.tracker.iterations, (std::vector<int>{3, 2}));
   EXPECT_EQ(e.tracker.fixed_gravity.z, 0.5f);
   ASSERT_EQ(e.spawn.size(), 2u);
-  EXPECT_EQ(e.spawn[0].kind, "cloth");
+  EXPECT_EQ(e.spawn[0].kind, SpawnKind::cloth);
   EXPECT_EQ(e.spawn[0].pinned, (std::vector<int>{0, 3}));
   EXPECT_EQ(e.spawn[0].nx, 5);
-  EXPECT_EQ(e.spawn[1].kind, "rigid");
+  EXPECT_EQ(e.spawn[1].kind, SpawnKind::rigid);
   EXPECT_EQ(e.spawn[1].position.y, 2.f);
   EXPECT_EQ(e.spawn[1].size.x, SpawnParams{}.size.x);  // element defaults apply per entry
 }
@@ -274,15 +274,15 @@ TEST(ConfigFiles, EveryShippedConfigLoads) {
 
 TEST(ConfigFiles, DemoSaysWhatItShould) {
   Experiment e = load_experiment(std::string(SEAMLESS_SOURCE_DIR) + "/configs/demo.yaml");
-  EXPECT_EQ(e.input.source, "synthetic");
-  EXPECT_EQ(e.mode, "scan_then_simulate");
+  EXPECT_EQ(e.input.source, InputSource::synthetic);
+  EXPECT_EQ(e.mode, ExperimentMode::scan_then_simulate);
   // The demo of the issue: fluid on the desk, a cloth, cubes (plural) on the floor.
-  auto count = [&](const char* kind) {
+  auto count = [&](SpawnKind kind) {
     return std::count_if(e.spawn.begin(), e.spawn.end(), [&](const SpawnParams& s) { return s.kind == kind; });
   };
-  EXPECT_GE(count("fluid_block") + count("emitter"), 1);
-  EXPECT_GE(count("cloth"), 1);
-  EXPECT_GE(count("rigid"), 2);
+  EXPECT_GE(count(SpawnKind::fluid_block) + count(SpawnKind::emitter), 1);
+  EXPECT_GE(count(SpawnKind::cloth), 1);
+  EXPECT_GE(count(SpawnKind::rigid), 2);
 }
 
 }  // namespace

@@ -100,7 +100,7 @@ TEST(ConfigRoundTrip, OverriddenLoadWritesTheOverride) {
   Experiment back = load_experiment(file);
   EXPECT_EQ(back.render.width, 320);
   ASSERT_EQ(back.spawn.size(), 1u);
-  EXPECT_EQ(back.spawn[0].kind, "emitter");
+  EXPECT_EQ(back.spawn[0].kind, SpawnKind::emitter);
   EXPECT_TRUE(diff_experiments(e, back).empty());
 }
 
