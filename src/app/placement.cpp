@@ -139,8 +139,9 @@ ResolvedPlacement resolve_placement(int i, SpawnParams& s, const SolverParams& s
   } else {
     const HorizontalSurface& f = surface_pick(i, s, scene);
     r.surface_point = s.place.offset.empty() ? f.centre : offset_point(i, s, f, scene.up);
-    r.how = "on " + std::string(enum_name(s.place.on)) +
-            (s.place.on == PlaceOn::support ? " " + std::to_string(s.place.index) : "") + ": " + describe(f);
+    r.how = std::string("on ") + enum_name(s.place.on);
+    if (s.place.on == PlaceOn::support) r.how.append(" ").append(std::to_string(s.place.index));
+    r.how += ": " + describe(f);
   }
   r.position = r.surface_point + normalize(scene.up) * s.place.above;
   s.position = r.position;
