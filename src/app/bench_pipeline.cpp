@@ -99,7 +99,7 @@ std::vector<std::string> bench_overrides(const PipelineBenchOptions& o) {
 // 25 x 16 x 25 = 10,000 particles spawned at the start, 1.5 m in front of the first camera.
 SpawnParams fluid_10k(const SolverParams& p) {
   SpawnParams s;
-  s.kind = "fluid_block";
+  s.kind = SpawnKind::fluid_block;
   s.time = 0.f;
   const float d = p.particle_diameter;
   s.size = {25 * d, 16 * d, 25 * d};

@@ -18,7 +18,7 @@ namespace {
 std::vector<ReconFrame> load_frames(const BenchOptions& o, int max_frames, Intrinsics* K) {
   InputParams in;
   if (!o.data_dir.empty()) {
-    in.source = "tum";
+    in.source = InputSource::tum;
     in.path = o.data_dir;
   }
   auto src = make_source(in, o.device);

@@ -53,7 +53,7 @@ void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
   m->callback([&action, sim] {
     action = [sim] {
       RunContext ctx(*sim);
-      if (ctx.experiment().input.source != "synthetic")
+      if (ctx.experiment().input.source != InputSource::synthetic)
         throw ConfigError(
             "seamless simulate runs on the synthetic room's analytic scene (input.source: synthetic); to "
             "simulate on a scanned scene use `seamless run` with mode: scan_then_simulate");

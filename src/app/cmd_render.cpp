@@ -62,13 +62,13 @@ Experiment load_run_config(const RenderOptions& o) {
     throw Error(cfg + " is missing: `seamless render` needs the run's effective config (output.write_config: true)");
   Experiment e = load_experiment(cfg, o.sets);
   RenderParams& p = e.render;
-  if (!o.view.empty()) p.view = o.view;
+  if (!o.view.empty()) enum_from_name(o.view, p.view);  // --view is checked to be a RenderView name
   if (o.width > 0) p.width = o.width;
   if (o.height > 0) p.height = o.height;
   p.stage_images = p.stage_images || o.stage_images;
   p.video = o.video;
   p.write_frames = true;
-  p.mode = "headless";
+  p.mode = RenderMode::headless;
   return e;
 }
 
@@ -76,7 +76,8 @@ Experiment load_run_config(const RenderOptions& o) {
 // step per frame), otherwise the scan's last frame; each at its pose in trajectory.txt.
 class KinectFrames {
  public:
-  KinectFrames(const Experiment& e, const std::string& run_dir) : live_(e.mode == "live"), limit_(e.frames) {
+  KinectFrames(const Experiment& e, const std::string& run_dir)
+      : live_(e.mode == ExperimentMode::live), limit_(e.frames) {
     traj_ = read_tum_trajectory(run_dir + "/trajectory.txt");
     source_ = make_source(e.input, Device::CPU);
   }
@@ -129,7 +130,6 @@ int render_run(const RenderOptions& o) {
   if (!fs::is_directory(o.run_dir)) throw UsageError("run folder '" + o.run_dir + "' does not exist");
   Experiment e = load_run_config(o);
   const RenderParams& p = e.render;
-  check_render_camera(p);
   const std::string out_dir = o.out.empty() ? o.run_dir + "/render" : o.out;
   fs::create_directories(out_dir);
   const auto states = snapshots(o.run_dir, o.last_only);
@@ -146,18 +146,18 @@ int render_run(const RenderOptions& o) {
   attach_body_meshes(objects, e.spawn, e.solver);
   Renderer r(p, p.width, p.height);
   spdlog::info("re-rendering {} states of {} at {}x{}, {} view, with {}", states.size(), o.run_dir, p.width, p.height,
-               p.view, r.gl_info().renderer);
-  const SceneCamera scene_cam = p.view == "mesh" ? mesh_camera(r, o, p) : SceneCamera{};
+               enum_name(p.view), r.gl_info().renderer);
+  const SceneCamera scene_cam = p.view == RenderView::mesh ? mesh_camera(r, o, p) : SceneCamera{};
   std::unique_ptr<KinectFrames> kinect;
-  if (p.view == "kinect") kinect = std::make_unique<KinectFrames>(e, o.run_dir);
+  if (p.view == RenderView::kinect) kinect = std::make_unique<KinectFrames>(e, o.run_dir);
   HeadlessOutput out(out_dir, p);
   std::vector<vec4> warm;
   for (const auto& [step, path] : states) {
     if (kinect && !kinect->set(r, step)) throw Error("the run's input gives no frame for the Kinect view");
     ParticleState s = read_particles_ply(path);
     std::vector<RigidFrame> frames = rigid_frames_of_state(objects, s, warm);
-    RenderCamera cam{};      // the Kinect view uses its own
-    if (p.view == "mesh") {  // the orbit's progress as in the run: the state's time over the duration
+    RenderCamera cam{};                // the Kinect view uses its own
+    if (p.view == RenderView::mesh) {  // the orbit's progress as in the run: the state's time over the duration
       const float progress = e.duration > 0.0 ? static_cast<float>(step * e.solver.dt / e.duration) : 0.f;
       const SceneCamera c = orbit_camera(scene_cam, p, progress);
       cam = RenderCamera::look_at(c.eye, c.target, {0.f, 1.f, 0.f}, p.fov_y, p.width, p.height, p.znear, p.zfar);
@@ -188,7 +188,7 @@ void add_render_command(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("run_dir", o->run_dir, "output folder of `seamless run`")->required();
   cmd->add_option("--out", o->out, "where frames/ go (default: <run_dir>/render)");
   cmd->add_option("--view", o->view, "mesh or kinect (default: the run's render.view)")
-      ->check(CLI::IsMember({"mesh", "kinect"}));
+      ->check(CLI::IsMember(enum_choices<RenderView>().values));
   cmd->add_option("--width", o->width, "frame width, pixels (default: the run's render.width)")
       ->check(CLI::Range(16, 16384));
   cmd->add_option("--height", o->height, "frame height, pixels")->check(CLI::Range(16, 16384));

@@ -25,22 +25,11 @@ namespace seamless::app {
 
 namespace {
 
-// render.zoom / zoom_at crop the recorded camera of the mesh view (render_stage.cpp); elsewhere
-// they would be ignored silently.
-void check_render_zoom(const RenderParams& r) {
-  if (!r.zoom_at.empty() && r.zoom_at.size() != 2)
-    throw ConfigError("render.zoom_at: expected [u, v] (two numbers), got " + std::to_string(r.zoom_at.size()));
-  if ((r.zoom != 1.f || !r.zoom_at.empty()) && (r.camera != "recorded" || r.view != "mesh"))
-    throw ConfigError(
-        "render.zoom and render.zoom_at magnify the recorded camera of the mesh view; they need "
-        "render.camera: recorded and render.view: mesh (the mesh view's fixed camera has render.fov_y)");
-}
-
 int dry_run(const CommonOptions& o) {
+  // load_experiment checks the rules across keys (Experiment::validate: placements, render.zoom, ...).
   Experiment e = load_experiment(o.config, overrides(o));
-  check_placements(e.spawn);
-  check_render_zoom(e.render);
-  spdlog::info("{}: valid ({} spawn entries, input {}, device {})", o.config, e.spawn.size(), e.input.source, e.device);
+  spdlog::info("{}: valid ({} spawn entries, input {}, device {})", o.config, e.spawn.size(), enum_name(e.input.source),
+               e.device);
   return 0;
 }
 
@@ -90,7 +79,7 @@ std::string groundtruth_path(const RunContext& ctx) {
   if (std::filesystem::exists(ctx.out_path("groundtruth.txt"))) return ctx.out_path("groundtruth.txt");
   const InputParams& in = ctx.experiment().input;
   const std::string gt = in.path + "/groundtruth.txt";
-  return in.source == "tum" && std::filesystem::exists(gt) ? gt : "";
+  return in.source == InputSource::tum && std::filesystem::exists(gt) ? gt : "";
 }
 
 std::vector<vec3> camera_positions(const Trajectory& tr) {
@@ -103,18 +92,13 @@ int run(const CommonOptions& o) {
   if (o.dry_run) return dry_run(o);
   RunContext ctx(o);
   Experiment& e = ctx.experiment();
-  check_placements(e.spawn);  // before the scan: a malformed place costs no scan
-  check_render_zoom(e.render);
-  check_render_camera(e.render);
-  if (e.render.camera == "recorded" && e.input.source == "kinect" && e.mode != "live")
-    throw ConfigError(
-        "render.camera: recorded replays the input after the scan, which a live Kinect cannot; use "
-        "mode: live (each frame drawn from its own pose) or record first (`seamless record`)");
+  // The rules across keys (placements, render camera and zoom, ...) were checked when the config was
+  // loaded (Experiment::validate), so a malformed config costs no scan.
   auto renderer = RunRenderer::make(ctx);
   RunSummary summary;
   summary.command = "run", summary.config = o.config, summary.device = device_name(ctx.device());
   if (ctx.device() == Device::CUDA) summary.device += std::string(" (") + cuda_device_description() + ")";
-  if (e.mode == "live") {
+  if (e.mode == ExperimentMode::live) {
     live(ctx, renderer.get());
     spdlog::info("outputs in {}", ctx.out_dir());
     return ctx.exit_code();
@@ -160,7 +144,7 @@ int run(const CommonOptions& o) {
 
   if (renderer) {
     renderer->set_scene(scan_result.mesh, traj.empty() ? SE3::identity() : traj.front().se3());
-    if (e.render.camera == "fixed" && !traj.empty())
+    if (e.render.camera == RenderCameraMode::fixed && !traj.empty())
       renderer->set_kinect_frame(scan_result.first_frame, traj.front().se3());
   }
   const HorizontalSurface* floor_surface = e.floor_plane ? find_floor(ps.surfaces) : nullptr;
@@ -171,7 +155,7 @@ int run(const CommonOptions& o) {
   summary.floor_height = bounds.floor;
   summary.surfaces = ps.surfaces;
   Replay replay{&traj, e.render.replay_start};
-  const bool replaying = e.render.camera == "recorded" && renderer;
+  const bool replaying = e.render.camera == RenderCameraMode::recorded && renderer;
   // The scene particles go to the solver on the volume's device (the host copy above is for the
   // PLY and the placement); with solver.scene_collision: sdf the TSDF replaces them.
   SimulationResult sim = simulate(ctx, grid ? nullptr : &scene, floor ? &*floor : nullptr, renderer.get(),

@@ -22,7 +22,7 @@ std::optional<std::pair<SE3, SE3>> first_common_pose(const Trajectory& a, const 
 
 std::optional<std::int64_t> ghost_vertices(const Mesh& mesh, const InputParams& in, const Trajectory& estimate,
                                            const Trajectory& groundtruth, float margin) {
-  if (in.source != "synthetic" || in.synthetic.movers.empty()) return std::nullopt;
+  if (in.source != InputSource::synthetic || in.synthetic.movers.empty()) return std::nullopt;
   const auto poses = first_common_pose(estimate, groundtruth);
   if (!poses) return std::nullopt;
   const SE3 room_T_world = poses->second * poses->first.inverse();

@@ -350,7 +350,8 @@ class LiveLoop : public FrameLoop {
       if (!t0_) t0_ = frame_.timestamp;
       // camera recorded: the simulation keeps the recording's time (several steps a frame);
       // otherwise one step a frame, as the dissertation's live loop.
-      const double target = e_.render.camera == "recorded" ? frame_.timestamp - *t0_ : time_ + 0.5 * e_.solver.dt;
+      const double target =
+          e_.render.camera == RenderCameraMode::recorded ? frame_.timestamp - *t0_ : time_ + 0.5 * e_.solver.dt;
       pose_ = rec.result.world_T_camera;
       int steps = 0;
       while (time_ + (steps + 0.5) * e_.solver.dt <= target) ++steps;
@@ -364,7 +365,7 @@ class LiveLoop : public FrameLoop {
     if (renderer_) {
       renderer_->set_kinect_frame(frame_, rec.result.world_T_camera);
       // The window switches between the views (key V): it needs the mesh whatever render.view says.
-      if (reextract && (e_.render.view == "mesh" || e_.render.mode == "window"))
+      if (reextract && (e_.render.view == RenderView::mesh || e_.render.mode == RenderMode::window))
         renderer_->set_scene(volume_->extract_mesh(), rec.result.world_T_camera);
       renderer_->draw(solver_);
     }

@@ -12,7 +12,7 @@
 namespace seamless::app {
 namespace {
 
-std::string entry_name(int i, const SpawnParams& s) { return "spawn[" + std::to_string(i) + "] (" + s.kind + ")"; }
+std::string entry_name(int i, const SpawnParams& s) { return s.label(i); }
 
 std::string fmt_vec(vec3 v) {
   char buf[64];
@@ -51,7 +51,7 @@ vec3 pixel_point(int i, const SpawnParams& s, const PlacementScene& scene) {
 const HorizontalSurface& surface_pick(int i, const SpawnParams& s, const PlacementScene& scene) {
   const PlaceParams& pl = s.place;
   const std::string who = entry_name(i, s) + ".place";
-  if (pl.on == "floor") {
+  if (pl.on == PlaceOn::floor) {
     if (const HorizontalSurface* f = find_floor(scene.surfaces)) return *f;
     throw Error(who + ": on floor, but no floor was seen in the scan; " + describe_surfaces(scene.surfaces));
   }
@@ -85,9 +85,9 @@ vec3 offset_point(int i, const SpawnParams& s, const HorizontalSurface& f, vec3 
 std::pair<std::size_t, std::size_t> overlap(const SpawnParams& s, const SolverParams& p,
                                             const std::vector<vec3>& scene) {
   ParticleBatch b;
-  if (s.kind == "fluid_block") b = make_fluid_block(s, p);
-  else if (s.kind == "cloth") b = make_cloth(s, p);
-  else if (s.kind == "rigid") b = make_rigid(s, p);
+  if (s.kind == SpawnKind::fluid_block) b = make_fluid_block(s, p);
+  else if (s.kind == SpawnKind::cloth) b = make_cloth(s, p);
+  else if (s.kind == SpawnKind::rigid) b = make_rigid(s, p);
   else b = make_emitter_layer(s, p);
   const float cell = p.particle_diameter, r = 0.5f * p.particle_diameter;
   auto key = [cell](vec3 x) {
@@ -118,19 +118,8 @@ std::pair<std::size_t, std::size_t> overlap(const SpawnParams& s, const SolverPa
 }  // namespace
 
 void check_placements(const std::vector<SpawnParams>& spawns) {
-  for (int i = 0; i < static_cast<int>(spawns.size()); ++i) {
-    const PlaceParams& pl = spawns[i].place;
-    const std::string who = entry_name(i, spawns[i]) + ".place";
-    if (!pl.pixel.empty() && pl.pixel.size() != 2)
-      throw ConfigError(who + ".pixel: expected [u, v] (two numbers), got " + std::to_string(pl.pixel.size()));
-    if (!pl.pixel.empty() && pl.on != "none")
-      throw ConfigError(who + ": give either `on` (" + pl.on + ") or `pixel`, not both");
-    if (!pl.offset.empty() && pl.offset.size() != 2)
-      throw ConfigError(who + ".offset: expected [x, z] (two numbers), got " + std::to_string(pl.offset.size()));
-    if (!pl.offset.empty() && pl.on == "none")
-      throw ConfigError(who +
-                        ".offset moves an `on:` placement across its surface; it needs `on: support` or `on: floor`");
-  }
+  for (int i = 0; i < static_cast<int>(spawns.size()); ++i)
+    spawns[i].place.validate(entry_name(i, spawns[i]) + ".place");
 }
 
 std::string describe_surfaces(const std::vector<HorizontalSurface>& surfaces) {
@@ -150,8 +139,9 @@ ResolvedPlacement resolve_placement(int i, SpawnParams& s, const SolverParams& s
   } else {
     const HorizontalSurface& f = surface_pick(i, s, scene);
     r.surface_point = s.place.offset.empty() ? f.centre : offset_point(i, s, f, scene.up);
-    r.how =
-        "on " + s.place.on + (s.place.on == "support" ? " " + std::to_string(s.place.index) : "") + ": " + describe(f);
+    r.how = std::string("on ") + enum_name(s.place.on);
+    if (s.place.on == PlaceOn::support) r.how.append(" ").append(std::to_string(s.place.index));
+    r.how += ": " + describe(f);
   }
   r.position = r.surface_point + normalize(scene.up) * s.place.above;
   s.position = r.position;

@@ -28,8 +28,9 @@ struct PlacementScene {
   vec3 up{0, 1, 0};
 };
 
-// Checks each entry's `place` on its own (before the scan, so a typo costs no scan): a pixel is two
-// numbers, not given together with `on`. Throws seamless::Error naming spawn[i].place.
+// Checks each entry's `place` on its own (PlaceParams::validate: a pixel is two numbers, not given
+// together with `on`). A loaded config was checked already (Experiment::validate); this is for
+// entries built in code. Throws seamless::Error naming spawn[i].place.
 void check_placements(const std::vector<SpawnParams>& spawns);
 
 // One resolved entry, for the log and summary.json.

@@ -26,15 +26,6 @@
 
 namespace seamless::app {
 
-void check_render_camera(const RenderParams& p) {
-  for (const auto& [key, v] : {std::pair{"eye", &p.eye}, std::pair{"target", &p.target}})
-    if (!v->empty() && v->size() != 3)
-      throw ConfigError(std::string("render.") + key + ": expected [x, y, z] (three numbers, world metres), got " +
-                        std::to_string(v->size()));
-  if (p.eye.size() == 3 && p.target.size() == 3 && p.eye == p.target)
-    throw ConfigError("render.eye and render.target are the same point: the camera would look nowhere");
-}
-
 SceneCamera mesh_view_camera(const Mesh& mesh, const SE3& scan_camera, const RenderParams& p) {
   vec3 lo{1e9f, 1e9f, 1e9f}, hi{-1e9f, -1e9f, -1e9f};
   for (vec3 q : mesh.positions) lo = vmin(lo, q), hi = vmax(hi, q);
@@ -83,8 +74,8 @@ class GlRunRenderer : public RunRenderer {
  public:
   explicit GlRunRenderer(RunContext& ctx)
       : ctx_(ctx), p_(ctx.experiment().render), renderer_(p_, p_.width, p_.height), out_(ctx.out_dir(), p_) {
-    spdlog::info("rendering {}x{} {} view with {} ({})", p_.width, p_.height, p_.view, renderer_.gl_info().renderer,
-                 renderer_.gl_info().version);
+    spdlog::info("rendering {}x{} {} view with {} ({})", p_.width, p_.height, enum_name(p_.view),
+                 renderer_.gl_info().renderer, renderer_.gl_info().version);
 #if SEAMLESS_HAS_CUDA
     // The solver's device arrays go straight into the GL buffers (no host round trip) when the GL
     // context is on the CUDA device (NVIDIA's EGL); elsewhere registration fails: host upload.
@@ -100,7 +91,7 @@ class GlRunRenderer : public RunRenderer {
   }
 
   void set_scene(const Mesh& mesh, const SE3& scan_camera) override {
-    if (p_.view != "mesh") return;
+    if (p_.view != RenderView::mesh) return;
     renderer_.set_scene_mesh(mesh);
     if (have_recorded_camera_) return;  // the recorded frames set it
     mesh_camera_ = mesh_view_camera(mesh, scan_camera, p_);
@@ -109,10 +100,10 @@ class GlRunRenderer : public RunRenderer {
   }
 
   void set_kinect_frame(const RgbdFrame& frame, const SE3& world_T_camera) override {
-    if (p_.view == "kinect") {
+    if (p_.view == RenderView::kinect) {
       renderer_.set_kinect_view(frame.rgb, frame.depth, frame.intrinsics, world_T_camera);
       camera_ = renderer_.kinect_camera();
-    } else if (p_.camera == "recorded") {  // the mesh seen through the recorded camera
+    } else if (p_.camera == RenderCameraMode::recorded) {  // the mesh seen through the recorded camera
       camera_.K = scale_intrinsics(zoom_intrinsics(frame.intrinsics, p_.zoom, p_.zoom_at), p_.width, p_.height);
       camera_.world_T_camera = world_T_camera;
       camera_.znear = p_.znear, camera_.zfar = p_.zfar;
@@ -258,9 +249,9 @@ std::string no_window_reason() {
 
 std::unique_ptr<RunRenderer> RunRenderer::make(RunContext& ctx) {
   const RenderParams& p = ctx.experiment().render;
-  if (p.mode == "none") return nullptr;
+  if (p.mode == RenderMode::none) return nullptr;
 #if SEAMLESS_HAS_GL
-  if (p.mode == "window") {
+  if (p.mode == RenderMode::window) {
 #if SEAMLESS_HAS_GLFW
     const std::string why = no_window_reason();
     if (why.empty()) return std::make_unique<WindowRunRenderer>(ctx);
@@ -275,7 +266,7 @@ std::unique_ptr<RunRenderer> RunRenderer::make(RunContext& ctx) {
   spdlog::warn(
       "render.mode is {} but this build has no renderer (GL module off: apt-get install libegl-dev "
       "libgl-dev libepoxy-dev); continuing without pictures",
-      p.mode);
+      enum_name(p.mode));
   return nullptr;
 #endif
 }

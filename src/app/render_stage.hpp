@@ -61,8 +61,5 @@ SceneCamera mesh_view_camera(const Mesh& mesh, const SE3& scan_camera, const Ren
 // render.orbit_deg: the eye turned about the vertical through the target by orbit_deg * progress
 // (progress 0 at the run's first frame, 1 at its last; clamped); a positive angle turns +z towards +x.
 SceneCamera orbit_camera(const SceneCamera& c, const RenderParams& p, float progress);
-// Throws ConfigError when render.eye or render.target is given but not as three numbers, or both
-// are the same point.
-void check_render_camera(const RenderParams& p);
 
 }  // namespace seamless::app

@@ -126,7 +126,7 @@ void write_summary(const std::string& path, const RunSummary& s) {
   Json& spawns = j["spawns"] = Json::array();
   for (std::size_t i = 0; i < s.spawns.size(); ++i) {
     const SpawnParams& sp = s.spawns[i];
-    Json e = {{"index", i}, {"kind", sp.kind}, {"time", sp.time}, {"position", vec_json(sp.position)}};
+    Json e = {{"index", i}, {"kind", enum_name(sp.kind)}, {"time", sp.time}, {"position", vec_json(sp.position)}};
     for (const ResolvedPlacement& r : s.placements)
       if (r.spawn == static_cast<int>(i)) e["placed"] = r.how, e["surface_point"] = vec_json(r.surface_point);
     spawns.push_back(std::move(e));

@@ -44,7 +44,16 @@ Experiment parse_experiment(const std::string& yaml_text, const std::vector<std:
 
 void Experiment::validate() const {
   volume.validate();
-  if (solver.dynamic_colliders != DynamicColliders::none && mode != "live")
+  tracker.validate();
+  render.validate();
+  for (std::size_t i = 0; i < spawn.size(); ++i) spawn[i].validate(static_cast<int>(i));
+  if (render.camera == RenderCameraMode::recorded && input.source == InputSource::kinect &&
+      mode != ExperimentMode::live)
+    throw ConfigError(
+        "render.camera: recorded with input.source: kinect needs mode: live: the recorded camera replays the input "
+        "after the scan, which a live Kinect cannot (each frame is drawn from its own pose in live mode); or record "
+        "first (`seamless record`)");
+  if (solver.dynamic_colliders != DynamicColliders::none && mode != ExperimentMode::live)
     throw ConfigError("solver.dynamic_colliders: " + std::string(enum_name(solver.dynamic_colliders)) +
                       " needs mode: live (the colliders are each frame's depth points while the camera runs)");
 }

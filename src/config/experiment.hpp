@@ -17,6 +17,13 @@
 
 namespace seamless {
 
+enum class ExperimentMode { live, scan_then_simulate };
+inline std::span<const EnumName<ExperimentMode>> enum_names(ExperimentMode) {
+  static constexpr EnumName<ExperimentMode> names[] = {{ExperimentMode::live, "live"},
+                                                       {ExperimentMode::scan_then_simulate, "scan_then_simulate"}};
+  return names;
+}
+
 // What a run writes into its output folder.
 struct OutputParams {
   std::string dir = "out";
@@ -47,7 +54,7 @@ struct OutputParams {
 struct Experiment {
   std::string name = "experiment";
   std::string device = "auto";
-  std::string mode = "live";
+  ExperimentMode mode = ExperimentMode::live;
   std::int64_t frames = 0;           // 0 = as many as the input gives
   double duration = 3.0;             // simulated seconds after the scan (scan_then_simulate)
   bool floor_plane = true;           // scan_then_simulate: an infinite floor under the scanned floor
@@ -71,8 +78,7 @@ struct Experiment {
   template <class V> void visit(V& v) {
     v("name", name, "experiment name (used in logs and output names)");
     v("device", device, "compute backend (auto: CUDA when built and a GPU is present)", Choices{"cpu", "cuda", "auto"});
-    v("mode", mode, "reconstruct and simulate at once, or scan first then simulate",
-      Choices{"live", "scan_then_simulate"});
+    v("mode", mode, "reconstruct and simulate at once, or scan first then simulate");
     v("frames", frames, "frames to process; 0 = all the input has", Range{0, 1e12});
     v("floor_plane", floor_plane,
       "collide with an infinite plane at the scanned floor's height (unseen floor "

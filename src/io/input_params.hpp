@@ -10,6 +10,31 @@
 
 namespace seamless {
 
+enum class InputSource { synthetic, tum, frames, kinect };
+inline std::span<const EnumName<InputSource>> enum_names(InputSource) {
+  static constexpr EnumName<InputSource> names[] = {{InputSource::synthetic, "synthetic"},
+                                                    {InputSource::tum, "tum"},
+                                                    {InputSource::frames, "frames"},
+                                                    {InputSource::kinect, "kinect"}};
+  return names;
+}
+enum class MoverKind { person, ball };
+inline std::span<const EnumName<MoverKind>> enum_names(MoverKind) {
+  static constexpr EnumName<MoverKind> names[] = {{MoverKind::person, "person"}, {MoverKind::ball, "ball"}};
+  return names;
+}
+enum class CameraPath { orbit, still };
+inline std::span<const EnumName<CameraPath>> enum_names(CameraPath) {
+  static constexpr EnumName<CameraPath> names[] = {{CameraPath::orbit, "orbit"}, {CameraPath::still, "still"}};
+  return names;
+}
+// `auto` is a C++ keyword: the value is `automatic`, its name `auto`.
+enum class Association { automatic, file };
+inline std::span<const EnumName<Association>> enum_names(Association) {
+  static constexpr EnumName<Association> names[] = {{Association::automatic, "auto"}, {Association::file, "file"}};
+  return names;
+}
+
 // Camera intrinsics: a named preset, `custom` with fx fy cx cy given here, or a camera file.
 struct IntrinsicsParams {
   std::string preset = "auto";
@@ -62,7 +87,7 @@ struct SyntheticNoiseParams {
 // a ball rolling along a path on the floor, at constant speed, present from `start` until the
 // path's end (then gone, as if it left the room). Posed per frame by src/io/movers.cpp.
 struct MoverParams {
-  std::string kind = "person";
+  MoverKind kind = MoverKind::person;
   std::vector<vec3> path;  // waypoints on the floor, room frame (x, y; z is ignored)
   float speed = 1.0f;      // metres per second along the path
   double start = 0.0;      // seconds: when it stands at the path's first point
@@ -70,8 +95,7 @@ struct MoverParams {
   float radius = 0.12f;    // ball: radius, metres
 
   template <class V> void visit(V& v) {
-    v("kind", kind, "person (torso, head, arms and legs swinging as it walks) or ball (rolling)",
-      Choices{"person", "ball"});
+    v("kind", kind, "person (torso, head, arms and legs swinging as it walks) or ball (rolling)");
     v("path", path, "waypoints on the floor in the room frame of groundtruth.txt (x, y, z ignored), metres");
     v("speed", speed, "speed along the path, m/s", Range{0.01, 10.0});
     v("start", start, "time it appears at the path's first point, seconds (it leaves at the path's end)",
@@ -86,7 +110,7 @@ struct SyntheticParams {
   std::uint64_t seed = 1;
   bool noise = true;
   int frames = 120;
-  std::string trajectory = "orbit";
+  CameraPath trajectory = CameraPath::orbit;
   double fps = 30.0;
   float radius = 1.6f;      // orbit: horizontal distance to the desk centre, metres
   float height = 1.35f;     // camera height above the floor, metres
@@ -100,7 +124,7 @@ struct SyntheticParams {
     v("seed", seed, "random seed for the noise and the hand-held wobble");
     v("noise", noise, "add Kinect-like depth noise and dropouts (off: exact depth everywhere)");
     v("frames", frames, "number of frames to generate", Range{1, 1000000});
-    v("trajectory", trajectory, "camera path: orbit around the desk, or still (fixed pose)", Choices{"orbit", "still"});
+    v("trajectory", trajectory, "camera path: orbit around the desk, or still (fixed pose)");
     v("fps", fps, "frames per second (timestamps and motion speed)", Range{1.0, 1000.0});
     v("radius", radius, "orbit radius around the desk centre, metres", Range{0.5, 1.8});
     v("height", height, "camera height above the floor, metres (above the furniture)", Range{1.05, 2.3});
@@ -129,7 +153,7 @@ struct KinectParams {
 };
 
 struct InputParams {
-  std::string source = "synthetic";
+  InputSource source = InputSource::synthetic;
   std::string path;               // TUM folder (source: tum) or frame folder (source: frames)
   double depth_scale = 0.0;       // units per metre; 0: the layout's own (TUM 5000, frames 1000)
   bool check_depth_scale = true;  // compare depth_scale with the depth's Kinect quantisation
@@ -139,16 +163,17 @@ struct InputParams {
   std::int64_t max_frames = 0;  // 0 = all
   std::int64_t first_frame = 0;
   bool skip_bad_frames = false;
-  bool undistort = true;             // remove lens distortion of presets that have it (freiburg1/2)
-  double max_gt_gap = 0.1;           // seconds: no ground truth across larger motion-capture gaps
-  std::string association = "auto";  // TUM: pair rgb.txt/depth.txt by time (auto) or trust the folder's file
+  bool undistort = true;    // remove lens distortion of presets that have it (freiburg1/2)
+  double max_gt_gap = 0.1;  // seconds: no ground truth across larger motion-capture gaps
+  // TUM: pair rgb.txt/depth.txt by time (auto) or trust the folder's association file.
+  Association association = Association::automatic;
   double association_max_dt = 0.02;  // TUM's associate.py --max_difference, seconds
   double association_offset = 0.0;   // TUM's associate.py --offset: added to depth timestamps, seconds
   SyntheticParams synthetic;
   KinectParams kinect;
 
   template <class V> void visit(V& v) {
-    v("source", source, "frame source", Choices{"synthetic", "tum", "frames", "kinect"});
+    v("source", source, "frame source");
     v("path", path,
       "dataset folder: a TUM folder (source: tum), e.g. rgbd_dataset_freiburg1_desk, or a frame folder of "
       "frame-NNNNNN.color/depth/pose files (source: frames)");
@@ -173,8 +198,7 @@ struct InputParams {
     // derived product and some published ones are partial: fr1_desk's 9-frame sample lists 2 pairs).
     v("association", association,
       "TUM rgb/depth pairing: auto pairs rgb.txt and depth.txt by time like TUM's associate.py (an "
-      "associations.txt/associate.txt that disagrees is reported and ignored); file uses that file as written",
-      Choices{"auto", "file"});
+      "associations.txt/associate.txt that disagrees is reported and ignored); file uses that file as written");
     v("association_max_dt", association_max_dt, "auto association: largest rgb/depth timestamp difference, seconds",
       Range{0.0, 1.0});
     v("association_offset", association_offset, "auto association: seconds added to depth timestamps",
@@ -188,7 +212,7 @@ struct InputParams {
 // TUM folders store 5000 units per metre, frame folders (7-Scenes, 3DMatch) millimetres.
 inline double effective_depth_scale(const InputParams& p) {
   if (p.depth_scale > 0.0) return p.depth_scale;
-  return p.source == "frames" ? 1000.0 : 5000.0;
+  return p.source == InputSource::frames ? 1000.0 : 5000.0;
 }
 
 }  // namespace seamless

@@ -15,10 +15,10 @@ namespace seamless {
 
 std::unique_ptr<FrameSource> make_source(const InputParams& params, Device device) {
   const bool pinned = device == Device::CUDA;
-  if (params.source == "tum") return std::make_unique<TumSource>(params, pinned);
-  if (params.source == "frames") return std::make_unique<FrameFolderSource>(params, pinned);
-  if (params.source == "synthetic") return std::make_unique<SyntheticSource>(params, device);
-  if (params.source == "kinect") {
+  if (params.source == InputSource::tum) return std::make_unique<TumSource>(params, pinned);
+  if (params.source == InputSource::frames) return std::make_unique<FrameFolderSource>(params, pinned);
+  if (params.source == InputSource::synthetic) return std::make_unique<SyntheticSource>(params, device);
+  if (params.source == InputSource::kinect) {
 #if SEAMLESS_HAS_FREENECT
     return std::make_unique<KinectSource>(params, pinned);
 #else
@@ -26,7 +26,8 @@ std::unique_ptr<FrameSource> make_source(const InputParams& params, Device devic
         "input.source is kinect but this build has no libfreenect: apt-get install libfreenect-dev, reconfigure");
 #endif
   }
-  throw ConfigError("unknown input.source '" + params.source + "': use synthetic, tum, frames or kinect");
+  throw ConfigError("unknown input.source '" + std::string(enum_name(params.source)) +
+                    "': use synthetic, tum, frames or kinect");
 }
 
 namespace {

@@ -76,7 +76,7 @@ kernels::movers::Scene pose_movers(const std::vector<MoverParams>& movers, doubl
     vec3 at, facing;
     if (!along_path(m.path, travelled, &at, &facing)) continue;  // it has left
     const int id = static_cast<int>(i) + 1;
-    if (m.kind == "ball") {
+    if (m.kind == MoverKind::ball) {
       const vec3 c = at + vec3{0.f, 0.f, m.radius};
       push(s, {c, c, m.radius, id, {0.9f, 0.4f, 0.1f}});
     } else {

@@ -57,7 +57,7 @@ struct PathPoint {
 PathPoint path_point(const SyntheticParams& p, double t) {
   const vec3 c = kernels::room::desk_centre();
   double shake = p.shake;
-  double ang = (p.start_deg + (p.trajectory == "orbit" ? p.speed_deg * t : 0.0)) * kPi / 180.0;
+  double ang = (p.start_deg + (p.trajectory == CameraPath::orbit ? p.speed_deg * t : 0.0)) * kPi / 180.0;
   double r = p.radius + 0.05 * shake * wobble(p.seed, 0, t);
   // Amplitudes: a few centimetres and a degree or two, what a steady hand-held camera does.
   return {{c.x + r * std::cos(ang), c.y + r * std::sin(ang), p.height + 0.04 * shake * wobble(p.seed, 1, t)},

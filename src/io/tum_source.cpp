@@ -153,7 +153,7 @@ bool same_pairs(const std::vector<TumPair>& a, const std::vector<TumPair>& b) {
 std::vector<TumPair> tum_folder_pairs(const std::string& folder, const InputParams& params) {
   const fs::path dir(folder);
   const std::string file = association_file(dir);
-  if (params.association == "file") {
+  if (params.association == Association::file) {
     if (file.empty())
       throw InputError("input.association is 'file' but '" + folder +
                        "' has neither associations.txt nor associate.txt: " +
@@ -186,8 +186,8 @@ TumSource::TumSource(const InputParams& params, bool pinned) : params_(params), 
   fs::path dir(folder_);
   pairs_ = tum_folder_pairs(folder_, params);
   if (pairs_.empty())
-    throw InputError("TUM folder '" + folder_ + "' has no rgb/depth pairs (input.association " + params.association +
-                     ": no rgb/depth timestamps within input.association_max_dt " +
+    throw InputError("TUM folder '" + folder_ + "' has no rgb/depth pairs (input.association " +
+                     enum_name(params.association) + ": no rgb/depth timestamps within input.association_max_dt " +
                      std::to_string(params.association_max_dt) +
                      " s, or empty lists); check rgb.txt and depth.txt, or input.association_offset");
   std::size_t first = static_cast<std::size_t>(std::min<std::int64_t>(params.first_frame, pairs_.size()));

@@ -33,7 +33,7 @@ PhysicsBenchCase fluid(Device dev, bool graph, const std::string& name, int nx, 
   const float d = s->params().particle_diameter;
   s->set_scene_sdf(floor_box(0.5f * nx * d + 0.2f));
   SpawnParams f;
-  f.kind = "fluid_block", f.size = {nx * d, ny * d, nz * d}, f.position = {0.f, 0.5f * ny * d + 0.01f, 0.f};
+  f.kind = SpawnKind::fluid_block, f.size = {nx * d, ny * d, nz * d}, f.position = {0.f, 0.5f * ny * d + 0.01f, 0.f};
   s->spawn(f);
   return make_case(name, std::to_string(s->size()) + " fluid particles, 2 iterations", s);
 }
@@ -42,7 +42,7 @@ PhysicsBenchCase cloth(Device dev, bool graph, const std::string& name, int n) {
   auto s = std::make_shared<ParticleSolver>(bench_params(std::int64_t{n} * n, graph), dev);
   s->set_scene_sdf(floor_box(0.05f * n + 1.f));
   SpawnParams c;
-  c.kind = "cloth", c.nx = n, c.ny = n, c.position = {0.f, 1.f, 0.f}, c.pinned = {0, 1};
+  c.kind = SpawnKind::cloth, c.nx = n, c.ny = n, c.position = {0.f, 1.f, 0.f}, c.pinned = {0, 1};
   s->spawn(c);
   return make_case(name, std::to_string(n) + "x" + std::to_string(n) + " cloth, 2 iterations", s);
 }
@@ -54,7 +54,7 @@ PhysicsBenchCase rigid(Device dev, bool graph, const std::string& name, int bodi
   s->set_scene_sdf(floor_box(0.5f * side * 6 * d + 0.5f));
   for (int b = 0; b < bodies; ++b) {
     SpawnParams c;
-    c.kind = "rigid", c.size = {4 * d, 4 * d, 4 * d};
+    c.kind = SpawnKind::rigid, c.size = {4 * d, 4 * d, 4 * d};
     c.position = {(b % side - 0.5f * side) * 6 * d, 0.1f + 0.3f * (b / (side * side)),
                   (b / side % side - 0.5f * side) * 6 * d};
     s->spawn(c);

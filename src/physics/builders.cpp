@@ -77,9 +77,9 @@ std::vector<vec4> voxel_sdf(const std::vector<int3>& cells, float d) {
 
 ParticleBatch rigid_from_cells(const std::vector<int3>& cells, const SpawnParams& s, const SolverParams& p) {
   if (cells.empty())
-    throw ConfigError("spawn rigid: shape '" + s.shape + "' of size (" + std::to_string(s.size.x) + ", " +
-                      std::to_string(s.size.y) + ", " + std::to_string(s.size.z) + ") holds no particle of diameter " +
-                      std::to_string(p.particle_diameter) + "; make it larger");
+    throw ConfigError("spawn rigid: shape '" + std::string(enum_name(s.shape)) + "' of size (" +
+                      std::to_string(s.size.x) + ", " + std::to_string(s.size.y) + ", " + std::to_string(s.size.z) +
+                      ") holds no particle of diameter " + std::to_string(p.particle_diameter) + "; make it larger");
   const float d = p.particle_diameter;
   ParticleBatch b;
   b.kind = ParticleBatch::kRigid;
@@ -214,12 +214,12 @@ ParticleBatch make_cloth(const SpawnParams& s, const SolverParams& p) {
 ParticleBatch make_rigid(const SpawnParams& s, const SolverParams& p) {
   const float d = p.particle_diameter;
   std::vector<int3> cells;
-  if (s.shape == "box") {
+  if (s.shape == RigidShape::box) {
     int nx = count_along(s.size.x, d), ny = count_along(s.size.y, d), nz = count_along(s.size.z, d);
     for (int z = 0; z < nz; ++z)
       for (int y = 0; y < ny; ++y)
         for (int x = 0; x < nx; ++x) cells.push_back({x, y, z});
-  } else if (s.shape == "sphere") {
+  } else if (s.shape == RigidShape::sphere) {
     float R = 0.5f * s.size.x - 0.5f * d;  // particle centres, so that the surface is at size.x / 2
     int k = static_cast<int>(std::ceil(R / d)) + 1;
     for (int z = -k; z <= k; ++z)
@@ -227,6 +227,7 @@ ParticleBatch make_rigid(const SpawnParams& s, const SolverParams& p) {
         for (int x = -k; x <= k; ++x)
           if (static_cast<float>(x * x + y * y + z * z) * d * d <= R * R + 1e-6f * d * d) cells.push_back({x, y, z});
   } else {
+    // A loaded config was checked already (SpawnParams::validate); this is for entries built in code.
     if (s.mesh.empty()) throw ConfigError("spawn rigid: shape 'mesh' needs the key 'mesh' (an OBJ file path)");
     for (vec3 q : voxelize_obj(s.mesh, d, s.size)) cells.push_back(floor_to_int(q / d + vec3{0.5f, 0.5f, 0.5f}));
   }
@@ -235,10 +236,10 @@ ParticleBatch make_rigid(const SpawnParams& s, const SolverParams& p) {
 
 std::int64_t spawn_particle_count(const SpawnParams& s, const SolverParams& p) {
   const float d = p.particle_diameter;
-  if (s.kind == "fluid_block")
+  if (s.kind == SpawnKind::fluid_block)
     return std::int64_t{count_along(s.size.x, d)} * count_along(s.size.y, d) * count_along(s.size.z, d);
-  if (s.kind == "cloth") return std::int64_t{s.nx} * s.ny;
-  if (s.kind == "rigid") return make_rigid(s, p).size();
+  if (s.kind == SpawnKind::cloth) return std::int64_t{s.nx} * s.ny;
+  if (s.kind == SpawnKind::rigid) return make_rigid(s, p).size();
   if (s.duration <= 0.f) return -1;
   return static_cast<std::int64_t>(std::ceil(s.rate * s.duration)) + make_emitter_layer(s, p).size();
 }
@@ -249,8 +250,9 @@ void check_spawn_capacity(const std::vector<SpawnParams>& spawns, const SolverPa
     std::int64_t n = spawn_particle_count(spawns[i], p);
     if (n > 0) total += n;
     if (total > p.max_particles)
-      throw ConfigError("spawn[" + std::to_string(i) + "] (" + spawns[i].kind + ") brings the particle count to " +
-                        std::to_string(total) + ", over solver.max_particles = " + std::to_string(p.max_particles) +
+      throw ConfigError("spawn[" + std::to_string(i) + "] (" + enum_name(spawns[i].kind) +
+                        ") brings the particle count to " + std::to_string(total) +
+                        ", over solver.max_particles = " + std::to_string(p.max_particles) +
                         "; raise solver.max_particles or make the spawn entries smaller");
   }
 }

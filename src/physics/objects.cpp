@@ -79,9 +79,9 @@ std::shared_ptr<const BodyMesh> obj_body_mesh(const SpawnParams& s, const Solver
 }  // namespace
 
 std::shared_ptr<const BodyMesh> body_mesh(const SpawnParams& s, const SolverParams& p) {
-  if (s.kind != "rigid") return nullptr;
-  if (s.shape == "sphere") return sphere_mesh(0.5f * s.size.x);
-  if (s.shape == "mesh") return obj_body_mesh(s, p);
+  if (s.kind != SpawnKind::rigid) return nullptr;
+  if (s.shape == RigidShape::sphere) return sphere_mesh(0.5f * s.size.x);
+  if (s.shape == RigidShape::mesh) return obj_body_mesh(s, p);
   return nullptr;
 }
 

@@ -589,7 +589,7 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
           (p.x < lo.x - m || p.y < lo.y - m || p.z < lo.z - m || p.x > hi.x + m || p.y > hi.y + m || p.z > hi.z + m))
         ++far;
     }
-    const std::string what = s.kind + " at (" + format_vec(s.position) + ")";
+    const std::string what = enum_name(s.kind) + std::string(" at (") + format_vec(s.position) + ")";
     if (solid > 0)
       spdlog::warn(
           "spawn {}: {} of {} particles start inside the scene's solid (in a wall or object, or outside the "
@@ -632,16 +632,17 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
       report_placement(s, b.x);
       return add_batch(b, index, &s);
     };
-    if (s.kind == "fluid_block") return placed(make_fluid_block(s, P));
-    if (s.kind == "cloth") return placed(make_cloth(s, P));
-    if (s.kind == "rigid") return placed(make_rigid(s, P));
-    if (s.kind == "emitter") {
+    if (s.kind == SpawnKind::fluid_block) return placed(make_fluid_block(s, P));
+    if (s.kind == SpawnKind::cloth) return placed(make_cloth(s, P));
+    if (s.kind == SpawnKind::rigid) return placed(make_rigid(s, P));
+    if (s.kind == SpawnKind::emitter) {
       report_placement(s, make_emitter_layer(s, P).x);
       report_emitter_rate(s);
       emitters.push_back({s, time, P.particle_diameter, 0.0});
       return n;
     }
-    throw ConfigError("spawn: unknown kind '" + s.kind + "' (expected fluid_block, emitter, cloth or rigid)");
+    throw ConfigError("spawn: unknown kind '" + std::string(enum_name(s.kind)) +
+                      "' (expected fluid_block, emitter, cloth or rigid)");
   }
 
   // The scene particles' bounding box: one download of them, on the first spawn after they changed
@@ -777,7 +778,7 @@ void ParticleSolver::set_spawn_gate(SpawnSchedule::Gate gate) { impl_->gate = st
 void ParticleSolver::spawn_next() {
   std::optional<SpawnSchedule::Entry> e = impl_->schedule.take_next();
   if (!e) return spdlog::info("spawn: every configured object is spawned already");
-  spdlog::info("spawn: {} (configured for t = {:.2f} s) now", e->s.kind, e->s.time);
+  spdlog::info("spawn: {} (configured for t = {:.2f} s) now", enum_name(e->s.kind), e->s.time);
   impl_->spawn(e->s, e->index);
 }
 

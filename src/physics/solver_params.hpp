@@ -6,11 +6,32 @@
 #include <string>
 #include <vector>
 
+#include "core/error.hpp"
 #include "core/math.hpp"
 #include "core/params.hpp"
 
 namespace seamless {
 
+enum class SpawnKind { fluid_block, emitter, cloth, rigid };
+inline std::span<const EnumName<SpawnKind>> enum_names(SpawnKind) {
+  static constexpr EnumName<SpawnKind> names[] = {{SpawnKind::fluid_block, "fluid_block"},
+                                                  {SpawnKind::emitter, "emitter"},
+                                                  {SpawnKind::cloth, "cloth"},
+                                                  {SpawnKind::rigid, "rigid"}};
+  return names;
+}
+enum class RigidShape { box, sphere, mesh };
+inline std::span<const EnumName<RigidShape>> enum_names(RigidShape) {
+  static constexpr EnumName<RigidShape> names[] = {
+      {RigidShape::box, "box"}, {RigidShape::sphere, "sphere"}, {RigidShape::mesh, "mesh"}};
+  return names;
+}
+enum class PlaceOn { none, support, floor };
+inline std::span<const EnumName<PlaceOn>> enum_names(PlaceOn) {
+  static constexpr EnumName<PlaceOn> names[] = {
+      {PlaceOn::none, "none"}, {PlaceOn::support, "support"}, {PlaceOn::floor, "floor"}};
+  return names;
+}
 enum class SceneCollision { particles, sdf };
 inline std::span<const EnumName<SceneCollision>> enum_names(SceneCollision) {
   static constexpr EnumName<SceneCollision> names[] = {{SceneCollision::particles, "particles"},
@@ -136,17 +157,30 @@ struct SolverParams {
 // on the surface seen at a pixel of a recorded frame. `on: none` and no pixel: `position` is used
 // as given (world metres). docs/PLACEMENT.md.
 struct PlaceParams {
-  std::string on = "none";    // support: the index-th largest horizontal surface that is not the floor
-  int index = 0;              // 0 = largest
-  float above = 0.15f;        // metres above the surface (to the entry's centre)
-  std::vector<float> offset;  // [x, z]: metres from the surface's centre along world x and z
-  std::vector<int> pixel;     // [u, v]: the surface seen at this pixel of frame `frame`
-  int frame = 0;              // input frame whose camera the pixel belongs to
+  PlaceOn on = PlaceOn::none;  // support: the index-th largest horizontal surface that is not the floor
+  int index = 0;               // 0 = largest
+  float above = 0.15f;         // metres above the surface (to the entry's centre)
+  std::vector<float> offset;   // [x, z]: metres from the surface's centre along world x and z
+  std::vector<int> pixel;      // [u, v]: the surface seen at this pixel of frame `frame`
+  int frame = 0;               // input frame whose camera the pixel belongs to
 
-  bool active() const { return on != "none" || !pixel.empty(); }
+  bool active() const { return on != PlaceOn::none || !pixel.empty(); }
+  // Rules across keys; `who` names the entry in messages ("spawn[0] (rigid).place"). Checked when a
+  // config is loaded (Experiment::validate) and before placing (app/placement.cpp, for code that
+  // builds spawn entries without a config).
+  void validate(const std::string& who) const {
+    if (!pixel.empty() && pixel.size() != 2)
+      throw ConfigError(who + ".pixel: expected [u, v] (two numbers), got " + std::to_string(pixel.size()));
+    if (!pixel.empty() && on != PlaceOn::none)
+      throw ConfigError(who + ": give either `on` (" + enum_name(on) + ") or `pixel`, not both");
+    if (!offset.empty() && offset.size() != 2)
+      throw ConfigError(who + ".offset: expected [x, z] (two numbers), got " + std::to_string(offset.size()));
+    if (!offset.empty() && on == PlaceOn::none)
+      throw ConfigError(who +
+                        ".offset moves an `on:` placement across its surface; it needs `on: support` or `on: floor`");
+  }
   template <class V> void visit(V& v) {
-    v("on", on, "place on a scanned horizontal surface: support (largest that is not the floor), floor, or none",
-      Choices{"none", "support", "floor"});
+    v("on", on, "place on a scanned horizontal surface: support (largest that is not the floor), floor, or none");
     v("index", index, "which surface: 0 = largest, 1 = second largest, ...", Range{0, 1000});
     v("above", above, "height of the entry's centre above the surface, metres", Range{-10.0, 10.0});
     v("offset", offset,
@@ -160,29 +194,40 @@ struct PlaceParams {
 
 // One thing to drop into the scene at time `time`. Which fields matter depends on `kind`.
 struct SpawnParams {
-  std::string kind = "fluid_block";
-  float time = 0.f;              // seconds of simulated time
-  vec3 position{0.f, 1.f, 0.f};  // world, metres (centre; emitter: nozzle)
-  PlaceParams place;             // relative to the scan instead (resolved into position)
-  vec3 size{0.2f, 0.2f, 0.2f};   // metres (fluid_block, rigid box/sphere bounding box)
-  vec3 velocity{0.f, 0.f, 0.f};  // m/s (initial velocity; emitter: jet velocity)
-  float rate = 500.f;            // emitter: particles per second
-  float duration = 0.f;          // emitter: seconds to run; 0 = until the end
-  float nozzle_radius = 0.05f;   // emitter, metres
-  int nx = 32, ny = 32;          // cloth grid
-  float spacing = 0.f;           // cloth particle spacing, metres; 0 = particle diameter
-  std::vector<int> pinned;       // cloth corners held fixed: 0..3 = (0,0) (nx-1,0) (0,ny-1) (nx-1,ny-1)
-  float stiffness = 1.f;         // cloth stretch stiffness (PBD k); rigid: shape matching stiffness
-  float bend_stiffness = 0.1f;   // cloth bending stiffness
-  float max_strain = 0.1f;       // cloth: largest relative edge length change (Provot 1995); 0 = no limit
-  bool self_collide = false;     // cloth collides with itself
-  std::string shape = "box";     // rigid
-  std::string mesh;              // rigid, shape: mesh (OBJ/PLY path)
-  vec3 rotation{0.f, 0.f, 0.f};  // pose: Euler angles about x, y, z (applied in that order), degrees
-  float density = 1000.f;        // kg/m^3: particle mass = density * diameter^3 (fluid: solver.rest_density)
+  SpawnKind kind = SpawnKind::fluid_block;
+  float time = 0.f;                    // seconds of simulated time
+  vec3 position{0.f, 1.f, 0.f};        // world, metres (centre; emitter: nozzle)
+  PlaceParams place;                   // relative to the scan instead (resolved into position)
+  vec3 size{0.2f, 0.2f, 0.2f};         // metres (fluid_block, rigid box/sphere bounding box)
+  vec3 velocity{0.f, 0.f, 0.f};        // m/s (initial velocity; emitter: jet velocity)
+  float rate = 500.f;                  // emitter: particles per second
+  float duration = 0.f;                // emitter: seconds to run; 0 = until the end
+  float nozzle_radius = 0.05f;         // emitter, metres
+  int nx = 32, ny = 32;                // cloth grid
+  float spacing = 0.f;                 // cloth particle spacing, metres; 0 = particle diameter
+  std::vector<int> pinned;             // cloth corners held fixed: 0..3 = (0,0) (nx-1,0) (0,ny-1) (nx-1,ny-1)
+  float stiffness = 1.f;               // cloth stretch stiffness (PBD k); rigid: shape matching stiffness
+  float bend_stiffness = 0.1f;         // cloth bending stiffness
+  float max_strain = 0.1f;             // cloth: largest relative edge length change (Provot 1995); 0 = no limit
+  bool self_collide = false;           // cloth collides with itself
+  RigidShape shape = RigidShape::box;  // rigid
+  std::string mesh;                    // rigid, shape: mesh (OBJ/PLY path)
+  vec3 rotation{0.f, 0.f, 0.f};        // pose: Euler angles about x, y, z (applied in that order), degrees
+  float density = 1000.f;              // kg/m^3: particle mass = density * diameter^3 (fluid: solver.rest_density)
+
+  // "spawn[2] (rigid)": how messages name the entry at `index` of the spawn list.
+  std::string label(int index) const { return "spawn[" + std::to_string(index) + "] (" + enum_name(kind) + ")"; }
+  // Rules across keys, checked when a config is loaded (Experiment::validate). The builders check
+  // the mesh path again (physics/builders.cpp) for code that builds entries without a config.
+  void validate(int index) const {
+    place.validate(label(index) + ".place");
+    if (kind == SpawnKind::rigid && shape == RigidShape::mesh && mesh.empty())
+      throw ConfigError(label(index) + ": spawn." + std::to_string(index) + ".shape: mesh needs the key spawn." +
+                        std::to_string(index) + ".mesh (an OBJ file path)");
+  }
 
   template <class V> void visit(V& v) {
-    v("kind", kind, "what to spawn", Choices{"fluid_block", "emitter", "cloth", "rigid"});
+    v("kind", kind, "what to spawn");
     v("time", time, "when to spawn, seconds of simulated time", Range{0.0, 1e6});
     v("position", position, "centre (emitter: nozzle position), world metres");
     v("place", place, "place relative to the scanned scene instead of `position` (resolved after the scan)");
@@ -200,7 +245,7 @@ struct SpawnParams {
     v("max_strain", max_strain, "cloth strain limit: largest relative edge stretch or compression; 0 = none",
       Range{0.0, 1.0});
     v("self_collide", self_collide, "cloth collides with itself");
-    v("shape", shape, "rigid body shape", Choices{"box", "sphere", "mesh"});
+    v("shape", shape, "rigid body shape");
     v("rotation", rotation, "Euler angles about x, y, z, degrees (cloth, rigid)");
     v("density", density, "material density, kg/m^3 (rigid, cloth)", Range{1.0, 1e5});
     v("mesh", mesh, "rigid body mesh file (shape: mesh)");

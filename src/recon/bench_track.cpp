@@ -17,10 +17,10 @@ namespace {
 std::vector<RgbdFrame> first_frames(const std::string& data_dir, int n, Device device) {
   InputParams in;
   if (data_dir.empty()) {
-    in.source = "synthetic";
+    in.source = InputSource::synthetic;
     in.synthetic.frames = n;
   } else {
-    in.source = "tum";
+    in.source = InputSource::tum;
     in.path = data_dir;
     in.max_frames = n;
   }

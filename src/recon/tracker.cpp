@@ -145,7 +145,7 @@ bool Tracker::use_photometric(const FramePyramid& frame, const ReferenceMaps& re
 }
 
 bool Tracker::robust(const FramePyramid& frame, const ReferenceMaps& ref) const {
-  return params_.weighting == "robust" && use_photometric(frame, ref);
+  return params_.weighting == RgbdWeighting::robust && use_photometric(frame, ref);
 }
 
 kernels::IcpState* Tracker::state() const {
@@ -193,8 +193,8 @@ void Tracker::reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, i
                          params_.photometric_weight,
                          params_.max_intensity_diff,
                          robust(frame, ref) ? params_.robust_dof : 0.f,
-                         params_.depth_noise == "depth_squared"};
-    R.photometric_all_visible = params_.photometric_pixels == "visible";
+                         params_.depth_noise == DepthNoiseModel::depth_squared};
+    R.photometric_all_visible = params_.photometric_pixels == PhotometricPixels::visible;
     R.min_gradient = params_.min_gradient;
     if (rgbd_sums_.size() != 1 || rgbd_sums_.device() != device_) rgbd_sums_ = Buffer<kernels::RgbdSums>(1, device_);
     if (steps == 0) return kernels::Rgbd<E>::rgbd_reduce_into(ex, R, &st->pose, rgbd_sums_.data(), out);

@@ -83,6 +83,7 @@ GravityEstimate estimate_gravity(const TrackerParams& p, const std::optional<vec
   const std::string& how = p.gravity;
   if (how == "none") return g;
   if (how == "fixed") {
+    // A loaded config was checked already (TrackerParams::validate); this is for params built in code.
     if (length2(p.fixed_gravity) == 0) throw ConfigError("tracker.fixed_gravity is the zero vector; give a direction");
     return {normalize(p.fixed_gravity), "fixed", true, 0};
   }

@@ -4,10 +4,31 @@
 #include <string>
 #include <vector>
 
+#include "core/error.hpp"
 #include "core/math.hpp"
 #include "core/params.hpp"
 
 namespace seamless {
+
+// RGB-D weighting choices, shared by tracker: and refine:.
+enum class RgbdWeighting { fixed, robust };
+inline std::span<const EnumName<RgbdWeighting>> enum_names(RgbdWeighting) {
+  static constexpr EnumName<RgbdWeighting> names[] = {{RgbdWeighting::fixed, "fixed"},
+                                                      {RgbdWeighting::robust, "robust"}};
+  return names;
+}
+enum class DepthNoiseModel { uniform, depth_squared };
+inline std::span<const EnumName<DepthNoiseModel>> enum_names(DepthNoiseModel) {
+  static constexpr EnumName<DepthNoiseModel> names[] = {{DepthNoiseModel::uniform, "uniform"},
+                                                        {DepthNoiseModel::depth_squared, "depth_squared"}};
+  return names;
+}
+enum class PhotometricPixels { inliers, visible };
+inline std::span<const EnumName<PhotometricPixels>> enum_names(PhotometricPixels) {
+  static constexpr EnumName<PhotometricPixels> names[] = {{PhotometricPixels::inliers, "inliers"},
+                                                          {PhotometricPixels::visible, "visible"}};
+  return names;
+}
 
 struct TrackerParams {
   std::string kind = "icp";
@@ -35,12 +56,12 @@ struct TrackerParams {
   // rgbd: fixed weights (photometric_weight), or robust self-balancing ones: each residual type
   // whitened by its own scale, estimated every step, with Student-t weights against outliers
   // (Kerl et al. 2013; docs/TRACKING.md, "RGB-D").
-  std::string weighting = "fixed";
-  float robust_dof = 5.f;               // degrees of freedom of the t-distribution (Kerl et al. 2013: 5)
-  std::string depth_noise = "uniform";  // robust: geometric noise uniform or ~ depth^2 (Kinect v1)
+  RgbdWeighting weighting = RgbdWeighting::fixed;
+  float robust_dof = 5.f;  // degrees of freedom of the t-distribution (Kerl et al. 2013: 5)
+  DepthNoiseModel depth_noise = DepthNoiseModel::uniform;  // robust: geometric noise uniform or ~ depth^2 (Kinect v1)
   // rgbd: the pixels that get a photometric row (kernels/recon/rgbd.hpp, RgbdLevel): the geometric
   // inliers only, or every pixel that sees the reference surface (the normal test left to geometry).
-  std::string photometric_pixels = "inliers";
+  PhotometricPixels photometric_pixels = PhotometricPixels::inliers;
   float min_gradient = 0.f;            // rgbd: photometric rows only where |grad I| >= this (per pixel)
   bool constant_velocity = false;      // start each frame from the last motion instead of the last pose
   float max_translation_jump = 0.3f;   // metres per frame
@@ -56,6 +77,13 @@ struct TrackerParams {
   float relocalise_max_residual_ratio = 2.0f;
   std::string gravity = "auto";
   vec3 fixed_gravity{0.f, 1.f, 0.f};  // camera frame (y down), used when gravity: fixed
+
+  // Rules across keys, checked when a config is loaded (Experiment::validate); tracker_gravity.cpp
+  // checks the vector again for code that builds TrackerParams without a config.
+  void validate() const {
+    if (gravity == "fixed" && length2(fixed_gravity) == 0.f)
+      throw ConfigError("tracker.gravity: fixed needs a direction, but tracker.fixed_gravity is the zero vector");
+  }
 
   template <class V> void visit(V& v) {
     v("kind", kind, "tracker; opencv_* and pcl_gicp are external libraries, always frame to frame",
@@ -92,17 +120,14 @@ struct TrackerParams {
     v("weighting", weighting,
       "rgbd: fixed (photometric_weight) or robust (each term whitened by its own residual scale, estimated "
       "every step, with t-distribution weights against outliers; photometric_weight then scales the whitened "
-      "colour term)",
-      Choices{"fixed", "robust"});
+      "colour term)");
     v("robust_dof", robust_dof, "rgbd weighting robust: degrees of freedom of the t-distribution", Range{0.1, 1e6});
     v("depth_noise", depth_noise,
       "rgbd weighting robust: the geometric residual's noise is uniform, or grows with depth squared "
-      "(structured-light sensors such as the Kinect v1)",
-      Choices{"uniform", "depth_squared"});
+      "(structured-light sensors such as the Kinect v1)");
     v("photometric_pixels", photometric_pixels,
       "rgbd: photometric rows for the geometric inliers only, or for every pixel whose projection sees the "
-      "reference surface within dist_threshold (the normal test then applies to the geometric rows only)",
-      Choices{"inliers", "visible"});
+      "reference surface within dist_threshold (the normal test then applies to the geometric rows only)");
     v("min_gradient", min_gradient,
       "rgbd: photometric rows only where the reference intensity gradient is at least this, intensity [0, 1] "
       "per pixel (central difference); 0: every pixel",

@@ -4,11 +4,34 @@
 #include <string>
 #include <vector>
 
+#include "core/error.hpp"
 #include "core/math.hpp"
 #include "core/params.hpp"
 
 namespace seamless {
 
+enum class RenderMode { window, headless, none };
+inline std::span<const EnumName<RenderMode>> enum_names(RenderMode) {
+  static constexpr EnumName<RenderMode> names[] = {
+      {RenderMode::window, "window"}, {RenderMode::headless, "headless"}, {RenderMode::none, "none"}};
+  return names;
+}
+enum class RenderView { mesh, kinect };
+inline std::span<const EnumName<RenderView>> enum_names(RenderView) {
+  static constexpr EnumName<RenderView> names[] = {{RenderView::mesh, "mesh"}, {RenderView::kinect, "kinect"}};
+  return names;
+}
+enum class RenderCameraMode { fixed, recorded };
+inline std::span<const EnumName<RenderCameraMode>> enum_names(RenderCameraMode) {
+  static constexpr EnumName<RenderCameraMode> names[] = {{RenderCameraMode::fixed, "fixed"},
+                                                         {RenderCameraMode::recorded, "recorded"}};
+  return names;
+}
+enum class FluidDraw { ssfr, particles };
+inline std::span<const EnumName<FluidDraw>> enum_names(FluidDraw) {
+  static constexpr EnumName<FluidDraw> names[] = {{FluidDraw::ssfr, "ssfr"}, {FluidDraw::particles, "particles"}};
+  return names;
+}
 enum class FluidFilter { narrow_range, bilateral };
 inline std::span<const EnumName<FluidFilter>> enum_names(FluidFilter) {
   static constexpr EnumName<FluidFilter> names[] = {{FluidFilter::narrow_range, "narrow_range"},
@@ -22,20 +45,20 @@ inline std::span<const EnumName<FluidSplat>> enum_names(FluidSplat) {
 }
 
 struct RenderParams {
-  std::string mode = "none";
+  RenderMode mode = RenderMode::none;
   int width = 1280;
   int height = 720;
-  std::string view = "mesh";  // mesh: coloured scene mesh; kinect: live RGB with depth occlusion
+  RenderView view = RenderView::mesh;  // mesh: coloured scene mesh; kinect: live RGB with depth occlusion
   // fixed: the mesh view from behind and above the first camera, the Kinect view from the first
   // frame; recorded: output frame k is recorded frame k seen from its tracked pose, the simulation
   // advancing by the recording's frame interval (scan_then_simulate replays the recording after the scan).
-  std::string camera = "fixed";
+  RenderCameraMode camera = RenderCameraMode::fixed;
   int replay_start = 0;  // recorded, scan_then_simulate: first input frame of the replay
   // recorded, mesh view: magnify the recorded camera about pixel zoom_at (default the centre), so
   // that a figure can frame an object that the recording saw from afar (a chair across the room).
   float zoom = 1.f;
   std::vector<float> zoom_at;
-  std::string fluid = "ssfr";  // screen-space fluid rendering (van der Laan 2009) or raw particles
+  FluidDraw fluid = FluidDraw::ssfr;  // screen-space fluid rendering (van der Laan 2009) or raw particles
   bool write_frames = false;
   bool video = false;
   bool stage_images = false;
@@ -96,21 +119,38 @@ struct RenderParams {
   float max_point_size = 64.f;   // sprite size limit, pixels: nearer spheres are cut to this square
   bool cuda_interop = true;      // CUDA runs: copy particles device to device into GL (no host trip)
 
+  // Rules across keys, checked when a config is loaded (Experiment::validate).
+  void validate() const {
+    for (const auto& [key, xyz] : {std::pair{"eye", &eye}, std::pair{"target", &target}})
+      if (!xyz->empty() && xyz->size() != 3)
+        throw ConfigError(std::string("render.") + key + ": expected [x, y, z] (three numbers, world metres), got " +
+                          std::to_string(xyz->size()));
+    if (eye.size() == 3 && target.size() == 3 && eye == target)
+      throw ConfigError("render.eye and render.target are the same point: the camera would look nowhere");
+    // zoom / zoom_at crop the recorded camera of the mesh view (app/render_stage.cpp); elsewhere they
+    // would be ignored silently.
+    if (!zoom_at.empty() && zoom_at.size() != 2)
+      throw ConfigError("render.zoom_at: expected [u, v] (two numbers), got " + std::to_string(zoom_at.size()));
+    if ((zoom != 1.f || !zoom_at.empty()) && (camera != RenderCameraMode::recorded || view != RenderView::mesh))
+      throw ConfigError(
+          "render.zoom and render.zoom_at magnify the recorded camera of the mesh view; they need "
+          "render.camera: recorded and render.view: mesh (the mesh view's fixed camera has render.fov_y)");
+  }
+
   template <class V> void visit(V& v) {
-    v("mode", mode, "window, headless (PNGs) or no rendering", Choices{"window", "headless", "none"});
+    v("mode", mode, "window, headless (PNGs) or no rendering");
     v("width", width, "framebuffer width, pixels", Range{16, 16384});
     v("height", height, "framebuffer height, pixels", Range{16, 16384});
-    v("view", view, "scene as reconstructed mesh or as the Kinect's view", Choices{"mesh", "kinect"});
+    v("view", view, "scene as reconstructed mesh or as the Kinect's view");
     v("camera", camera,
       "fixed: one viewpoint (mesh: behind the first camera; kinect: the first frame); recorded: replay the "
-      "recording, output frame k = input frame k from its tracked pose, simulation in the recording's time",
-      Choices{"fixed", "recorded"});
+      "recording, output frame k = input frame k from its tracked pose, simulation in the recording's time");
     v("replay_start", replay_start, "camera recorded, scan_then_simulate: input frame the replay starts at",
       Range{0, 1e9});
     v("zoom", zoom, "camera recorded, view mesh: magnify the recorded camera this many times about zoom_at",
       Range{1.0, 20.0});
     v("zoom_at", zoom_at, "[u, v]: input image pixel that zoom centres on (empty: the image centre)", Range{-1e5, 1e5});
-    v("fluid", fluid, "fluid drawing", Choices{"ssfr", "particles"});
+    v("fluid", fluid, "fluid drawing");
     v("write_frames", write_frames, "write each rendered frame as PNG into the output folder");
     v("video", video, "encode the frames into a video (needs ffmpeg)");
     v("stage_images", stage_images, "also write the intermediate SSFR stages (depth, blur, thickness)");

@@ -144,7 +144,7 @@ void Renderer::Impl::draw_mesh(const GlMesh& m, const RenderCamera& cam, const M
 
 void Renderer::Impl::draw_scene(const RenderCamera& cam) {
   if (!p.show_scene) return;
-  if (p.view == "kinect" && has_kinect) {
+  if (p.view == RenderView::kinect && has_kinect) {
     // Depth test always passes: the image is the background and sets every pixel's depth.
     glDepthFunc(GL_ALWAYS);
     set_camera_uniforms(kinect_prog, cam);
@@ -155,7 +155,7 @@ void Renderer::Impl::draw_scene(const RenderCamera& cam) {
     glBindVertexArray(empty_vao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glDepthFunc(GL_LESS);
-  } else if (p.view == "mesh" && has_scene) {
+  } else if (p.view == RenderView::mesh && has_scene) {
     draw_mesh(scene, cam, model_matrix(SE3::identity()), true, {0.7f, 0.7f, 0.7f}, p.light_scene);
   }
 }
@@ -301,7 +301,7 @@ void Renderer::Impl::draw_objects(const DrawList& list, std::int64_t n, const Re
       upload_cloth(c.triangles, n);
       draw_cloth(cam);
     }
-  const bool fluid_as_particles = p.show_fluid && p.fluid == "particles";
+  const bool fluid_as_particles = p.show_fluid && p.fluid == FluidDraw::particles;
   if (n > 0 && (p.show_particles || fluid_as_particles)) {
     const std::uint32_t mask = p.show_particles ? 0u : kernels::phase::kFluid;
     draw_spheres(particle_prog, n, mask, list.particle_radius, cam);
@@ -333,7 +333,7 @@ void Renderer::Impl::draw_frame(const DrawList& list, std::int64_t n, const Rend
   timer.mark("scene");
   draw_objects(list, n, cam);
   timer.mark("objects");
-  last_has_fluid = p.show_fluid && p.fluid == "ssfr" && n > 0 && draw_fluid(n, list.particle_radius, cam);
+  last_has_fluid = p.show_fluid && p.fluid == FluidDraw::ssfr && n > 0 && draw_fluid(n, list.particle_radius, cam);
   if (last_has_fluid && p.stage_images) capture_stages();
   timings = timer.resolve();
 }
@@ -468,7 +468,7 @@ RenderCamera Renderer::kinect_camera() const {
 namespace {
 // The camera actually used: Kinect view overrides; a free camera's intrinsics must fit the target.
 RenderCamera effective_camera(const Renderer& r, const RenderParams& p, const RenderCamera& cam) {
-  if (p.view == "kinect") return r.kinect_camera();
+  if (p.view == RenderView::kinect) return r.kinect_camera();
   if (cam.K.width != r.width() || cam.K.height != r.height()) {
     RenderCamera c = cam;
     c.K = scale_intrinsics(cam.K, r.width(), r.height());

@@ -62,7 +62,7 @@ class Renderer {
   // The camera the Kinect view draws with: K scaled to the framebuffer, the tracked pose.
   RenderCamera kinect_camera() const;
 
-  // Draws one frame. In the Kinect view (params().view == "kinect") `camera` is ignored and
+  // Draws one frame. In the Kinect view (params().view == RenderView::kinect) `camera` is ignored and
   // kinect_camera() is used, so that the virtual objects line up with the image.
   void draw(const DrawList& list, const RenderCamera& camera);
   // The last frame, rows top to bottom.

@@ -250,11 +250,11 @@ void Renderer::Impl::composite_pass(const RenderCamera& cam) {
   bind_tex(5, GL_TEXTURE_2D, scene_depth);
   const char* samplers[] = {"u_scene_color", "u_fluid_depth", "u_normal", "u_thickness", "u_cube", "u_scene_depth"};
   for (int i = 0; i < 6; ++i) glUniform1i(cp.loc(samplers[i]), i);
-  const bool use_cube = has_cube && p.view == "mesh";
+  const bool use_cube = has_cube && p.view == RenderView::mesh;
   glUniform1i(cp.loc("u_use_cube"), use_cube);
   // Without a cube map, the Kinect image's mean colour (or the mesh view's background) is what
   // the surface reflects.
-  const vec3 env = p.view == "kinect" && has_kinect ? kin_mean : srgb_to_linear(p.background);
+  const vec3 env = p.view == RenderView::kinect && has_kinect ? kin_mean : srgb_to_linear(p.background);
   glUniform3f(cp.loc("u_env"), env.x, env.y, env.z);
   const std::vector<float> R = {
       cam.world_T_camera.R.m[0][0], cam.world_T_camera.R.m[1][0], cam.world_T_camera.R.m[2][0],

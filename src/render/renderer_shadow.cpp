@@ -148,7 +148,7 @@ void Renderer::Impl::shadow_pass(const DrawList& list, std::int64_t n) {
   if (!rigids && !cloth && !fluid) return;
   // The fluid's spheres as the camera sees them: the SSFR passes' enlarged spheres, a body of
   // water that transmits (fluid_transmittance, shadow.glsl); or the debug view's opaque balls.
-  const bool ssfr = p.fluid == "ssfr";
+  const bool ssfr = p.fluid == FluidDraw::ssfr;
   const float sphere_r = list.particle_radius * (ssfr ? p.fluid_radius_scale : 1.f);
   list_sphere_r = sphere_r;
 

@@ -50,8 +50,8 @@ void press(GLFWwindow* w, int key) {
     case GLFW_KEY_3: p.show_rigid = !p.show_rigid; break;
     case GLFW_KEY_4: p.show_cloth = !p.show_cloth; break;
     case GLFW_KEY_5: p.show_particles = !p.show_particles; break;
-    case GLFW_KEY_F: p.fluid = p.fluid == "ssfr" ? "particles" : "ssfr"; break;
-    case GLFW_KEY_V: p.view = p.view == "mesh" ? "kinect" : "mesh"; break;
+    case GLFW_KEY_F: p.fluid = p.fluid == FluidDraw::ssfr ? FluidDraw::particles : FluidDraw::ssfr; break;
+    case GLFW_KEY_V: p.view = p.view == RenderView::mesh ? RenderView::kinect : RenderView::mesh; break;
     case GLFW_KEY_C:
       if (!u.fly) {  // start flying from where the orbit camera is, looking the same way
         u.fly_pos = u.orbit.eye(u.up);

@@ -11,9 +11,9 @@ namespace {
 
 InputParams person_walking() {
   InputParams in;
-  in.source = "synthetic";
+  in.source = InputSource::synthetic;
   MoverParams person;
-  person.kind = "person", person.path = {{-1.f, 1.2f, 0.f}, {1.f, 1.2f, 0.f}}, person.speed = 1.f;
+  person.kind = MoverKind::person, person.path = {{-1.f, 1.2f, 0.f}, {1.f, 1.2f, 0.f}}, person.speed = 1.f;
   in.synthetic.movers = {person};
   return in;
 }

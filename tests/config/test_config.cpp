@@ -64,10 +64,10 @@ spawn:
   EXPECT_EQ(e.tracker.iterations, (std::vector<int>{3, 2}));
   EXPECT_EQ(e.tracker.fixed_gravity.z, 0.5f);
   ASSERT_EQ(e.spawn.size(), 2u);
-  EXPECT_EQ(e.spawn[0].kind, "cloth");
+  EXPECT_EQ(e.spawn[0].kind, SpawnKind::cloth);
   EXPECT_EQ(e.spawn[0].pinned, (std::vector<int>{0, 3}));
   EXPECT_EQ(e.spawn[0].nx, 5);
-  EXPECT_EQ(e.spawn[1].kind, "rigid");
+  EXPECT_EQ(e.spawn[1].kind, SpawnKind::rigid);
   EXPECT_EQ(e.spawn[1].position.y, 2.f);
   EXPECT_EQ(e.spawn[1].size.x, SpawnParams{}.size.x);  // element defaults apply per entry
 }
@@ -140,6 +140,54 @@ TEST(ConfigErrors, RulesAcrossKeysAreCheckedAtLoad) {
   // depth without dynamic.enabled is allowed (no pixel is dynamic, so nothing collides: the live
   // loop says so), so that `--set dynamic.enabled=false` compares a run with and without.
   EXPECT_EQ(error_of("mode: live\nsolver: {dynamic_colliders: depth}"), "");
+}
+
+TEST(ConfigErrors, RenderCameraRulesAreCheckedAtLoad) {
+  // zoom acts only on the recorded camera of the mesh view; elsewhere it would be ignored silently.
+  const std::string zoom_rule =
+      "render.zoom and render.zoom_at magnify the recorded camera of the mesh view; they need "
+      "render.camera: recorded and render.view: mesh";
+  EXPECT_THAT(error_of("render: {camera: recorded, view: kinect, zoom: 2}"), HasSubstr(zoom_rule));
+  EXPECT_THAT(error_of("render: {camera: fixed, view: mesh, zoom_at: [320, 240]}"), HasSubstr(zoom_rule));
+  EXPECT_EQ(error_of("render: {camera: recorded, view: mesh, zoom: 2, zoom_at: [320, 240]}"), "");
+  EXPECT_THAT(error_of("render: {camera: recorded, view: mesh, zoom_at: [1, 2, 3]}"),
+              HasSubstr("render.zoom_at: expected [u, v] (two numbers), got 3"));
+  EXPECT_THAT(error_of("render: {eye: [0, 1]}"), HasSubstr("render.eye: expected [x, y, z] (three numbers"));
+  EXPECT_THAT(error_of("render: {target: [0, 1, 2, 3]}"), HasSubstr("render.target: expected [x, y, z]"));
+  EXPECT_THAT(error_of("render: {eye: [0, 1, 2], target: [0, 1, 2]}"),
+              HasSubstr("render.eye and render.target are the same point"));
+  EXPECT_EQ(error_of("render: {eye: [0, 1, 2], target: [0, 1, 3]}"), "");
+  // A live Kinect cannot be replayed after a scan.
+  EXPECT_THAT(error_of("mode: scan_then_simulate\ninput: {source: kinect}\nrender: {camera: recorded}"),
+              HasSubstr("render.camera: recorded with input.source: kinect needs mode: live"));
+  EXPECT_EQ(error_of("mode: live\ninput: {source: kinect}\nrender: {camera: recorded}"), "");
+  EXPECT_EQ(error_of("mode: scan_then_simulate\ninput: {source: tum}\nrender: {camera: recorded}"), "");
+}
+
+TEST(ConfigErrors, SpawnRulesAreCheckedAtLoad) {
+  EXPECT_THAT(error_of("spawn:\n  - kind: rigid\n    place: {on: floor, pixel: [10, 20]}"),
+              HasSubstr("spawn[0] (rigid).place: give either `on` (floor) or `pixel`, not both"));
+  EXPECT_THAT(error_of("spawn:\n  - kind: cloth\n  - kind: rigid\n    place: {pixel: [10, 20, 30]}"),
+              HasSubstr("spawn[1] (rigid).place.pixel: expected [u, v] (two numbers), got 3"));
+  EXPECT_THAT(error_of("spawn:\n  - kind: fluid_block\n    place: {on: support, offset: [0.1]}"),
+              HasSubstr("spawn[0] (fluid_block).place.offset: expected [x, z] (two numbers), got 1"));
+  EXPECT_THAT(error_of("spawn:\n  - kind: fluid_block\n    place: {offset: [0.1, 0.2]}"),
+              HasSubstr("spawn[0] (fluid_block).place.offset moves an `on:` placement across its surface; it needs "
+                        "`on: support` or `on: floor`"));
+  EXPECT_EQ(error_of("spawn:\n  - kind: fluid_block\n    place: {on: support, offset: [0.1, 0.2]}"), "");
+  EXPECT_EQ(error_of("spawn:\n  - kind: rigid\n    place: {pixel: [10, 20], frame: 3}"), "");
+  // A mesh body needs its file.
+  EXPECT_THAT(error_of("spawn:\n  - kind: cloth\n  - kind: rigid\n    shape: mesh"),
+              HasSubstr("spawn[1] (rigid): spawn.1.shape: mesh needs the key spawn.1.mesh"));
+  EXPECT_EQ(error_of("spawn:\n  - kind: rigid\n    shape: mesh\n    mesh: bunny.obj"), "");
+  EXPECT_EQ(error_of("spawn:\n  - kind: fluid_block\n    shape: mesh"), "");  // shape is a rigid key
+}
+
+TEST(ConfigErrors, TrackerRulesAreCheckedAtLoad) {
+  EXPECT_THAT(error_of("tracker: {gravity: fixed, fixed_gravity: [0, 0, 0]}"),
+              HasSubstr("tracker.gravity: fixed needs a direction, but tracker.fixed_gravity is the zero vector"));
+  EXPECT_EQ(error_of("tracker: {gravity: fixed, fixed_gravity: [0, 0, 1]}"), "");
+  EXPECT_EQ(error_of("tracker: {gravity: none, fixed_gravity: [0, 0, 0]}"), "");  // not used
 }
 
 TEST(ConfigErrors, ListElementsHaveIndexedPathsAndPositions) {
@@ -226,15 +274,15 @@ TEST(ConfigFiles, EveryShippedConfigLoads) {
 
 TEST(ConfigFiles, DemoSaysWhatItShould) {
   Experiment e = load_experiment(std::string(SEAMLESS_SOURCE_DIR) + "/configs/demo.yaml");
-  EXPECT_EQ(e.input.source, "synthetic");
-  EXPECT_EQ(e.mode, "scan_then_simulate");
+  EXPECT_EQ(e.input.source, InputSource::synthetic);
+  EXPECT_EQ(e.mode, ExperimentMode::scan_then_simulate);
   // The demo of the issue: fluid on the desk, a cloth, cubes (plural) on the floor.
-  auto count = [&](const char* kind) {
+  auto count = [&](SpawnKind kind) {
     return std::count_if(e.spawn.begin(), e.spawn.end(), [&](const SpawnParams& s) { return s.kind == kind; });
   };
-  EXPECT_GE(count("fluid_block") + count("emitter"), 1);
-  EXPECT_GE(count("cloth"), 1);
-  EXPECT_GE(count("rigid"), 2);
+  EXPECT_GE(count(SpawnKind::fluid_block) + count(SpawnKind::emitter), 1);
+  EXPECT_GE(count(SpawnKind::cloth), 1);
+  EXPECT_GE(count(SpawnKind::rigid), 2);
 }
 
 }  // namespace

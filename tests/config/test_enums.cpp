@@ -89,7 +89,31 @@ TEST(ConfigEnums, EveryEnumFieldRoundTripsItsNamesAndRejectsOthers) {
   EnumWalker walker{"", &found};
   e.visit(walker);
   // The enums made so far (issue 19); a new one is checked here without being listed.
-  for (const char* path : {"volume.layout", "solver.scene_collision", "solver.dynamic_colliders", "render.fluid_filter",
+  for (const char* path : {"mode",
+                           "input.source",
+                           "input.association",
+                           "input.synthetic.trajectory",
+                           "input.synthetic.movers[].kind",
+                           "volume.layout",
+                           "tracker.weighting",
+                           "tracker.depth_noise",
+                           "tracker.photometric_pixels",
+                           "refine.keyframes",
+                           "refine.pair_tracker",
+                           "refine.weighting",
+                           "refine.depth_noise",
+                           "refine.photometric_pixels",
+                           "refine.robust_loss",
+                           "solver.scene_collision",
+                           "solver.dynamic_colliders",
+                           "spawn[].kind",
+                           "spawn[].shape",
+                           "spawn[].place.on",
+                           "render.mode",
+                           "render.view",
+                           "render.camera",
+                           "render.fluid",
+                           "render.fluid_filter",
                            "render.fluid_splat"})
     EXPECT_NE(std::find(found.begin(), found.end(), path), found.end()) << path;
 }

@@ -47,7 +47,7 @@ TEST(ConfigOverride, ValuesAreYamlFlowNodes) {
   Experiment two = parse_experiment(kBase, {"spawn=[{kind: emitter, rate: 5}, {kind: rigid}]"}, "base.yaml");
   ASSERT_EQ(two.spawn.size(), 2u);
   EXPECT_EQ(two.spawn[0].rate, 5.f);
-  EXPECT_EQ(two.spawn[1].kind, "rigid");
+  EXPECT_EQ(two.spawn[1].kind, SpawnKind::rigid);
   EXPECT_EQ(parse_experiment(kBase, {"input.path="}, "base.yaml").input.path, "");
 }
 
@@ -60,10 +60,10 @@ TEST(ConfigOverride, ListElementsByIndex) {
   Experiment e = parse_experiment(kBase, {"spawn.0.rate=3", "spawn.1.kind=cloth", "spawn.1.nx=9"}, "base.yaml");
   ASSERT_EQ(e.spawn.size(), 2u);  // index == size appends an entry
   EXPECT_EQ(e.spawn[0].rate, 3.f);
-  EXPECT_EQ(e.spawn[0].kind, "fluid_block");  // the rest of the entry comes from the file
-  EXPECT_EQ(e.spawn[1].kind, "cloth");
+  EXPECT_EQ(e.spawn[0].kind, SpawnKind::fluid_block);  // the rest of the entry comes from the file
+  EXPECT_EQ(e.spawn[1].kind, SpawnKind::cloth);
   EXPECT_EQ(e.spawn[1].nx, 9);
-  EXPECT_EQ(parse_experiment("", {"spawn.0.kind=rigid"}, "empty.yaml").spawn.at(0).kind, "rigid");
+  EXPECT_EQ(parse_experiment("", {"spawn.0.kind=rigid"}, "empty.yaml").spawn.at(0).kind, SpawnKind::rigid);
   EXPECT_THAT(error_of(kBase, {"spawn.5.rate=3"}), HasSubstr("'spawn' has 1 entries"));
   EXPECT_THAT(error_of(kBase, {"spawn.first.rate=3"}), HasSubstr("'spawn' is a list"));
 }

@@ -21,7 +21,7 @@ Experiment unusual_experiment() {
   Experiment e;
   e.name = "run: #1 \"quoted\" \\ back";
   e.device = "cpu";
-  e.mode = "scan_then_simulate";
+  e.mode = ExperimentMode::scan_then_simulate;
   e.frames = 999999999999;  // the largest the range allows; not exact in a float or 32 bits
   e.input.path = "/data/with space/rgbd";
   e.input.synthetic.seed = std::numeric_limits<std::uint64_t>::max();
@@ -31,15 +31,15 @@ Experiment unusual_experiment() {
   e.volume.dense_origin = {-0.f, 1e-7f, -123.456f};
   e.tracker.iterations = {};
   e.solver.gravity = {0.1f, 0.2f, 0.3f};
-  e.render.mode = "none";
+  e.render.mode = RenderMode::none;
   e.output.dir = "";
   SpawnParams cloth;
-  cloth.kind = "cloth";
+  cloth.kind = SpawnKind::cloth;
   cloth.pinned = {0, 1, 2, 3};
   cloth.time = 0.1f;
   SpawnParams rigid;
-  rigid.kind = "rigid";
-  rigid.shape = "mesh";
+  rigid.kind = SpawnKind::rigid;
+  rigid.shape = RigidShape::mesh;
   rigid.mesh = "null";  // would read back as "nothing" if written plain
   e.spawn = {cloth, rigid};
   return e;
@@ -100,7 +100,7 @@ TEST(ConfigRoundTrip, OverriddenLoadWritesTheOverride) {
   Experiment back = load_experiment(file);
   EXPECT_EQ(back.render.width, 320);
   ASSERT_EQ(back.spawn.size(), 1u);
-  EXPECT_EQ(back.spawn[0].kind, "emitter");
+  EXPECT_EQ(back.spawn[0].kind, SpawnKind::emitter);
   EXPECT_TRUE(diff_experiments(e, back).empty());
 }
 

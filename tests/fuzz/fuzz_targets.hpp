@@ -54,7 +54,7 @@ inline void tum(const std::uint8_t* data, std::size_t size) {
   for (int i = 0; i < 6; ++i)
     if (!p[i].empty()) put("tum/" + std::string(names[i]), p[i]);
   InputParams params;
-  params.source = "tum";
+  params.source = InputSource::tum;
   params.path = dir;
   params.intrinsics.preset = "auto";  // calibration.txt when there is one
   expect_error_or_success([&] {
@@ -98,7 +98,7 @@ inline void frames(const std::uint8_t* data, std::size_t size) {
     put("frames/" + name, content);
   }
   InputParams params;
-  params.source = "frames";
+  params.source = InputSource::frames;
   params.path = dir;
   expect_error_or_success([&] {
     FrameFolderSource src(params);

@@ -18,7 +18,7 @@ int main(int argc, char** argv) {
   }
   try {
     seamless::InputParams p;
-    p.source = "kinect";
+    p.source = seamless::InputSource::kinect;
     p.kinect.queue_size = 64;  // the recorder writes PNGs slower than 30 Hz on a busy CI machine
     p.kinect.timeout_s = 20;
     auto src = seamless::make_source(p);

@@ -89,10 +89,10 @@ TEST(Association, FolderPairsByTimeUnlessAskedForTheFile) {
   std::ofstream(dir / "associate.txt") << std::fixed << rgb[0].timestamp << ' ' << rgb[0].file << ' '
                                        << depth[0].timestamp << ' ' << depth[0].file << '\n';
   InputParams p;
-  p.source = "tum";
+  p.source = InputSource::tum;
   p.path = dir.str();
   EXPECT_EQ(tum_folder_pairs(dir.str(), p).size(), 3u);  // auto: by time, the partial file ignored
-  p.association = "file";
+  p.association = Association::file;
   EXPECT_EQ(tum_folder_pairs(dir.str(), p).size(), 1u);
   std::filesystem::remove(dir / "associate.txt");
   try {

@@ -33,7 +33,7 @@ void make_folder(const TmpDir& dir) {
 
 InputParams tum(const TmpDir& dir, bool skip = false) {
   InputParams p;
-  p.source = "tum";
+  p.source = InputSource::tum;
   p.path = dir.str();
   p.skip_bad_frames = skip;
   return p;
@@ -84,7 +84,7 @@ TEST(BadInput, MissingListFile) {
 
 TEST(BadInput, MissingFolder) {
   InputParams p;
-  p.source = "tum";
+  p.source = InputSource::tum;
   p.path = "/nonexistent/rgbd_dataset_freiburg1_xyz";
   EXPECT_MENTIONS(read_all(p), "/nonexistent/rgbd_dataset_freiburg1_xyz");
 }
@@ -198,12 +198,12 @@ TEST(BadInput, RepeatedListLinesAreDroppedWithAWarning) {
   // depth.txt: 3 comment lines, frame 0 on line 4, frame 1 on lines 5 and 6.
   EXPECT_MENTIONS(log.str(), "depth.txt' line 6");
   EXPECT_MENTIONS(log.str(), "repeats the line before it; line dropped");
-  for (const char* association : {"auto", "file"}) {
+  for (Association association : {Association::automatic, Association::file}) {
     InputParams p = tum(dir);
     p.association = association;
     std::int64_t n = 0;
-    EXPECT_EQ(read_all(p, &n), "") << association;
-    EXPECT_EQ(n, 3) << association;
+    EXPECT_EQ(read_all(p, &n), "") << enum_name(association);
+    EXPECT_EQ(n, 3) << enum_name(association);
   }
 }
 

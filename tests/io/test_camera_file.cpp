@@ -299,7 +299,7 @@ TEST(CameraFile, FrameFolderWithNegativeFocalLengthSeesTheSamePoint) {
   write_png_u16(dir / "frame-000000.depth.png", depth);
   write_png_rgb(dir / "frame-000000.color.png", colour);
   InputParams p;
-  p.source = "frames";
+  p.source = InputSource::frames;
   p.path = dir.str();
   p.check_depth_scale = false;  // a flat wall says nothing about the depth unit
   p.intrinsics.file =

@@ -83,7 +83,7 @@ TEST(DepthScale, RealKinectDepthInMillimetresSaysOneThousand) {
 TEST(DepthScale, TumSourceStopsOnMillimetresAndIsSilentOnItsOwnScale) {
   REQUIRE_DATA(data_dir(kTum));
   InputParams p;
-  p.source = "tum";
+  p.source = InputSource::tum;
   p.path = data_dir(kTum);
   p.max_frames = 12;
   auto read_all = [](const InputParams& params) -> std::string {
@@ -121,7 +121,7 @@ TEST(DepthScale, RealFrameFolderIsNotMeasurableAndPasses) {
   EXPECT_LE(q.median_gap, 1.0);
   EXPECT_EQ(judge_depth_scale(q, 1000, "f").kind, DepthScaleVerdict::not_measurable);
   InputParams p;
-  p.source = "frames";
+  p.source = InputSource::frames;
   p.path = dir;
   p.depth_scale = 1000;
   FrameFolderSource src(p);

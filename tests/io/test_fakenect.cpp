@@ -42,7 +42,7 @@ TEST(Fakenect, ReplayedFramesEqualTheSyntheticOnes) {
   EXPECT_NE(text.find("frames 5 dropped 0"), std::string::npos) << text;
 
   InputParams q;
-  q.source = "tum";
+  q.source = InputSource::tum;
   q.path = dir / "out";
   TumSource replay(q);
   ASSERT_EQ(replay.size(), 5);
@@ -96,7 +96,7 @@ TEST(Fakenect, NoKinectIsAClearError) {
   // The real libfreenect on a machine without a Kinect (CI): a seamless::Error that says so.
   if (std::getenv("FAKENECT_PATH")) GTEST_SKIP() << "running under fakenect";
   InputParams p;
-  p.source = "kinect";
+  p.source = InputSource::kinect;
   p.kinect.device_index = 3;  // even with a Kinect plugged in, hardly a fourth one
   try {
     KinectSource k(p);

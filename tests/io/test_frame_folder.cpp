@@ -23,7 +23,7 @@ namespace {
 
 InputParams frames_params(const std::string& dir) {
   InputParams p;
-  p.source = "frames";
+  p.source = InputSource::frames;
   p.path = dir;
   return p;
 }

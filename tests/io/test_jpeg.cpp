@@ -150,7 +150,7 @@ TEST(Jpeg, TumFolderWithJpegColour) {
   for (const auto& e : fs::directory_iterator(dir.path / "rgb"))
     if (e.path().extension() == ".png") fs::remove(e.path());
   InputParams p;
-  p.source = "tum";
+  p.source = InputSource::tum;
   p.path = dir.str();
   TumSource src(p);
   SyntheticSource again(sp);

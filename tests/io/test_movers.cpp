@@ -47,7 +47,7 @@ std::vector<MoverParams> walker_and_ball() {
   person.speed = 1.f;
   person.start = 1.0;
   MoverParams ball;
-  ball.kind = "ball";
+  ball.kind = MoverKind::ball;
   ball.path = {{0.f, -1.f, 0.f}, {0.f, 1.f, 0.f}};
   ball.speed = 0.5f;
   return {person, ball};
@@ -92,9 +92,9 @@ TEST(Movers, BadPathIsAConfigError) {
 // with depth lies on the room and outside every capsule.
 TEST(Movers, RenderedMaskAndDepthAgreeWithTheCapsules) {
   InputParams in;
-  in.source = "synthetic";
+  in.source = InputSource::synthetic;
   in.synthetic.noise = false;
-  in.synthetic.trajectory = "still";
+  in.synthetic.trajectory = CameraPath::still;
   in.synthetic.frames = 1;
   // The still camera stands at (0, -1, 1.35) looking at the desk (0, 0.6, 0.75): the person 0.45 m
   // in front of it, the ball on the floor left of the desk, both in view.
@@ -135,7 +135,7 @@ TEST(Movers, RenderedMaskAndDepthAgreeWithTheCapsules) {
 
 TEST(Movers, RecordingWritesMasksAndCapsules) {
   InputParams in;
-  in.source = "synthetic";
+  in.source = InputSource::synthetic;
   in.synthetic.frames = 3;
   in.synthetic.movers = walker_and_ball();
   SyntheticSource src(in, Device::CPU);

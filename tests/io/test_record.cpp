@@ -25,7 +25,7 @@ TEST(Record, SyntheticRoomRoundTripsThroughATumFolder) {
     EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
 
   InputParams q;
-  q.source = "tum";
+  q.source = InputSource::tum;
   q.path = dir.str();  // preset auto: calibration.txt gives the synthetic camera back
   TumSource back(q);
   ASSERT_EQ(back.size(), 4);

@@ -18,7 +18,7 @@ namespace {
 
 InputParams synthetic(bool noise, float sigma = 0.f) {
   InputParams p;
-  p.source = "synthetic";
+  p.source = InputSource::synthetic;
   p.synthetic.noise = noise;
   p.synthetic.sensor.sigma_disparity = sigma;
   p.synthetic.frames = 10;
@@ -234,13 +234,13 @@ TEST(SyntheticRoom, CameraPathStaysInFreeSpaceAndLooksAtTheDesk) {
 TEST(SyntheticRoom, AccelerometerReadsGravityPlusMotion) {
   InputParams p = synthetic(false);
   p.synthetic.shake = 0.f;
-  p.synthetic.trajectory = "still";
+  p.synthetic.trajectory = CameraPath::still;
   SE3 T = synthetic_camera_pose(p.synthetic, 0.0);
   vec3 a = synthetic_accelerometer(p.synthetic, 0.0);
   vec3 up = transpose(T.R) * vec3{0, 0, 9.80665f};  // at rest: the reaction to gravity
   EXPECT_NEAR(length(a - up), 0.f, 1e-3f);
   // Smooth orbit: R a + g is the centripetal acceleration omega^2 r towards the desk's vertical.
-  p.synthetic.trajectory = "orbit";
+  p.synthetic.trajectory = CameraPath::orbit;
   T = synthetic_camera_pose(p.synthetic, 1.0);
   vec3 acc = T.rotate(synthetic_accelerometer(p.synthetic, 1.0)) + room::gravity();
   double w = p.synthetic.speed_deg * M_PI / 180;
@@ -274,10 +274,10 @@ TEST(SyntheticRoomParity, CpuAndCudaRenderTheSameFrames) {
 TEST(SyntheticRoomParity, CpuAndCudaRenderTheSameMovers) {
   if (!cuda_available()) GTEST_SKIP() << "no CUDA device";
   InputParams in = synthetic(true, 0.3f);
-  in.synthetic.trajectory = "still";
+  in.synthetic.trajectory = CameraPath::still;
   MoverParams person, ball;
   person.path = {{-0.3f, -0.4f, 0.f}, {1.5f, -0.4f, 0.f}};
-  ball.kind = "ball";
+  ball.kind = MoverKind::ball;
   ball.radius = 0.2f;
   ball.path = {{-1.1f, 1.3f, 0.f}, {-1.1f, 2.f, 0.f}};
   in.synthetic.movers = {person, ball};

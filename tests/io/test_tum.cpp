@@ -23,7 +23,7 @@ std::string data_dir(const std::string& name) { return std::string(SEAMLESS_TEST
 
 InputParams tum_params(const std::string& dir) {
   InputParams p;
-  p.source = "tum";
+  p.source = InputSource::tum;
   p.path = dir;
   return p;
 }
@@ -75,7 +75,7 @@ TEST(TumReader, AssociationReproducesAssociateDotPy) {
   // associations.txt in this folder was made by TUM's associate.py: our pairing must match it.
   auto pairs = associate(read_tum_list(dir + "/rgb.txt"), read_tum_list(dir + "/depth.txt"));
   InputParams p = tum_params(dir);
-  p.association = "file";
+  p.association = Association::file;
   TumSource src(p);
   const auto& want = src.pairs();
   ASSERT_EQ(pairs.size(), want.size());
@@ -168,7 +168,7 @@ TEST(TumReader, NineFrameDeskPairsAllNineByTime) {
   EXPECT_DOUBLE_EQ(f.timestamp, 1305031453.627706);  // the last line of rgb.txt
   // The file, when asked for, gives its 2 pairs, which agree with pairing by time.
   InputParams p = tum_params(dir);
-  p.association = "file";
+  p.association = Association::file;
   TumSource file_src(p);
   ASSERT_EQ(file_src.size(), 2);
   EXPECT_EQ(file_src.pairs()[1].depth.file, src.pairs()[1].depth.file);

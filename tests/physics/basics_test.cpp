@@ -57,13 +57,15 @@ TEST(PhysicsMomentum, ConservedWithoutExternalForces) {
   p.max_speed = 20.f;  // the speed limit is a (deliberate) external impulse: keep it out of reach
   ParticleSolver s(p, Device::CPU);
   SpawnParams a;
-  a.kind = "rigid", a.size = {0.16f, 0.16f, 0.16f}, a.position = {-0.3f, 0.f, 0.f}, a.velocity = {2.f, 0.f, 0.f};
+  a.kind = SpawnKind::rigid, a.size = {0.16f, 0.16f, 0.16f}, a.position = {-0.3f, 0.f, 0.f},
+  a.velocity = {2.f, 0.f, 0.f};
   s.spawn(a);
   SpawnParams b = a;
   b.position = {0.3f, 0.05f, 0.02f}, b.velocity = {-1.f, 0.f, 0.f}, b.density = 400.f, b.rotation = {0.f, 30.f, 10.f};
   s.spawn(b);
   SpawnParams f;
-  f.kind = "fluid_block", f.size = {0.2f, 0.2f, 0.2f}, f.position = {0.f, 0.35f, 0.f}, f.velocity = {0.f, -2.f, 0.f};
+  f.kind = SpawnKind::fluid_block, f.size = {0.2f, 0.2f, 0.2f}, f.position = {0.f, 0.35f, 0.f},
+  f.velocity = {0.f, -2.f, 0.f};
   s.spawn(f);
   test::Momentum m0 = test::momentum(s.download_state());
   for (int i = 0; i < 50; ++i) s.step();

@@ -58,7 +58,7 @@ DrapeRun drape(float height = 0.2f) {
   s.set_scene_sdf(sdf);
   SpawnParams c;
   const int n = 24;
-  c.kind = "cloth", c.nx = n, c.ny = n, c.position = {0.01f, 2 * half + height, 0.02f};
+  c.kind = SpawnKind::cloth, c.nx = n, c.ny = n, c.position = {0.01f, 2 * half + height, 0.02f};
   s.spawn(c);
   kernels::SceneSdf only_box;
   only_box.count = 1, only_box.prims[0] = sdf.prims[1];

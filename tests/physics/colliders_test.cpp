@@ -127,7 +127,7 @@ Walk walk_through_cube(bool interpolate) {
   ParticleSolver solver(p, Device::CPU);
   solver.set_scene_sdf(test::half_space({0.f, 1.f, 0.f}, 0.5f * d));  // the floor
   SpawnParams c;
-  c.kind = "rigid", c.size = {4 * d, 4 * d, 4 * d}, c.position = {0.f, 2.f * d + 0.001f, 0.f};
+  c.kind = SpawnKind::rigid, c.size = {4 * d, 4 * d, 4 * d}, c.position = {0.f, 2.f * d + 0.001f, 0.f};
   solver.add_batch(make_rigid(c, p));
   for (int i = 0; i < 30; ++i) solver.step();  // settle on the floor
   const float x0 = solver.rigid_frames()[0].centre.x;
@@ -191,7 +191,7 @@ Pour pour_on_person(bool with_colliders) {
   ParticleSolver solver(p, Device::CPU);
   solver.set_scene_sdf(test::half_space({0.f, 1.f, 0.f}, 0.5f * d));  // the floor
   SpawnParams w;
-  w.kind = "fluid_block", w.size = {4 * d, 4 * d, 4 * d}, w.position = {0.f, 1.2f + r + 0.25f + 2 * d, 0.06f};
+  w.kind = SpawnKind::fluid_block, w.size = {4 * d, 4 * d, 4 * d}, w.position = {0.f, 1.2f + r + 0.25f + 2 * d, 0.06f};
   solver.add_batch(make_fluid_block(w, p));
   mv::Scene s;
   s.count = 1;

@@ -53,7 +53,7 @@ TEST(PhysicsDesk, FluidPouredOnDeskPoolsAndFlowsOffTheEdge) {
   s.add_static_particles(desk);
   s.set_scene_sdf(test::half_space({0.f, 0.f, 1.f}, 0.f));
   SpawnParams e;
-  e.kind = "emitter", e.position = {0.45f, 0.40f, 0.95f}, e.velocity = {0.f, 0.f, -2.f};
+  e.kind = SpawnKind::emitter, e.position = {0.45f, 0.40f, 0.95f}, e.velocity = {0.f, 0.f, -2.f};
   e.rate = 1000.f, e.duration = 1.5f, e.nozzle_radius = 0.1f;
   s.spawn(e);
   auto inside_desk = [](vec3 x) {

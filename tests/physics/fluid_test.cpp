@@ -31,7 +31,7 @@ RestResult fluid_at_rest(int iterations, int W) {
   ParticleSolver s(p, Device::CPU);
   s.add_static_particles(test::static_box({-d, 0.f, -d}, {W * d, (H + 5) * d, W * d}, d));
   SpawnParams f;
-  f.kind = "fluid_block";
+  f.kind = SpawnKind::fluid_block;
   f.size = {W * d, H * d, W * d};
   f.position = {(W - 1) * d / 2, d + (H - 1) * d / 2, (W - 1) * d / 2};
   s.spawn(f);
@@ -96,7 +96,7 @@ TEST(PhysicsFluid, DamBreakFollowsMartinMoyce) {
   sdf.prims[0] = {kernels::kSdfContainer, {3 * a, 1.5f * a, Z * d / 2}, {3 * a, 1.5f * a, Z * d / 2}, mat3::identity()};
   s.set_scene_sdf(sdf);
   SpawnParams f;
-  f.kind = "fluid_block";
+  f.kind = SpawnKind::fluid_block;
   f.size = {a, 2 * a, Z * d};
   f.position = {a / 2, a, Z * d / 2};
   s.spawn(f);
@@ -165,12 +165,12 @@ TEST(FluidSimd, TilesGiveTheScalarLoopsStatesBitForBit) {
     if (walls) s.add_static_particles(test::static_box({-d, 0.f, -d}, {W * d, (H + 8) * d, W * d}, d));
     else s.set_scene_sdf(test::half_space({0.f, 1.f, 0.f}, 0.f));
     SpawnParams f;
-    f.kind = "fluid_block";
+    f.kind = SpawnKind::fluid_block;
     f.size = {W * d, H * d, W * d};
     f.position = {(W - 1) * d / 2, d + (H - 1) * d / 2, (W - 1) * d / 2};
     s.spawn(f);
     SpawnParams c;
-    c.kind = "rigid";
+    c.kind = SpawnKind::rigid;
     c.size = {4 * d, 4 * d, 4 * d};
     c.position = {(W - 1) * d / 2, (H + 4) * d, (W - 1) * d / 2};
     if (walls) s.spawn(c);

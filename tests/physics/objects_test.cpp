@@ -11,9 +11,9 @@
 namespace seamless::test {
 namespace {
 
-SpawnParams rigid_at(float time, const char* shape) {
+SpawnParams rigid_at(float time, RigidShape shape) {
   SpawnParams s;
-  s.kind = "rigid", s.shape = shape, s.time = time;
+  s.kind = SpawnKind::rigid, s.shape = shape, s.time = time;
   s.size = {0.1f, 0.1f, 0.1f};
   s.position = {0.f, 1.f, 0.f};
   return s;
@@ -27,9 +27,10 @@ TEST(SolverObjects, ScheduleOrderSpawnIndexAndRest) {
   p.particle_diameter = 0.05f, p.dt = 0.01f, p.gravity = {0.f, 0.f, 0.f};
   ParticleSolver s(p, Device::CPU);
   SpawnParams cloth;
-  cloth.kind = "cloth", cloth.nx = 3, cloth.ny = 2, cloth.time = 0.005f, cloth.position = {1.f, 1.f, 0.f};
+  cloth.kind = SpawnKind::cloth, cloth.nx = 3, cloth.ny = 2, cloth.time = 0.005f, cloth.position = {1.f, 1.f, 0.f};
   // 0.02 s falls in the third step (starts 0, 0.01, 0.02): spawned then; 0.015 in the third too.
-  s.schedule({rigid_at(0.02f, "box"), cloth, rigid_at(0.f, "sphere"), rigid_at(0.015f, "box")});
+  s.schedule(
+      {rigid_at(0.02f, RigidShape::box), cloth, rigid_at(0.f, RigidShape::sphere), rigid_at(0.015f, RigidShape::box)});
   s.step();
   ASSERT_EQ(s.objects().bodies.size(), 1u);
   EXPECT_EQ(s.objects().bodies[0].spawn, 2);
@@ -46,7 +47,7 @@ TEST(SolverObjects, ScheduleOrderSpawnIndexAndRest) {
   EXPECT_EQ(s.objects().bodies[2].spawn, 3);
   EXPECT_EQ(s.objects().bodies[1].mesh, nullptr);  // a box: drawn as the box around its rest offsets
   EXPECT_EQ(s.pending_spawns(), 0u);
-  const ParticleBatch b = make_rigid(rigid_at(0.f, "box"), p);
+  const ParticleBatch b = make_rigid(rigid_at(0.f, RigidShape::box), p);
   const RigidBody& body = s.objects().bodies[1];
   EXPECT_EQ(body.first, s.objects().bodies[0].count + 6);
   ASSERT_EQ(body.count, b.size());
@@ -61,7 +62,7 @@ TEST(SolverObjects, SpawnNextTakesTheEarliest) {
   SolverParams p;
   p.particle_diameter = 0.05f;
   ParticleSolver s(p, Device::CPU);
-  s.schedule({rigid_at(2.f, "box"), rigid_at(1.f, "sphere")});
+  s.schedule({rigid_at(2.f, RigidShape::box), rigid_at(1.f, RigidShape::sphere)});
   s.spawn_next();
   ASSERT_EQ(s.objects().bodies.size(), 1u);
   EXPECT_EQ(s.objects().bodies[0].spawn, 1);

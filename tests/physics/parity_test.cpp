@@ -27,13 +27,14 @@ SimRun run(Device dev, bool graph = true, int steps = 10, float fluid_friction =
   const float d = p.particle_diameter;
   s.add_static_particles(test::static_box({-0.3f, 0.f, -0.3f}, {0.3f, 0.4f, 0.3f}, d));
   SpawnParams f;
-  f.kind = "fluid_block", f.size = {0.2f, 0.2f, 0.2f}, f.position = {0.f, 0.15f, 0.f};
+  f.kind = SpawnKind::fluid_block, f.size = {0.2f, 0.2f, 0.2f}, f.position = {0.f, 0.15f, 0.f};
   s.spawn(f);
   SpawnParams c;
-  c.kind = "rigid", c.size = {0.16f, 0.16f, 0.16f}, c.position = {0.1f, 0.4f, 0.05f}, c.rotation = {10.f, 20.f, 0.f};
+  c.kind = SpawnKind::rigid, c.size = {0.16f, 0.16f, 0.16f}, c.position = {0.1f, 0.4f, 0.05f},
+  c.rotation = {10.f, 20.f, 0.f};
   s.spawn(c);
   SpawnParams cl;
-  cl.kind = "cloth", cl.nx = 8, cl.ny = 8, cl.position = {-0.1f, 0.5f, 0.f};
+  cl.kind = SpawnKind::cloth, cl.nx = 8, cl.ny = 8, cl.position = {-0.1f, 0.5f, 0.f};
   s.spawn(cl);
   SpawnParams late = c;
   late.time = 0.05f, late.position = {-0.15f, 0.6f, -0.1f}, late.size = {0.08f, 0.08f, 0.08f};
@@ -86,15 +87,15 @@ ParticleState run_block(Device dev, bool with_solids) {
   box.prims[0] = {kernels::kSdfContainer, {0.f, 10.f, 0.f}, {2.f, 10.f, 2.f}, mat3::identity()};
   s.set_scene_sdf(box);
   SpawnParams f;
-  f.kind = "fluid_block", f.size = {74 * d, 74 * d, 74 * d}, f.position = {0.f, 37 * d + 0.01f, 0.f};
+  f.kind = SpawnKind::fluid_block, f.size = {74 * d, 74 * d, 74 * d}, f.position = {0.f, 37 * d + 0.01f, 0.f};
   s.spawn(f);
   if (with_solids) {
     const float top = 74 * d + 0.01f;  // the block's top face; its top layer's centres are d/2 below
     SpawnParams c;
-    c.kind = "rigid", c.size = {8 * d, 8 * d, 8 * d}, c.position = {0.5f, top + 4 * d + 0.5f * d, 0.f};
+    c.kind = SpawnKind::rigid, c.size = {8 * d, 8 * d, 8 * d}, c.position = {0.5f, top + 4 * d + 0.5f * d, 0.f};
     s.spawn(c);
     SpawnParams cl;
-    cl.kind = "cloth", cl.nx = 16, cl.ny = 16, cl.position = {-0.8f, top + 0.5f * d, 0.f};
+    cl.kind = SpawnKind::cloth, cl.nx = 16, cl.ny = 16, cl.position = {-0.8f, top + 0.5f * d, 0.f};
     s.spawn(cl);
   }
   for (int i = 0; i < 5; ++i) s.step();

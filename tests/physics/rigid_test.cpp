@@ -52,7 +52,7 @@ void resting_cube(bool particle_floor, double& err, float& vmax, float& centre_y
   if (particle_floor) s.add_static_particles(test::static_layer(0.f, -0.4f, 0.4f, -0.4f, 0.4f, d));
   else s.set_scene_sdf(test::half_space({0.f, 1.f, 0.f}, 0.5f * d));  // surface where particles at y = 0 end
   SpawnParams c;
-  c.kind = "rigid", c.size = {4 * d, 4 * d, 4 * d}, c.position = {0.01f, d + 1.5f * d + 0.01f, 0.f};
+  c.kind = SpawnKind::rigid, c.size = {4 * d, 4 * d, 4 * d}, c.position = {0.01f, d + 1.5f * d + 0.01f, 0.f};
   ParticleBatch b = make_rigid(c, p);
   s.add_batch(b);
   for (int i = 0; i < 300; ++i) s.step();
@@ -102,7 +102,7 @@ RoughRun cube_on_rough_scan() {
   }
   s.add_static_particles(scan);
   SpawnParams c;
-  c.kind = "rigid", c.size = {4 * d, 4 * d, 4 * d}, c.position = {0.003f, d + 1.5f * d + 0.013f, -0.002f};
+  c.kind = SpawnKind::rigid, c.size = {4 * d, 4 * d, 4 * d}, c.position = {0.003f, d + 1.5f * d + 0.013f, -0.002f};
   s.add_batch(make_rigid(c, p));
   RoughRun r;
   vec3 settled{0.f, 0.f, 0.f};
@@ -146,7 +146,7 @@ InclineRun incline(float mu) {
   vec3 n{std::sin(th), std::cos(th), 0.f}, down{std::cos(th), -std::sin(th), 0.f};
   s.set_scene_sdf(test::half_space(n, 0.f));
   SpawnParams c;
-  c.kind = "rigid", c.size = {4 * d, 4 * d, 4 * d}, c.rotation = {0.f, 0.f, -20.f};
+  c.kind = SpawnKind::rigid, c.size = {4 * d, 4 * d, 4 * d}, c.rotation = {0.f, 0.f, -20.f};
   c.position = n * (2 * d + 0.001f);  // bottom particle centres one radius + 1 mm above the plane
   s.spawn(c);
   const vec3 c0 = s.rigid_frames()[0].centre;

@@ -20,7 +20,7 @@ namespace {
 
 InputParams room(bool person) {
   InputParams in;
-  in.source = "synthetic";
+  in.source = InputSource::synthetic;
   in.synthetic.frames = 1;
   in.intrinsics.preset = "custom";
   in.intrinsics.fx = in.intrinsics.fy = 262.5f;  // half the Kinect's resolution: fast
@@ -28,7 +28,7 @@ InputParams room(bool person) {
   in.intrinsics.width = 320, in.intrinsics.height = 240;
   if (person) {
     MoverParams p;  // standing still (its path's first point) in front of the far wall, behind the desk
-    p.kind = "person", p.path = {{-0.3f, 1.15f, 0.f}, {1.8f, 1.15f, 0.f}}, p.speed = 0.8f;
+    p.kind = MoverKind::person, p.path = {{-0.3f, 1.15f, 0.f}, {1.8f, 1.15f, 0.f}}, p.speed = 0.8f;
     in.synthetic.movers = {p};
   }
   return in;

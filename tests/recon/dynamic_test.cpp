@@ -43,7 +43,7 @@ int downscale() { return device() == Device::CUDA ? 1 : 2; }
 // configs/dynamic_person.yaml's scene, at the Kinect's resolution on the GPU and at half of it on the CPU.
 InputParams scene(bool with_movers) {
   InputParams in;
-  in.source = "synthetic";
+  in.source = InputSource::synthetic;
   in.synthetic.frames = kFrames;
   in.synthetic.fps = kFps;
   in.synthetic.speed_deg = 15.f;
@@ -54,10 +54,12 @@ InputParams scene(bool with_movers) {
   in.intrinsics.width = 640 / k, in.intrinsics.height = 480 / k;
   if (with_movers) {
     MoverParams person;
-    person.kind = "person", person.path = {{-1.3f, 1.15f, 0.f}, {1.8f, 1.15f, 0.f}}, person.speed = kPersonSpeed;
+    person.kind = MoverKind::person, person.path = {{-1.3f, 1.15f, 0.f}, {1.8f, 1.15f, 0.f}},
+    person.speed = kPersonSpeed;
     person.start = kPersonStart;
     MoverParams ball;
-    ball.kind = "ball", ball.path = {{1.5f, 1.7f, 0.f}, {-1.2f, 1.7f, 0.f}}, ball.speed = 0.4f, ball.start = 0.5;
+    ball.kind = MoverKind::ball, ball.path = {{1.5f, 1.7f, 0.f}, {-1.2f, 1.7f, 0.f}}, ball.speed = 0.4f,
+    ball.start = 0.5;
     ball.radius = 0.15f;
     in.synthetic.movers = {person, ball};
   }

@@ -121,7 +121,7 @@ TEST(Refine, KeyframesEveryNFramesAndByMotion) {
   kf = select_keyframes(gt, p, tracked);
   EXPECT_EQ(kf[1], 11);
   // By motion: the orbit turns 0.5 deg a frame, so a 2.5-degree threshold takes about every 5th.
-  p.keyframes = "motion";
+  p.keyframes = KeyframeRule::motion;
   p.keyframe_rotation_deg = 2.5f;
   p.keyframe_translation = 10.f;
   kf = select_keyframes(gt, p);

@@ -224,7 +224,7 @@ TrackResult track_rgbd_pair(const TrackerParams& tp, const std::vector<SynthFram
 TrackerParams robust_rgbd() {
   TrackerParams tp;
   tp.kind = "rgbd";
-  tp.weighting = "robust";
+  tp.weighting = RgbdWeighting::robust;
   tp.photometric_weight = 1.f;
   return tp;
 }
@@ -291,7 +291,7 @@ TEST(Rgbd, VisiblePixelsMatchGroundTruth) {
   // pass it, so here it must simply not be worse than the per-pair tolerance.
   auto f = synthetic_frames(5, true, true);
   TrackerParams tp = robust_rgbd();
-  tp.photometric_pixels = "visible";
+  tp.photometric_pixels = PhotometricPixels::visible;
   TrackResult r = track_rgbd_pair(tp, f);
   ASSERT_TRUE(r.ok()) << to_string(r.status);
   expect_pair_within_tolerance(r.world_T_camera, *f[4].frame.ground_truth);
@@ -303,7 +303,7 @@ TEST(Rgbd, PixelStrideMatchesGroundTruth) {
   // stays within the same per-pair tolerance.
   auto f = synthetic_frames(5, true, true);
   TrackerParams tp = robust_rgbd();
-  tp.photometric_pixels = "visible";
+  tp.photometric_pixels = PhotometricPixels::visible;
   tp.pixel_stride = {2, 2};
   TrackResult r = track_rgbd_pair(tp, f);
   ASSERT_TRUE(r.ok()) << to_string(r.status);
@@ -421,8 +421,8 @@ double border_pair_rotation_ratio(int border) {
   ReferenceMaps ref;
   ref.set_from_raycast(model, l0.K, SE3::identity(), 3, 0.09f, f[0].cut.get());
   TrackerParams tp = robust_rgbd();
-  tp.photometric_pixels = "visible";
-  tp.depth_noise = "depth_squared";
+  tp.photometric_pixels = PhotometricPixels::visible;
+  tp.depth_noise = DepthNoiseModel::depth_squared;
   const SE3 truth = f[0].truth.inverse() * f[2].truth;
   TrackResult r = Tracker(tp, Device::CPU).track(*f[2].cut, ref, SE3::identity());
   EXPECT_TRUE(r.ok()) << to_string(r.status);

@@ -79,10 +79,10 @@ Image<float> host_intensity(const RgbdFrame& f, Device d) {
 TrackerParams visible_rgbd() {
   TrackerParams tp;
   tp.kind = "rgbd";
-  tp.weighting = "robust";
+  tp.weighting = RgbdWeighting::robust;
   tp.photometric_weight = 1.f;
-  tp.photometric_pixels = "visible";
-  tp.depth_noise = "depth_squared";
+  tp.photometric_pixels = PhotometricPixels::visible;
+  tp.depth_noise = DepthNoiseModel::depth_squared;
   return tp;
 }
 
@@ -160,12 +160,15 @@ TEST(TrackerParity, TrackedTrajectoriesOverAFewFrames) {
   struct Case {
     const char* mode;
     const char* kind;
-    const char* weighting;
+    RgbdWeighting weighting;
     bool visible = false;
   };
-  for (const Case& c : {Case{"frame_to_frame", "icp", "fixed"}, Case{"frame_to_model", "icp", "fixed"},
-                        Case{"frame_to_model", "rgbd", "robust"}, Case{"frame_to_model", "rgbd", "robust", true}}) {
-    const std::string mode = std::string(c.mode) + " " + c.kind + " " + c.weighting + (c.visible ? " visible" : "");
+  for (const Case& c :
+       {Case{"frame_to_frame", "icp", RgbdWeighting::fixed}, Case{"frame_to_model", "icp", RgbdWeighting::fixed},
+        Case{"frame_to_model", "rgbd", RgbdWeighting::robust},
+        Case{"frame_to_model", "rgbd", RgbdWeighting::robust, true}}) {
+    const std::string mode =
+        std::string(c.mode) + " " + c.kind + " " + enum_name(c.weighting) + (c.visible ? " visible" : "");
     TrackSequenceParams p;
     if (c.visible) {
       p.tracker = visible_rgbd();

@@ -159,9 +159,9 @@ TrackSequenceParams best_tum_params() {
   TrackSequenceParams p = default_params("frame_to_model");
   p.tracker.kind = "rgbd";
   p.tracker.photometric_weight = 1.f;
-  p.tracker.weighting = "robust";
-  p.tracker.depth_noise = "depth_squared";
-  p.tracker.photometric_pixels = "visible";
+  p.tracker.weighting = RgbdWeighting::robust;
+  p.tracker.depth_noise = DepthNoiseModel::depth_squared;
+  p.tracker.photometric_pixels = PhotometricPixels::visible;
   p.tracker.photometric_reference = "frame";
   p.tracker.constant_velocity = true;
   p.write_files = false;
@@ -202,9 +202,9 @@ TEST(TrackSequence, TumFreiburg1RpyBestTrackerWithinThreeCentimetres) {
   RefineParams refine;
   refine.enabled = true;
   refine.keyframe_every = 5;
-  refine.weighting = "robust";
-  refine.depth_noise = "depth_squared";
-  refine.photometric_pixels = "visible";
+  refine.weighting = RgbdWeighting::robust;
+  refine.depth_noise = DepthNoiseModel::depth_squared;
+  refine.photometric_pixels = PhotometricPixels::visible;
   auto again = make_source(test::tum_input(dir));
   RefineResult r = refine_trajectory(*again, t.result.trajectory, refine, p.preprocess, Device::CPU, tracked);
   const Trajectory gt = read_tum_trajectory(dir + "/groundtruth.txt");

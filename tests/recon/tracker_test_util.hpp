@@ -15,7 +15,7 @@ namespace seamless::test {
 
 inline InputParams synthetic_input(int frames, bool noise = true) {
   InputParams p;
-  p.source = "synthetic";
+  p.source = InputSource::synthetic;
   p.synthetic.frames = frames;
   p.synthetic.noise = noise;
   return p;
@@ -25,7 +25,7 @@ inline std::string tum_rpy_dir() { return std::string(SEAMLESS_TEST_DATA) + "/tu
 
 inline InputParams tum_input(const std::string& dir) {
   InputParams p;
-  p.source = "tum";
+  p.source = InputSource::tum;
   p.path = dir;
   return p;
 }

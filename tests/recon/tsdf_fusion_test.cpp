@@ -314,7 +314,7 @@ TEST(TsdfFusion, CullingChangesNothingOnRealFrames) {
   const std::string dir = std::string(SEAMLESS_TEST_DATA) + "/tum_fr1_rpy_000-149";
   if (!std::filesystem::exists(dir)) GTEST_SKIP() << "no test data at " << dir;
   InputParams in;
-  in.source = "tum";
+  in.source = InputSource::tum;
   in.path = dir;
   in.max_frames = 12;
   auto src = make_source(in, Device::CPU);

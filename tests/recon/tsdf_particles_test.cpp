@@ -235,7 +235,7 @@ float room_sdf(vec3 p) { return R::room_sdf(p - kShift); }
 // The demo's volume (1 cm voxels, 4 cm truncation) fused from exact depth at ground-truth poses.
 VoxelHashVolume fuse_room(Device d, std::vector<SE3>* poses = nullptr) {
   InputParams in;
-  in.source = "synthetic";
+  in.source = InputSource::synthetic;
   in.synthetic.noise = false;
   in.synthetic.frames = 2 * kRoomFrames;
   SyntheticSource src(in);

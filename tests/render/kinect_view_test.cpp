@@ -32,8 +32,8 @@ struct KinectScene {
 // Renders one sphere (a debug particle) at camera coordinates `c` and returns the frame.
 Pixels render_sphere(const KinectScene& s, vec3 c, float radius, int W, int H) {
   RenderParams p;
-  p.view = "kinect";
-  p.fluid = "particles";
+  p.view = RenderView::kinect;
+  p.fluid = FluidDraw::particles;
   Renderer r(p, W, H);
   r.set_kinect_view(s.rgb, s.depth, s.K, s.world_T_camera);
   const std::vector<vec3> x = {s.world_T_camera * c};

@@ -44,7 +44,7 @@ struct RealFrame {
 
   RealFrame() {
     InputParams in;
-    in.source = "tum";
+    in.source = InputSource::tum;
     in.path = std::string(SEAMLESS_TEST_DATA) + "/" + kFolder;
     in.first_frame = kFrame;
     in.max_frames = 1;
@@ -126,7 +126,7 @@ vec3 desk_light(const RealFrame& s) { return normalize(-s.n - 0.45f * s.t1 + 0.2
 
 RenderParams kinect_params(const RealFrame& s) {
   RenderParams p;
-  p.view = "kinect";
+  p.view = RenderView::kinect;
   p.light_dir = desk_light(s);
   return p;
 }

@@ -119,7 +119,7 @@ void OnlineRefiner::add_keyframe(Item& it) {
   const auto t0 = std::chrono::steady_clock::now();
   KeyframeData k;
   k.frame = it.frame, k.timestamp = it.timestamp, k.odometry = from_se3(it.odometry);
-  k.pyr = build_pyramid(it.images, K_, pre_, p_.pair_tracker == "rgbd", Device::CPU);
+  k.pyr = build_pyramid(it.images, K_, pre_, p_.pair_tracker == PairTracker::rgbd, Device::CPU);
   it.images = RgbdFrame();
   kf_.push_back(std::move(k));
   const int j = static_cast<int>(kf_.size()) - 1;

@@ -59,7 +59,7 @@ bool is_tracked(const std::vector<bool>& tracked, std::size_t i) { return tracke
 
 bool keyframe_due(const Pose& last_keyframe, std::int64_t last_index, const Pose& pose, std::int64_t index,
                   const RefineParams& p) {
-  if (p.keyframes == "every") return index - last_index >= p.keyframe_every;
+  if (p.keyframes == KeyframeRule::every) return index - last_index >= p.keyframe_every;
   auto [deg, m] = distance(last_keyframe, pose);
   return m > p.keyframe_translation || deg > p.keyframe_rotation_deg;
 }
@@ -157,7 +157,7 @@ std::vector<KeyframeData> load_keyframes(FrameSource& source, const Trajectory& 
 // refinement's tests at the level it uses).
 TrackerParams pair_tracker_params(const RefineParams& p) {
   TrackerParams t;
-  t.kind = p.pair_tracker;
+  t.kind = enum_name(p.pair_tracker);
   t.mode = "frame_to_frame";
   t.iterations = p.iterations;
   t.photometric_weight = p.photometric_weight;
@@ -358,7 +358,7 @@ RefineResult refine_trajectory(FrameSource& source, const Trajectory& odometry, 
   if (!refine_available())
     throw ConfigError("refine: this build has no Ceres; install libceres-dev (scripts/packages.txt) and reconfigure");
   std::vector<KeyframeData> kf =
-      load_keyframes(source, odometry, r.keyframes, preprocess, params.pair_tracker == "rgbd", device);
+      load_keyframes(source, odometry, r.keyframes, preprocess, params.pair_tracker == PairTracker::rgbd, device);
   const double t_load = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   Graph g = build_graph(kf, params, device);
   const double t_graph = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() - t_load;

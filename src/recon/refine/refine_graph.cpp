@@ -50,8 +50,8 @@ struct EdgeCost {
 };
 
 ceres::LossFunction* make_loss(const RefineParams& p) {
-  if (p.robust_loss == "huber") return new ceres::HuberLoss(p.robust_scale);
-  if (p.robust_loss == "cauchy") return new ceres::CauchyLoss(p.robust_scale);
+  if (p.robust_loss == RobustLoss::huber) return new ceres::HuberLoss(p.robust_scale);
+  if (p.robust_loss == RobustLoss::cauchy) return new ceres::CauchyLoss(p.robust_scale);
   return nullptr;
 }
 
