@@ -67,10 +67,10 @@ SimResult run(Device solver_dev, Input in, Device points_dev, std::int64_t drop 
     s.set_collider_particles(padded(pts.colliders, points_dev), n(pts.colliders));
   }
   SpawnParams f;
-  f.kind = "fluid_block", f.size = {0.16f, 0.16f, 0.16f}, f.position = {0.f, 0.2f, 0.f};
+  f.kind = SpawnKind::fluid_block, f.size = {0.16f, 0.16f, 0.16f}, f.position = {0.f, 0.2f, 0.f};
   s.spawn(f);
   SpawnParams c;
-  c.kind = "rigid", c.size = {0.12f, 0.12f, 0.12f}, c.position = {0.15f, 0.35f, 0.15f};
+  c.kind = SpawnKind::rigid, c.size = {0.12f, 0.12f, 0.12f}, c.position = {0.15f, 0.35f, 0.15f};
   s.spawn(c);
   for (int i = 0; i < 30; ++i) s.step();
   return {s.download_state(), s.stats()};
