@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <utility>
 
 #include "core/error.hpp"
 #include "core/exec.hpp"
@@ -139,9 +140,10 @@ void TrackingSession::find_dynamic(const ReferenceMaps& model, const SE3& world_
   in.search_radius = d.search_radius;
   with_exec(device_, [&]<class E>(const E& ex) {
     kernels::Dynamic<E>::classify_dynamic(ex, in, dyn_candidates_.view());
-    kernels::Dynamic<E>::age_dynamic(ex, in, dyn_prev_anchor_.cview(), dyn_prev_age_.cview(),
-                                     dyn_prev_pose_.inverse() * world_T_camera, d.static_after_frames,
-                                     dyn_candidates_.view(), dyn_age_.view(), dyn_anchor_.view());
+    if (d.static_after_frames > 0)  // 0: no ageing (and no cost)
+      kernels::Dynamic<E>::age_dynamic(ex, in, dyn_prev_anchor_.cview(), dyn_prev_age_.cview(),
+                                       dyn_prev_pose_.inverse() * world_T_camera, d.static_after_frames,
+                                       dyn_candidates_.view(), dyn_age_.view(), dyn_anchor_.view());
     kernels::Dynamic<E>::filter_dynamic(ex, dyn_candidates_.cview(), dyn_prev_.cview(), l0.depth.cview(),
                                         d.support_radius, d.min_support, d.dilate_max_step, dyn_kept_.view(),
                                         dyn_mask_.view());
@@ -411,9 +413,11 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
     // grown border reaches static neighbours at the mover's depth, which are then never fused and,
     // from the mask, would support themselves frame after frame (a line left on the desk's edge).
     dyn_prev_.buffer().copy_from(dyn_kept_.buffer());
-    dyn_prev_age_.buffer().copy_from(dyn_age_.buffer());
-    dyn_prev_anchor_.buffer().copy_from(dyn_anchor_.buffer());
-    dyn_prev_pose_ = rec.result.world_T_camera;
+    if (p_.dynamic.static_after_frames > 0) {
+      std::swap(dyn_prev_age_, dyn_age_);  // the next frame's previous ages and anchors
+      std::swap(dyn_prev_anchor_, dyn_anchor_);
+      dyn_prev_pose_ = rec.result.world_T_camera;
+    }
   } else if (p_.dynamic.enabled) {
     rec.dynamic_fraction = 0;  // the first frame, or a lost one: nothing masked, nothing fused
   }
