@@ -61,8 +61,8 @@ std::vector<std::uint8_t> full_mask() {
   return m;
 }
 
-// The app's host code before the device path (src/app/pipeline.cpp, block_any): a level pixel is
-// dynamic when any full-resolution pixel it averages is.
+// The app's host code before the device path (src/app/pipeline.cpp, block_any, before the live loop moved to live.cpp):
+// a level pixel is dynamic when any full-resolution pixel it averages is.
 std::vector<std::uint8_t> block_any(const std::vector<std::uint8_t>& m, int W, int H, int w, int h) {
   std::vector<std::uint8_t> out(static_cast<std::size_t>(w) * h, 0);
   const int sx = W / w, sy = H / h;
