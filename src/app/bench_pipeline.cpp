@@ -231,7 +231,7 @@ void write_json(const std::string& path, const PipelineBenchOptions& o, const Ex
             {"config", o.config},
             {"data", e.input.path},
             {"tracker", e.tracker.kind},
-            {"tracker_mode", e.tracker.mode},
+            {"tracker_mode", enum_name(e.tracker.mode)},
             {"voxel_size", e.volume.voxel_size},
             {"volume", enum_name(e.volume.layout)},
             {"frames_requested", e.frames},

@@ -44,7 +44,7 @@ std::shared_ptr<FramePyramid> pyramid(const RgbdFrame& f, Device d) {
 TrackBenchCase align_case(const std::string& kind, const std::vector<RgbdFrame>& f, Device d) {
   TrackerParams tp;
   tp.kind = kind;
-  tp.mode = "frame_to_frame";
+  tp.mode = TrackingMode::frame_to_frame;
   tp.stop_translation = tp.stop_rotation_deg = 0.f;  // every iteration of 10/5/4, as the goal counts them
   auto tracker = std::make_shared<Tracker>(tp, d);
   auto cur = pyramid(f[2], d), prev = pyramid(f[0], d);
@@ -60,7 +60,7 @@ std::vector<TrackBenchCase> make_track_bench(Device device, const std::string& d
   auto frames = std::make_shared<std::vector<RgbdFrame>>(first_frames(data_dir, 3, device));
   std::vector<TrackBenchCase> cases = {align_case("icp", *frames, device), align_case("rgbd", *frames, device)};
   TrackSequenceParams p;  // frame-to-model ICP, 5 mm voxels: the default pipeline
-  p.tracker.gravity = "none";
+  p.tracker.gravity = GravitySource::none;
   auto session = std::make_shared<TrackingSession>(p, device, (*frames)[0].intrinsics);
   session->process((*frames)[0]);  // the first frame only defines the world; later calls track
   auto i = std::make_shared<std::size_t>(1);

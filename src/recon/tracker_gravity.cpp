@@ -80,18 +80,19 @@ GravityEstimate floor_plane_gravity(const FramePyramid& frame) {
 GravityEstimate estimate_gravity(const TrackerParams& p, const std::optional<vec3>& accelerometer,
                                  const FramePyramid& frame) {
   GravityEstimate g;
-  const std::string& how = p.gravity;
-  if (how == "none") return g;
-  if (how == "fixed") {
+  const GravitySource how = p.gravity;
+  if (how == GravitySource::none) return g;
+  if (how == GravitySource::fixed) {
     // A loaded config was checked already (TrackerParams::validate); this is for params built in code.
     if (length2(p.fixed_gravity) == 0) throw ConfigError("tracker.fixed_gravity is the zero vector; give a direction");
     return {normalize(p.fixed_gravity), "fixed", true, 0};
   }
-  if ((how == "accelerometer" || how == "auto") && accelerometer && length2(*accelerometer) > 0) {
+  if ((how == GravitySource::accelerometer || how == GravitySource::automatic) && accelerometer &&
+      length2(*accelerometer) > 0) {
     // At rest the accelerometer measures the reaction to gravity: it points up.
     return {normalize(-*accelerometer), "accelerometer", true, 0};
   }
-  if (how == "accelerometer") {
+  if (how == GravitySource::accelerometer) {
     g.source = "accelerometer";
     return g;  // asked for, but this frame has none: reported as not found
   }

@@ -30,9 +30,34 @@ inline std::span<const EnumName<PhotometricPixels>> enum_names(PhotometricPixels
   return names;
 }
 
+// Frame to model (KinectFusion: against the raycast of the fused volume) or to the previous frame.
+enum class TrackingMode { frame_to_model, frame_to_frame };
+inline std::span<const EnumName<TrackingMode>> enum_names(TrackingMode) {
+  static constexpr EnumName<TrackingMode> names[] = {{TrackingMode::frame_to_model, "frame_to_model"},
+                                                     {TrackingMode::frame_to_frame, "frame_to_frame"}};
+  return names;
+}
+// What an rgbd frame-to-model step's photometric term compares with.
+enum class PhotometricReference { model, frame };
+inline std::span<const EnumName<PhotometricReference>> enum_names(PhotometricReference) {
+  static constexpr EnumName<PhotometricReference> names[] = {{PhotometricReference::model, "model"},
+                                                             {PhotometricReference::frame, "frame"}};
+  return names;
+}
+// Where "down" comes from (`automatic` is written "auto": a C++ keyword).
+enum class GravitySource { automatic, accelerometer, floor, fixed, none };
+inline std::span<const EnumName<GravitySource>> enum_names(GravitySource) {
+  static constexpr EnumName<GravitySource> names[] = {{GravitySource::automatic, "auto"},
+                                                      {GravitySource::accelerometer, "accelerometer"},
+                                                      {GravitySource::floor, "floor"},
+                                                      {GravitySource::fixed, "fixed"},
+                                                      {GravitySource::none, "none"}};
+  return names;
+}
+
 struct TrackerParams {
   std::string kind = "icp";
-  std::string mode = "frame_to_model";
+  TrackingMode mode = TrackingMode::frame_to_model;
   std::vector<int> iterations{10, 5, 4};  // finest level first (KinectFusion, sec. 3.5)
   // Per level, finest first: the reduction visits every n-th pixel of every n-th row (levels not
   // listed: every pixel). The CPU's cost is the finest level's pixels (docs/TRACKING.md, "Pixel stride").
@@ -52,7 +77,7 @@ struct TrackerParams {
   float max_intensity_diff = 0.3f;        // rgbd: larger photometric residuals are outliers
   // rgbd frame_to_model: the model's colour (consistent with the model geometry) or the last tracked
   // frame's image (sharper, but tied to that frame's estimated pose: see docs/TRACKING.md).
-  std::string photometric_reference = "model";
+  PhotometricReference photometric_reference = PhotometricReference::model;
   // rgbd: fixed weights (photometric_weight), or robust self-balancing ones: each residual type
   // whitened by its own scale, estimated every step, with Student-t weights against outliers
   // (Kerl et al. 2013; docs/TRACKING.md, "RGB-D").
@@ -75,13 +100,13 @@ struct TrackerParams {
   float relocalise_max_speed = 1.0f;               // m/s
   float relocalise_max_angular_speed_deg = 180.f;  // deg/s
   float relocalise_max_residual_ratio = 2.0f;
-  std::string gravity = "auto";
+  GravitySource gravity = GravitySource::automatic;
   vec3 fixed_gravity{0.f, 1.f, 0.f};  // camera frame (y down), used when gravity: fixed
 
   // Rules across keys, checked when a config is loaded (Experiment::validate); tracker_gravity.cpp
   // checks the vector again for code that builds TrackerParams without a config.
   void validate() const {
-    if (gravity == "fixed" && length2(fixed_gravity) == 0.f)
+    if (gravity == GravitySource::fixed && length2(fixed_gravity) == 0.f)
       throw ConfigError("tracker.gravity: fixed needs a direction, but tracker.fixed_gravity is the zero vector");
   }
 
@@ -89,7 +114,7 @@ struct TrackerParams {
     v("kind", kind, "tracker; opencv_* and pcl_gicp are external libraries, always frame to frame",
       Choices{"icp", "rgbd", "ground_truth", "opencv_rgbd_odometry", "opencv_icp", "opencv_rgbd_icp", "opencv_fast_icp",
               "pcl_gicp"});
-    v("mode", mode, "align to the model raycast or to the previous frame", Choices{"frame_to_model", "frame_to_frame"});
+    v("mode", mode, "align to the model raycast or to the previous frame");
     v("iterations", iterations, "ICP iterations per pyramid level, finest first", Range{0, 1000});
     v("pixel_stride", pixel_stride,
       "per pyramid level, finest first: track on every n-th pixel of every n-th row (a full-resolution "
@@ -115,8 +140,7 @@ struct TrackerParams {
       Range{0.0, 1.0});
     v("photometric_reference", photometric_reference,
       "rgbd frame_to_model: the photometric term compares with the model raycast's fused colour or with the "
-      "last tracked frame's image",
-      Choices{"model", "frame"});
+      "last tracked frame's image");
     v("weighting", weighting,
       "rgbd: fixed (photometric_weight) or robust (each term whitened by its own residual scale, estimated "
       "every step, with t-distribution weights against outliers; photometric_weight then scales the whitened "
@@ -149,8 +173,7 @@ struct TrackerParams {
       "after lost frames, a frame is accepted only if its residual against the model is at most this multiple "
       "of the median of the last 10 good frames' (0: no residual test)",
       Range{0.0, 1000.0});
-    v("gravity", gravity, "where 'down' comes from (auto: accelerometer if present, else floor plane)",
-      Choices{"auto", "accelerometer", "floor", "fixed", "none"});
+    v("gravity", gravity, "where 'down' comes from (auto: accelerometer if present, else floor plane)");
     v("fixed_gravity", fixed_gravity, "down direction in the first camera frame (gravity: fixed)");
   }
 };

@@ -115,8 +115,8 @@ TrackSequenceResult track_sequence(FrameSource& source, const TrackSequenceParam
   if (params.write_files) {
     std::filesystem::create_directories(out_dir);
     writer = std::make_unique<TrajectoryWriter>(
-        out_dir + "/trajectory.txt",
-        "camera trajectory (world_T_camera) by seamless, tracker " + params.tracker.kind + " " + params.tracker.mode);
+        out_dir + "/trajectory.txt", "camera trajectory (world_T_camera) by seamless, tracker " + params.tracker.kind +
+                                         " " + enum_name(params.tracker.mode));
   }
   TrackSequenceResult out;
   RgbdFrame frame;
@@ -186,8 +186,8 @@ TrackSequenceResult track_sequence(FrameSource& source, const TrackSequenceParam
   if (gt_writer) gt_writer->close();
   if (params.write_files) write_tracking_stats(out_dir + "/tracking_stats.csv", out.frames);
   spdlog::info("tracked {} frames with {} ({}), {} lost; median {:.2f} ms tracking, {:.2f} ms a frame",
-               out.frames.size(), params.tracker.kind, params.tracker.mode, out.lost_frames, out.median_track_ms,
-               out.median_frame_ms);
+               out.frames.size(), params.tracker.kind, enum_name(params.tracker.mode), out.lost_frames,
+               out.median_track_ms, out.median_frame_ms);
   return out;
 }
 

@@ -56,21 +56,21 @@ TrackingSession::TrackingSession(const TrackSequenceParams& params, Device devic
   const TrackerInfo& info = tracker_info(p_.tracker.kind);
   if (info.make_external) {
     odometry_ = info.make_external(K, p_.tracker);
-    if (p_.tracker.mode != "frame_to_frame")
+    if (p_.tracker.mode != TrackingMode::frame_to_frame)
       spdlog::info("tracker.kind {} is frame to frame (tracker.mode {} does not apply)", p_.tracker.kind,
-                   p_.tracker.mode);
+                   enum_name(p_.tracker.mode));
   } else if (p_.tracker.kind != "ground_truth") {
     tracker_ = std::make_unique<Tracker>(p_.tracker, device);
   }
   // Only our own trackers need a model of their own; a volume that is given is fused into by all.
-  if (!volume_ && p_.tracker.mode == "frame_to_model" && tracker_) {
+  if (!volume_ && p_.tracker.mode == TrackingMode::frame_to_model && tracker_) {
     own_volume_ = make_volume(p_.volume, device);
     volume_ = own_volume_.get();
   }
   if (p_.dynamic.enabled) {
     if (!volume_)
       spdlog::warn("dynamic.enabled: no volume to compare frames with (tracker {} {}); no pixel is masked",
-                   p_.tracker.kind, p_.tracker.mode);
+                   p_.tracker.kind, enum_name(p_.tracker.mode));
     else if (p_.dynamic.carve_truncations > 0)
       volume_->set_free_space_carving(p_.dynamic.carve_truncations * volume_->params().truncation);
   }
@@ -79,7 +79,7 @@ TrackingSession::TrackingSession(const TrackSequenceParams& params, Device devic
 // ---- dynamic pixels (issue 22, docs/DYNAMIC.md) -------------------------------------------------
 
 const ReferenceMaps* TrackingSession::dynamic_reference() {
-  if (tracker_ && p_.tracker.mode == "frame_to_model") return ref_.empty() ? nullptr : &ref_;
+  if (tracker_ && p_.tracker.mode == TrackingMode::frame_to_model) return ref_.empty() ? nullptr : &ref_;
   if (!volume_) return nullptr;
   volume_->raycast(K_, last_good_, dyn_maps_);
   dyn_ref_.set_from_raycast(dyn_maps_, K_, last_good_, 1, p_.preprocess.pyramid_max_diff, nullptr, false);
@@ -206,10 +206,10 @@ void TrackingSession::join_colour() {
 }
 
 void TrackingSession::update_reference(const SE3& pose) {
-  if (volume_ && p_.tracker.mode == "frame_to_model") {
+  if (volume_ && p_.tracker.mode == TrackingMode::frame_to_model) {
     volume_->raycast(K_, pose, maps_, p_.volume_stages);
     // The current pyramid is the frame just tracked at `pose`, the pose the raycast is seen from.
-    const bool frame_colour = p_.tracker.photometric_reference == "frame";
+    const bool frame_colour = p_.tracker.photometric_reference == PhotometricReference::frame;
     ref_.set_from_raycast(maps_, K_, pose, pyr_.levels(), p_.preprocess.pyramid_max_diff,
                           frame_colour ? &pyr_ : nullptr, tracker_->reads_intensity());
   } else {
@@ -234,9 +234,9 @@ void TrackingSession::accept(const RgbdFrame& frame, const SE3& pose, FrameRecor
 
 void TrackingSession::first_frame(const RgbdFrame& frame, FrameRecord& rec) {
   gravity_ = estimate_gravity(p_.tracker, frame.accelerometer, pyr_);
-  if (p_.tracker.gravity != "none" && !gravity_.found)
+  if (p_.tracker.gravity != GravitySource::none && !gravity_.found)
     spdlog::warn("tracker.gravity: {} gave no gravity direction; the world frame is the first camera's",
-                 p_.tracker.gravity);
+                 enum_name(p_.tracker.gravity));
   SE3 world_T_first = gravity_.found ? gravity_aligned_pose(gravity_.down) : SE3::identity();
   if (frame.ground_truth) world_T_gt_ = world_T_first * frame.ground_truth->inverse();
   rec.result.world_T_camera = world_T_first;

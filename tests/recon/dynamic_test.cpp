@@ -69,7 +69,7 @@ InputParams scene(bool with_movers) {
 TrackSequenceParams params(bool dynamic, const std::string& tracker) {
   TrackSequenceParams p;
   p.tracker.kind = tracker;
-  p.tracker.mode = "frame_to_model";
+  p.tracker.mode = TrackingMode::frame_to_model;
   p.volume.voxel_size = 0.01f;  // configs/dynamic_person.yaml's volume
   p.volume.truncation = 0.04f;
   p.volume.hash_buckets = 1 << 16;

@@ -158,21 +158,21 @@ TEST(TrackerParity, TrackedTrajectoriesOverAFewFrames) {
   // The last case is configs/tum_fr1.yaml's tracker (photometric_pixels: visible, depth-squared
   // noise, the last frame's colour as the photometric reference).
   struct Case {
-    const char* mode;
+    TrackingMode mode;
     const char* kind;
     RgbdWeighting weighting;
     bool visible = false;
   };
-  for (const Case& c :
-       {Case{"frame_to_frame", "icp", RgbdWeighting::fixed}, Case{"frame_to_model", "icp", RgbdWeighting::fixed},
-        Case{"frame_to_model", "rgbd", RgbdWeighting::robust},
-        Case{"frame_to_model", "rgbd", RgbdWeighting::robust, true}}) {
+  for (const Case& c : {Case{TrackingMode::frame_to_frame, "icp", RgbdWeighting::fixed},
+                        Case{TrackingMode::frame_to_model, "icp", RgbdWeighting::fixed},
+                        Case{TrackingMode::frame_to_model, "rgbd", RgbdWeighting::robust},
+                        Case{TrackingMode::frame_to_model, "rgbd", RgbdWeighting::robust, true}}) {
     const std::string mode =
-        std::string(c.mode) + " " + c.kind + " " + enum_name(c.weighting) + (c.visible ? " visible" : "");
+        std::string(enum_name(c.mode)) + " " + c.kind + " " + enum_name(c.weighting) + (c.visible ? " visible" : "");
     TrackSequenceParams p;
     if (c.visible) {
       p.tracker = visible_rgbd();
-      p.tracker.photometric_reference = "frame";
+      p.tracker.photometric_reference = PhotometricReference::frame;
     }
     p.tracker.mode = c.mode;
     p.tracker.kind = c.kind;

@@ -17,7 +17,7 @@ using namespace seamless;
 
 namespace {
 
-TrackSequenceParams default_params(const std::string& mode) {
+TrackSequenceParams default_params(TrackingMode mode) {
   TrackSequenceParams p;
   p.tracker.mode = mode;
   // 1 cm voxels: frame-to-model on the CPU stays within seconds a frame for CI; the model is only
@@ -70,7 +70,7 @@ TEST(TrackSequence, SyntheticRoomFrameToModelWithinOneCentimetre) {
   InputParams in = test::synthetic_input(60);
   auto src = make_source(in);
   test::TmpOut out("synth");
-  auto t = test::track_with_gt(*src, default_params("frame_to_model"), Device::CPU, out.str());
+  auto t = test::track_with_gt(*src, default_params(TrackingMode::frame_to_model), Device::CPU, out.str());
   EXPECT_EQ(t.result.lost_frames, 0);
   ASSERT_EQ(t.result.trajectory.size(), 60u);
   AteResult ate = compute_ate(t.result.trajectory, t.gt);
@@ -106,7 +106,7 @@ TEST(TrackSequence, SyntheticRoomFrameToFrameTracksEveryFrame) {
   // per pixel, and a pose fitted to 10^5 correspondences averages it far below that.
   InputParams in = test::synthetic_input(30);
   auto src = make_source(in);
-  TrackSequenceParams p = default_params("frame_to_frame");
+  TrackSequenceParams p = default_params(TrackingMode::frame_to_frame);
   p.write_files = false;
   auto t = test::track_with_gt(*src, p, Device::CPU, "");
   EXPECT_EQ(t.result.lost_frames, 0);
@@ -120,7 +120,7 @@ TEST(TrackSequence, CutIsDetectedNotFusedAndTrackingResumes) {
   // fused, and frames 25.. must track again against the last good view (the camera moved 2.5 deg
   // along its path meanwhile), so the trajectory of the real frames stays within 1 cm.
   CutSource src(test::synthetic_input(40), 20, 25);
-  TrackSequenceParams p = default_params("frame_to_model");
+  TrackSequenceParams p = default_params(TrackingMode::frame_to_model);
   p.write_files = false;
   auto t = test::track_with_gt(src, p, Device::CPU, "");
   EXPECT_EQ(t.result.lost_frames, 5);
@@ -156,13 +156,13 @@ TEST(TrackSequence, UnavailableTrackerSaysSo) {
 // weights, the Kinect's depth-squared noise, a colour row for every visible pixel and the last frame's image as the
 // photometric reference, a constant-velocity prediction, photometric weight 1. Volume at 1 cm (see default_params).
 TrackSequenceParams best_tum_params() {
-  TrackSequenceParams p = default_params("frame_to_model");
+  TrackSequenceParams p = default_params(TrackingMode::frame_to_model);
   p.tracker.kind = "rgbd";
   p.tracker.photometric_weight = 1.f;
   p.tracker.weighting = RgbdWeighting::robust;
   p.tracker.depth_noise = DepthNoiseModel::depth_squared;
   p.tracker.photometric_pixels = PhotometricPixels::visible;
-  p.tracker.photometric_reference = "frame";
+  p.tracker.photometric_reference = PhotometricReference::frame;
   p.tracker.constant_velocity = true;
   p.write_files = false;
   return p;

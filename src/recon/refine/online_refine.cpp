@@ -202,7 +202,7 @@ Trajectory OnlineRefiner::corrected(const Trajectory& odometry) const {
 // ---- OnlineCorrector (tracking thread) ----------------------------------------------------------
 
 bool online_feedback(const TrackerParams& tracker) {
-  return !(tracker.mode == "frame_to_model" && (tracker.kind == "icp" || tracker.kind == "rgbd"));
+  return !(tracker.mode == TrackingMode::frame_to_model && (tracker.kind == "icp" || tracker.kind == "rgbd"));
 }
 
 OnlineCorrector::OnlineCorrector(const RefineParams& params, const PreprocessParams& preprocess, const Intrinsics& K,

@@ -158,7 +158,7 @@ std::vector<KeyframeData> load_keyframes(FrameSource& source, const Trajectory& 
 TrackerParams pair_tracker_params(const RefineParams& p) {
   TrackerParams t;
   t.kind = enum_name(p.pair_tracker);
-  t.mode = "frame_to_frame";
+  t.mode = TrackingMode::frame_to_frame;
   t.iterations = p.iterations;
   t.photometric_weight = p.photometric_weight;
   t.weighting = p.weighting;
