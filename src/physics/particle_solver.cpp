@@ -112,6 +112,9 @@ struct StaticScene {
   bool static_bounds_known = false;
   Buffer<vec3> stat;
   Buffer<int> scell_start;
+  Buffer<vec3> static_raw;  // rebuild_static's scratch: the points before sorting, their keys and order
+  Buffer<std::uint32_t> static_keys;
+  Buffer<int> static_idx;
   K::GridSpec sgrid{};
   K::SceneSdf sdf{};
   Buffer<float> sdf_grid;
@@ -659,10 +662,8 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
   // Appends n points at src (on device src_dev) to the scene particles, in order.
   void append_static(const vec3* src, Device src_dev, std::int64_t n) {
     if (n <= 0) return;
-    Buffer<vec3> grown(n_static + n, dev);
-    memory::copy(grown.data(), dev, static_points.data(), dev, sizeof(vec3) * static_cast<std::size_t>(n_static));
-    memory::copy(grown.data() + n_static, dev, src, src_dev, sizeof(vec3) * static_cast<std::size_t>(n));
-    static_points = std::move(grown);
+    grow(static_points, n_static + n, n_static, dev);
+    memory::copy(static_points.data() + n_static, dev, src, src_dev, sizeof(vec3) * static_cast<std::size_t>(n));
     n_static += n;
     static_bounds_known = false;
     rebuild_static();
@@ -685,15 +686,16 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
     int sb = grid_bits(ns);
     sgrid = K::GridSpec::for_radius(std::max(P.fluid_smoothing * P.particle_diameter, 1.5f * P.particle_diameter), sb);
     std::int64_t cells = std::int64_t{1} << (3 * sb);
-    // The scene's points, then the colliders' (device to device).
-    Buffer<vec3> raw(ns, dev);
+    // The scene's points, then the colliders' (device to device), in buffers kept between calls:
+    // live mode rebuilds this grid every frame with the new colliders.
+    Buffer<vec3>& raw = static_raw;
+    Buffer<std::uint32_t>& keys = static_keys;
+    Buffer<int>& idx = static_idx;
+    raw.reserve_discard(ns, dev), keys.reserve_discard(ns, dev), idx.reserve_discard(ns, dev);
+    stat.reserve_discard(ns, dev), scell_start.reserve_discard(cells + 1, dev);
     memory::copy(raw.data(), dev, static_points.data(), dev, sizeof(vec3) * static_cast<std::size_t>(n_static));
     memory::copy(raw.data() + n_static, dev, collider_points.data(), dev,
                  sizeof(vec3) * static_cast<std::size_t>(n_colliders));
-    Buffer<std::uint32_t> keys(ns, dev);
-    Buffer<int> idx(ns, dev);
-    stat = Buffer<vec3>(ns, dev);
-    scell_start = Buffer<int>(cells + 1, dev);
     with_exec(dev, [&]<class E>(const E& ex) {
       using Grid = K::NeighbourGrid<E>;
       Grid::cell_keys(ex, raw.data(), ns, sgrid, keys.data(), idx.data());
