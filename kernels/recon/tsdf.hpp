@@ -121,7 +121,7 @@ template <Executor Exec> struct TsdfFusion {
                                   VoxelGeometry geom, View<std::int32_t> visible_slots, View<std::int32_t> keep,
                                   DepthTiles tiles = {});
 
-  // Fuses one frame into the listed blocks, one thread per voxel. When keep is not empty, keep[j]
+  // Fuses one frame into the listed blocks, one thread per column of 8 voxels. When keep is not empty, keep[j]
   // becomes 1 if block j still has a voxel near a surface afterwards (voxel_keeps_block), so that
   // finding the empty blocks costs no second pass over the voxels.
   static void fuse_hash_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,

@@ -207,18 +207,30 @@ void TsdfFusion<Exec>::fuse_hash_blocks(const Exec& ex, HashTableView t, View<co
                                         std::int64_t count, Voxel* voxels, FrameInput in, VoxelGeometry geom,
                                         float max_weight, bool color, View<std::int32_t> keep, float keep_below) {
   const SE3 camera_T_world = in.world_T_camera.inverse();
-  ex.for_each(count * kBlockVoxels, [=] SEAMLESS_HD(std::int64_t i) {
-    const std::int64_t j = i / kBlockVoxels;
-    std::int32_t slot = slots[j];
-    int li = static_cast<int>(i % kBlockVoxels);
-    std::int32_t block = t.values[slot];
+  // One thread per column of a block (its 8 voxels along z, 64 threads a block): the block's slot,
+  // index and key are read once per column instead of once per voxel, and the column's 8 voxels
+  // are independent work in one thread, so their loads can be in flight together. A warp's 32
+  // columns are 32 consecutive voxels of each z layer, so its loads stay contiguous. Every voxel
+  // is computed exactly as one thread per voxel computed it.
+  constexpr int kColumns = kBlockSide * kBlockSide;
+  ex.for_each(count * kColumns, [=] SEAMLESS_HD(std::int64_t i) {
+    const std::int64_t j = i / kColumns;
+    const std::int32_t slot = slots[j];
+    const std::int32_t block = t.values[slot];
     if (block < 0) return;
-    int3 b = unpack_block(t.keys[slot]);
-    int3 l = local_coords(li);
-    vec3 g{float(b.x * 8 + l.x), float(b.y * 8 + l.y), float(b.z * 8 + l.z)};
-    Voxel& v = voxels[static_cast<std::int64_t>(block) * kBlockVoxels + li];
-    fuse_voxel(v, geom.to_world(g), in, camera_T_world, geom.truncation, max_weight, color);
-    if (keep.data && voxel_keeps_block(v, keep_below)) set_keep(&keep[j]);
+    const int3 b = unpack_block(t.keys[slot]);
+    const int column = static_cast<int>(i % kColumns);
+    Voxel* v = voxels + static_cast<std::int64_t>(block) * kBlockVoxels + column;
+    bool kept = false;
+#pragma unroll
+    for (int z = 0; z < kBlockSide; ++z) {
+      const int3 l = local_coords(column + kColumns * z);
+      const vec3 g{float(b.x * 8 + l.x), float(b.y * 8 + l.y), float(b.z * 8 + l.z)};
+      Voxel& vz = v[kColumns * z];
+      fuse_voxel(vz, geom.to_world(g), in, camera_T_world, geom.truncation, max_weight, color);
+      kept = kept || (keep.data && voxel_keeps_block(vz, keep_below));
+    }
+    if (kept) set_keep(&keep[j]);
   });
 }
 

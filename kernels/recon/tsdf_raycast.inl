@@ -192,13 +192,14 @@ SEAMLESS_HD inline void raycast_pixel(const Acc& a, int x, int y, const Intrinsi
   vec3 col{0.f, 0.f, 0.f}, vw{0.f, 0.f, 0.f};
   if (march_ray(a, o, d, z, z_end, c, &zh)) {
     vec3 qh = o + d * zh;
-    sample_tsdf(a, qh, c, &fh, &col);
+    if (out.color.data) sample_tsdf(a, qh, c, &fh, &col);  // no colour wanted: no ninth sample
     vw = g.to_world(qh);
   }
   out.depth(x, y) = zh;  // each output written once; zero where no hit
   out.vertex(x, y) = vw;
-  out.color(x, y) = {static_cast<std::uint8_t>(col.x + 0.5f), static_cast<std::uint8_t>(col.y + 0.5f),
-                     static_cast<std::uint8_t>(col.z + 0.5f)};
+  if (out.color.data)
+    out.color(x, y) = {static_cast<std::uint8_t>(col.x + 0.5f), static_cast<std::uint8_t>(col.y + 0.5f),
+                       static_cast<std::uint8_t>(col.z + 0.5f)};
 }
 
 // Threads take pixels in 8 x 4 groups (one CUDA warp each), which stay inside one interval tile

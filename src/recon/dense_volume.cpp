@@ -46,7 +46,8 @@ void DenseVolume::integrate(const Image<float>& depth, const Image<uchar3>& rgb,
 
 void DenseVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, RaycastMaps& maps, StageTimer* timer) {
   detail::resize_maps(maps, K, device_);
-  kernels::RaycastOutput out{maps.depth.view(), maps.vertex.view(), maps.normal.view(), maps.color.view()};
+  kernels::RaycastOutput out{maps.depth.view(), maps.vertex.view(), maps.normal.view(),
+                             maps.with_color ? maps.color.view() : View2D<uchar3>{}};
   if (timer) timer->begin("raycast");
   with_exec(device_, [&]<class E>(const E& ex) {
     kernels::TsdfRaycast<E, kernels::DenseAccess>::raycast(ex, device_view(), K, world_T_camera, params_.min_depth,

@@ -23,6 +23,9 @@ struct RaycastMaps {
   Image<vec3> vertex;
   Image<vec3> normal;
   Image<uchar3> color;
+  // False: the raycast leaves `color` as it was (a geometric tracker never reads it, and its
+  // trilinear colour sample is one more TSDF read per hit pixel).
+  bool with_color = true;
 };
 
 // Per-frame statistics (counts of the last integrate(), totals for the rest).

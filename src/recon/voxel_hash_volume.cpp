@@ -341,7 +341,8 @@ kernels::BlockWindow VoxelHashVolume::raycast_window(const SE3& world_T_camera) 
 
 void VoxelHashVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, RaycastMaps& maps, StageTimer* timer) {
   detail::resize_maps(maps, K, device_);
-  kernels::RaycastOutput out{maps.depth.view(), maps.vertex.view(), maps.normal.view(), maps.color.view()};
+  kernels::RaycastOutput out{maps.depth.view(), maps.vertex.view(), maps.normal.view(),
+                             maps.with_color ? maps.color.view() : View2D<uchar3>{}};
   kernels::RayIntervals iv;  // empty: every ray marches from min_depth
   if (params_.raycast_tile > 0) {
     const auto grid = kernels::TileGrid::covering(K.width, K.height, params_.raycast_tile);
