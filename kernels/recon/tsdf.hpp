@@ -4,6 +4,7 @@
 #pragma once
 #include <cstdint>
 #include <cstring>
+#include <type_traits>
 
 #include "core/camera.hpp"
 #include "core/exec.hpp"
@@ -185,6 +186,12 @@ template <Executor Exec, class Acc = HashAccess> struct TsdfRaycast {
   // both take the same samples from the first block on and hit the same surfaces.
   static void raycast(const Exec& ex, Acc a, Intrinsics K, SE3 world_T_camera, float min_depth, float max_depth,
                       RaycastOutput out, RayIntervals iv = {});
+  // An accessor derived from Acc (WindowedHashAccess from HashAccess) would be sliced into Acc and
+  // silently lose what it adds (the window: a third of the raycast's time): name the family by the
+  // accessor actually passed, TsdfRaycast<Exec, Derived>.
+  template <class Derived, class... Rest>
+  requires(!std::is_same_v<Derived, Acc> &&
+           std::is_base_of_v<Acc, Derived>) static void raycast(const Exec& ex, Derived a, Rest&&... rest) = delete;
 };
 
 }  // namespace seamless::kernels

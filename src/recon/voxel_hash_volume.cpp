@@ -366,9 +366,9 @@ void VoxelHashVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, Ra
       if (!iv.bits)
         staged(timer, "raycast_window",
                [&] { kernels::TsdfRaycast<E>::fill_block_window(ex, table(), w); });  // part of "raycast"
-      kernels::TsdfRaycast<E, kernels::HashAccess>::raycast(ex, kernels::WindowedHashAccess{device_view(), w}, K,
-                                                            world_T_camera, params_.min_depth, params_.max_depth, out,
-                                                            iv);
+      kernels::TsdfRaycast<E, kernels::WindowedHashAccess>::raycast(ex, kernels::WindowedHashAccess{device_view(), w},
+                                                                    K, world_T_camera, params_.min_depth,
+                                                                    params_.max_depth, out, iv);
     });
   });
 }
