@@ -18,21 +18,6 @@ SEAMLESS_HD inline float block_exit(vec3 o, vec3 d, vec3 inv_d, int3 b) {
   return t;
 }
 
-// Regula falsi on the trilinear field between a positive sample at ta and a negative one at tb.
-template <class Acc>
-SEAMLESS_HD inline float refine_crossing(const Acc& a, vec3 o, vec3 d, float ta, float fa, float tb, float fb,
-                                         BlockCache& c) {
-#pragma unroll 1  // one copy of the sample code: the kernel is large enough to miss the instruction cache
-  for (int it = 0; it < 3; ++it) {
-    float tm = ta + (tb - ta) * fa / (fa - fb);
-    float fm;
-    if (!sample_tsdf(a, o + d * tm, c, &fm)) return tm;
-    if (fm > 0.f) ta = tm, fa = fm;
-    else tb = tm, fb = fm;
-  }
-  return ta + (tb - ta) * fa / (fa - fb);
-}
-
 // Pixel bounding box and camera-depth range of a block's cell box clipped to the depth slab.
 struct ScreenBounds {
   float u0 = 1e30f, u1 = -1e30f, v0 = 1e30f, v1 = -1e30f, z0 = 1e30f, z1 = -1e30f;
@@ -127,7 +112,10 @@ void TsdfRaycast<Exec, Acc>::fill_block_window(const Exec& ex, HashTableView t, 
 }
 
 // Marches the ray o + d z (voxel units, z = camera depth) from z to z_end; on a +/- zero crossing
-// returns true with its refined depth in *hit and the block cache left near it.
+// returns true with its refined depth in *hit and the block cache left near it. The crossing is
+// refined by three steps of regula falsi on the trilinear field, taken by the same loop: its
+// samples then run through the one copy of the sample code (on the GPU the kernel's size, not its
+// arithmetic, held the march back: most warps waited on instruction fetch).
 template <class Acc>
 SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z_end, BlockCache& c, float* hit) {
   const float dlen = length(d);        // voxels per metre of depth
@@ -139,26 +127,39 @@ SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z
   const float unobserved_step = fmaxf(min_step, 0.5f * a.geom.truncation / (dlen * a.geom.voxel_size));
   const float step_per_sdf = 0.8f / (dlen * a.geom.voxel_size);  // see the step below
   const vec3 inv_d{1.f / d.x, 1.f / d.y, 1.f / d.z};             // +-inf on an axis d does not move along
+  constexpr int kRefineSteps = 3;
   float z_prev = 0.f, f_prev = 0.f;
   bool have_prev = false;
-  for (int it = 0; it < 8192 && z < z_end; ++it) {
+  int refine = -1;                               // -1: marching; else regula falsi steps taken
+  float ta = 0.f, fa = 0.f, tb = 0.f, fb = 0.f;  // the bracket: fa > 0 at ta, fb <= 0 at tb
+  for (int it = 0; refine >= 0 || (it < 8192 && z < z_end); ++it) {
     vec3 q = o + d * z;
     const int3 g0 = floor_to_int(q), b = block_of_voxel(g0);
     const std::int32_t i0 = cached_block(a, b, c);
+    float f = 0.f;
+    const bool sampled = i0 >= 0 && sample_tsdf_in(a, q, g0, i0, c, &f);  // the block just found: no second lookup
+    if (refine >= 0) {                                                    // regula falsi between the bracket's ends
+      if (!sampled) break;  // no value here: the last estimate, z, is the hit
+      if (f > 0.f) ta = z, fa = f;
+      else tb = z, fb = f;
+      z = ta + (tb - ta) * fa / (fa - fb);
+      if (++refine == kRefineSteps) break;
+      continue;
+    }
     if (i0 < 0) {  // empty space: skip the whole block (Niessner section 4.3)
       z = fmaxf(block_exit(o, d, inv_d, b), z) + min_step * 0.1f;
       have_prev = false;
       continue;
     }
-    float f;
-    if (!sample_tsdf_in(a, q, g0, i0, c, &f)) {  // the block just found: no second lookup
+    if (!sampled) {
       z += unobserved_step;
       have_prev = false;
       continue;
     }
     if (have_prev && f_prev > 0.f && f <= 0.f) {
-      *hit = refine_crossing(a, o, d, z_prev, f_prev, z, f, c);
-      return true;
+      ta = z_prev, fa = f_prev, tb = z, fb = f, refine = 0;
+      z = ta + (tb - ta) * fa / (fa - fb);
+      continue;
     }
     z_prev = z, f_prev = f, have_prev = true;
     // |TSDF| is at most about the distance to the nearest zero crossing (projective distances
@@ -168,7 +169,9 @@ SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z
     // voxel at the surface.
     z += fmaxf(fabsf(f) * step_per_sdf, min_step);
   }
-  return false;
+  if (refine < 0) return false;
+  *hit = z;
+  return true;
 }
 
 template <class Acc>
