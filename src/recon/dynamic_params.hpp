@@ -6,6 +6,17 @@
 
 namespace seamless {
 
+// What a candidate must show of the volume at its measured point (docs/DYNAMIC.md, "Evidence of free
+// space"): nothing more (none), not a surface the volume holds (not_occupied), or space that
+// earlier frames saw through (seen_free, ReFusion's free-space test).
+enum class FreeSpaceEvidence { none, not_occupied, seen_free };
+inline std::span<const EnumName<FreeSpaceEvidence>> enum_names(FreeSpaceEvidence) {
+  static constexpr EnumName<FreeSpaceEvidence> names[] = {{FreeSpaceEvidence::none, "none"},
+                                                          {FreeSpaceEvidence::not_occupied, "not_occupied"},
+                                                          {FreeSpaceEvidence::seen_free, "seen_free"}};
+  return names;
+}
+
 struct DynamicParams {
   bool enabled = false;
   // Residual threshold: max(residual_min, residual_sigmas * noise_coeff * z^2 + one depth
@@ -34,6 +45,14 @@ struct DynamicParams {
   // 30 (1 s) ends the loop that keeps a newly seen chair seat masked (worst-frame IoU 0.30 -> 0.61)
   // but the live demo then leaves 203 ghost vertices of the person instead of 5 (docs/DYNAMIC.md).
   int static_after_frames = 0;
+  // Evidence of free space at the measured point (docs/DYNAMIC.md, "Evidence of free space"). none
+  // by default: the voxel-hashed volume stores only the +-truncation band around surfaces, so the
+  // space a person walks through in the middle of a room is unknown to it, like a chair's seat
+  // never seen before; seen_free then drops the person too.
+  FreeSpaceEvidence free_space_evidence = FreeSpaceEvidence::none;
+  // Frames a voxel must have been fused to count as observed: one frame's free space may come from a
+  // single mixed pixel at a silhouette reading the background behind it; two frames seldom repeat it.
+  float evidence_min_weight = 2.f;
   bool write_masks = false;  // dynamic_mask/<frame>.png (255 = dynamic) into the run's folder
 
   template <class V> void visit(V& v) {
@@ -68,6 +87,11 @@ struct DynamicParams {
       "(a person who stopped, a surface first seen in front of one seen before); 0: never (docs/DYNAMIC.md: a "
       "trade-off, off by default)",
       Range{0, 250});
+    v("free_space_evidence", free_space_evidence,
+      "what a dynamic candidate must show of the volume at its measured point: none, not_occupied (no surface "
+      "the volume holds there) or seen_free (space earlier frames saw through; ReFusion's free-space test)");
+    v("evidence_min_weight", evidence_min_weight,
+      "frames a voxel must have been fused for free_space_evidence to count it as observed", Range{0.0, 1000.0});
     v("write_masks", write_masks, "write each frame's mask as dynamic_mask/<frame>.png (255 = dynamic)");
   }
 };
