@@ -46,13 +46,18 @@ struct DynamicParams {
   // but the live demo then leaves 203 ghost vertices of the person instead of 5 (docs/DYNAMIC.md).
   int static_after_frames = 0;
   // Evidence of free space at the measured point (docs/DYNAMIC.md, "Evidence of free space"). none
-  // by default: the voxel-hashed volume stores only the +-truncation band around surfaces, so the
-  // space a person walks through in the middle of a room is unknown to it, like a chair's seat
-  // never seen before; seen_free then drops the person too.
+  // by default: the voxel-hashed volume (the default layout) stores only the +-truncation band
+  // around surfaces, so the space a person walks through in the middle of a room is as unknown to it
+  // as a chair's seat never seen before, and seen_free drops the person too; the dense grid stores
+  // every voxel, and there seen_free ends the newly-seen-surface loop.
   FreeSpaceEvidence free_space_evidence = FreeSpaceEvidence::none;
-  // Frames a voxel must have been fused to count as observed: one frame's free space may come from a
-  // single mixed pixel at a silhouette reading the background behind it; two frames seldom repeat it.
-  float evidence_min_weight = 2.f;
+  // Frames a voxel must have been fused to count as observed. 1: free-space carving resets a voxel
+  // it carves to weight 1 every frame it carves it (kernels/recon/tsdf_fusion.inl), so space more
+  // than carve_truncations in front of every reading never holds more, and that is most of the
+  // space a person walks through; the carve already asks the 3x3 readings around the pixel to
+  // agree, which keeps one mixed pixel at a silhouette from making free space. (With 2 the dense
+  // grid's seen_free lost a quarter of the person's IoU: docs/DYNAMIC.md.)
+  float evidence_min_weight = 1.f;
   bool write_masks = false;  // dynamic_mask/<frame>.png (255 = dynamic) into the run's folder
 
   template <class V> void visit(V& v) {
