@@ -69,7 +69,7 @@ SEAMLESS_HD inline SpaceEvidence space_evidence(const Acc& a, vec3 p_world, floa
   const Voxel* v[8];
   if (!cell_voxels(a, g0, c, v)) return SpaceEvidence::unknown;
   for (int k = 0; k < 8; ++k)
-    if (!(v[k]->weight >= min_weight) || !(v[k]->weight > 0.f)) return SpaceEvidence::unknown;
+    if (!(v[k]->weight > 0.f && v[k]->weight >= min_weight)) return SpaceEvidence::unknown;
   const vec3 f = q - to_vec3(g0);
   float sdf = 0.f;
   for (int k = 0; k < 8; ++k)
