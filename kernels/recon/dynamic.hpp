@@ -12,6 +12,7 @@
 #include "core/exec.hpp"
 #include "core/math.hpp"
 #include "core/view.hpp"
+#include "kernels/recon/voxel_hash.hpp"
 
 namespace seamless::kernels {
 
@@ -48,6 +49,32 @@ SEAMLESS_HD inline float depth_step(const DynamicInput& in, float z) {
 // in front of its model made speckles in the mask. The noise comes on top of that step.
 SEAMLESS_HD inline float dynamic_threshold(const DynamicInput& in, float z) {
   return fmaxf(in.residual_min, in.residual_sigmas * in.noise_coeff * z * z + depth_step(in, z));
+}
+
+// What the volume shows of the space at a measured point: the 8 voxels of its cell (the trilinear
+// TSDF's), each observed by at least min_weight frames (weight is frames fused, up to
+// volume.max_weight). Seen free: their distance there is at least half the truncation, i.e. earlier
+// rays passed through the point to a surface behind it (voxels more than the truncation in front of
+// every reading hold exactly +truncation, a static surface's own voxels about 0; half of it splits
+// the two). Occupied: observed, and less than that (a surface is there, or the point is inside
+// one). Unknown: a voxel missing (the voxel-hashed volume stores only the band of +-truncation
+// around surfaces, so most of the space between the camera and a wall is unknown) or not observed
+// enough.
+enum class SpaceEvidence : std::uint8_t { unknown, seen_free, occupied };
+
+template <class Acc>
+SEAMLESS_HD inline SpaceEvidence space_evidence(const Acc& a, vec3 p_world, float min_weight, BlockCache& c) {
+  const vec3 q = a.geom.to_voxel(p_world);
+  const int3 g0 = floor_to_int(q);
+  const Voxel* v[8];
+  if (!cell_voxels(a, g0, c, v)) return SpaceEvidence::unknown;
+  for (int k = 0; k < 8; ++k)
+    if (!(v[k]->weight > 0.f && v[k]->weight >= min_weight)) return SpaceEvidence::unknown;
+  const vec3 f = q - to_vec3(g0);
+  float sdf = 0.f;
+  for (int k = 0; k < 8; ++k)
+    sdf += v[k]->sdf * (k & 1 ? f.x : 1.f - f.x) * ((k >> 1) & 1 ? f.y : 1.f - f.y) * (k >> 2 ? f.z : 1.f - f.z);
+  return sdf >= 0.5f * a.geom.truncation ? SpaceEvidence::seen_free : SpaceEvidence::occupied;
 }
 
 template <Executor Exec> struct Dynamic {
@@ -105,6 +132,20 @@ template <Executor Exec> struct Dynamic {
 
   // Dynamic pixels in a mask (the frame's masked fraction for summary.json).
   static std::int64_t count_dynamic(const Exec& ex, View2D<const std::uint8_t> mask);
+};
+
+// The candidate test's positive evidence of free space (ReFusion, Palazzolo et al. 2019, section
+// III-D: a measurement in front of the model is dynamic only where earlier frames saw through that
+// space), read from the volume through its accessor (HashAccess, DenseAccess; family recon/dynamic).
+template <Executor Exec, class Acc> struct DynamicSpace {
+  // Clears each candidate whose measured point (the depth at world_T_camera) is not where the volume
+  // shows free space (space_evidence): with require_seen_free, every candidate that is not seen
+  // free (unknown space too); without, only the occupied ones (the volume holds a static surface
+  // there, e.g. a face of an object revealed at a depth edge). Earlier frames' rays that never
+  // passed there (a chair's seat first seen from above after the floor beneath it was seen from the
+  // side) give no free space, so such a surface is not a candidate and gets fused.
+  static void require_free_space(const Exec& ex, Acc a, View2D<const float> depth, Intrinsics K, SE3 world_T_camera,
+                                 float min_weight, bool require_seen_free, View2D<std::uint8_t> candidates);
 };
 
 }  // namespace seamless::kernels

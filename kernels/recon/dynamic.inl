@@ -149,4 +149,19 @@ template <Executor Exec> std::int64_t Dynamic<Exec>::count_dynamic(const Exec& e
   });
 }
 
+template <Executor Exec, class Acc>
+void DynamicSpace<Exec, Acc>::require_free_space(const Exec& ex, Acc a, View2D<const float> depth, Intrinsics K,
+                                                 SE3 world_T_camera, float min_weight, bool require_seen_free,
+                                                 View2D<std::uint8_t> candidates) {
+  const int w = depth.width;
+  ex.for_each(depth.count(), [=] SEAMLESS_HD(std::int64_t i) {
+    const int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
+    if (!candidates(x, y)) return;  // a candidate has a reading (classify_dynamic)
+    BlockCache c;
+    const SpaceEvidence e = space_evidence(
+        a, world_T_camera * K.unproject(static_cast<float>(x), static_cast<float>(y), depth(x, y)), min_weight, c);
+    if (require_seen_free ? e != SpaceEvidence::seen_free : e == SpaceEvidence::occupied) candidates(x, y) = 0;
+  });
+}
+
 }  // namespace seamless::kernels

@@ -5,6 +5,7 @@
 
 #include "core/error.hpp"
 #include "core/exec.hpp"
+#include "kernels/recon/dynamic.hpp"
 #include "kernels/recon/tsdf.hpp"
 #include "recon/marching_cubes.hpp"
 
@@ -64,6 +65,14 @@ SceneParticles DenseVolume::extract_scene_particles(const SceneParticleParams& p
 
 std::vector<float> DenseVolume::sample_sdf_grid(vec3 origin, int3 dims, float voxel) {
   return seamless::sample_sdf_grid(device_, device_view(), origin, dims, voxel, params_.truncation);
+}
+
+void DenseVolume::require_free_space(const Image<float>& depth, const Intrinsics& K, const SE3& world_T_camera,
+                                     float min_weight, bool require_seen_free, Image<std::uint8_t>& candidates) {
+  with_exec(device_, [&]<class E>(const E& ex) {
+    kernels::DynamicSpace<E, kernels::DenseAccess>::require_free_space(
+        ex, device_view(), depth.cview(), K, world_T_camera, min_weight, require_seen_free, candidates.view());
+  });
 }
 
 VolumeStats DenseVolume::stats() {

@@ -22,6 +22,8 @@ class DenseVolume final : public Volume {
   Mesh extract_mesh() override;
   SceneParticles extract_scene_particles(const SceneParticleParams& p) override;
   std::vector<float> sample_sdf_grid(vec3 origin, int3 dims, float voxel) override;
+  void require_free_space(const Image<float>& depth, const Intrinsics& K, const SE3& world_T_camera, float min_weight,
+                          bool require_seen_free, Image<std::uint8_t>& candidates) override;
   VolumeStats stats() override;
   Device device() const override { return device_; }
   const VolumeParams& params() const override { return params_; }

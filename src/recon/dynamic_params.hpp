@@ -6,6 +6,17 @@
 
 namespace seamless {
 
+// What a candidate must show of the volume at its measured point (docs/DYNAMIC.md, "Evidence of free
+// space"): nothing more (none), not a surface the volume holds (not_occupied), or space that
+// earlier frames saw through (seen_free, ReFusion's free-space test).
+enum class FreeSpaceEvidence { none, not_occupied, seen_free };
+inline std::span<const EnumName<FreeSpaceEvidence>> enum_names(FreeSpaceEvidence) {
+  static constexpr EnumName<FreeSpaceEvidence> names[] = {{FreeSpaceEvidence::none, "none"},
+                                                          {FreeSpaceEvidence::not_occupied, "not_occupied"},
+                                                          {FreeSpaceEvidence::seen_free, "seen_free"}};
+  return names;
+}
+
 struct DynamicParams {
   bool enabled = false;
   // Residual threshold: max(residual_min, residual_sigmas * noise_coeff * z^2 + one depth
@@ -34,6 +45,19 @@ struct DynamicParams {
   // 30 (1 s) ends the loop that keeps a newly seen chair seat masked (worst-frame IoU 0.30 -> 0.61)
   // but the live demo then leaves 203 ghost vertices of the person instead of 5 (docs/DYNAMIC.md).
   int static_after_frames = 0;
+  // Evidence of free space at the measured point (docs/DYNAMIC.md, "Evidence of free space"). none
+  // by default: the voxel-hashed volume (the default layout) stores only the +-truncation band
+  // around surfaces, so the space a person walks through in the middle of a room is as unknown to it
+  // as a chair's seat never seen before, and seen_free drops the person too; the dense grid stores
+  // every voxel, and there seen_free ends the newly-seen-surface loop.
+  FreeSpaceEvidence free_space_evidence = FreeSpaceEvidence::none;
+  // Frames a voxel must have been fused to count as observed. 1: free-space carving resets a voxel
+  // it carves to weight 1 every frame it carves it (kernels/recon/tsdf_fusion.inl), so space more
+  // than carve_truncations in front of every reading never holds more, and that is most of the
+  // space a person walks through; the carve already asks the 3x3 readings around the pixel to
+  // agree, which keeps one mixed pixel at a silhouette from making free space. (With 2 the dense
+  // grid's seen_free lost a quarter of the person's IoU: docs/DYNAMIC.md.)
+  float evidence_min_weight = 1.f;
   bool write_masks = false;  // dynamic_mask/<frame>.png (255 = dynamic) into the run's folder
 
   template <class V> void visit(V& v) {
@@ -68,6 +92,11 @@ struct DynamicParams {
       "(a person who stopped, a surface first seen in front of one seen before); 0: never (docs/DYNAMIC.md: a "
       "trade-off, off by default)",
       Range{0, 250});
+    v("free_space_evidence", free_space_evidence,
+      "what a dynamic candidate must show of the volume at its measured point: none, not_occupied (no surface "
+      "the volume holds there) or seen_free (space earlier frames saw through; ReFusion's free-space test)");
+    v("evidence_min_weight", evidence_min_weight,
+      "frames a voxel must have been fused for free_space_evidence to count it as observed", Range{0.0, 1000.0});
     v("write_masks", write_masks, "write each frame's mask as dynamic_mask/<frame>.png (255 = dynamic)");
   }
 };

@@ -140,6 +140,11 @@ void TrackingSession::find_dynamic(const ReferenceMaps& model, const SE3& world_
   in.search_radius = d.search_radius;
   with_exec(device_, [&]<class E>(const E& ex) {
     kernels::Dynamic<E>::classify_dynamic(ex, in, dyn_candidates_.view());
+    // Evidence of free space: the volume at the measured points (world frame; the model maps are in
+    // the reference camera's).
+    if (d.free_space_evidence != FreeSpaceEvidence::none && volume_)
+      volume_->require_free_space(l0.depth, K_, world_T_camera, d.evidence_min_weight,
+                                  d.free_space_evidence == FreeSpaceEvidence::seen_free, dyn_candidates_);
     if (d.static_after_frames > 0)  // 0: no ageing (and no cost)
       kernels::Dynamic<E>::age_dynamic(ex, in, dyn_prev_anchor_.cview(), dyn_prev_age_.cview(),
                                        dyn_prev_pose_.inverse() * world_T_camera, d.static_after_frames,

@@ -73,6 +73,12 @@ class Volume {
   // The SDF on a regular grid (x fastest) at origin + voxel * (x, y, z); unknown points read as
   // +truncation (free space). For the solver's scene_collision: sdf.
   virtual std::vector<float> sample_sdf_grid(vec3 origin, int3 dims, float voxel) = 0;
+  // Dynamic pixels (issue 22, docs/DYNAMIC.md): clears the candidates (1 per pixel of depth, seen
+  // from world_T_camera) whose measured point the volume does not show in free space, i.e. not
+  // seen through by earlier frames (require_seen_free) or occupied by a surface (otherwise);
+  // kernels::DynamicSpace::require_free_space. Both images live on the volume's device.
+  virtual void require_free_space(const Image<float>& depth, const Intrinsics& K, const SE3& world_T_camera,
+                                  float min_weight, bool require_seen_free, Image<std::uint8_t>& candidates) = 0;
   virtual VolumeStats stats() = 0;
   virtual Device device() const = 0;
   virtual const VolumeParams& params() const = 0;
