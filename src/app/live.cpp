@@ -95,6 +95,11 @@ class LiveLoop : public FrameLoop {
       if (reextract && (e_.render.view == RenderView::mesh || e_.render.mode == RenderMode::window))
         renderer_->set_scene(volume_->extract_mesh(), rec.result.world_T_camera);
       renderer_->draw(solver_);
+      // The draw's GPU time, pass by pass (GL timer queries): "render" is the host's side of it.
+      double gpu_ms = 0.0;
+      const auto passes = renderer_->gpu_passes();
+      for (const auto& [pass, ms] : passes) ctx_.timer().add(k, "gl_" + pass, ms), gpu_ms += ms;
+      if (!passes.empty()) ctx_.timer().add(k, "render_gpu", gpu_ms);
     }
     ctx_.timer().add(k, "preprocess", rec.preprocess_ms);  // as scan()'s rows: upload included
     ctx_.timer().add(k, "track", rec.track_ms);

@@ -129,6 +129,12 @@ class GlRunRenderer : public RunRenderer {
     out_.add(renderer_);
   }
 
+  std::vector<std::pair<std::string, double>> gpu_passes() const override {
+    std::vector<std::pair<std::string, double>> out;
+    for (const RenderTiming& t : renderer_.timings()) out.emplace_back(t.pass, t.ms);
+    return out;
+  }
+
   void finish() override {
     out_.finish();
     // The last frame on its own: what a reader sees first of a run (scripts/demo prints it).

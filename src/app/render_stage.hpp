@@ -8,6 +8,7 @@
 #pragma once
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "app/run_context.hpp"
@@ -49,6 +50,9 @@ class RunRenderer {
   virtual void set_kinect_frame(const RgbdFrame& frame, const SE3& world_T_camera) = 0;
   virtual void draw(const ParticleSolver& solver) = 0;
   virtual void finish() = 0;
+  // The last draw's GPU time per pass (name, ms), from the renderer's GL timer queries; empty where
+  // there are none (the window draws on its own clock).
+  virtual std::vector<std::pair<std::string, double>> gpu_passes() const { return {}; }
 };
 
 // The camera of the mesh view: at render.eye looking at render.target where given, else looking

@@ -29,6 +29,12 @@ SUM_TOL = 1e-9
 CSV_TOL = 5e-4 + 1e-9
 
 
+def frame_parts(doc):
+    """The stages that partition the frame: all but the frame and render_gpu (the draw's GPU time,
+    already inside render)."""
+    return [n for n in doc["stages"] if n not in ("frame", "render_gpu")]
+
+
 def seamless(*args):
     r = subprocess.run([EXE, *args], capture_output=True, text=True, timeout=600)
     if r.returncode != 0:
@@ -146,13 +152,29 @@ class BenchPipeline(unittest.TestCase):
         if not rendered:  # a build or machine without OpenGL: said so, in the JSON and the output
             self.assertTrue(doc["render"].startswith("skipped"), doc["render"])
             self.assertIn("render: skipped", r.stdout)
-        self.assertEqual(doc["stages"], TRACKING + ["physics", "extract"] + (["render"] if rendered else []) + ["frame"])
+        self.assertEqual(doc["stages"], TRACKING + ["physics", "extract"] + (["render"] if rendered else []) + ["frame"] +
+                         (["render_gpu"] if rendered else []))
         self.check_statistics(doc, frames)
         rep = doc["replays"][0]
         st = {n: rep["stages"][n]["per_frame_ms"] for n in doc["stages"]}
         for i in range(frames):
-            self.check_sum(st, [n for n in doc["stages"] if n != "frame"], i)
+            self.check_sum(st, frame_parts(doc), i)
             self.assertGreater(st["physics"][i], 0)  # one solver step a fused frame
+        if rendered:
+            # render_gpu is the sum of the run's gl_<pass> rows of the frame (timings.csv), and lies
+            # inside render: the draw ends by reading its timer queries, so the host's interval
+            # holds the GPU's from the first pass to the last.
+            gl, passes = {}, {}
+            with open(os.path.join(out, "bench", "rep_0", "timings.csv")) as f:
+                for row in csv.DictReader(f):
+                    if row["stage"].startswith("gl_"):
+                        k = int(row["frame"])
+                        gl[k], passes[k] = gl.get(k, 0.0) + float(row["ms"]), passes.get(k, 0) + 1
+            for i in range(frames):
+                self.assertGreater(st["render_gpu"][i], 0)
+                # timings.csv prints 6 significant digits: each row within 5e-6 of its value, relative
+                self.assertAlmostEqual(st["render_gpu"][i], gl[i], delta=5e-6 * gl[i] + SUM_TOL * passes[i])
+                self.assertLessEqual(st["render_gpu"][i], st["render"][i] + CSV_TOL)
         self.assertGreater(st["extract"][0], 0)  # the first fused frame extracts the scene
         with open(os.path.join(out, "bench", "rep_0", "summary.json")) as f:
             summary = json.load(f)
@@ -194,7 +216,7 @@ class BenchPipeline(unittest.TestCase):
         self.assertLess(doc["stages"].index("colliders"), doc["stages"].index("physics"))
         st = {n: doc["replays"][0]["stages"][n]["per_frame_ms"] for n in doc["stages"]}
         for i in range(frames):
-            self.check_sum(st, [n for n in doc["stages"] if n != "frame"], i)
+            self.check_sum(st, frame_parts(doc), i)
         self.assertGreater(st["colliders"][frames - 1], 0)  # a tracked frame's depth points became colliders
 
 
