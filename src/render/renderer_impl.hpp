@@ -143,7 +143,8 @@ struct Renderer::Impl {
   // Shadows of the virtual objects (renderer_shadow.cpp): built when the context has compute
   // shaders and glClearTexImage (GL 4.4 or ARB_clear_texture).
   bool has_shadow = false;
-  Program shadow_bounds_prog, shadow_splat_prog, shadow_resolve_prog, shadow_mesh_prog, shadow_cloth_prog;
+  Program shadow_bounds_prog, shadow_clear_prog, shadow_splat_prog, shadow_resolve_prog, shadow_mesh_prog,
+      shadow_cloth_prog;
   Texture light_bounds;               // 6 x 1 R32I: casters' bounds in the light frame (shadow.glsl)
   Texture shadow_depth, shadow_map;   // rasterised casters' depth, the opaque map
   Texture shadow_bits, shadow_thick;  // fluid splat: front depth bits, fixed-point path in fluid
