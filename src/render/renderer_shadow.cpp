@@ -55,11 +55,9 @@ std::vector<float> cols(const mat3& R) {  // column-major for glUniformMatrix3fv
 }  // namespace
 
 void Renderer::Impl::build_shadow_programs() {
-  has_shadow = has_compute && (epoxy_gl_version() >= 44 || epoxy_has_gl_extension("GL_ARB_clear_texture"));
+  has_shadow = has_compute;  // the splat, its clear and the resolve are compute shaders
   if (!has_shadow) {
-    if (p.shadows)
-      spdlog::info("render: OpenGL {} has no compute shaders or glClearTexImage; no shadows",
-                   epoxy_gl_version() / 10.0);
+    if (p.shadows) spdlog::info("render: OpenGL {} has no compute shaders; no shadows", epoxy_gl_version() / 10.0);
     return;
   }
   auto cs = [](std::vector<std::string> f) { return ShaderStage{GL_COMPUTE_SHADER, std::move(f)}; };
