@@ -65,15 +65,21 @@ void ReferenceMaps::set_from_frame(const FramePyramid& frame, const SE3& world_T
   world_T_ref_ = world_T_camera;
 }
 
+bool ReferenceMaps::reads_model_colour(const Intrinsics& K, int levels, const FramePyramid* photometric,
+                                       bool with_intensity) {
+  const bool frame =
+      photometric && photometric->level(0).intensity.width() == K.width && photometric->levels() >= levels;
+  return with_intensity && !frame;
+}
+
 void ReferenceMaps::set_from_raycast(const RaycastMaps& maps, const Intrinsics& K, const SE3& world_T_camera,
                                      int levels, float max_diff, const FramePyramid* photometric, bool with_intensity) {
   if (maps.vertex.width() != K.width || maps.vertex.height() != K.height)
     throw Error("raycast maps are " + std::to_string(maps.vertex.width()) + "x" + std::to_string(maps.vertex.height()) +
                 " but the tracker's intrinsics say " + std::to_string(K.width) + "x" + std::to_string(K.height));
-  const bool from_frame = with_intensity && photometric && photometric->level(0).intensity.width() == K.width &&
-                          photometric->levels() >= levels;
-  const bool from_model =
-      with_intensity && !from_frame && maps.color.width() == K.width && maps.color.height() == K.height;
+  const bool model_colour = reads_model_colour(K, levels, photometric, with_intensity);
+  const bool from_frame = with_intensity && !model_colour;
+  const bool from_model = model_colour && maps.color.width() == K.width && maps.color.height() == K.height;
   const bool intensity = from_frame || from_model;
   Device d = maps.vertex.device();
   resize(K, levels, d, intensity);

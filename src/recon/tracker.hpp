@@ -45,6 +45,9 @@ class ReferenceMaps {
   // tracker reads none, and its conversion and pyramid would be wasted work).
   void set_from_raycast(const RaycastMaps& maps, const Intrinsics& K, const SE3& world_T_camera, int levels,
                         float max_diff = 0.09f, const FramePyramid* photometric = nullptr, bool with_intensity = true);
+  // Whether set_from_raycast with these arguments reads the raycast's colour (so that the raycast
+  // may leave it out: RaycastMaps::with_color).
+  static bool reads_model_colour(const Intrinsics& K, int levels, const FramePyramid* photometric, bool with_intensity);
   const ReferenceLevel& level(int l) const { return levels_.at(l); }
   int levels() const { return static_cast<int>(levels_.size()); }
   bool empty() const { return levels_.empty(); }

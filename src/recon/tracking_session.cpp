@@ -214,13 +214,11 @@ void TrackingSession::update_reference(const SE3& pose) {
   if (volume_ && p_.tracker.mode == TrackingMode::frame_to_model) {
     // The current pyramid is the frame just tracked at `pose`, the pose the raycast is seen from.
     const bool frame_colour = p_.tracker.photometric_reference == PhotometricReference::frame;
-    // The model's colour is read only where the photometric term has no frame intensity
-    // (ReferenceMaps::set_from_raycast's from_model).
-    const bool frame_intensity = frame_colour && pyr_.level(0).intensity.width() == K_.width;
-    maps_.with_color = tracker_->reads_intensity() && !frame_intensity;
+    const FramePyramid* photometric = frame_colour ? &pyr_ : nullptr;
+    maps_.with_color = ReferenceMaps::reads_model_colour(K_, pyr_.levels(), photometric, tracker_->reads_intensity());
     volume_->raycast(K_, pose, maps_, p_.volume_stages);
-    ref_.set_from_raycast(maps_, K_, pose, pyr_.levels(), p_.preprocess.pyramid_max_diff,
-                          frame_colour ? &pyr_ : nullptr, tracker_->reads_intensity());
+    ref_.set_from_raycast(maps_, K_, pose, pyr_.levels(), p_.preprocess.pyramid_max_diff, photometric,
+                          tracker_->reads_intensity());
   } else {
     ref_.set_from_frame(pyr_, pose);
   }
