@@ -12,8 +12,8 @@ SEAMLESS_HD inline float block_exit(vec3 o, vec3 d, vec3 inv_d, int3 b) {
   float lo[3] = {b.x * 8.f, b.y * 8.f, b.z * 8.f};
   float oo[3] = {o.x, o.y, o.z}, dd[3] = {d.x, d.y, d.z}, ii[3] = {inv_d.x, inv_d.y, inv_d.z};
   for (int k = 0; k < 3; ++k) {
-    if (dd[k] > 0.f) t = fminf(t, (lo[k] + 8.f - oo[k]) * ii[k]);
-    if (dd[k] < 0.f) t = fminf(t, (lo[k] - oo[k]) * ii[k]);
+    if (dd[k] > 0.f) t = min_of(t, (lo[k] + 8.f - oo[k]) * ii[k]);
+    if (dd[k] < 0.f) t = min_of(t, (lo[k] - oo[k]) * ii[k]);
   }
   return t;
 }
@@ -147,7 +147,7 @@ SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z
       continue;
     }
     if (i0 < 0) {  // empty space: skip the whole block (Niessner section 4.3)
-      z = fmaxf(block_exit(o, d, inv_d, b), z) + min_step * 0.1f;
+      z = max_of(block_exit(o, d, inv_d, b), z) + min_step * 0.1f;
       have_prev = false;
       continue;
     }
@@ -167,7 +167,7 @@ SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z
     // metres per unit of z) cannot jump over one: truncation-sized steps in the band's free-space
     // side (and through the back of a surface a ray enters from behind), shrinking to half a
     // voxel at the surface.
-    z += fmaxf(fabsf(f) * step_per_sdf, min_step);
+    z += max_of(fabsf(f) * step_per_sdf, min_step);
   }
   if (refine < 0) return false;
   *hit = z;
