@@ -294,9 +294,12 @@ template <class Acc> SEAMLESS_HD inline bool cell_voxels(const Acc& a, int3 g0, 
 template <class Acc>
 SEAMLESS_HD inline bool sample_tsdf_in(const Acc& a, vec3 q, int3 g0, std::int32_t i0, BlockCache& c, float* sdf,
                                        vec3* color = nullptr) {
-  // Corner 0 first: its block is known, and an unobserved corner means no value (a sixth of the
-  // raycast's samples end here, in cells at the edge of what was seen) without the other seven.
+#ifndef __CUDA_ARCH__
+  // On the CPU, corner 0 first: its block is known, and an unobserved corner means no value (a
+  // sixth of the raycast's samples end here, at the edge of what was seen) without the other
+  // seven. Not on the GPU, where the other seven loads would wait for this one's latency.
   if (!(a.voxels[static_cast<std::int64_t>(i0) * kBlockVoxels + local_index(g0)].weight > 0.f)) return false;
+#endif
   const vec3 f = q - to_vec3(g0);
   const Voxel* v[8];
   if ((g0.x & 7) != 7 && (g0.y & 7) != 7 && (g0.z & 7) != 7) {
