@@ -79,6 +79,13 @@ TrackSequenceParams params(bool dynamic, const std::string& tracker) {
   return p;
 }
 
+// A variant of a run: how its parameters and its volume differ from params()'s.
+struct Variant {
+  FreeSpaceEvidence evidence = FreeSpaceEvidence::none;
+  float evidence_min_weight = 1.f;
+  bool store_free_space = false;  // also without seen_free (which stores it itself)
+};
+
 struct Outcome {
   double ate_m = 0;  // ATE RMSE after se3 alignment (seamless eval's)
   double min_iou = 1, mean_iou = 0;
@@ -86,6 +93,10 @@ struct Outcome {
   std::int64_t ghost_vertices = 0;  // mesh vertices inside the person's swept volume
   double mean_fraction = 0;
   std::vector<std::pair<std::int64_t, double>> below;  // frames with IoU under 0.8, and their IoU
+  // Median ms per frame of the volume's stages (allocate includes the free-space rays), and the
+  // volume's size at the end.
+  double allocate_ms = 0, visible_ms = 0, fuse_ms = 0, raycast_ms = 0;
+  VolumeStats volume;
 };
 
 void print_below(const char* what, const Outcome& o) {
@@ -105,10 +116,15 @@ std::vector<kernels::movers::Scene> person_track(const InputParams& in) {
 
 // tracker ground_truth: the map is exactly in the room frame (up to the first pose), so the ghost
 // measures fusion and carving alone; icp: the tracking error.
-Outcome run(const InputParams& in, bool dynamic, const std::string& tracker = "icp") {
+Outcome run(const InputParams& in, bool dynamic, const std::string& tracker = "icp", const Variant& variant = {}) {
   SyntheticSource src(in);
-  const TrackSequenceParams p = params(dynamic, tracker);
+  TrackSequenceParams p = params(dynamic, tracker);
+  p.dynamic.free_space_evidence = variant.evidence;
+  p.dynamic.evidence_min_weight = variant.evidence_min_weight;
+  StageTimer stages(device());
+  p.volume_stages = &stages;
   std::unique_ptr<Volume> volume = make_volume(p.volume, device());  // ground_truth makes none itself
+  if (variant.store_free_space) volume->set_free_space_storage(true);
   TrackingSession s(p, device(), src.intrinsics(), volume.get());
   SE3 world_T_room = SE3::identity();
   const std::vector<MoverParams> person{in.synthetic.movers.empty() ? MoverParams{} : in.synthetic.movers[0]};
@@ -147,6 +163,9 @@ Outcome run(const InputParams& in, bool dynamic, const std::string& tracker = "i
     iou_sum += iou;
     ++o.iou_frames;
   }
+  o.allocate_ms = stages.median_ms("allocate"), o.visible_ms = stages.median_ms("visible");
+  o.fuse_ms = stages.median_ms("fuse"), o.raycast_ms = stages.median_ms("raycast");
+  o.volume = s.volume()->stats();
   const AteResult ate = compute_ate(est, gt);
   o.ate_m = ate.trans.rmse;
   o.mean_iou = o.iou_frames ? iou_sum / o.iou_frames : 0;
@@ -204,4 +223,35 @@ TEST(Dynamic, SlowPersonWalkingThroughTheRoom) {
     EXPECT_LE(tracked_on.ate_m, 0.01);
   }
   EXPECT_LE(tracked_on.ate_m, 1.2 * empty.ate_m);
+}
+
+// Evidence of free space on the voxel-hashed volume (docs/DYNAMIC.md, "Evidence of free space"),
+// the mask and the ghost on ground-truth poses: dynamic.free_space_evidence none (the default),
+// none with the free space stored (what storing it alone changes: carving no longer frees blocks),
+// and seen_free, which stores it, at evidence_min_weight 1 and 2; with the volume's cost. Each run
+// prints its row of docs/DYNAMIC.md's table.
+TEST(Dynamic, SlowFreeSpaceEvidenceOnTheHashedVolume) {
+  struct Row {
+    const char* name;
+    Variant variant;
+  };
+  const Row rows[] = {{"none", {}},
+                      {"none, free space stored", {FreeSpaceEvidence::none, 1.f, true}},
+                      {"seen_free, min weight 1", {FreeSpaceEvidence::seen_free, 1.f}},
+                      {"seen_free, min weight 2", {FreeSpaceEvidence::seen_free, 2.f}}};
+  std::printf("%s, %dx%d, ground-truth poses, hashed volume at 1 cm\n", device_name(device()), 640 / downscale(),
+              480 / downscale());
+  std::vector<Outcome> out;
+  for (const Row& r : rows) {
+    out.push_back(run(scene(true), true, "ground_truth", r.variant));
+    const Outcome& o = out.back();
+    std::printf(
+        "%-24s IoU min %.3f mean %.3f (%d frames, %zu under 0.8), ghost %lld, masked %.2f%%; ms per frame "
+        "(median): allocate %.2f visible %.2f fuse %.2f raycast %.2f; %lld blocks (%.0f MiB)\n",
+        r.name, o.min_iou, o.mean_iou, o.iou_frames, o.below.size(), static_cast<long long>(o.ghost_vertices),
+        100 * o.mean_fraction, o.allocate_ms, o.visible_ms, o.fuse_ms, o.raycast_ms,
+        static_cast<long long>(o.volume.allocated_blocks), o.volume.voxel_bytes / 1048576.0);
+    std::fflush(stdout);
+  }
+  print_below("seen_free, min weight 1", out[2]);
 }
