@@ -102,7 +102,7 @@ struct DepthTiles : TileGrid {
 };
 // A block is worth keeping while one of its voxels is observed (weight > 0) and near a surface
 // (|sdf| < keep_below, metres); a block of free space or never-observed voxels can go. (A volume
-// that stores free space passes keep_below = infinity: every observed block stays.)
+// that stores free space passes the largest float: every observed block stays.)
 SEAMLESS_HD inline bool voxel_keeps_block(const Voxel& v, float keep_below) {
   return v.weight > 0.f && fabsf(v.sdf) < keep_below;
 }

@@ -70,9 +70,7 @@ class VoxelHashVolume final : public Volume {
   kernels::BlockWindow raycast_window(const SE3& world_T_camera);
   // Blocks with no observed voxel closer to a surface than this (metres) are freed as empty; with
   // free space stored, no observed block is (its +truncation voxels are the evidence kept).
-  float keep_below() const {
-    return store_free_space_ ? std::numeric_limits<float>::infinity() : 0.999f * geom_.truncation;
-  }
+  float keep_below() const { return store_free_space_ ? std::numeric_limits<float>::max() : 0.999f * geom_.truncation; }
   kernels::HashCounters read_counters() const;
   void allocate_and_list(const kernels::FrameInput& in, StageTimer* timer);
   void handle_failures(const kernels::HashCounters& c);
