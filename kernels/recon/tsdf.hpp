@@ -101,10 +101,26 @@ struct DepthTiles : TileGrid {
   std::int32_t* zmax = nullptr;  // nullptr: no tiles, nothing is culled
 };
 // A block is worth keeping while one of its voxels is observed (weight > 0) and near a surface
-// (|sdf| < keep_below, metres); a block of free space or never-observed voxels can go.
+// (|sdf| < keep_below, metres); a block of free space or never-observed voxels can go. (A volume
+// that stores free space passes the largest float: every observed block stays.)
 SEAMLESS_HD inline bool voxel_keeps_block(const Voxel& v, float keep_below) {
   return v.weight > 0.f && fabsf(v.sdf) < keep_below;
 }
+
+// Free space in the voxel-hashed volume (issue 22, docs/DYNAMIC.md "Evidence of free space"): as in
+// ReFusion (Palazzolo et al. 2019), the blocks along the whole ray in front of a reading are
+// allocated, so fusion stores the free space (+truncation) there, not only the band around the
+// surface (Niessner et al. 2013, section 4.1). Only the pixels on a lattice of every stride-th
+// pixel of every stride-th row cast such rays: fusion writes every voxel of a block from every
+// pixel, so the rays need only hit every block in front of the readings. A block of side L holds a
+// ball of diameter L, whose shadow across the rays is a disc of that diameter, and a square lattice
+// of spacing g leaves no disc of diameter sqrt(2) g empty: rays at most L / sqrt(2) apart at the
+// farthest depth (stride * max_depth / fx <= L / sqrt(2)) hit every block out to it.
+SEAMLESS_HD inline int free_space_stride(float fx, float max_depth, const VoxelGeometry& geom) {
+  const float s = floorf(kBlockSide * geom.voxel_size * fx / (1.41421356f * max_depth));
+  return s > 1.f ? static_cast<int>(s) : 1;
+}
+
 template <Executor Exec> struct TsdfFusion {
   static void clear_depth_tiles(const Exec& ex, DepthTiles tiles);
 
@@ -113,6 +129,12 @@ template <Executor Exec> struct TsdfFusion {
   // Raises each tile of `tiles` (when given) to the farthest valid reading in it.
   static void allocate_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list,
                               HashCounters* counters, FrameInput in, VoxelGeometry geom, DepthTiles tiles = {});
+
+  // Inserts the blocks in front of the band, from min_depth along the rays of the pixels on a
+  // lattice of free_space_stride (above), like allocate_blocks. Run after it (the depth tiles are
+  // its): the blocks it adds lie in front of their tiles' readings, so find_visible_blocks lists them.
+  static void allocate_free_space(const Exec& ex, HashTableView t, View<const std::int32_t> free_list,
+                                  HashCounters* counters, FrameInput in, VoxelGeometry geom);
 
   // Appends to visible_slots every allocated block that the frame may change (counters->visible is
   // the count) and zeroes its keep flag (keep may be empty): blocks whose voxels may project into

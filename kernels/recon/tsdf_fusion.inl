@@ -30,9 +30,14 @@ SEAMLESS_HD inline void allocate_block(HashTableView t, const std::int32_t* free
 }
 
 // Amanatides & Woo (1987) traversal of the block grid along the segment a -> b (block units):
-// visits every block the segment touches, in order.
+// visits every block the segment touches, in order. A walk from c to e takes |e - c|_1 steps; the
+// bound only stops one that float rounding carries past e (which otherwise ends once t passes 1),
+// and is never below 64, the bound of the truncation band's short segments.
 template <class F> SEAMLESS_HD inline void traverse_blocks(vec3 a, vec3 b, F visit) {
   int3 c = floor_to_int(a), e = floor_to_int(b);
+  const int3 span{e.x - c.x, e.y - c.y, e.z - c.z};
+  const int steps =
+      (span.x < 0 ? -span.x : span.x) + (span.y < 0 ? -span.y : span.y) + (span.z < 0 ? -span.z : span.z) + 1;
   vec3 d = b - a;
   const float inf = 1e30f;
   int sx = d.x > 0 ? 1 : -1, sy = d.y > 0 ? 1 : -1, sz = d.z > 0 ? 1 : -1;
@@ -41,7 +46,7 @@ template <class F> SEAMLESS_HD inline void traverse_blocks(vec3 a, vec3 b, F vis
   float tz = d.z != 0.f ? ((c.z + (sz > 0)) - a.z) / d.z : inf;
   float dx = d.x != 0.f ? fabsf(1.f / d.x) : inf, dy = d.y != 0.f ? fabsf(1.f / d.y) : inf,
         dz = d.z != 0.f ? fabsf(1.f / d.z) : inf;
-  for (int n = 0; n < 64; ++n) {
+  for (int n = 0, n_max = steps > 64 ? steps : 64; n < n_max; ++n) {
     visit(c);
     if (c == e) return;
     if (tx <= ty && tx <= tz) {
@@ -80,6 +85,28 @@ void TsdfFusion<Exec>::allocate_blocks(const Exec& ex, HashTableView t, View<con
     float r = mu / length(p);  // the band is +-mu along the ray (Niessner section 4.1)
     vec3 a = (in.world_T_camera * (p * (1.f - r)) - geom.origin) * to_block;
     vec3 b = (in.world_T_camera * (p * (1.f + r)) - geom.origin) * to_block;
+    traverse_blocks(a, b, [&](int3 blk) { allocate_block(t, free_list.data, counters, blk); });
+  });
+}
+
+template <Executor Exec>
+void TsdfFusion<Exec>::allocate_free_space(const Exec& ex, HashTableView t, View<const std::int32_t> free_list,
+                                           HashCounters* counters, FrameInput in, VoxelGeometry geom) {
+  const int s = free_space_stride(in.K.fx, in.max_depth, geom), w = in.depth.width;
+  const int nx = (w + s - 1) / s, ny = (in.depth.height + s - 1) / s;
+  const float mu = geom.truncation;
+  const float to_block = 1.f / (geom.voxel_size * kBlockSide);
+  ex.for_each(static_cast<std::int64_t>(nx) * ny, [=] SEAMLESS_HD(std::int64_t i) {
+    const int x = static_cast<int>(i % nx) * s, y = static_cast<int>(i / nx) * s;
+    const float d = in.depth(x, y);
+    if (!(d >= in.min_depth && d <= in.max_depth)) return;
+    const vec3 p = in.K.unproject(static_cast<float>(x), static_cast<float>(y), d);
+    // From min_depth along the ray (the sensor reads nothing nearer) to where allocate_blocks'
+    // band begins; the segments overlap by the block they share.
+    const float from = in.min_depth / d, to = 1.f - mu / length(p);
+    if (!(to > from)) return;
+    const vec3 a = (in.world_T_camera * (p * from) - geom.origin) * to_block;
+    const vec3 b = (in.world_T_camera * (p * to) - geom.origin) * to_block;
     traverse_blocks(a, b, [&](int3 blk) { allocate_block(t, free_list.data, counters, blk); });
   });
 }

@@ -45,11 +45,14 @@ struct DynamicParams {
   // 30 (1 s) ends the loop that keeps a newly seen chair seat masked (worst-frame IoU 0.30 -> 0.61)
   // but the live demo then leaves 203 ghost vertices of the person instead of 5 (docs/DYNAMIC.md).
   int static_after_frames = 0;
-  // Evidence of free space at the measured point (docs/DYNAMIC.md, "Evidence of free space"). none
-  // by default: the voxel-hashed volume (the default layout) stores only the +-truncation band
-  // around surfaces, so the space a person walks through in the middle of a room is as unknown to it
-  // as a chair's seat never seen before, and seen_free drops the person too; the dense grid stores
-  // every voxel, and there seen_free ends the newly-seen-surface loop.
+  // Evidence of free space at the measured point (docs/DYNAMIC.md, "Evidence of free space").
+  // seen_free makes the voxel-hashed volume (the default layout) store the free space in front of
+  // the readings (Volume::set_free_space_storage), without which it knows only the +-truncation
+  // band around surfaces and seen_free drops a person walking through the room's middle; the
+  // dense grid stores every voxel anyway. With it, seen_free ends the newly-seen-surface loop (a
+  // chair's seat) on the test scene: worst-frame IoU 0.30 -> 0.77 at 320x240. none by default:
+  // the stored free space is several times the blocks, fused every frame and marched through by
+  // the mask's raycast, and the ghost is 16 vertices against 10 (docs/DYNAMIC.md has the costs).
   FreeSpaceEvidence free_space_evidence = FreeSpaceEvidence::none;
   // Frames a voxel must have been fused to count as observed. 1: free-space carving resets a voxel
   // it carves to weight 1 every frame it carves it (kernels/recon/tsdf_fusion.inl), so space more
@@ -94,7 +97,8 @@ struct DynamicParams {
       Range{0, 250});
     v("free_space_evidence", free_space_evidence,
       "what a dynamic candidate must show of the volume at its measured point: none, not_occupied (no surface "
-      "the volume holds there) or seen_free (space earlier frames saw through; ReFusion's free-space test)");
+      "the volume holds there) or seen_free (space earlier frames saw through; ReFusion's free-space test; the "
+      "voxel-hashed volume then also stores the free space in front of the readings: more blocks, docs/DYNAMIC.md)");
     v("evidence_min_weight", evidence_min_weight,
       "frames a voxel must have been fused for free_space_evidence to count it as observed", Range{0.0, 1000.0});
     v("write_masks", write_masks, "write each frame's mask as dynamic_mask/<frame>.png (255 = dynamic)");

@@ -73,6 +73,10 @@ TrackingSession::TrackingSession(const TrackSequenceParams& params, Device devic
                    p_.tracker.kind, enum_name(p_.tracker.mode));
     else if (p_.dynamic.carve_truncations > 0)
       volume_->set_free_space_carving(p_.dynamic.carve_truncations * volume_->params().truncation);
+    // seen_free needs the free space stored: the voxel-hashed volume otherwise knows none away from
+    // surfaces, and drops every mover in the middle of the room (docs/DYNAMIC.md).
+    if (volume_ && p_.dynamic.free_space_evidence == FreeSpaceEvidence::seen_free)
+      volume_->set_free_space_storage(true);
   }
 }
 

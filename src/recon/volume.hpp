@@ -85,9 +85,16 @@ class Volume {
   // Free-space carving in later integrate() calls (issue 22, docs/DYNAMIC.md): voxels more than
   // `metres` in front of the measurement are reset to free space; 0 (the default) turns it off.
   void set_free_space_carving(float metres) { carve_ = metres; }
+  // Evidence of free space (issue 22, docs/DYNAMIC.md): later integrate() calls also store the free
+  // space in front of each reading, so that require_free_space can find space seen through. The
+  // dense grid stores every voxel anyway; the voxel-hashed volume then allocates the blocks along
+  // the rays in front of the readings (kernels::TsdfFusion::allocate_free_space) and keeps every
+  // block with an observed voxel. Off (the default): only the truncation band is stored.
+  void set_free_space_storage(bool on) { store_free_space_ = on; }
 
  protected:
   float carve_ = 0.f;
+  bool store_free_space_ = false;
 };
 
 // Builds the layout named by params.layout ("hash" or "dense") on device d.

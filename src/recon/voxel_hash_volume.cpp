@@ -121,6 +121,8 @@ void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTime
       staged(timer, "allocate", [&] {
         if (tiles.zmax) kernels::TsdfFusion<E>::clear_depth_tiles(ex, tiles);
         kernels::TsdfFusion<E>::allocate_blocks(ex, table(), free_list_.cview(), counters_.data(), in, geom_, tiles);
+        if (store_free_space_)
+          kernels::TsdfFusion<E>::allocate_free_space(ex, table(), free_list_.cview(), counters_.data(), in, geom_);
       });
       staged(timer, "visible", [&] {
         kernels::TsdfFusion<E>::find_visible_blocks(ex, table(), counters_.data(), in, geom_, visible_.view(),

@@ -1,6 +1,7 @@
 // The voxel-hashed TSDF volume (Niessner, Zollhoefer, Izadi, Stamminger 2013). Design, memory and
 // failure handling: docs/RECONSTRUCTION.md.
 #pragma once
+#include <limits>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -67,8 +68,9 @@ class VoxelHashVolume final : public Volume {
   kernels::HashTableView table() const;
   // The block-index window for a raycast from world_T_camera (index nullptr when off).
   kernels::BlockWindow raycast_window(const SE3& world_T_camera);
-  // Blocks with no observed voxel closer to a surface than this (metres) are freed as empty.
-  float keep_below() const { return 0.999f * geom_.truncation; }
+  // Blocks with no observed voxel closer to a surface than this (metres) are freed as empty; with
+  // free space stored, no observed block is (its +truncation voxels are the evidence kept).
+  float keep_below() const { return store_free_space_ ? std::numeric_limits<float>::max() : 0.999f * geom_.truncation; }
   kernels::HashCounters read_counters() const;
   void allocate_and_list(const kernels::FrameInput& in, StageTimer* timer);
   void handle_failures(const kernels::HashCounters& c);

@@ -335,6 +335,82 @@ TEST(TsdfFusion, CullingChangesNothingOnRealFrames) {
   ASSERT_NO_FATAL_FAILURE(test::expect_same_blocks(a.download_blocks(), b.download_blocks(), true));
 }
 
+namespace {
+
+// A wall 2 m in front of the camera, fused three times from the origin with the free space stored
+// or not (Volume::set_free_space_storage). max_depth 2.1 m makes the free-space rays' stride 7
+// pixels (kernels::free_space_stride: floor(8 cm * 280 / (sqrt(2) * 2.1 m))), 5 cm apart at the
+// wall, just under the 5.66 cm (a block over sqrt(2)) that hits every block.
+VoxelHashVolume wall_seen_three_times(bool store_free_space) {
+  VolumeParams p = test::small_volume_params();
+  p.truncation = 0.04f, p.max_depth = 2.1f;
+  VoxelHashVolume vol(p, Device::CPU);
+  vol.set_free_space_storage(store_free_space);
+  const Intrinsics K = test::camera(160, 120, 280.f);
+  EXPECT_EQ(kernels::free_space_stride(K.fx, p.max_depth, {{0.f, 0.f, 0.f}, p.voxel_size, p.truncation}), 7);
+  const auto depth = Image<float>::from_host(std::vector<float>(160 * 120, 2.f), 160, 120, Device::CPU);
+  for (int f = 0; f < 3; ++f) vol.integrate(depth, Image<uchar3>(), K, SE3::identity());
+  return vol;
+}
+
+// Blocks wholly in the camera's view (every corner of the box [8b, 8b + 8] projects a pixel or more
+// inside the image) and wholly between 0.3 m and 1.88 m deep, a block clear of the wall's band
+// [1.96, 2.04] m: only rays in front of the wall reach them.
+bool in_front_of_the_wall(int3 b) {
+  const Intrinsics K = test::camera(160, 120, 280.f);
+  for (int k = 0; k < 8; ++k) {
+    const vec3 c{(b.x * 8 + (k & 1) * 8) * 0.01f, (b.y * 8 + ((k >> 1) & 1) * 8) * 0.01f,
+                 (b.z * 8 + (k >> 2) * 8) * 0.01f};
+    if (c.z < 0.3f || c.z > 1.88f) return false;
+    const vec2 uv = K.project(c);
+    if (uv.x < 1.f || uv.x > K.width - 2.f || uv.y < 1.f || uv.y > K.height - 2.f) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+// Stored free space: every block in front of the wall in the view is allocated, each of its voxels
+// fused three times with +truncation (every ray passed it on its way to the wall, 12 cm or more
+// beyond), and none is freed as empty, per frame or by the stand-alone pass. Without it, none of
+// those blocks exists.
+TEST(TsdfFusion, StoredFreeSpaceFillsTheViewInFrontOfTheWall) {
+  VoxelHashVolume vol = wall_seen_three_times(true);
+  int front = 0;
+  for (int bz = 3; bz < 24; ++bz)
+    for (int by = -8; by < 8; ++by)
+      for (int bx = -8; bx < 8; ++bx) front += in_front_of_the_wall({bx, by, bz});
+  ASSERT_GT(front, 300);
+  int found = 0;
+  for (const auto& blk : vol.download_blocks()) {
+    if (!in_front_of_the_wall(blk.coord)) continue;
+    ++found;
+    for (const kernels::Voxel& v : blk.voxels) {
+      ASSERT_EQ(v.weight, 3.f);
+      ASSERT_NEAR(v.sdf, 0.04f, 1e-6f);  // (mu + mu) / 2, then (2 mu + mu) / 3: an ulp at most
+    }
+  }
+  EXPECT_EQ(found, front);
+  EXPECT_EQ(vol.stats().failed_insertions, 0);
+  EXPECT_EQ(vol.remove_empty_blocks(), 0);
+  VoxelHashVolume band_only = wall_seen_three_times(false);
+  for (int3 b : band_only.allocated_block_coords()) EXPECT_FALSE(in_front_of_the_wall(b));
+  EXPECT_LE(band_only.stats().allocated_blocks + front, vol.stats().allocated_blocks);
+}
+
+// The free-space rays on CUDA against the CPU: the same blocks and voxels.
+TEST(TsdfParity, StoredFreeSpace) {
+  if (!cuda_available()) GTEST_SKIP() << "no CUDA device";
+  Intrinsics K = test::camera(320, 240, 280.f);
+  Scene s;
+  VoxelHashVolume cpu(test::small_volume_params(), Device::CPU), gpu(test::small_volume_params(), Device::CUDA);
+  cpu.set_free_space_storage(true), gpu.set_free_space_storage(true);
+  fuse(cpu, s, K, translations(), true);
+  fuse(gpu, s, K, translations(), true);
+  ASSERT_NO_FATAL_FAILURE(test::expect_same_blocks(cpu.download_blocks(), gpu.download_blocks(), true));
+  EXPECT_EQ(cpu.stats().allocated_blocks, gpu.stats().allocated_blocks);
+}
+
 TEST(TsdfParity, SameBlocksAndValues) {
   if (!cuda_available()) GTEST_SKIP() << "no CUDA device";
   Intrinsics K = test::camera(320, 240, 280.f);
