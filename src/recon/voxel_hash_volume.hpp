@@ -69,6 +69,7 @@ class VoxelHashVolume final : public Volume {
   kernels::BlockWindow raycast_window(const SE3& world_T_camera);
   // Blocks with no observed voxel closer to a surface than this (metres) are freed as empty.
   float keep_below() const { return 0.999f * geom_.truncation; }
+  std::uint64_t pool_size() const;  // blocks in the pool: every block index is below it
   kernels::HashCounters read_counters() const;
   void allocate_and_list(const kernels::FrameInput& in, StageTimer* timer);
   void handle_failures(const kernels::HashCounters& c);
