@@ -14,3 +14,9 @@ seamless_kernel_family(recon/dynamic)
 if(SEAMLESS_HAS_CUDA)
   set_source_files_properties(recon/tsdf_raycast_cuda.cu PROPERTIES COMPILE_OPTIONS "-maxrregcount=72")
 endif()
+
+# The bilateral filter's lane loops (kernels/recon/preprocess.inl, bilateral_run) become vector
+# instructions only where GCC may evaluate both sides of a float select: -fno-trapping-math
+# (floating-point exceptions are never trapped or read here; no value changes).
+set_source_files_properties(recon/preprocess_cpu.cpp PROPERTIES COMPILE_OPTIONS
+  "$<$<CXX_COMPILER_ID:GNU,Clang>:-fno-trapping-math>")

@@ -144,6 +144,14 @@ template <Executor Exec> struct TsdfFusion {
                                   VoxelGeometry geom, View<std::int32_t> visible_slots, View<std::int32_t> keep,
                                   DepthTiles tiles = {});
 
+  // Reorders the first count visible slots by their block's index in the pool (block_keys:
+  // count entries of scratch). Fusing in pool order walks the voxel pool and the depth image with
+  // far fewer cache and TLB misses on the CPU than the hash table's slot order (blocks allocated
+  // together lie together, and come from neighbouring pixels); the fused values are the same in
+  // any order, since every voxel is fused by one thread from its own reading.
+  static void sort_visible_by_block(const Exec& ex, HashTableView t, View<std::int32_t> slots, std::int64_t count,
+                                    View<std::int32_t> block_keys, int key_bits);
+
   // Fuses one frame into the listed blocks, one thread per column of 8 voxels. When keep is not empty, keep[j]
   // becomes 1 if block j still has a voxel near a surface afterwards (voxel_keeps_block), so that
   // finding the empty blocks costs no second pass over the voxels.

@@ -176,6 +176,13 @@ void TsdfFusion<Exec>::find_visible_blocks(const Exec& ex, HashTableView t, Hash
   });
 }
 
+template <Executor Exec>
+void TsdfFusion<Exec>::sort_visible_by_block(const Exec& ex, HashTableView t, View<std::int32_t> slots,
+                                             std::int64_t count, View<std::int32_t> block_keys, int key_bits) {
+  ex.for_each(count, [=] SEAMLESS_HD(std::int64_t i) { block_keys[i] = t.values[slots[i]]; });
+  ex.sort_by_key(block_keys.data, slots.data, count, key_bits);
+}
+
 // Sets a keep flag; the read first spares the atomic when another voxel already set it.
 SEAMLESS_HD inline void set_keep(std::int32_t* flag) {
   if (atomic_load(flag) == 0) atomic_exch(flag, 1);
@@ -216,17 +223,17 @@ SEAMLESS_HD inline void fuse_voxel(Voxel& v, vec3 p_world, const FrameInput& in,
     v.weight = 1.f;
     return;
   }
-  float tsdf = fminf(sdf, mu);
+  float tsdf = min_of(sdf, mu);
   float wt = v.weight;
   v.sdf = (v.sdf * wt + tsdf) / (wt + 1.f);
   if (color && in.rgb.data && sdf < mu) {
     uchar3 c = in.rgb(u, w);
     auto avg = [&](std::uint8_t old, std::uint8_t obs) {
-      return static_cast<std::uint8_t>(fminf(255.f, (old * wt + obs) / (wt + 1.f) + 0.5f));
+      return static_cast<std::uint8_t>(min_of((old * wt + obs) / (wt + 1.f) + 0.5f, 255.f));
     };
     v.color = {avg(v.color.x, c.x), avg(v.color.y, c.y), avg(v.color.z, c.z)};
   }
-  v.weight = fminf(wt + 1.f, max_weight);
+  v.weight = min_of(wt + 1.f, max_weight);
 }
 
 template <Executor Exec>

@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <string>
 #include <tuple>
@@ -62,6 +63,8 @@ VoxelHashVolume::VoxelHashVolume(const VolumeParams& p, Device d) : params_(p), 
   last_ = read_counters();
 }
 
+std::uint64_t VoxelHashVolume::pool_size() const { return static_cast<std::uint64_t>(free_list_.size()); }
+
 kernels::HashTableView VoxelHashVolume::table() const {
   return {keys_.data(), values_.data(), static_cast<std::uint32_t>(keys_.size() - 1), kMaxProbe};
 }
@@ -93,6 +96,12 @@ void VoxelHashVolume::integrate(const Image<float>& depth, const Image<uchar3>& 
   const View<std::int32_t> keep = params_.remove_empty_blocks ? keep_.view() : View<std::int32_t>{};
   with_exec(device_, [&]<class E>(const E& ex) {
     staged(timer, "fuse", [&] {
+      // On the CPU the visible blocks are fused in pool order (kernels/recon/tsdf.hpp,
+      // sort_visible_by_block: docs/PERFORMANCE.md measures it); CUDA fuses them as listed, each
+      // block's voxels in one pass of coalesced loads, where the order of the blocks matters little.
+      if (device_ == Device::CPU)
+        kernels::TsdfFusion<E>::sort_visible_by_block(ex, table(), visible_.view(), n, scratch_.view(),
+                                                      static_cast<int>(std::bit_width(pool_size())));
       kernels::TsdfFusion<E>::fuse_hash_blocks(ex, table(), visible_.cview(), n, voxels_.data(), in, geom_,
                                                params_.max_weight, params_.integrate_color, keep, keep_below());
     });

@@ -71,6 +71,7 @@ class VoxelHashVolume final : public Volume {
   // Blocks with no observed voxel closer to a surface than this (metres) are freed as empty; with
   // free space stored, no observed block is (its +truncation voxels are the evidence kept).
   float keep_below() const { return store_free_space_ ? std::numeric_limits<float>::max() : 0.999f * geom_.truncation; }
+  std::uint64_t pool_size() const;  // blocks in the pool: every block index is below it
   kernels::HashCounters read_counters() const;
   void allocate_and_list(const kernels::FrameInput& in, StageTimer* timer);
   void handle_failures(const kernels::HashCounters& c);

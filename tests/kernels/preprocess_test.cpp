@@ -1,6 +1,8 @@
 // Preprocessing kernels against analytic geometry, on the CPU, and CPU/CUDA parity.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
 #include <random>
 
@@ -114,6 +116,100 @@ TEST(Preprocess, BilateralKeepsPlanesAndEdges) {
   kernels::Preprocess<CpuExec>::bilateral_filter(CpuExec{}, in.cview(), out.view(), 4.5f, 0.03f, 3);
   auto r = out.to_host();
   for (std::size_t i = 0; i < r.size(); ++i) ASSERT_NEAR(r[i], depth[i], 1e-6f) << i;
+}
+
+TEST(ExpNonpositive, RelativeErrorBound) {
+  // The bound its comment derives: truncation ~5e-9, the reduction's rounding ~0.7 ulp of e^r, the
+  // Horner steps' ~2 ulp (u = 6e-8 each); 3e-7 is ~2.5 ulp. Every 97th float of [-87, 0].
+  const std::uint32_t last = std::bit_cast<std::uint32_t>(87.f);
+  double worst = 0.0;
+  for (std::uint32_t m = 0; m <= last; m += 97) {
+    const float x = -std::bit_cast<float>(m);
+    const double truth = std::exp(static_cast<double>(x));
+    worst = std::max(worst, std::fabs(kernels::exp_nonpositive(x) - truth) / truth);
+  }
+  EXPECT_LT(worst, 3e-7);
+  EXPECT_EQ(kernels::exp_nonpositive(0.f), 1.f);  // a pixel's own tap weighs exactly 1
+  EXPECT_EQ(kernels::exp_nonpositive(-87.5f), 0.f);
+  EXPECT_EQ(kernels::exp_nonpositive(std::nanf("")), 0.f);
+}
+
+// The bilateral filter on dev against KinectFusion eq. 2 evaluated in double, pixel by pixel, with
+// a first-order bound of the float filter's error (u = 2^-24):
+// - a weight w = e^x is off by w (8 u |x| + 3e-7): the float argument's ~6 roundings (8 allowed)
+//   and exp_nonpositive's own error (ExpNonpositive.RelativeErrorBound), or by w itself where x
+//   is near -87 and the float weight may be 0; it moves the result by sum |dw_k| |d_k - out| / W;
+// - the sums S = sum w d and W = sum w, in tap order, are off by u (sum of w_k d_k + the partial
+//   sums S_i after the first) and u (the partial sums W_i after the first) (Higham, "Accuracy and
+//   Stability of Numerical Algorithms", eq. 4.4), which moves S / W by err_S / W + out err_W / W;
+//   the division adds u out. 5 % more covers the second-order terms.
+void expect_bilateral_matches_exact_formula(Device dev) {
+  const float sigma_s = 4.5f, sigma_d = 0.03f;
+  const int r = 3, W = 160, H = 120;
+  // A noisy slanted surface (weights across their whole range), random far readings (weights that
+  // underflow), holes, and a step; the image is small, so the border is a large part of it.
+  std::mt19937 rng(11);
+  std::normal_distribution<float> noise(0.f, 0.02f);
+  std::uniform_real_distribution<float> far(0.5f, 4.f);
+  std::vector<float> depth(W * H);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const int i = y * W + x;
+      depth[i] = (x < 100 ? 1.f + 0.002f * x : 1.8f) + noise(rng);
+      if (i % 13 == 0) depth[i] = far(rng);
+      if (i % 31 == 0) depth[i] = 0.f;
+    }
+  auto in = Image<float>::from_host(depth, W, H, dev);
+  Image<float> out(W, H, dev);
+  with_exec(dev, [&]<class E>(const E& ex) {
+    kernels::Preprocess<E>::bilateral_filter(ex, in.cview(), out.view(), sigma_s, sigma_d, r);
+  });
+  const auto got = out.to_host();
+  const double u = std::ldexp(1.0, -24);
+  const double inv_s2 = 0.5 / (double(sigma_s) * sigma_s), inv_d2 = 0.5 / (double(sigma_d) * sigma_d);
+  int checked = 0;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const double d0 = depth[y * W + x];
+      if (!(d0 > 0.0)) {
+        ASSERT_EQ(got[y * W + x], 0.f) << x << "," << y;
+        continue;
+      }
+      std::vector<double> w, d;
+      for (int dy = -r; dy <= r; ++dy)
+        for (int dx = -r; dx <= r; ++dx) {
+          const int xx = x + dx, yy = y + dy;
+          if (xx < 0 || yy < 0 || xx >= W || yy >= H || !(depth[yy * W + xx] > 0.f)) continue;
+          d.push_back(depth[yy * W + xx]);
+          w.push_back(std::exp(-(dx * dx + dy * dy) * inv_s2 - (d.back() - d0) * (d.back() - d0) * inv_d2));
+        }
+      double S = 0, Wt = 0, sum_wd = 0, partial_S = 0, partial_W = 0;
+      for (std::size_t k = 0; k < w.size(); ++k) {
+        S += w[k] * d[k];
+        Wt += w[k];
+        sum_wd += w[k] * d[k];
+        if (k > 0) partial_S += S, partial_W += Wt;
+      }
+      const double exact = S / Wt;
+      double weight_err = 0;
+      for (std::size_t k = 0; k < w.size(); ++k) {
+        const double x_k = std::log(w[k]);
+        const double dw = x_k < -86.0 ? w[k] : w[k] * (8 * u * std::fabs(x_k) + 3e-7);
+        weight_err += dw * std::fabs(d[k] - exact);
+      }
+      const double bound =
+          1.05 * (weight_err / Wt + u * (sum_wd + partial_S) / Wt + exact * u * partial_W / Wt + exact * u);
+      ASSERT_NEAR(got[y * W + x], exact, bound) << x << "," << y;
+      ++checked;
+    }
+  EXPECT_GT(checked, W * H * 9 / 10);
+}
+
+TEST(PreprocessBilateral, MatchesExactFormula) { expect_bilateral_matches_exact_formula(Device::CPU); }
+
+TEST(PreprocessParity, BilateralMatchesExactFormulaOnCuda) {
+  if (!cuda_available()) GTEST_SKIP() << "no CUDA device on this machine";
+  expect_bilateral_matches_exact_formula(Device::CUDA);
 }
 
 TEST(Preprocess, PyramidAveragesWithoutBridgingEdges) {

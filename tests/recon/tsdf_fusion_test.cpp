@@ -5,12 +5,16 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <numeric>
+#include <random>
 
 #include "core/buffer.hpp"
 #include "core/device.hpp"
 #include "core/error.hpp"
+#include "core/exec.hpp"
 #include "io/frame_source.hpp"
 #include "io/input_params.hpp"
+#include "kernels/recon/tsdf.hpp"
 #include "recon/voxel_hash_volume.hpp"
 #include "tsdf_scene.hpp"
 
@@ -409,6 +413,41 @@ TEST(TsdfParity, StoredFreeSpace) {
   fuse(gpu, s, K, translations(), true);
   ASSERT_NO_FATAL_FAILURE(test::expect_same_blocks(cpu.download_blocks(), gpu.download_blocks(), true));
   EXPECT_EQ(cpu.stats().allocated_blocks, gpu.stats().allocated_blocks);
+}
+
+// sort_visible_by_block on dev: a shuffled list of the slots of 1000 blocks with distinct pool
+// indices comes back as the same slots, ordered by their block's index.
+void expect_visible_sorted_by_block(Device dev) {
+  const int slots = 4096, listed = 1000;
+  std::mt19937 rng(3);
+  std::vector<std::int32_t> values(slots, -1), blocks(slots);
+  std::iota(blocks.begin(), blocks.end(), 0);
+  std::shuffle(blocks.begin(), blocks.end(), rng);
+  std::vector<std::int32_t> list(slots);
+  std::iota(list.begin(), list.end(), 0);
+  std::shuffle(list.begin(), list.end(), rng);
+  list.resize(listed);
+  for (std::int32_t s : list) values[s] = blocks[s];
+  auto v = Buffer<std::int32_t>::from_host(values, dev);
+  auto l = Buffer<std::int32_t>::from_host(list, dev);
+  Buffer<std::int32_t> keys(listed, dev);
+  kernels::HashTableView t{nullptr, v.data(), static_cast<std::uint32_t>(slots - 1)};
+  with_exec(dev, [&]<class E>(const E& ex) {
+    kernels::TsdfFusion<E>::sort_visible_by_block(ex, t, l.view(), listed, keys.view(), 12);
+  });
+  const auto sorted = l.to_host();
+  for (int j = 1; j < listed; ++j) ASSERT_LT(values[sorted[j - 1]], values[sorted[j]]) << j;
+  auto a = sorted, b = list;
+  std::sort(a.begin(), a.end());
+  std::sort(b.begin(), b.end());
+  EXPECT_EQ(a, b);
+}
+
+TEST(TsdfFusion, VisibleListSortsByBlockIndex) { expect_visible_sorted_by_block(Device::CPU); }
+
+TEST(TsdfParity, VisibleListSortsByBlockIndexOnCuda) {
+  if (!cuda_available()) GTEST_SKIP() << "no CUDA device";
+  expect_visible_sorted_by_block(Device::CUDA);
 }
 
 TEST(TsdfParity, SameBlocksAndValues) {
