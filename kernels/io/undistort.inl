@@ -19,7 +19,7 @@ void Undistort<Exec>::remap_depth(const Exec& ex, View2D<const vec2> map, View2D
   ex.for_each(out.count(), [=] SEAMLESS_HD(std::int64_t i) {
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
     vec2 s = map(x, y);
-    int sx = static_cast<int>(floorf(s.x + 0.5f)), sy = static_cast<int>(floorf(s.y + 0.5f));
+    int sx = floor_int(s.x + 0.5f), sy = floor_int(s.y + 0.5f);
     out(x, y) = in.inside(sx, sy) ? in(sx, sy) : 0.f;
   });
 }
@@ -30,7 +30,7 @@ void Undistort<Exec>::remap_rgb(const Exec& ex, View2D<const vec2> map, View2D<c
   ex.for_each(out.count(), [=] SEAMLESS_HD(std::int64_t i) {
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
     vec2 s = map(x, y);
-    int x0 = static_cast<int>(floorf(s.x)), y0 = static_cast<int>(floorf(s.y));
+    int x0 = floor_int(s.x), y0 = floor_int(s.y);
     if (x0 < 0 || y0 < 0 || x0 + 1 >= in.width || y0 + 1 >= in.height) {
       out(x, y) = {0, 0, 0};
       return;

@@ -16,7 +16,7 @@ void Dynamic<Exec>::classify_dynamic(const Exec& ex, DynamicInput in, View2D<std
     const vec3 p = in.ref_T_cur * in.K.unproject(static_cast<float>(x), static_cast<float>(y), d);
     if (p.z <= 0.f) return;
     const vec2 uv = in.K.project(p);
-    const int u0 = static_cast<int>(floorf(uv.x + 0.5f)), v0 = static_cast<int>(floorf(uv.y + 0.5f));
+    const int u0 = floor_int(uv.x + 0.5f), v0 = floor_int(uv.y + 0.5f);
     // The model planes and the nearest model surface in a small window: projective association is
     // off by the pose error (a pixel or two), which at a depth edge would otherwise pair a
     // measurement on the near side with model on the far side. A plane explains the measurement
@@ -67,7 +67,7 @@ void Dynamic<Exec>::age_dynamic(const Exec& ex, DynamicInput in, View2D<const fl
     const vec3 p = prev_T_cur * in.K.unproject(static_cast<float>(x), static_cast<float>(y), d);
     if (has_prev && p.z > 0.f) {
       const vec2 uv = in.K.project(p);
-      const int u0 = static_cast<int>(floorf(uv.x + 0.5f)), v0 = static_cast<int>(floorf(uv.y + 0.5f));
+      const int u0 = floor_int(uv.x + 0.5f), v0 = floor_int(uv.y + 0.5f);
       const float threshold = dynamic_threshold(in, d);
       for (int dy = -in.search_radius; dy <= in.search_radius; ++dy)
         for (int dx = -in.search_radius; dx <= in.search_radius; ++dx) {

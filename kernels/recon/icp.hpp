@@ -111,7 +111,7 @@ SEAMLESS_HD inline bool find_correspondence(const IcpLevel& L, int x, int y, Cor
   c.q = L.ref_T_cur * p;
   if (c.q.z <= 0.f) return false;
   c.uv = L.K.project(c.q);
-  int u = static_cast<int>(floorf(c.uv.x + 0.5f)), v = static_cast<int>(floorf(c.uv.y + 0.5f));
+  int u = floor_int(c.uv.x + 0.5f), v = floor_int(c.uv.y + 0.5f);
   if (!L.ref_vertex.inside(u, v)) return false;
   c.v = L.ref_vertex(u, v);
   c.n = L.ref_normal(u, v);

@@ -103,7 +103,7 @@ constexpr float kNoIntensity = -1.f;
 // Bilinear sample into v; false when one of the four pixels has no reading (kNoIntensity). The
 // caller keeps (x, y) inside [0, w-1) x [0, h-1).
 SEAMLESS_HD inline bool bilinear(View2D<const float> im, float x, float y, float& v) {
-  int x0 = static_cast<int>(floorf(x)), y0 = static_cast<int>(floorf(y));
+  int x0 = floor_int(x), y0 = floor_int(y);
   float ax = x - x0, ay = y - y0;
   const float a = im(x0, y0), b = im(x0 + 1, y0), c = im(x0, y0 + 1), d = im(x0 + 1, y0 + 1);
   v = (1.f - ay) * ((1.f - ax) * a + ax * b) + ay * ((1.f - ax) * c + ax * d);

@@ -212,7 +212,7 @@ SEAMLESS_HD inline void fuse_voxel(Voxel& v, vec3 p_world, const FrameInput& in,
   vec3 pc = camera_T_world * p_world;
   if (pc.z <= 0.f) return;
   vec2 uv = in.K.project(pc);
-  int u = static_cast<int>(floorf(uv.x + 0.5f)), w = static_cast<int>(floorf(uv.y + 0.5f));
+  int u = floor_int(uv.x + 0.5f), w = floor_int(uv.y + 0.5f);
   if (!in.depth.inside(u, w)) return;
   float d = in.depth(u, w);
   if (!(d >= in.min_depth && d <= in.max_depth)) return;
