@@ -47,10 +47,11 @@ SEAMLESS_HD inline float exp_nonpositive(float x) {
 template <Executor Exec> struct Preprocess {
   // Edge-preserving smoothing of depth (KinectFusion eq. 2): Gaussian weights in pixel distance
   // (sigma_space, pixels) and in depth difference (sigma_depth, metres) over a (2r+1)^2 window.
-  // The weight is exp_nonpositive of the same float argument as expf had, so the result differs
-  // from the expf filter by a few ulp of each weight (PreprocessBilateral.MatchesExactFormula).
+  // The weight is expf of the Gaussians' summed exponent, or with inline_exp exp_nonpositive of the
+  // same float argument (vectorised on the CPU: preprocess.bilateral_inline_exp), which differs
+  // from expf by a few ulp of each weight (PreprocessBilateral.MatchesExactFormula bounds both).
   static void bilateral_filter(const Exec& ex, View2D<const float> depth, View2D<float> out, float sigma_space,
-                               float sigma_depth, int radius);
+                               float sigma_depth, int radius, bool inline_exp = false);
 
   // Half resolution: mean of the 2x2 block's valid depths within max_diff of the block's first
   // valid depth, so that averaging never bridges a depth discontinuity.

@@ -23,7 +23,10 @@ template <class Exec> inline constexpr int kBilateralRun = Exec::device == Devic
 #define SEAMLESS_BILATERAL_RUN inline
 #endif
 
-template <int G, bool Interior>
+// InlineExp: the range weight from exp_nonpositive for every lane, with no branch, so that the lane
+// loop vectorises; else libm's expf (CUDA's on the GPU) for the valid taps only, as the filter had
+// it: the same bits as one pixel a work item, since the argument, the taps and their order are.
+template <int G, bool Interior, bool InlineExp>
 SEAMLESS_HD SEAMLESS_BILATERAL_RUN void bilateral_run(View2D<const float> depth, View2D<float> out, int x0, int y,
                                                       int radius, float inv_s2, float inv_d2) {
   float d0[G], sum[G], wsum[G];
@@ -50,8 +53,13 @@ SEAMLESS_HD SEAMLESS_BILATERAL_RUN void bilateral_run(View2D<const float> depth,
         const float d = Interior || (xx >= 0 && xx < depth.width) ? row[xx] : 0.f;
         const bool valid = d > 0.f;
         const float diff = d - d0[k];
-        const float e = exp_nonpositive(spatial - diff * diff * inv_d2);  // for every lane: no branch
-        const float wgt = valid ? e : 0.f;
+        float wgt;
+        if constexpr (InlineExp) {
+          const float e = exp_nonpositive(spatial - diff * diff * inv_d2);
+          wgt = valid ? e : 0.f;
+        } else {
+          wgt = valid ? expf(spatial - diff * diff * inv_d2) : 0.f;
+        }
         sum[k] += wgt * (valid ? d : 0.f);
         wsum[k] += wgt;
       }
@@ -63,16 +71,18 @@ SEAMLESS_HD SEAMLESS_BILATERAL_RUN void bilateral_run(View2D<const float> depth,
 
 template <Executor Exec>
 void Preprocess<Exec>::bilateral_filter(const Exec& ex, View2D<const float> depth, View2D<float> out, float sigma_space,
-                                        float sigma_depth, int radius) {
+                                        float sigma_depth, int radius, bool inline_exp) {
   constexpr int G = kBilateralRun<Exec>;
   const float inv_s2 = 0.5f / (sigma_space * sigma_space);
   const float inv_d2 = 0.5f / (sigma_depth * sigma_depth);
   const int runs = (depth.width + G - 1) / G;
   ex.for_each(static_cast<std::int64_t>(runs) * depth.height, [=] SEAMLESS_HD(std::int64_t i) {
     const int x0 = static_cast<int>(i % runs) * G, y = static_cast<int>(i / runs);
-    if (x0 >= radius && x0 + G - 1 + radius < depth.width)
-      bilateral_run<G, true>(depth, out, x0, y, radius, inv_s2, inv_d2);
-    else bilateral_run<G, false>(depth, out, x0, y, radius, inv_s2, inv_d2);
+    const bool interior = x0 >= radius && x0 + G - 1 + radius < depth.width;
+    if (interior && inline_exp) bilateral_run<G, true, true>(depth, out, x0, y, radius, inv_s2, inv_d2);
+    else if (interior) bilateral_run<G, true, false>(depth, out, x0, y, radius, inv_s2, inv_d2);
+    else if (inline_exp) bilateral_run<G, false, true>(depth, out, x0, y, radius, inv_s2, inv_d2);
+    else bilateral_run<G, false, false>(depth, out, x0, y, radius, inv_s2, inv_d2);
   });
 }
 

@@ -22,8 +22,8 @@ void FramePyramid::build(const Image<float>& raw, const Image<float>* intensity,
                 " but the intrinsics say " + std::to_string(l0.K.width) + "x" + std::to_string(l0.K.height));
   with_exec(device_, [&]<class E>(const E& ex) {
     if (p.bilateral)
-      kernels::Preprocess<E>::bilateral_filter(ex, raw.cview(), l0.depth.view(), p.sigma_space, p.sigma_depth,
-                                               p.radius);
+      kernels::Preprocess<E>::bilateral_filter(ex, raw.cview(), l0.depth.view(), p.sigma_space, p.sigma_depth, p.radius,
+                                               p.bilateral_inline_exp);
     else levels_[0].depth.buffer().copy_from(raw.buffer());
     if (intensity) levels_[0].intensity.buffer().copy_from(intensity->buffer());
     for (std::size_t l = 1; l < levels_.size(); ++l) {

@@ -137,13 +137,15 @@ TEST(ExpNonpositive, RelativeErrorBound) {
 // The bilateral filter on dev against KinectFusion eq. 2 evaluated in double, pixel by pixel, with
 // a first-order bound of the float filter's error (u = 2^-24):
 // - a weight w = e^x is off by w (8 u |x| + 3e-7): the float argument's ~6 roundings (8 allowed)
-//   and exp_nonpositive's own error (ExpNonpositive.RelativeErrorBound), or by w itself where x
-//   is near -87 and the float weight may be 0; it moves the result by sum |dw_k| |d_k - out| / W;
+//   and the exp's own error: exp_nonpositive's (ExpNonpositive.RelativeErrorBound), or expf's
+//   (glibc: < 1 ulp; CUDA: 2 ulp, CUDA C Programming Guide, "Mathematical Functions"), or by w
+//   itself where x is near -87 and the float weight may be 0 (exp_nonpositive flushes below -87);
+//   it moves the result by sum |dw_k| |d_k - out| / W;
 // - the sums S = sum w d and W = sum w, in tap order, are off by u (sum of w_k d_k + the partial
 //   sums S_i after the first) and u (the partial sums W_i after the first) (Higham, "Accuracy and
 //   Stability of Numerical Algorithms", eq. 4.4), which moves S / W by err_S / W + out err_W / W;
 //   the division adds u out. 5 % more covers the second-order terms.
-void expect_bilateral_matches_exact_formula(Device dev) {
+void expect_bilateral_matches_exact_formula(Device dev, bool inline_exp) {
   const float sigma_s = 4.5f, sigma_d = 0.03f;
   const int r = 3, W = 160, H = 120;
   // A noisy slanted surface (weights across their whole range), random far readings (weights that
@@ -162,7 +164,7 @@ void expect_bilateral_matches_exact_formula(Device dev) {
   auto in = Image<float>::from_host(depth, W, H, dev);
   Image<float> out(W, H, dev);
   with_exec(dev, [&]<class E>(const E& ex) {
-    kernels::Preprocess<E>::bilateral_filter(ex, in.cview(), out.view(), sigma_s, sigma_d, r);
+    kernels::Preprocess<E>::bilateral_filter(ex, in.cview(), out.view(), sigma_s, sigma_d, r, inline_exp);
   });
   const auto got = out.to_host();
   const double u = std::ldexp(1.0, -24);
@@ -205,11 +207,15 @@ void expect_bilateral_matches_exact_formula(Device dev) {
   EXPECT_GT(checked, W * H * 9 / 10);
 }
 
-TEST(PreprocessBilateral, MatchesExactFormula) { expect_bilateral_matches_exact_formula(Device::CPU); }
+TEST(PreprocessBilateral, MatchesExactFormula) {
+  expect_bilateral_matches_exact_formula(Device::CPU, false);
+  expect_bilateral_matches_exact_formula(Device::CPU, true);
+}
 
 TEST(PreprocessParity, BilateralMatchesExactFormulaOnCuda) {
   if (!cuda_available()) GTEST_SKIP() << "no CUDA device on this machine";
-  expect_bilateral_matches_exact_formula(Device::CUDA);
+  expect_bilateral_matches_exact_formula(Device::CUDA, false);
+  expect_bilateral_matches_exact_formula(Device::CUDA, true);
 }
 
 TEST(Preprocess, PyramidAveragesWithoutBridgingEdges) {
