@@ -97,16 +97,14 @@ SEAMLESS_HD inline vec3 spiky_grad(vec3 r, float h) { return SphKernel::make(h).
 SEAMLESS_HD inline float akinci_spline(float r, float h) { return SphKernel::make(h).akinci(r); }
 
 // ---- neighbour grid -------------------------------------------------------------------------
-// floor as an int without a libm call on the CPU (x86-64 without SSE4.1 calls floorf); equal to
-// static_cast<int>(floorf(x)) wherever that is defined. x is first held within +-kFloorIntRange
-// (a NaN goes to its lower end): a particle that has flown off to infinity, or a NaN, gets a far
-// cell instead of a conversion whose result is undefined (UBSan: the cell index INT_MIN, then
-// INT_MIN - 2 in the neighbour search). Cells are wrapped by the periodic grid anyway.
+// seamless::floor_int (src/core/math.hpp: no libm call on the CPU) with x first held within
+// +-kFloorIntRange (a NaN goes to its lower end): a particle that has flown off to infinity, or a
+// NaN, gets a far cell instead of a conversion whose result is undefined (UBSan: the cell index
+// INT_MIN, then INT_MIN - 2 in the neighbour search). Cells are wrapped by the periodic grid anyway.
 constexpr float kFloorIntRange = 1e9f;
 SEAMLESS_HD inline int floor_int(float x) {
   x = x >= -kFloorIntRange ? (x <= kFloorIntRange ? x : kFloorIntRange) : -kFloorIntRange;
-  int i = static_cast<int>(x);
-  return static_cast<float>(i) > x ? i - 1 : i;
+  return ::seamless::floor_int(x);
 }
 
 // A periodic uniform grid of 2^bits cells per axis: cell coordinates wrap, so the grid covers all
