@@ -97,15 +97,9 @@ SEAMLESS_HD inline vec3 spiky_grad(vec3 r, float h) { return SphKernel::make(h).
 SEAMLESS_HD inline float akinci_spline(float r, float h) { return SphKernel::make(h).akinci(r); }
 
 // ---- neighbour grid -------------------------------------------------------------------------
-// seamless::floor_int (src/core/math.hpp: no libm call on the CPU) with x first held within
-// +-kFloorIntRange (a NaN goes to its lower end): a particle that has flown off to infinity, or a
-// NaN, gets a far cell instead of a conversion whose result is undefined (UBSan: the cell index
-// INT_MIN, then INT_MIN - 2 in the neighbour search). Cells are wrapped by the periodic grid anyway.
-constexpr float kFloorIntRange = 1e9f;
-SEAMLESS_HD inline int floor_int(float x) {
-  x = x >= -kFloorIntRange ? (x <= kFloorIntRange ? x : kFloorIntRange) : -kFloorIntRange;
-  return ::seamless::floor_int(x);
-}
+// Cells come from seamless::floor_int (src/core/math.hpp), which holds x within +-1e9 first: a
+// particle that has flown off to infinity, or a NaN, gets a far cell (wrapped by the periodic grid
+// anyway) instead of an undefined conversion.
 
 // A periodic uniform grid of 2^bits cells per axis: cell coordinates wrap, so the grid covers all
 // of space, and with at least 2 * reach + 1 cells per axis the cells around a particle are

@@ -71,9 +71,9 @@ SEAMLESS_SIMD_INL vm operator!=(vi a, vi b) { return {a.v != b.v}; }
 SEAMLESS_SIMD_INL vm operator<(vi a, vi b) { return {a.v < b.v}; }
 SEAMLESS_SIMD_INL vm operator>(vi a, vi b) { return {a.v > b.v}; }
 SEAMLESS_SIMD_INL vi select(vm m, vi a, vi b) { return m.v ? a.v : b.v; }
-// kernels::floor_int lane by lane (truncation, then one down where that rounded up).
+// seamless::floor_int lane by lane (truncation, then one down where that rounded up).
 SEAMLESS_SIMD_INL vi floor_int(vf x) {
-  // Held within +-1e9 first, as the scalar kernels::floor_int (kFloorIntRange; a NaN: -1e9).
+  // Held within +-1e9 first, as the scalar seamless::floor_int (kFloorIntRange; a NaN: -1e9).
   const f8 hi = f8{} + 1e9f, lo = f8{} - 1e9f;
   x.v = x.v >= lo ? (x.v <= hi ? x.v : hi) : lo;
   const i8 i = __builtin_convertvector(x.v, i8);

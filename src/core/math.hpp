@@ -108,12 +108,17 @@ SEAMLESS_HD inline bool is_finite(vec3 a) { return is_finite(a.x) && is_finite(a
 SEAMLESS_HD inline int3 operator+(int3 a, int3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 SEAMLESS_HD inline int3 operator-(int3 a, int3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
 SEAMLESS_HD inline bool operator==(int3 a, int3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
-// floor(x) as an int, for |x| < 2^31. On the GPU floorf and the conversion are one instruction;
-// on the host without SSE4.1 (the Debian x86-64 baseline has no roundss) floorf is a libm bit
-// sequence of ~15 instructions, a fifth of the CPU raycast's march. Truncation, then one down
-// where it rounded up (x < 0, not an integer), gives the same integer: static_cast<float>(i) is
-// exact, since |i| < 2^24 or x is already an integer there.
+// floor(x) as an int, for any x: x is first held within +-kFloorIntRange (a NaN goes to its lower
+// end), so a point projected from a depth near zero, a particle flown off to infinity or a NaN gets
+// a far index that every caller's bounds test rejects, never an undefined conversion (UBSan: INT_MIN,
+// then INT_MIN - 1 below). On the GPU floorf and the conversion are one instruction; on the host
+// without SSE4.1 (the Debian x86-64 baseline has no roundss) floorf is a libm bit sequence of ~15
+// instructions, a fifth of the CPU raycast's march. Truncation, then one down where it rounded up
+// (x < 0, not an integer), gives the same integer: static_cast<float>(i) is exact, since
+// |i| < 2^24 or x is already an integer there.
+constexpr float kFloorIntRange = 1e9f;
 SEAMLESS_HD inline int floor_int(float x) {
+  x = x >= -kFloorIntRange ? (x <= kFloorIntRange ? x : kFloorIntRange) : -kFloorIntRange;
 #ifdef __CUDA_ARCH__
   return static_cast<int>(floorf(x));
 #else

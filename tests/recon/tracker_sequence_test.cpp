@@ -168,35 +168,28 @@ TrackSequenceParams best_tum_params() {
   return p;
 }
 
-TEST(TrackSequence, TumFreiburg1RpyBestTrackerTracksEveryFrame) {
-  // Issue 5: real Kinect v1 frames with fast roll/pitch/yaw (up to 6 deg a frame); every one of the
-  // 150 frames must be tracked (none reported lost).
-  const std::string dir = test::tum_rpy_dir();
-  if (!std::filesystem::exists(dir)) GTEST_SKIP() << dir << " is absent (shared test data)";
-  auto src = make_source(test::tum_input(dir));
-  auto t = test::track_with_gt(*src, best_tum_params(), Device::CPU, "");
-  EXPECT_EQ(t.result.lost_frames, 0);
-  ASSERT_EQ(t.result.trajectory.size(), 150u);
-  AteResult ate = compute_ate(t.result.trajectory, read_tum_trajectory(dir + "/groundtruth.txt"));
-  RecordProperty("ate_rmse_m", std::to_string(ate.trans.rmse));
-}
-
-// Issue 5 asks ATE RMSE <= 3 cm here. The tracker alone measures 2.5 cm at 5 mm (session 4: robust
-// weights, depth-squared noise, colour on every visible pixel; 3.3 cm before them; frame-to-frame RGB-D 3.1 cm,
+// Issue 5: real Kinect v1 frames with fast roll/pitch/yaw (up to 6 deg a frame); every one of the
+// 150 frames must be tracked (none reported lost). One tracking run serves both checks (it takes
+// minutes on the CPU, so CI runs it once): every frame tracked, then, where Ceres is built, the
+// refined trajectory within 3 cm (issue 5's ATE RMSE goal). The tracker alone measures 2.5 cm at 5 mm (session 4:
+// robust weights, depth-squared noise, colour on every visible pixel; 3.3 cm before them; frame-to-frame RGB-D 3.1 cm,
 // geometric ICP much worse: on these frames the Kinect depth shows about 25 % less rotation between frames than the
 // ground truth and the colour do, see docs/TRACKING.md). Our best tracker is therefore the tracker followed by the
 // Ceres refinement (the refine section of configs/tum_fr1.yaml: a keyframe every 5 frames, so that consecutive
 // keyframes of this fast rotation stay within the 30 degrees a pair may differ; docs/TRACKING.md, "Ceres refinement",
 // has the sensitivity to the keyframe spacing). Needs Ceres (libceres-dev).
-TEST(TrackSequence, TumFreiburg1RpyBestTrackerWithinThreeCentimetres) {
+TEST(TrackSequence, TumFreiburg1RpyBestTrackerTracksEveryFrameAndRefinesWithinThreeCentimetres) {
   const std::string dir = test::tum_rpy_dir();
   if (!std::filesystem::exists(dir)) GTEST_SKIP() << dir << " is absent (shared test data)";
-  if (!refine_available()) GTEST_SKIP() << "this build has no Ceres (libceres-dev): the refinement is not built";
   auto src = make_source(test::tum_input(dir));
   TrackSequenceParams p = best_tum_params();
   auto t = test::track_with_gt(*src, p, Device::CPU, "");
   EXPECT_EQ(t.result.lost_frames, 0);
   ASSERT_EQ(t.result.trajectory.size(), 150u);
+  const Trajectory gt = read_tum_trajectory(dir + "/groundtruth.txt");
+  const AteResult odometry = compute_ate(t.result.trajectory, gt);
+  RecordProperty("ate_odometry_m", std::to_string(odometry.trans.rmse));
+  if (!refine_available()) GTEST_SKIP() << "this build has no Ceres (libceres-dev): the refinement is not built";
   std::vector<bool> tracked;
   for (const FrameRecord& f : t.result.frames) tracked.push_back(f.result.ok());
   RefineParams refine;
@@ -207,9 +200,7 @@ TEST(TrackSequence, TumFreiburg1RpyBestTrackerWithinThreeCentimetres) {
   refine.photometric_pixels = PhotometricPixels::visible;
   auto again = make_source(test::tum_input(dir));
   RefineResult r = refine_trajectory(*again, t.result.trajectory, refine, p.preprocess, Device::CPU, tracked);
-  const Trajectory gt = read_tum_trajectory(dir + "/groundtruth.txt");
-  AteResult odometry = compute_ate(t.result.trajectory, gt), refined = compute_ate(r.trajectory, gt);
+  const AteResult refined = compute_ate(r.trajectory, gt);
   EXPECT_LE(refined.trans.rmse, 0.03) << "odometry alone " << odometry.trans.rmse;
-  RecordProperty("ate_odometry_m", std::to_string(odometry.trans.rmse));
   RecordProperty("ate_refined_m", std::to_string(refined.trans.rmse));
 }
