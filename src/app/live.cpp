@@ -64,6 +64,7 @@ class LiveLoop : public FrameLoop {
         !source_->next(frame_))
       return !(finished_ = true);
     const FrameRecord rec = session_.process(frame_);
+    if (e_.dynamic.write_masks) write_dynamic_mask(ctx_.out_dir(), frame_.index, session_);
     if (online_)
       if (std::optional<SE3> delta = online_->after_frame(frame_, rec)) session_.correct(*delta);
     const auto k = static_cast<std::int64_t>(records_.size());

@@ -90,9 +90,6 @@ void log_lost(const FrameRecord& rec) {
 }
 }  // namespace
 
-namespace {
-// dynamic.write_masks: out_dir/dynamic_mask/<frame, 6 digits>.png, 255 where dynamic (an empty mask
-// before the first frame with a model).
 void write_dynamic_mask(const std::string& out_dir, std::int64_t index, const TrackingSession& session) {
   const std::string dir = out_dir + "/dynamic_mask";
   std::filesystem::create_directories(dir);
@@ -105,7 +102,6 @@ void write_dynamic_mask(const std::string& out_dir, std::int64_t index, const Tr
   png.buffer().copy_from_host(m.data(), static_cast<std::int64_t>(m.size()));
   write_png_u8(dir + name, png);
 }
-}  // namespace
 
 TrackSequenceResult track_sequence(FrameSource& source, const TrackSequenceParams& params, Device device,
                                    const std::string& out_dir, Volume* volume,

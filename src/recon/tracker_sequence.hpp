@@ -190,6 +190,11 @@ TrackSequenceResult track_sequence(FrameSource& source, const TrackSequenceParam
 // frame_ms.
 void write_tracking_stats(const std::string& path, const std::vector<FrameRecord>& frames);
 
+// dynamic.write_masks: out_dir/dynamic_mask/<frame index, 6 digits>.png, 255 where the session's
+// last frame is dynamic (an empty mask before the first frame with a model). `seamless track` and
+// `seamless run` both write them.
+void write_dynamic_mask(const std::string& out_dir, std::int64_t index, const TrackingSession& session);
+
 // The trackers this build knows (tracker.kind values): every entry says whether it is available and,
 // if not, what to install. Adding a tracker is one entry in tracker_registry() plus its
 // implementation: our own kinds are driven by Tracker, an external one by the Odometry its

@@ -62,21 +62,19 @@ TrackingSession::TrackingSession(const TrackSequenceParams& params, Device devic
   } else if (p_.tracker.kind != "ground_truth") {
     tracker_ = std::make_unique<Tracker>(p_.tracker, device);
   }
-  // Only our own trackers need a model of their own; a volume that is given is fused into by all.
-  if (!volume_ && p_.tracker.mode == TrackingMode::frame_to_model && tracker_) {
+  // Our own trackers need a model of their own in frame-to-model mode, and dynamic handling needs
+  // one whatever the tracker (it compares each frame with the model: docs/DYNAMIC.md); a volume that
+  // is given is fused into by all.
+  if (!volume_ && ((p_.tracker.mode == TrackingMode::frame_to_model && tracker_) || p_.dynamic.enabled)) {
     own_volume_ = make_volume(p_.volume, device);
     volume_ = own_volume_.get();
   }
   if (p_.dynamic.enabled) {
-    if (!volume_)
-      spdlog::warn("dynamic.enabled: no volume to compare frames with (tracker {} {}); no pixel is masked",
-                   p_.tracker.kind, enum_name(p_.tracker.mode));
-    else if (p_.dynamic.carve_truncations > 0)
+    if (p_.dynamic.carve_truncations > 0)
       volume_->set_free_space_carving(p_.dynamic.carve_truncations * volume_->params().truncation);
     // seen_free needs the free space stored: the voxel-hashed volume otherwise knows none away from
     // surfaces, and drops every mover in the middle of the room (docs/DYNAMIC.md).
-    if (volume_ && p_.dynamic.free_space_evidence == FreeSpaceEvidence::seen_free)
-      volume_->set_free_space_storage(true);
+    if (p_.dynamic.free_space_evidence == FreeSpaceEvidence::seen_free) volume_->set_free_space_storage(true);
   }
 }
 

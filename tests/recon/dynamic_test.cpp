@@ -274,3 +274,47 @@ TEST(Dynamic, SlowFreeSpaceEvidenceOnTheHashedVolume) {
   EXPECT_GT(out[2].mean_iou, out[0].mean_iou);
   EXPECT_LE(static_cast<double>(out[2].ghost_vertices), 0.02 * static_cast<double>(off.ghost_vertices));
 }
+
+// `seamless track` and `seamless run` with a tracker that builds no model of its own (the
+// ground-truth poses here; a frame-to-frame tracker alike) and dynamic.enabled: the session makes
+// the volume the dynamic pixels are found against (it masked nothing before, with a warning). On
+// the CPU at 160x120 over the person's first 1.3 s (frames 0-69; fast enough for CI); truth: the rendered mover
+// masks. The bar is that the mask is the person's: most of the person's pixels are masked (recall
+// above one half) and most masked pixels are the person's (precision above one half), averaged over
+// the frames where the movers cover at least 1 % of the image. Masking nothing gives recall 0.
+TEST(Dynamic, AVolumeOfItsOwnForATrackerWithoutOne) {
+  InputParams in = scene(true);
+  in.synthetic.frames = 70;
+  in.intrinsics.fx = in.intrinsics.fy = 525.f / 4;
+  in.intrinsics.cx = 79.5f, in.intrinsics.cy = 59.5f;
+  in.intrinsics.width = 160, in.intrinsics.height = 120;
+  SyntheticSource src(in);
+  TrackSequenceParams p = params(true, "ground_truth");
+  TrackingSession s(p, Device::CPU, src.intrinsics(), nullptr);
+  ASSERT_NE(s.volume(), nullptr);
+  RgbdFrame f;
+  double recall = 0, precision = 0;
+  int frames = 0;
+  while (src.next(f)) {
+    s.process(f);
+    const std::vector<std::uint8_t> truth = f.mover_mask.to_host();
+    std::vector<std::uint8_t> mine = s.dynamic_mask().to_host();
+    if (mine.empty()) mine.assign(truth.size(), 0);  // no mask before the first frame with a model
+    ASSERT_EQ(truth.size(), mine.size());
+    std::int64_t inter = 0, truth_n = 0, mine_n = 0;
+    for (std::size_t i = 0; i < truth.size(); ++i) {
+      inter += truth[i] && mine[i];
+      truth_n += truth[i] != 0;
+      mine_n += mine[i] != 0;
+    }
+    if (truth_n < static_cast<std::int64_t>(truth.size() / 100)) continue;
+    recall += static_cast<double>(inter) / static_cast<double>(truth_n);
+    precision += mine_n ? static_cast<double>(inter) / static_cast<double>(mine_n) : 0.0;
+    ++frames;
+  }
+  ASSERT_GT(frames, 10);
+  RecordProperty("recall", std::to_string(recall / frames));
+  RecordProperty("precision", std::to_string(precision / frames));
+  EXPECT_GT(recall / frames, 0.5);
+  EXPECT_GT(precision / frames, 0.5);
+}
