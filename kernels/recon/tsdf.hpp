@@ -109,10 +109,10 @@ SEAMLESS_HD inline bool voxel_keeps_block(const Voxel& v, float keep_below) {
 
 // The surface flag of each block of the pool (issue 22, docs/DYNAMIC.md "The surface flag"): 1
 // while one of its voxels is observed and near a surface (voxel_keeps_block with the band's
-// threshold below = 0.999 truncation, whatever the garbage collection keeps), else 0. It is what
-// the band-only volume's garbage collection decides (Niessner et al. 2013, section 4.2), kept for
-// the blocks that a volume storing free space keeps anyway (ReFusion, Palazzolo et al. 2019), so
-// that the raycast can pass through them as through unallocated space.
+// threshold below = 0.999 truncation, whatever the garbage collection keeps), else 0. It is the
+// band-only volume's garbage collection's decision (Niessner et al. 2013), kept for the blocks
+// that a volume storing free space keeps anyway (ReFusion, Palazzolo et al. 2019), so that the
+// raycast can pass through them as through unallocated space.
 struct SurfaceFlags {
   std::int32_t* flag = nullptr;  // one per pool block, by block index; nullptr: not kept
   float below = 0.f;             // metres
