@@ -257,7 +257,7 @@ void TsdfFusion<Exec>::fuse_hash_blocks(const Exec& ex, HashTableView t, View<co
     const int3 b = unpack_block(t.keys[slot]);
     const int column = static_cast<int>(i % kColumns);
     Voxel* v = voxels + static_cast<std::int64_t>(block) * kBlockVoxels + column;
-    bool kept = false, near = false;
+    bool kept = false, surface_near = false;
 #pragma unroll
     for (int z = 0; z < kBlockSide; ++z) {
       const int3 l = local_coords(column + kColumns * z);
@@ -265,10 +265,10 @@ void TsdfFusion<Exec>::fuse_hash_blocks(const Exec& ex, HashTableView t, View<co
       Voxel& vz = v[kColumns * z];
       fuse_voxel(vz, geom.to_world(g), in, camera_T_world, geom.truncation, max_weight, color);
       kept = kept || (keep.data && voxel_keeps_block(vz, keep_below));
-      near = near || (surface.flag && voxel_keeps_block(vz, surface.below));
+      surface_near = surface_near || (surface.flag && voxel_keeps_block(vz, surface.below));
     }
     if (kept) set_keep(&keep[j]);
-    if (near) set_keep(&surface.flag[block]);
+    if (surface_near) set_keep(&surface.flag[block]);
   });
 }
 
@@ -308,9 +308,9 @@ void TsdfFusion<Exec>::mark_surface_blocks(const Exec& ex, View<const std::int32
     const std::int32_t block = blocks[i];
     if (block < 0) return;
     const Voxel* v = voxels + static_cast<std::int64_t>(block) * kBlockVoxels;
-    std::int32_t near = 0;
-    for (int k = 0; k < kBlockVoxels && !near; ++k) near = voxel_keeps_block(v[k], surface.below) ? 1 : 0;
-    surface.flag[block] = near;
+    std::int32_t flag = 0;
+    for (int k = 0; k < kBlockVoxels && !flag; ++k) flag = voxel_keeps_block(v[k], surface.below) ? 1 : 0;
+    surface.flag[block] = flag;
   });
 }
 
