@@ -421,7 +421,9 @@ TEST(TsdfFusion, SurfaceFlagMarksTheWallsBlocks) {
   std::vector<int3> flagged, band_blocks;
   for (const auto& b : vol.download_blocks()) {
     ASSERT_EQ(b.surface, has_voxel_near_surface(b, 0.04f)) << b.coord.x << "," << b.coord.y << "," << b.coord.z;
-    if (in_front_of_the_wall(b.coord)) ASSERT_FALSE(b.surface);
+    if (in_front_of_the_wall(b.coord)) {
+      ASSERT_FALSE(b.surface) << b.coord.x << "," << b.coord.y << "," << b.coord.z;
+    }
     if (b.surface) flagged.push_back(b.coord);
   }
   for (const auto& b : band.download_blocks()) {
