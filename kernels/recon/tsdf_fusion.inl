@@ -163,7 +163,7 @@ template <Executor Exec> void TsdfFusion<Exec>::clear_depth_tiles(const Exec& ex
 template <Executor Exec>
 void TsdfFusion<Exec>::find_visible_blocks(const Exec& ex, HashTableView t, HashCounters* counters, FrameInput in,
                                            VoxelGeometry geom, View<std::int32_t> visible_slots,
-                                           View<std::int32_t> keep, DepthTiles tiles) {
+                                           View<std::int32_t> keep, DepthTiles tiles, std::int32_t* surface) {
   const SE3 camera_T_world = in.world_T_camera.inverse();
   ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
     if (i == 0 && counters->free_top < 0) counters->free_top = 0;  // after failed pops
@@ -173,6 +173,7 @@ void TsdfFusion<Exec>::find_visible_blocks(const Exec& ex, HashTableView t, Hash
     const int j = atomic_add(&counters->visible, 1);
     visible_slots[j] = static_cast<std::int32_t>(i);
     if (keep.data) keep[j] = 0;
+    if (surface) surface[t.values[i]] = 0;
   });
 }
 
@@ -239,7 +240,8 @@ SEAMLESS_HD inline void fuse_voxel(Voxel& v, vec3 p_world, const FrameInput& in,
 template <Executor Exec>
 void TsdfFusion<Exec>::fuse_hash_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots,
                                         std::int64_t count, Voxel* voxels, FrameInput in, VoxelGeometry geom,
-                                        float max_weight, bool color, View<std::int32_t> keep, float keep_below) {
+                                        float max_weight, bool color, View<std::int32_t> keep, float keep_below,
+                                        SurfaceFlags surface) {
   const SE3 camera_T_world = in.world_T_camera.inverse();
   // One thread per column of a block (its 8 voxels along z, 64 threads a block): the block's slot,
   // index and key are read once per column instead of once per voxel, and the column's 8 voxels
@@ -255,7 +257,7 @@ void TsdfFusion<Exec>::fuse_hash_blocks(const Exec& ex, HashTableView t, View<co
     const int3 b = unpack_block(t.keys[slot]);
     const int column = static_cast<int>(i % kColumns);
     Voxel* v = voxels + static_cast<std::int64_t>(block) * kBlockVoxels + column;
-    bool kept = false;
+    bool kept = false, surface_near = false;
 #pragma unroll
     for (int z = 0; z < kBlockSide; ++z) {
       const int3 l = local_coords(column + kColumns * z);
@@ -263,8 +265,10 @@ void TsdfFusion<Exec>::fuse_hash_blocks(const Exec& ex, HashTableView t, View<co
       Voxel& vz = v[kColumns * z];
       fuse_voxel(vz, geom.to_world(g), in, camera_T_world, geom.truncation, max_weight, color);
       kept = kept || (keep.data && voxel_keeps_block(vz, keep_below));
+      surface_near = surface_near || (surface.flag && voxel_keeps_block(vz, surface.below));
     }
     if (kept) set_keep(&keep[j]);
+    if (surface_near) set_keep(&surface.flag[block]);
   });
 }
 
@@ -294,6 +298,19 @@ void TsdfFusion<Exec>::mark_kept_blocks(const Exec& ex, HashTableView t, View<co
     if (block < 0) return;
     if (voxel_keeps_block(voxels[static_cast<std::int64_t>(block) * kBlockVoxels + i % kBlockVoxels], keep_below))
       set_keep(&keep[j]);
+  });
+}
+
+template <Executor Exec>
+void TsdfFusion<Exec>::mark_surface_blocks(const Exec& ex, View<const std::int32_t> blocks, const Voxel* voxels,
+                                           SurfaceFlags surface) {
+  ex.for_each(blocks.size, [=] SEAMLESS_HD(std::int64_t i) {
+    const std::int32_t block = blocks[i];
+    if (block < 0) return;
+    const Voxel* v = voxels + static_cast<std::int64_t>(block) * kBlockVoxels;
+    std::int32_t flag = 0;
+    for (int k = 0; k < kBlockVoxels && !flag; ++k) flag = voxel_keeps_block(v[k], surface.below) ? 1 : 0;
+    surface.flag[block] = flag;
   });
 }
 

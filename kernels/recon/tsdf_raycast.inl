@@ -71,7 +71,7 @@ void TsdfRaycast<Exec, Acc>::clear_ray_intervals(const Exec& ex, RayIntervals iv
 template <Executor Exec, class Acc>
 void TsdfRaycast<Exec, Acc>::splat_ray_intervals(const Exec& ex, HashTableView t, VoxelGeometry geom, Intrinsics K,
                                                  SE3 world_T_camera, float min_depth, float max_depth, RayIntervals iv,
-                                                 BlockWindow w) {
+                                                 BlockWindow w, const std::int32_t* surface, std::int32_t* near) {
   const SE3 camera_T_world = world_T_camera.inverse();
   const float zn = fmaxf(min_depth, 1e-3f);
   ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
@@ -81,6 +81,11 @@ void TsdfRaycast<Exec, Acc>::splat_ray_intervals(const Exec& ex, HashTableView t
     if (w.index) {
       const std::int64_t e = w.entry(unpack_block(k));
       if (e >= 0) w.index[e] = block;  // keys are unique: one writer per entry
+    }
+    if (surface) {  // a block the march skips needs no interval (see block_near_surface)
+      const bool n = block_near_surface(t, surface, unpack_block(k), block);
+      near[block] = n ? 1 : 0;
+      if (!n) return;
     }
     ScreenBounds s;
     if (!block_screen_bounds(unpack_block(k), geom, K, camera_T_world, zn, max_depth, &s)) return;
@@ -101,6 +106,17 @@ void TsdfRaycast<Exec, Acc>::splat_ray_intervals(const Exec& ex, HashTableView t
 }
 
 template <Executor Exec, class Acc>
+void TsdfRaycast<Exec, Acc>::mark_near_surface(const Exec& ex, HashTableView t, const std::int32_t* surface,
+                                               std::int32_t* near) {
+  ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
+    const HashKey k = t.keys[i];
+    const std::int32_t block = t.values[i];
+    if (!is_live_key(k) || block < 0) return;
+    near[block] = block_near_surface(t, surface, unpack_block(k), block) ? 1 : 0;
+  });
+}
+
+template <Executor Exec, class Acc>
 void TsdfRaycast<Exec, Acc>::fill_block_window(const Exec& ex, HashTableView t, BlockWindow w) {
   ex.for_each(w.count(), [=] SEAMLESS_HD(std::int64_t i) { w.index[i] = -1; });
   ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
@@ -109,6 +125,17 @@ void TsdfRaycast<Exec, Acc>::fill_block_window(const Exec& ex, HashTableView t, 
     const std::int64_t e = w.entry(unpack_block(k));
     if (e >= 0) w.index[e] = t.values[i];  // keys are unique: one writer per entry
   });
+}
+
+// Whether block i (>= 0) may hold a surface for the march: false only where the accessor has
+// near-surface flags (a volume storing free space; block_near_surface in tsdf.hpp) and block i's
+// is 0, so that the march skips it like an unallocated block.
+template <class Acc> SEAMLESS_HD inline bool near_surface(const Acc& a, std::int32_t i) {
+  if constexpr (requires { a.near_surface; }) {
+    return !a.near_surface || a.near_surface[i];
+  } else {
+    return true;
+  }
 }
 
 // Marches the ray o + d z (voxel units, z = camera depth) from z to z_end; on a +/- zero crossing
@@ -129,16 +156,22 @@ SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z
   const vec3 inv_d{1.f / d.x, 1.f / d.y, 1.f / d.z};             // +-inf on an axis d does not move along
   constexpr int kRefineSteps = 3;
   float z_prev = 0.f, f_prev = 0.f;
-  bool have_prev = false;
+  bool have_prev = false, prev_near = false;     // prev_near: the last sample's block is near a surface
   int refine = -1;                               // -1: marching; else regula falsi steps taken
   float ta = 0.f, fa = 0.f, tb = 0.f, fb = 0.f;  // the bracket: fa > 0 at ta, fb <= 0 at tb
   for (int it = 0; refine >= 0 || (it < 8192 && z < z_end); ++it) {
     vec3 q = o + d * z;
     const int3 g0 = floor_to_int(q), b = block_of_voxel(g0);
     const std::int32_t i0 = cached_block(a, b, c);
+    // Skipped: unallocated, or not near a surface while marching (not while refining a bracket),
+    // except for one sample right after a sample in a block near a surface: a crossing between
+    // the two (the step from the last sample in front of a surface may land past it) is then
+    // bracketed as without the flags (block_near_surface in tsdf.hpp).
+    const bool near = i0 >= 0 && (refine >= 0 || near_surface(a, i0));
+    const bool skip = i0 < 0 || (!near && !(have_prev && prev_near));
     float f = 0.f;
-    const bool sampled = i0 >= 0 && sample_tsdf_in(a, q, g0, i0, c, &f);  // the block just found: no second lookup
-    if (refine >= 0) {                                                    // regula falsi between the bracket's ends
+    const bool sampled = !skip && sample_tsdf_in(a, q, g0, i0, c, &f);  // the block just found: no second lookup
+    if (refine >= 0) {                                                  // regula falsi between the bracket's ends
       if (!sampled) break;  // no value here: the last estimate, z, is the hit
       if (f > 0.f) ta = z, fa = f;
       else tb = z, fb = f;
@@ -146,7 +179,7 @@ SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z
       if (++refine == kRefineSteps) break;
       continue;
     }
-    if (i0 < 0) {  // empty space: skip the whole block (Niessner section 4.3)
+    if (skip) {  // empty space: skip the whole block (Niessner section 4.3)
       z = max_of(block_exit(o, d, inv_d, b), z) + min_step * 0.1f;
       have_prev = false;
       continue;
@@ -161,7 +194,7 @@ SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z
       z = ta + (tb - ta) * fa / (fa - fb);
       continue;
     }
-    z_prev = z, f_prev = f, have_prev = true;
+    z_prev = z, f_prev = f, have_prev = true, prev_near = near;
     // |TSDF| is at most about the distance to the nearest zero crossing (projective distances
     // over-estimate at grazing angles, hence the 0.8), so stepping that far along the ray (|d| s
     // metres per unit of z) cannot jump over one: truncation-sized steps in the band's free-space

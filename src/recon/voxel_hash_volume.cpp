@@ -55,6 +55,8 @@ VoxelHashVolume::VoxelHashVolume(const VolumeParams& p, Device d) : params_(p), 
   free_list_ = Buffer<std::int32_t>(p.capacity, d);
   visible_ = Buffer<std::int32_t>(p.capacity, d);
   keep_ = Buffer<std::int32_t>(p.capacity, d);
+  surface_ = Buffer<std::int32_t>(p.capacity, d);
+  surface_.zero();
   counters_ = Buffer<HashCounters>(1, d);
   with_exec(d, [&]<class E>(const E& ex) {
     kernels::VoxelHash<E>::hash_clear(ex, table());
@@ -103,7 +105,8 @@ void VoxelHashVolume::integrate(const Image<float>& depth, const Image<uchar3>& 
         kernels::TsdfFusion<E>::sort_visible_by_block(ex, table(), visible_.view(), n, scratch_.view(),
                                                       static_cast<int>(std::bit_width(pool_size())));
       kernels::TsdfFusion<E>::fuse_hash_blocks(ex, table(), visible_.cview(), n, voxels_.data(), in, geom_,
-                                               params_.max_weight, params_.integrate_color, keep, keep_below());
+                                               params_.max_weight, params_.integrate_color, keep, keep_below(),
+                                               surface_flags());
     });
     if (params_.remove_empty_blocks)
       staged(timer, "remove_empty", [&] {
@@ -135,7 +138,7 @@ void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTime
       });
       staged(timer, "visible", [&] {
         kernels::TsdfFusion<E>::find_visible_blocks(ex, table(), counters_.data(), in, geom_, visible_.view(),
-                                                    keep_.view(), tiles);
+                                                    keep_.view(), tiles, surface_.data());
       });
     });
     last_ = read_counters();
@@ -270,6 +273,10 @@ void VoxelHashVolume::grow_pool(std::int64_t blocks) {
   free_list_ = std::move(free_list);
   visible_ = Buffer<std::int32_t>(blocks, device_);
   keep_ = Buffer<std::int32_t>(blocks, device_);
+  Buffer<std::int32_t> surface(blocks, device_);
+  surface.zero();
+  surface.copy_from(surface_);
+  surface_ = std::move(surface);
   with_exec(device_, [&]<class E>(const E& ex) {
     kernels::VoxelHash<E>::pool_append(ex, free_list_.view(), counters_.data(), static_cast<std::int32_t>(old),
                                        static_cast<std::int32_t>(blocks - old));
@@ -321,10 +328,12 @@ std::vector<VoxelHashVolume::HostBlock> VoxelHashVolume::download_blocks() const
   });
   std::vector<kernels::HashKey> hk = keys.to_host();
   std::vector<kernels::Voxel> hv = vox.to_host();
+  const std::vector<std::int32_t> hb = values.to_host(), flags = surface_.to_host();
   std::vector<HostBlock> out(static_cast<std::size_t>(n));
   for (std::int64_t i = 0; i < n; ++i) {
     out[i].coord = kernels::unpack_block(hk[i]);
     out[i].voxels.assign(hv.begin() + i * kBlockVoxels, hv.begin() + (i + 1) * kBlockVoxels);
+    out[i].surface = flags[hb[i]] != 0;
   }
   std::sort(out.begin(), out.end(), [](const HostBlock& a, const HostBlock& b) {
     return std::tie(a.coord.x, a.coord.y, a.coord.z) < std::tie(b.coord.x, b.coord.y, b.coord.z);
@@ -361,6 +370,14 @@ void VoxelHashVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, Ra
     intervals_.reserve_discard(2 * grid.count(), device_);
     iv = {grid, intervals_.data()};
   }
+  // With free space stored, the march skips the blocks not near a surface as it skips unallocated
+  // ones (kernels::block_near_surface); the band-only volume has freed those blocks already.
+  kernels::HashAccess view = device_view();
+  const std::int32_t* surface = nullptr;
+  if (store_free_space_) {
+    near_.reserve_discard(static_cast<std::int64_t>(pool_size()), device_);
+    surface = surface_.data(), view.near_surface = near_.data();
+  }
   with_exec(device_, [&]<class E>(const E& ex) {
     staged(timer, "raycast", [&] {
       const kernels::BlockWindow w = raycast_window(world_T_camera);
@@ -368,19 +385,19 @@ void VoxelHashVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, Ra
         staged(timer, "raycast_splat", [&] {  // part of "raycast"
           kernels::TsdfRaycast<E>::clear_ray_intervals(ex, iv, w);
           kernels::TsdfRaycast<E>::splat_ray_intervals(ex, table(), geom_, K, world_T_camera, params_.min_depth,
-                                                       params_.max_depth, iv, w);
+                                                       params_.max_depth, iv, w, surface, near_.data());
         });
+      else if (surface) kernels::TsdfRaycast<E>::mark_near_surface(ex, table(), surface, near_.data());
       if (!w.index) {
-        kernels::TsdfRaycast<E, kernels::HashAccess>::raycast(ex, device_view(), K, world_T_camera, params_.min_depth,
+        kernels::TsdfRaycast<E, kernels::HashAccess>::raycast(ex, view, K, world_T_camera, params_.min_depth,
                                                               params_.max_depth, out, iv);
         return;
       }
       if (!iv.bits)
         staged(timer, "raycast_window",
                [&] { kernels::TsdfRaycast<E>::fill_block_window(ex, table(), w); });  // part of "raycast"
-      kernels::TsdfRaycast<E, kernels::WindowedHashAccess>::raycast(ex, kernels::WindowedHashAccess{device_view(), w},
-                                                                    K, world_T_camera, params_.min_depth,
-                                                                    params_.max_depth, out, iv);
+      kernels::TsdfRaycast<E, kernels::WindowedHashAccess>::raycast(
+          ex, kernels::WindowedHashAccess{view, w}, K, world_T_camera, params_.min_depth, params_.max_depth, out, iv);
     });
   });
 }
@@ -437,7 +454,8 @@ VolumeStats VoxelHashVolume::stats() {
   s.bytes_per_block = sizeof(kernels::Voxel) * kBlockVoxels;
   s.voxel_bytes = s.bytes_per_block * static_cast<std::size_t>(s.allocated_blocks);
   s.device_bytes = keys_.bytes() + values_.bytes() + scratch_.bytes() + voxels_.bytes() + free_list_.bytes() +
-                   visible_.bytes() + keep_.bytes() + intervals_.bytes() + depth_tiles_.bytes() + counters_.bytes();
+                   visible_.bytes() + keep_.bytes() + surface_.bytes() + near_.bytes() + intervals_.bytes() +
+                   depth_tiles_.bytes() + counters_.bytes();
   s.host_blocks = host_count_;
   s.host_bytes = s.bytes_per_block * static_cast<std::size_t>(host_count_);
   s.streamed_out = streamed_out_;

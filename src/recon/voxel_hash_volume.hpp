@@ -43,6 +43,7 @@ class VoxelHashVolume final : public Volume {
   struct HostBlock {
     int3 coord;
     std::vector<kernels::Voxel> voxels;  // 512, x fastest
+    bool surface = false;                // its surface flag (kernels::SurfaceFlags)
   };
   std::vector<HostBlock> download_blocks() const;
   // Block coordinates of the allocated blocks, sorted like download_blocks().
@@ -70,7 +71,10 @@ class VoxelHashVolume final : public Volume {
   kernels::BlockWindow raycast_window(const SE3& world_T_camera);
   // Blocks with no observed voxel closer to a surface than this (metres) are freed as empty; with
   // free space stored, no observed block is (its +truncation voxels are the evidence kept).
-  float keep_below() const { return store_free_space_ ? std::numeric_limits<float>::max() : 0.999f * geom_.truncation; }
+  float keep_below() const { return store_free_space_ ? std::numeric_limits<float>::max() : surface_below(); }
+  // A voxel closer to a surface than this (metres) sets its block's surface flag (kernels::SurfaceFlags).
+  float surface_below() const { return 0.999f * geom_.truncation; }
+  kernels::SurfaceFlags surface_flags() const { return {surface_.data(), surface_below()}; }
   std::uint64_t pool_size() const;  // blocks in the pool: every block index is below it
   kernels::HashCounters read_counters() const;
   void allocate_and_list(const kernels::FrameInput& in, StageTimer* timer);
@@ -103,6 +107,8 @@ class VoxelHashVolume final : public Volume {
   Buffer<kernels::HashCounters> counters_;
   Buffer<std::int32_t> visible_;
   Buffer<std::int32_t> keep_;             // per visible block: 1 = has a voxel near a surface
+  Buffer<std::int32_t> surface_;          // per pool block: its surface flag (kernels::SurfaceFlags)
+  Buffer<std::int32_t> near_;             // per pool block, per raycast: kernels::block_near_surface
   Buffer<std::int32_t> intervals_;        // ray-interval tiles (kernels::RayIntervals)
   Buffer<std::int32_t> depth_tiles_;      // the frame's farthest reading per tile (kernels::DepthTiles)
   Buffer<std::int32_t> window_;           // the raycast's block-index window (kernels::BlockWindow)

@@ -181,6 +181,7 @@ void VoxelHashVolume::upload(std::vector<HashKey>& keys, std::vector<Voxel>& vox
     kernels::VoxelHash<E>::insert_with_blocks(ex, table(), free_list_.cview(), counters_.data(),
                                               View<const HashKey>{dkeys.data(), fit}, blocks.view());
     kernels::VoxelHash<E>::scatter_blocks(ex, voxels_.data(), blocks.cview(), dvox.cview());
+    kernels::TsdfFusion<E>::mark_surface_blocks(ex, blocks.cview(), voxels_.data(), surface_flags());
   });
   const std::vector<std::int32_t> got = blocks.to_host();
   const HashCounters after = read_counters();

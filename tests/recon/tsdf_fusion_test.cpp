@@ -402,6 +402,73 @@ TEST(TsdfFusion, StoredFreeSpaceFillsTheViewInFrontOfTheWall) {
   EXPECT_LE(band_only.stats().allocated_blocks + front, vol.stats().allocated_blocks);
 }
 
+// Whether block b has a voxel fused near a surface: observed, |sdf| below 0.999 truncation (the
+// surface flag's definition, kernels::SurfaceFlags, evaluated on the downloaded voxels).
+bool has_voxel_near_surface(const VoxelHashVolume::HostBlock& b, float truncation) {
+  for (const kernels::Voxel& v : b.voxels)
+    if (v.weight > 0.f && std::fabs(v.sdf) < 0.999f * truncation) return true;
+  return false;
+}
+
+// The surface flag (kernels::SurfaceFlags) on the wall seen three times: with or without the
+// free space stored, every block's flag is its definition evaluated on its voxels, no block in
+// front of the wall has it, and the flagged blocks of the volume storing free space are exactly
+// the blocks of the band-only volume, whose garbage collection keeps just the blocks with a
+// voxel near a surface (every block there is crossed by some pixel's band: rays 0.7 cm apart at
+// the wall, blocks of 8 cm).
+TEST(TsdfFusion, SurfaceFlagMarksTheWallsBlocks) {
+  VoxelHashVolume vol = wall_seen_three_times(true), band = wall_seen_three_times(false);
+  std::vector<int3> flagged, band_blocks;
+  for (const auto& b : vol.download_blocks()) {
+    ASSERT_EQ(b.surface, has_voxel_near_surface(b, 0.04f)) << b.coord.x << "," << b.coord.y << "," << b.coord.z;
+    if (in_front_of_the_wall(b.coord)) {
+      ASSERT_FALSE(b.surface) << b.coord.x << "," << b.coord.y << "," << b.coord.z;
+    }
+    if (b.surface) flagged.push_back(b.coord);
+  }
+  for (const auto& b : band.download_blocks()) {
+    ASSERT_TRUE(b.surface) << "garbage collection keeps only blocks near a surface";
+    ASSERT_TRUE(has_voxel_near_surface(b, 0.04f));
+    band_blocks.push_back(b.coord);
+  }
+  ASSERT_GT(band_blocks.size(), 300u);
+  EXPECT_EQ(flagged, band_blocks);  // both sorted by coordinate (download_blocks)
+}
+
+// The raycast through the stored free space, which skips the blocks not near a surface, against
+// the band-only volume's and the truth. The wall is fronto-parallel to the fusing camera, so every
+// voxel holds min(2 m - z, truncation) (the projective distance is the true one): linear in the
+// band, where the trilinear interpolation reproduces it and regula falsi lands on its zero, so
+// both volumes give the wall's depth to float rounding at 2 m (an ulp is 2.4e-7 m; 1e-6 allowed),
+// seen from the fusing camera and from one moved inside the fused view. Pixels within 2 of the
+// image border are left out: their rays run along the fused frustum's edge, where cells are
+// partly unobserved and the march's unobserved steps decide, differently where the samples differ.
+TEST(TsdfFusion, RaycastThroughStoredFreeSpaceFindsTheWall) {
+  VoxelHashVolume vol = wall_seen_three_times(true), band = wall_seen_three_times(false);
+  const Intrinsics K = test::camera(160, 120, 280.f);
+  Scene s;
+  s.wall_z = 2.f, s.sphere = false;
+  for (const SE3& v : {SE3::identity(), test::pose({0.05f, 0.02f, 0.4f}, 0.02f, 0.02f)}) {
+    const RaycastMaps a = vol.raycast(K, v), b = band.raycast(K, v);
+    const auto da = a.depth.to_host(), db = b.depth.to_host(), truth = s.render(K, v);
+    const auto na = a.normal.to_host(), nb = b.normal.to_host();
+    int compared = 0;
+    for (int y = 2; y < K.height - 2; ++y)
+      for (int x = 2; x < K.width - 2; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y) * K.width + x;
+        ASSERT_GT(da[i], 0.f) << x << "," << y;
+        ASSERT_GT(db[i], 0.f) << x << "," << y;
+        ASSERT_NEAR(da[i], truth[i], 1e-6f) << x << "," << y;
+        ASSERT_NEAR(db[i], truth[i], 1e-6f) << x << "," << y;
+        // Normals from neighbouring vertices of the same plane: the wall's, facing the camera.
+        ASSERT_LT(na[i].z, -0.99999f) << x << "," << y;
+        ASSERT_LT(nb[i].z, -0.99999f) << x << "," << y;
+        ++compared;
+      }
+    EXPECT_EQ(compared, (K.width - 4) * (K.height - 4));
+  }
+}
+
 // The free-space rays on CUDA against the CPU: the same blocks and voxels.
 TEST(TsdfParity, StoredFreeSpace) {
   if (!cuda_available()) GTEST_SKIP() << "no CUDA device";
@@ -413,6 +480,48 @@ TEST(TsdfParity, StoredFreeSpace) {
   fuse(gpu, s, K, translations(), true);
   ASSERT_NO_FATAL_FAILURE(test::expect_same_blocks(cpu.download_blocks(), gpu.download_blocks(), true));
   EXPECT_EQ(cpu.stats().allocated_blocks, gpu.stats().allocated_blocks);
+}
+
+// The surface flags and the raycast through the stored free space on CUDA against the CPU. The
+// voxels agree to 1e-5 m (expect_same_blocks), and each backend's flags are their definition on
+// its own voxels (the same float comparison), so the flags differ at most where a voxel lies
+// within 1e-5 m of the threshold. The raycast, with the ray intervals (whose pass also marks the
+// blocks near a surface) and without (mark_near_surface), as TsdfParity.SameBlocksAndValues
+// compares it: a ray grazing a block edge may go either way, depths within 1e-4 m.
+TEST(TsdfParity, SurfaceFlagsAndRaycastWithStoredFreeSpace) {
+  if (!cuda_available()) GTEST_SKIP() << "no CUDA device";
+  const Intrinsics K = test::camera(320, 240, 280.f);
+  Scene s;
+  std::vector<SE3> poses = translations();
+  poses.push_back(test::pose({0.03f, 0.f, 0.f}, 0.05f, 0.f));
+  for (int tile : {8, 0}) {
+    VolumeParams p = test::small_volume_params();
+    p.raycast_tile = tile;
+    VoxelHashVolume cpu(p, Device::CPU), gpu(p, Device::CUDA);
+    cpu.set_free_space_storage(true), gpu.set_free_space_storage(true);
+    fuse(cpu, s, K, poses, true);
+    fuse(gpu, s, K, poses, true);
+    const auto a = cpu.download_blocks(), b = gpu.download_blocks();
+    ASSERT_NO_FATAL_FAILURE(test::expect_same_blocks(a, b, true));
+    int flagged = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      ASSERT_EQ(a[i].surface, has_voxel_near_surface(a[i], p.truncation)) << "cpu block " << i;
+      ASSERT_EQ(b[i].surface, has_voxel_near_surface(b[i], p.truncation)) << "cuda block " << i;
+      flagged += a[i].surface;
+    }
+    EXPECT_GT(flagged, 0);
+    EXPECT_LT(flagged, static_cast<int>(a.size()) / 2);  // most stored blocks are free space
+    const SE3 view = test::pose({0.01f, 0.01f, 0.02f}, 0.02f, -0.01f);
+    const auto da = cpu.raycast(K, view).depth.to_host(), db = gpu.raycast(K, view).depth.to_host();
+    int differ = 0, hits = 0;
+    for (std::size_t i = 0; i < da.size(); ++i) {
+      if ((da[i] > 0.f) != (db[i] > 0.f)) ++differ;
+      else EXPECT_NEAR(da[i], db[i], 1e-4f);
+      hits += da[i] > 0.f;
+    }
+    EXPECT_LE(differ, int(da.size() / 1000)) << "tile " << tile;
+    EXPECT_GT(hits, int(da.size() / 2)) << "tile " << tile;
+  }
 }
 
 // sort_visible_by_block on dev: a shuffled list of the slots of 1000 blocks with distinct pool

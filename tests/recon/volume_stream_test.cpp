@@ -49,6 +49,8 @@ void expect_same_blocks(const std::vector<VoxelHashVolume::HostBlock>& a,
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) {
     ASSERT_TRUE(a[i].coord == b[i].coord) << "block " << i;
+    // The surface flag of a block streamed back in is recomputed from its voxels (mark_surface_blocks).
+    ASSERT_EQ(a[i].surface, b[i].surface) << "block " << i;
     for (int k = 0; k < kernels::kBlockVoxels; ++k) {  // copies: bit-identical
       ASSERT_EQ(a[i].voxels[k].sdf, b[i].voxels[k].sdf);
       ASSERT_EQ(a[i].voxels[k].weight, b[i].voxels[k].weight);
