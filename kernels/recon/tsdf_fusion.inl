@@ -257,11 +257,14 @@ void TsdfFusion<Exec>::fuse_hash_blocks(const Exec& ex, HashTableView t, View<co
     const int3 b = unpack_block(t.keys[slot]);
     const int column = static_cast<int>(i % kColumns);
     Voxel* v = voxels + static_cast<std::int64_t>(block) * kBlockVoxels + column;
+    // The column's x and y are fixed: written so, the compiler computes their part of the
+    // transform (to_world's, and the x and y products of each row's dot product, summed first)
+    // once a column instead of once a voxel. The same operations in the same order: same values.
+    const int3 l = local_coords(column);
     bool kept = false, surface_near = false;
 #pragma unroll
     for (int z = 0; z < kBlockSide; ++z) {
-      const int3 l = local_coords(column + kColumns * z);
-      const vec3 g{float(b.x * 8 + l.x), float(b.y * 8 + l.y), float(b.z * 8 + l.z)};
+      const vec3 g{float(b.x * 8 + l.x), float(b.y * 8 + l.y), float(b.z * 8 + z)};
       Voxel& vz = v[kColumns * z];
       fuse_voxel(vz, geom.to_world(g), in, camera_T_world, geom.truncation, max_weight, color);
       kept = kept || (keep.data && voxel_keeps_block(vz, keep_below));
