@@ -40,15 +40,15 @@ constexpr double kPersonStart = 1.0;
 Device device() { return cuda_available() ? Device::CUDA : Device::CPU; }
 int downscale() { return device() == Device::CUDA ? 1 : 2; }
 
-// configs/dynamic_person.yaml's scene, at the Kinect's resolution on the GPU and at half of it on the CPU.
-InputParams scene(bool with_movers) {
+// configs/dynamic_person.yaml's scene, at the Kinect's resolution on the GPU and at half of it on the
+// CPU, or at 1/k of it.
+InputParams scene(bool with_movers, int k = downscale()) {
   InputParams in;
   in.source = InputSource::synthetic;
   in.synthetic.frames = kFrames;
   in.synthetic.fps = kFps;
   in.synthetic.speed_deg = 15.f;
   in.intrinsics.preset = "custom";
-  const int k = downscale();
   in.intrinsics.fx = in.intrinsics.fy = 525.f / k;  // the Kinect's focal length in pixels
   in.intrinsics.cx = (640.f / k - 1.f) * 0.5f, in.intrinsics.cy = (480.f / k - 1.f) * 0.5f;
   in.intrinsics.width = 640 / k, in.intrinsics.height = 480 / k;
@@ -126,7 +126,7 @@ Outcome run(const InputParams& in, bool dynamic, const std::string& tracker = "i
   p.dynamic.evidence_min_weight = variant.evidence_min_weight;
   StageTimer stages(device());
   p.volume_stages = &stages;
-  std::unique_ptr<Volume> volume = make_volume(p.volume, device());  // ground_truth makes none itself
+  std::unique_ptr<Volume> volume = make_volume(p.volume, device());  // given: with dynamic off the session makes none
   if (variant.store_free_space) volume->set_free_space_storage(true);
   TrackingSession s(p, device(), src.intrinsics(), volume.get());
   SE3 world_T_room = SE3::identity();
@@ -285,11 +285,8 @@ TEST(Dynamic, SlowFreeSpaceEvidenceOnTheHashedVolume) {
 // above one half) and most masked pixels are the person's (precision above one half), averaged over
 // the frames where the movers cover at least 1 % of the image. Masking nothing gives recall 0.
 TEST(Dynamic, AVolumeOfItsOwnForATrackerWithoutOne) {
-  InputParams in = scene(true);
+  InputParams in = scene(true, 4);  // 160x120
   in.synthetic.frames = 70;
-  in.intrinsics.fx = in.intrinsics.fy = 525.f / 4;
-  in.intrinsics.cx = 79.5f, in.intrinsics.cy = 59.5f;
-  in.intrinsics.width = 160, in.intrinsics.height = 120;
   SyntheticSource src(in);
   TrackSequenceParams p = params(true, "ground_truth");
   TrackingSession s(p, Device::CPU, src.intrinsics(), nullptr);
