@@ -16,8 +16,9 @@ template <class Exec> inline constexpr int kBilateralRun = Exec::device == Devic
 // a weight of +0 (sums of non-negative terms: the same bits as skipping it).
 // On x86-64 CPUs the run is also compiled for AVX2 (8 pixels an instruction instead of SSE2's 4), and
 // the loader picks the variant the processor has (target_clones). AVX2 without FMA rounds every
-// operation as the baseline code does, so both give the same bits.
-#if !defined(__CUDACC__) && defined(__x86_64__) && defined(__GNUC__)
+// operation as the baseline code does, so both give the same bits. gcc only: clang (the fuzz
+// build's compiler) does not multiversion function templates, and gets the SSE2 code alone.
+#if !defined(__CUDACC__) && defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define SEAMLESS_BILATERAL_RUN __attribute__((target_clones("avx2", "default")))
 #else
 #define SEAMLESS_BILATERAL_RUN inline
