@@ -17,6 +17,7 @@
 #include "app/run_summary.hpp"
 #include "config/config.hpp"
 #include "core/error.hpp"
+#include "io/movers.hpp"
 #include "io/trajectory.hpp"
 #include "physics/particle_io.hpp"
 #include "physics/particle_solver.hpp"
@@ -107,6 +108,8 @@ int run(const CommonOptions& o) {
   const Trajectory& traj = scan_result.tracking.trajectory;
   summary.intrinsics = scan_result.intrinsics;
   add_tracking(summary, scan_result.tracking, scan_result.unreadable, groundtruth_path(ctx));
+  summary.mask_quality =
+      mask_quality(scan_result.tracking.frames, mover_ids(e.input.synthetic.movers, MoverKind::person));
   if (const std::string gt = groundtruth_path(ctx); !gt.empty())
     summary.ghost_vertices =
         ghost_vertices(scan_result.mesh, e.input, traj, read_tum_trajectory(gt), 2 * e.volume.voxel_size);

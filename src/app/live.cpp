@@ -18,6 +18,7 @@
 #include "core/progress.hpp"
 #include "io/frame_source.hpp"
 #include "io/intrinsics_presets.hpp"
+#include "io/movers.hpp"
 #include "io/trajectory.hpp"
 #include "physics/builders.hpp"
 #include "physics/depth_colliders.hpp"
@@ -196,6 +197,7 @@ class LiveLoop : public FrameLoop {
     sum.spawns = spawns_;
     sum.physics = solver_.stats();
     sum.dynamic_masked_fraction = mean_dynamic_fraction(records_);
+    sum.mask_quality = mask_quality(records_, mover_ids(e_.input.synthetic.movers, MoverKind::person));
     if (!groundtruth_.empty())  // the source's own poses (the synthetic room's)
       sum.ghost_vertices = ghost_vertices(mesh, e_.input, poses_, groundtruth_, 2 * e_.volume.voxel_size);
     if (online_) sum.online_refine = online_->stats();

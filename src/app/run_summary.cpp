@@ -78,7 +78,7 @@ Json median_max(const std::vector<double>& v) {
 }
 
 // refine.online: the tracking thread's time per frame (handover_ms) and the background's per
-// keyframe and per Ceres solve (docs/OUTPUTS.md).
+// keyframe and per Ceres solve (docs/PLACEMENT.md, "summary.json").
 Json online_json(const OnlineRefineStats& o) {
   return {{"keyframes", o.keyframes},
           {"solves", o.solves},
@@ -92,6 +92,20 @@ Json online_json(const OnlineRefineStats& o) {
           {"keyframe_s", median_max(o.keyframe_s)},
           {"solve_s", median_max(o.solve_s)},
           {"final_wait_s", o.final_wait_s}};
+}
+// A NaN (a mover never in view, nothing masked) as null: JSON has no NaN.
+Json number_or_null(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+
+Json mask_json(const MaskQuality& q) {
+  Json below = Json::array(), recall = Json::array();
+  for (const auto& [frame, iou] : q.below) below.push_back({{"frame", frame}, {"iou", iou}});
+  for (double r : q.mover_recall) recall.push_back(number_or_null(r));
+  return {{"frames_scored", q.frames},
+          {"iou_min", number_or_null(q.min_iou)},
+          {"iou_mean", number_or_null(q.mean_iou)},
+          {"frames_under_0_8", below},
+          {"recall_by_mover", recall},
+          {"precision", number_or_null(q.precision)}};
 }
 }  // namespace
 
@@ -108,10 +122,11 @@ void write_summary(const std::string& path, const RunSummary& s) {
   j["frames"] = {
       {"read", s.frames_read}, {"lost", s.frames_lost}, {"fused", s.frames_fused}, {"unreadable", s.frames_unreadable}};
   if (s.ate_rmse_m) j["ate"] = {{"rmse_m", *s.ate_rmse_m}, {"pairs", s.ate_pairs}};
-  if (s.dynamic_masked_fraction || s.ghost_vertices) {
+  if (s.dynamic_masked_fraction || s.ghost_vertices || s.mask_quality) {
     Json& d = j["dynamic"] = Json::object();
     if (s.dynamic_masked_fraction) d["mean_masked_fraction"] = *s.dynamic_masked_fraction;
     if (s.ghost_vertices) d["ghost_vertices"] = *s.ghost_vertices;
+    if (s.mask_quality) d["mask"] = mask_json(*s.mask_quality);
   }
   if (s.floor_height) j["floor_height"] = *s.floor_height;
   Json& surfaces = j["surfaces"] = Json::array();

@@ -1,5 +1,5 @@
 // What a run says about itself: which dynamic particles escaped the scanned scene, and summary.json
-// (docs/OUTPUTS.md), which scripts read instead of log lines.
+// (docs/PLACEMENT.md, "summary.json"), which scripts read instead of log lines.
 #pragma once
 #include <optional>
 #include <string>
@@ -39,6 +39,7 @@ struct RunSummary {
   std::int64_t ate_pairs = 0;
   std::optional<double> dynamic_masked_fraction;  // dynamic.enabled: mean over the tracked frames
   std::optional<std::int64_t> ghost_vertices;     // synthetic movers: what they left in the map (app/ghost.hpp)
+  std::optional<MaskQuality> mask_quality;        // synthetic movers: the dynamic mask against their masks
   std::vector<ResolvedPlacement> placements;
   std::vector<SpawnParams> spawns;  // as resolved
   std::optional<SolverStats> physics;

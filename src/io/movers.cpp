@@ -98,4 +98,11 @@ std::string movers_lines(double timestamp, const kernels::movers::Scene& s) {
   return out;
 }
 
+std::vector<int> mover_ids(const std::vector<MoverParams>& movers, MoverKind kind) {
+  std::vector<int> ids;
+  for (std::size_t i = 0; i < movers.size(); ++i)
+    if (movers[i].kind == kind) ids.push_back(static_cast<int>(i) + 1);
+  return ids;
+}
+
 }  // namespace seamless

@@ -14,6 +14,9 @@ namespace seamless {
 // of fewer than two distinct points or more capsules than the renderer takes.
 kernels::movers::Scene pose_movers(const std::vector<MoverParams>& movers, double t);
 
+// The ids (1-based, as in the mask) of the movers of one kind.
+std::vector<int> mover_ids(const std::vector<MoverParams>& movers, MoverKind kind);
+
 // movers.txt: a line per frame and capsule, `timestamp mover ax ay az bx by bz radius`, in the
 // room frame of groundtruth.txt; a frame with no mover present has no line.
 std::string movers_lines(double timestamp, const kernels::movers::Scene& s);

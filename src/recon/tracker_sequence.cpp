@@ -90,6 +90,13 @@ void log_lost(const FrameRecord& rec) {
 }
 }  // namespace
 
+std::optional<MaskQuality> mask_quality(const std::vector<FrameRecord>& frames, const std::vector<int>& people) {
+  std::vector<std::pair<std::int64_t, MaskScore>> scores;
+  for (const FrameRecord& f : frames)
+    if (f.mask_score) scores.push_back({f.frame, *f.mask_score});
+  return mask_quality(scores, people);
+}
+
 void write_dynamic_mask(const std::string& out_dir, std::int64_t index, const TrackingSession& session) {
   const std::string dir = out_dir + "/dynamic_mask";
   std::filesystem::create_directories(dir);

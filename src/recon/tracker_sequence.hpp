@@ -17,6 +17,7 @@
 #include "io/trajectory.hpp"
 #include "recon/dynamic_params.hpp"
 #include "recon/external/odometry.hpp"
+#include "recon/mask_score.hpp"
 #include "recon/preprocess.hpp"
 #include "recon/tracker.hpp"
 #include "recon/tracker_gravity.hpp"
@@ -73,6 +74,9 @@ struct FrameRecord {
   double dynamic_ms = 0;
   // dynamic.enabled: the fraction of the frame's pixels in its dynamic mask (NaN when off).
   double dynamic_fraction = std::numeric_limits<double>::quiet_NaN();
+  // dynamic.enabled on a source with the movers' ground truth (the synthetic room's movers): the
+  // mask against it (recon/mask_score.hpp); none for a frame without a mask (the first, a lost one).
+  std::optional<MaskScore> mask_score;
 };
 
 // The per-frame state machine. World frame: the first camera, rotated so that gravity is world -y
@@ -194,6 +198,10 @@ void write_tracking_stats(const std::string& path, const std::vector<FrameRecord
 // last frame is dynamic (an empty mask before the first frame with a model). `seamless track` and
 // `seamless run` both write them.
 void write_dynamic_mask(const std::string& out_dir, std::int64_t index, const TrackingSession& session);
+// The run's mask quality from the frames' mask scores (recon/mask_score.hpp; people: the persons'
+// mover ids); nothing when no frame has one (dynamic handling off, or a source without the movers'
+// ground truth).
+std::optional<MaskQuality> mask_quality(const std::vector<FrameRecord>& frames, const std::vector<int>& people);
 
 // The trackers this build knows (tracker.kind values): every entry says whether it is available and,
 // if not, what to install. Adding a tracker is one entry in tracker_registry() plus its

@@ -89,6 +89,7 @@ struct Variant {
 struct Outcome {
   double ate_m = 0;  // ATE RMSE after se3 alignment (seamless eval's)
   double min_iou = 1, mean_iou = 0;
+  std::vector<double> mover_recall;  // per mover (person, ball), over every frame with a mask
   int iou_frames = 0;
   std::int64_t ghost_vertices = 0;  // mesh vertices inside the person's swept volume
   double mean_fraction = 0;
@@ -103,6 +104,9 @@ struct Outcome {
 };
 
 void print_below(const char* what, const Outcome& o) {
+  std::printf("%s: recall per mover", what);
+  for (double r : o.mover_recall) std::printf(" %.3f", r);
+  std::printf("\n");
   if (o.below.empty()) return;
   std::printf("%s: %zu frames with IoU under 0.8:", what, o.below.size());
   for (const auto& [frame, iou] : o.below) std::printf(" %lld (%.2f)", static_cast<long long>(frame), iou);
@@ -130,12 +134,12 @@ Outcome run(const InputParams& in, bool dynamic, const std::string& tracker = "i
   if (variant.store_free_space) volume->set_free_space_storage(true);
   TrackingSession s(p, device(), src.intrinsics(), volume.get());
   SE3 world_T_room = SE3::identity();
-  const std::vector<MoverParams> person{in.synthetic.movers.empty() ? MoverParams{} : in.synthetic.movers[0]};
   Outcome o;
   RgbdFrame f;
   Trajectory est, gt;
-  double iou_sum = 0, fraction_sum = 0, fused_sum = 0;
+  double fraction_sum = 0, fused_sum = 0;
   std::vector<double> dynamic_ms;
+  std::vector<std::pair<std::int64_t, MaskScore>> scores;
   int n = 0;
   while (src.next(f)) {
     const FrameRecord r = s.process(f);
@@ -150,24 +154,8 @@ Outcome run(const InputParams& in, bool dynamic, const std::string& tracker = "i
     if (!dynamic || in.synthetic.movers.empty() || f.index == 0) continue;
     fraction_sum += r.dynamic_fraction;
     dynamic_ms.push_back(r.dynamic_ms);
-    // Mask quality where the person is at least 0.5 m from the camera (the issue's condition) and
-    // covers at least 1% of the image: a sliver at the image border has a handful of pixels, where
-    // one pixel of silhouette is already 10% of the IoU.
-    const auto scene_now = pose_movers(person, f.timestamp);
-    if (scene_now.count == 0 || kernels::movers::distance(scene_now, f.ground_truth->t) < 0.5f) continue;
-    const std::vector<std::uint8_t> truth = f.mover_mask.to_host(), mine = s.dynamic_mask().to_host();
-    std::int64_t inter = 0, uni = 0, truth_n = 0;
-    for (std::size_t i = 0; i < truth.size(); ++i) {
-      inter += truth[i] && mine[i];
-      uni += truth[i] || mine[i];
-      truth_n += truth[i] != 0;
-    }
-    if (truth_n < static_cast<std::int64_t>(truth.size() / 100)) continue;
-    const double iou = static_cast<double>(inter) / static_cast<double>(uni);
-    if (iou < 0.8) o.below.push_back({f.index, iou});
-    o.min_iou = std::min(o.min_iou, iou);
-    iou_sum += iou;
-    ++o.iou_frames;
+    // Mask quality (issue 22's condition, recon/mask_score.hpp): scored by the session itself.
+    if (r.mask_score) scores.push_back({f.index, *r.mask_score});
   }
   o.allocate_ms = stages.median_ms("allocate"), o.visible_ms = stages.median_ms("visible");
   o.fuse_ms = stages.median_ms("fuse"), o.dynamic_ms = median(dynamic_ms);
@@ -176,7 +164,9 @@ Outcome run(const InputParams& in, bool dynamic, const std::string& tracker = "i
   o.volume = s.volume()->stats();
   const AteResult ate = compute_ate(est, gt);
   o.ate_m = ate.trans.rmse;
-  o.mean_iou = o.iou_frames ? iou_sum / o.iou_frames : 0;
+  if (const std::optional<MaskQuality> q = mask_quality(scores, mover_ids(in.synthetic.movers, MoverKind::person)))
+    o.min_iou = q->min_iou, o.mean_iou = q->mean_iou, o.iou_frames = q->frames, o.below = q->below,
+    o.mover_recall = q->mover_recall;
   o.mean_fraction = fraction_sum / std::max(1, n - 1);
   // The ghost: mesh vertices inside the person's capsules of any frame, shrunk by 2 voxels so that
   // the floor the feet stand on (a true surface within a voxel of the leg capsules' ends) does not

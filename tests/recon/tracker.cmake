@@ -7,3 +7,5 @@ seamless_test(test_tracker_external SOURCES external_tracker_test.cpp LIBS seaml
 # Issue 22: dynamic pixels, ghosts and tracking with a person walking through (Parity: label gpu).
 seamless_test(test_dynamic SOURCES dynamic_test.cpp LIBS seamless_tracker seamless_eval)
 seamless_test(test_dynamic_kernels SOURCES dynamic_kernels_test.cpp LIBS seamless_tracker seamless_eval)
+# The dynamic mask against the movers' ground truth (recon/mask_score; summary.json dynamic.mask).
+seamless_test(test_mask_score SOURCES mask_score_test.cpp LIBS seamless_tracker)
