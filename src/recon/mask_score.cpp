@@ -69,8 +69,10 @@ std::optional<MaskQuality> mask_quality(const std::vector<std::pair<std::int64_t
   std::vector<std::int64_t> truth_n, hit_n;
   for (const auto& [frame, s] : frame_scores) {
     masked += s.masked, both += s.both;
-    if (s.mover_truth.size() > truth_n.size()) truth_n.resize(s.mover_truth.size(), 0), hit_n.resize(s.mover_truth.size(), 0);
-    for (std::size_t k = 0; k < s.mover_truth.size(); ++k) truth_n[k] += s.mover_truth[k], hit_n[k] += s.mover_masked[k];
+    if (s.mover_truth.size() > truth_n.size())
+      truth_n.resize(s.mover_truth.size(), 0), hit_n.resize(s.mover_truth.size(), 0);
+    for (std::size_t k = 0; k < s.mover_truth.size(); ++k)
+      truth_n[k] += s.mover_truth[k], hit_n[k] += s.mover_masked[k];
     if (!mask_scored(s, people)) continue;
     const double iou = s.iou();
     ++q.frames;

@@ -14,10 +14,10 @@ namespace seamless {
 
 // A frame's pixel counts. Mover ids are 1-based (the truth mask's values); index id - 1 below.
 struct MaskScore {
-  std::int64_t pixels = 0;  // of the image
-  std::int64_t truth = 0;   // pixels that see a mover
-  std::int64_t masked = 0;  // pixels of the dynamic mask
-  std::int64_t both = 0;    // pixels in both
+  std::int64_t pixels = 0;                              // of the image
+  std::int64_t truth = 0;                               // pixels that see a mover
+  std::int64_t masked = 0;                              // pixels of the dynamic mask
+  std::int64_t both = 0;                                // pixels in both
   std::vector<std::int64_t> mover_truth, mover_masked;  // each mover's pixels, and those of them masked
   // Each mover's distance from the camera (its nearest capsule's surface, metres); +infinity for
   // one not in the room at this frame's time.
@@ -43,8 +43,8 @@ bool mask_scored(const MaskScore& s, const std::vector<int>& people);
 // A run's mask quality: IoU over the scored frames; recall per mover and precision over every frame
 // with a score (a mover near the camera, at the border or alone in the room is still one to find).
 struct MaskQuality {
-  int frames = 0;                    // scored frames
-  double min_iou = 0, mean_iou = 0;  // NaN when no frame was scored
+  int frames = 0;                                      // scored frames
+  double min_iou = 0, mean_iou = 0;                    // NaN when no frame was scored
   std::vector<std::pair<std::int64_t, double>> below;  // scored frames with IoU under kGoodIou: (frame, IoU)
   std::vector<double> mover_recall;                    // index id - 1; NaN for a mover never seen
   double precision = 0;                                // masked pixels that see a mover; NaN when nothing was masked

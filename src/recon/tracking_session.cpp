@@ -402,6 +402,7 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
   marks_.mark(kPreprocessed);
   const bool tracked = started_;
   const ReferenceMaps* dyn_model = nullptr;
+  bool masked = false;  // this frame has a dynamic mask
   if (!started_) {
     first_frame(frame, rec);
   } else {
@@ -418,10 +419,7 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
       rec.dynamic_fraction = static_cast<double>(kernels::Dynamic<E>::count_dynamic(ex, dyn_mask_.cview())) /
                              static_cast<double>(K_.width * K_.height);
     });
-    if (frame.movers && frame.ground_truth && frame.mover_mask.width() == dyn_mask_.width() &&
-        frame.mover_mask.height() == dyn_mask_.height())
-      rec.mask_score =
-          score_mask(frame.mover_mask.to_host(), dyn_mask_.to_host(), *frame.movers, frame.ground_truth->t);
+    masked = true;
     // The next frame's temporal support is what this frame kept, not the mask grown from it: the
     // grown border reaches static neighbours at the mover's depth, which are then never fused and,
     // from the mask, would support themselves frame after frame (a line left on the desk's edge).
@@ -470,6 +468,11 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
     p_.volume_stages->end_frame(rec.frame);
     rec.allocate_ms = volume_allocate_ms(first_row);
   }
+  // The mask against the movers' ground truth (synthetic movers), after the frame's last mark:
+  // its downloads are in no stage's time.
+  if (masked && frame.movers && frame.ground_truth && frame.mover_mask.width() == dyn_mask_.width() &&
+      frame.mover_mask.height() == dyn_mask_.height())
+    rec.mask_score = score_mask(frame.mover_mask.to_host(), dyn_mask_.to_host(), *frame.movers, frame.ground_truth->t);
   return rec;
 }
 

@@ -55,7 +55,7 @@ TEST(MaskScore, ScoresFramesWithEveryPersonHalfAMetreAwayAndTheMoversInView) {
   EXPECT_TRUE(mask_scored(score_mask(truth, mask, two_movers(0.51f, 2.f), kEye), kPeople));
   EXPECT_FALSE(mask_scored(score_mask(truth, mask, two_movers(0.49f, 2.f), kEye), kPeople));  // person too near
   EXPECT_TRUE(mask_scored(score_mask(truth, mask, two_movers(1.f, 0.3f), kEye), kPeople));    // a near ball: fine
-  EXPECT_FALSE(mask_scored(score_mask(truth, mask, two_movers(1.f, 0.3f), kEye), {}));  // every mover a person
+  EXPECT_FALSE(mask_scored(score_mask(truth, mask, two_movers(1.f, 0.3f), kEye), {}));        // every mover a person
   kernels::movers::Scene ball_only;
   add_sphere(ball_only, 2.f, 2);
   EXPECT_FALSE(mask_scored(score_mask(truth, mask, ball_only, kEye), kPeople));  // no person in the room
@@ -70,9 +70,9 @@ TEST(MaskScore, ScoresFramesWithEveryPersonHalfAMetreAwayAndTheMoversInView) {
 
 TEST(MaskScore, RunQualityOverFrames) {
   EXPECT_FALSE(mask_quality({}, kPeople).has_value());
-  const MaskScore good = score_mask(truth_4x4(), truth_4x4(), two_movers(1.f, 2.f), kEye);   // IoU 1
-  const MaskScore part = score_mask(truth_4x4(), mask_4x4(), two_movers(1.f, 2.f), kEye);    // IoU 3/7
-  const MaskScore near = score_mask(truth_4x4(), mask_4x4(), two_movers(0.3f, 2.f), kEye);   // not scored
+  const MaskScore good = score_mask(truth_4x4(), truth_4x4(), two_movers(1.f, 2.f), kEye);  // IoU 1
+  const MaskScore part = score_mask(truth_4x4(), mask_4x4(), two_movers(1.f, 2.f), kEye);   // IoU 3/7
+  const MaskScore near = score_mask(truth_4x4(), mask_4x4(), two_movers(0.3f, 2.f), kEye);  // not scored
   const auto q = mask_quality({{1, good}, {2, part}, {3, near}}, kPeople);
   ASSERT_TRUE(q.has_value());
   EXPECT_EQ(q->frames, 2);
