@@ -35,6 +35,20 @@ struct DynamicInput {
   // dz = z^2 * disparity_step / (f b) (src/io/depth_scale.cpp; the synthetic sensor quantises the
   // same way with the frame's own fx). Pixels per metre of baseline; 0: no quantisation.
   float disparity_step_per_baseline = 0.125f / 0.075f;
+  // free_space_evidence views: a pixel with a reading and no model surface near its projection is
+  // 2 (undecided: views_evidence decides it) instead of 0.
+  bool undecided_without_model = false;
+};
+
+// Past views of the depth camera (free_space_evidence views, docs/DYNAMIC.md): up to kMax depth
+// maps of one pyramid level with the poses they were taken from, the newest last or anywhere (the
+// order does not matter).
+struct PastViews {
+  static constexpr int kMax = 16;
+  View2D<const float> depth[kMax];  // metres, 0 = no reading; unmasked (a mover's readings count)
+  SE3 view_T_world[kMax];
+  Intrinsics K;  // of the stored level
+  int count = 0;
 };
 
 // One depth quantisation step at depth z (metres).
@@ -77,6 +91,36 @@ SEAMLESS_HD inline SpaceEvidence space_evidence(const Acc& a, vec3 p_world, floa
   return sdf >= 0.5f * a.geom.truncation ? SpaceEvidence::seen_free : SpaceEvidence::occupied;
 }
 
+// What the past views show of the world point p. Seen through (free) by a view: p lies in front of
+// every reading of the 3x3 pixels around its projection there by more than the residual threshold,
+// so the ray of each passed through p to a surface behind it. All nine readings must exist and lie
+// behind: at a silhouette the window holds the near object's readings too, so a point on a static
+// object's edge is never seen through by a neighbouring pixel that saw past the edge (the same 3x3
+// rule as free-space carving, kernels/recon/tsdf_fusion.inl). Seen at: the reading at its
+// projection lies within the threshold of it (a surface was there). Neither: out of every view,
+// or hidden behind nearer readings. A static surface is never seen through: its point is either
+// seen at or hidden.
+enum class ViewEvidence : std::uint8_t { none, seen_at, seen_through };
+
+SEAMLESS_HD inline ViewEvidence view_evidence(const DynamicInput& in, const PastViews& views, vec3 p_world) {
+  ViewEvidence e = ViewEvidence::none;
+  for (int k = 0; k < views.count; ++k) {
+    const vec3 p = views.view_T_world[k] * p_world;
+    if (!(p.z > 0.f)) continue;
+    const vec2 uv = views.K.project(p);
+    const int u0 = floor_int(uv.x + 0.5f), v0 = floor_int(uv.y + 0.5f);
+    const View2D<const float>& d = views.depth[k];
+    if (!d.inside(u0 - 1, v0 - 1) || !d.inside(u0 + 1, v0 + 1)) continue;
+    const float threshold = dynamic_threshold(in, p.z);
+    if (fabsf(d(u0, v0) - p.z) <= threshold) e = ViewEvidence::seen_at;
+    bool through = true;
+    for (int dy = -1; dy <= 1 && through; ++dy)
+      for (int dx = -1; dx <= 1 && through; ++dx) through = d(u0 + dx, v0 + dy) > p.z + threshold;
+    if (through) return ViewEvidence::seen_through;
+  }
+  return e;
+}
+
 template <Executor Exec> struct Dynamic {
   // Candidates (1) per pixel: the measurement lies in front of the model, either (a) no model plane
   // near its projection lies within the residual threshold of it (point-to-plane, either side) and
@@ -104,13 +148,39 @@ template <Executor Exec> struct Dynamic {
   // front of one seen before (a chair's seat after the floor beneath it was seen from the side),
   // and a person who stopped (as in ReFusion, Palazzolo et al. 2019, a mover at rest joins the
   // map). Non-candidates get age 0 and anchor 0.
+  // Evidence of free space from past views (free_space_evidence views), after ReFusion (Palazzolo
+  // et al. 2019, section III-D: a measurement in front of the model is dynamic only where earlier
+  // frames saw empty space), with the last views' depth maps as the record of it instead of free
+  // space stored in the volume (no blocks in front of the readings to allocate, fuse and march
+  // through). Per pixel, from the model test's candidates (1) and undecided pixels (2: a reading
+  // with no model near, DynamicInput::undecided_without_model), by view_evidence of its point:
+  // - seen through by a view: a candidate (1), undecided or not;
+  // - a model candidate that continues a mover of the previous frame: within search_radius pixels of
+  //   where its point lands in the previous frame's camera (prev_T_cur) a pixel that frame kept as
+  //   1 (prev_kept, filter_dynamic's) has a depth (prev_depth) within the residual threshold of the
+  //   point's: 1. The space a mover covers was last seen empty before it came, perhaps by views
+  //   older than the history (the back half of a ball rolling into a region the orbit saw seconds
+  //   ago, where in the recent views the ball itself stood);
+  // - a model candidate that no view saw at all (out of the views, or hidden): 2, dynamic this frame
+  //   but not continued by the next (it needs evidence of its own by then: once the views hold
+  //   it, it is seen through, or seen at, i.e. static);
+  // - else 0.
+  // So a surface first seen in front of one seen before (a chair's seat after the floor beneath
+  // it) is masked at most until a view holds it, then fused; a person walking into space the
+  // camera saw past is a candidate and stays one while the model test holds. prev_kept may be
+  // empty (data == nullptr: no continuation).
+  static void views_evidence(const Exec& ex, DynamicInput in, SE3 world_T_cur, PastViews views,
+                             View2D<const std::uint8_t> prev_kept, View2D<const float> prev_depth, SE3 prev_T_cur,
+                             View2D<std::uint8_t> candidates);
+
   static void age_dynamic(const Exec& ex, DynamicInput in, View2D<const float> prev_anchor,
                           View2D<const std::uint8_t> prev_age, SE3 prev_T_cur, int static_after,
                           View2D<std::uint8_t> candidates, View2D<std::uint8_t> age, View2D<float> anchor);
 
   // Region and temporal consistency: a candidate stays dynamic when at least min_support of the
   // (2r+1)^2 candidates around it (itself included) are candidates, or when the previous frame kept
-  // it (its `kept`, not its grown mask; prev may be empty: data == nullptr); then the kept pixels
+  // it (its `kept`, not its grown mask; prev may be empty: data == nullptr); a kept pixel keeps its
+  // candidate's value (views_evidence's 2 marks one not to be continued). Then the kept pixels
   // are dilated by r into neighbours whose depth is within max_step of theirs (the silhouette's
   // mixed pixels, never the background behind) and into neighbours without a reading (the sensor
   // drops a mover's silhouette and scattered pixels on it: a fifth of a person's pixels in the

@@ -40,10 +40,45 @@ void Dynamic<Exec>::classify_dynamic(const Exec& ex, DynamicInput in, View2D<std
         front = fmaxf(front, r);
         nearest = fminf(nearest, m.z);
       }
-    if (!any) return;
+    if (!any) {
+      if (in.undecided_without_model) candidates(x, y) = 2;
+      return;
+    }
     const bool residual = !fits && front > threshold;       // (a)
     const bool free_space = p.z < nearest - in.free_space;  // (b)
     candidates(x, y) = residual || free_space ? 1 : 0;
+  });
+}
+
+template <Executor Exec>
+void Dynamic<Exec>::views_evidence(const Exec& ex, DynamicInput in, SE3 world_T_cur, PastViews views,
+                                   View2D<const std::uint8_t> prev_kept, View2D<const float> prev_depth, SE3 prev_T_cur,
+                                   View2D<std::uint8_t> candidates) {
+  const int w = in.depth.width;
+  const bool has_prev = prev_kept.data != nullptr && prev_depth.data != nullptr;
+  ex.for_each(in.depth.count(), [=] SEAMLESS_HD(std::int64_t i) {
+    const int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
+    const std::uint8_t c = candidates(x, y);
+    if (!c) return;  // a candidate or an undecided pixel has a reading
+    const vec3 p_cur = in.K.unproject(static_cast<float>(x), static_cast<float>(y), in.depth(x, y));
+    const ViewEvidence e = view_evidence(in, views, world_T_cur * p_cur);
+    if (e == ViewEvidence::seen_through) {
+      candidates(x, y) = 1;
+      return;
+    }
+    bool continued = false;
+    const vec3 p = prev_T_cur * p_cur;
+    if (c == 1 && has_prev && p.z > 0.f) {
+      const vec2 uv = in.K.project(p);
+      const int u0 = floor_int(uv.x + 0.5f), v0 = floor_int(uv.y + 0.5f);
+      const float threshold = dynamic_threshold(in, p.z);
+      for (int dy = -in.search_radius; dy <= in.search_radius && !continued; ++dy)
+        for (int dx = -in.search_radius; dx <= in.search_radius && !continued; ++dx) {
+          const int u = u0 + dx, v = v0 + dy;
+          continued = prev_kept.inside(u, v) && prev_kept(u, v) == 1 && fabsf(prev_depth(u, v) - p.z) <= threshold;
+        }
+    }
+    candidates(x, y) = continued ? 1 : c == 1 && e == ViewEvidence::none ? 2 : 0;
   });
 }
 
@@ -99,13 +134,13 @@ void Dynamic<Exec>::filter_dynamic(const Exec& ex, View2D<const std::uint8_t> ca
       for (int dy = -radius; dy <= radius; ++dy)
         for (int dx = -radius; dx <= radius; ++dx)
           if (candidates.inside(x + dx, y + dy) && candidates(x + dx, y + dy)) ++support;
-      k = support >= min_support || (has_prev && prev(x, y)) ? 1 : 0;
+      k = support >= min_support || (has_prev && prev(x, y)) ? candidates(x, y) : 0;
     }
     kept(x, y) = k;
   });
   ex.for_each(candidates.count(), [=] SEAMLESS_HD(std::int64_t i) {
     const int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
-    std::uint8_t m = kept(x, y);
+    std::uint8_t m = kept(x, y) ? 1 : 0;
     const float d = depth(x, y);
     if (!m)
       for (int dy = -radius; dy <= radius && !m; ++dy)

@@ -20,8 +20,8 @@ std::optional<std::pair<SE3, SE3>> first_common_pose(const Trajectory& a, const 
 
 }  // namespace
 
-std::optional<std::int64_t> ghost_vertices(const Mesh& mesh, const InputParams& in, const Trajectory& estimate,
-                                           const Trajectory& groundtruth, float margin) {
+std::optional<GhostCount> ghost_vertices(const Mesh& mesh, const InputParams& in, const Trajectory& estimate,
+                                         const Trajectory& groundtruth, float margin) {
   if (in.source != InputSource::synthetic || in.synthetic.movers.empty()) return std::nullopt;
   const auto poses = first_common_pose(estimate, groundtruth);
   if (!poses) return std::nullopt;
@@ -40,16 +40,20 @@ std::optional<std::int64_t> ghost_vertices(const Mesh& mesh, const InputParams& 
     }
     track.push_back(s);
   }
-  std::int64_t ghost = 0;
+  GhostCount ghost;
+  ghost.by_mover.assign(in.synthetic.movers.size(), 0);
   for (const vec3& v : mesh.positions) {
     const vec3 q = room_T_world * v;
     if (q.x < lo.x || q.y < lo.y || q.z < lo.z || q.x > hi.x || q.y > hi.y || q.z > hi.z) continue;
     if (std::fabs(kernels::room::room_sdf(q)) < margin) continue;
-    for (const kernels::movers::Scene& s : track)
-      if (kernels::movers::distance(s, q) < -margin) {
-        ++ghost;
+    for (const kernels::movers::Scene& s : track) {
+      int nearest = 0;
+      if (kernels::movers::distance(s, q, &nearest) < -margin) {
+        ++ghost.total;
+        ++ghost.by_mover.at(static_cast<std::size_t>(s.c[nearest].mover - 1));
         break;
       }
+    }
   }
   return ghost;
 }

@@ -125,7 +125,10 @@ void write_summary(const std::string& path, const RunSummary& s) {
   if (s.dynamic_masked_fraction || s.ghost_vertices || s.mask_quality) {
     Json& d = j["dynamic"] = Json::object();
     if (s.dynamic_masked_fraction) d["mean_masked_fraction"] = *s.dynamic_masked_fraction;
-    if (s.ghost_vertices) d["ghost_vertices"] = *s.ghost_vertices;
+    if (s.ghost_vertices) {
+      d["ghost_vertices"] = s.ghost_vertices->total;
+      d["ghost_vertices_by_mover"] = s.ghost_vertices->by_mover;
+    }
     if (s.mask_quality) d["mask"] = mask_json(*s.mask_quality);
   }
   if (s.floor_height) j["floor_height"] = *s.floor_height;

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "app/ghost.hpp"
 #include "app/placement.hpp"
 #include "core/camera.hpp"
 #include "physics/particle_solver.hpp"
@@ -38,7 +39,7 @@ struct RunSummary {
   std::optional<double> ate_rmse_m;  // against the input's ground truth, when it has one
   std::int64_t ate_pairs = 0;
   std::optional<double> dynamic_masked_fraction;  // dynamic.enabled: mean over the tracked frames
-  std::optional<std::int64_t> ghost_vertices;     // synthetic movers: what they left in the map (app/ghost.hpp)
+  std::optional<GhostCount> ghost_vertices;       // synthetic movers: what they left in the map (app/ghost.hpp)
   std::optional<MaskQuality> mask_quality;        // synthetic movers: the dynamic mask against their masks
   std::vector<ResolvedPlacement> placements;
   std::vector<SpawnParams> spawns;  // as resolved

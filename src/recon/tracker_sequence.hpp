@@ -132,6 +132,7 @@ class TrackingSession {
   const ReferenceMaps* dynamic_reference();
   const ReferenceMaps* mask_before_tracking();  // dynamic_reference(), and the tracker's pixels masked
   void find_dynamic(const ReferenceMaps& model, const SE3& world_T_camera);
+  void remember_view(const SE3& world_T_camera);  // free_space_evidence views: keep this frame's depth
 
   TrackSequenceParams p_;
   Device device_;
@@ -152,6 +153,13 @@ class TrackingSession {
   Image<std::uint8_t> dyn_age_, dyn_prev_age_;
   Image<float> dyn_anchor_, dyn_prev_anchor_;
   SE3 dyn_prev_pose_ = SE3::identity();
+  // free_space_evidence views: the kept depth maps (a ring), their cameras, the next slot to fill,
+  // and the frames remember_view has seen.
+  std::vector<Image<float>> dyn_views_;
+  Image<float> dyn_prev_depth_;  // the previous frame's depth (level 0), for the continuation of its kept pixels
+  std::vector<SE3> dyn_view_T_world_;
+  std::size_t dyn_view_next_ = 0;
+  std::int64_t dyn_view_frames_ = 0;
   Image<vec3> kept_vertices_, kept_normals_;  // params.keep_unmasked_level before masking
   bool kept_ = false;                         // they hold this frame's level
   Image<float> depth_, intensity_;

@@ -140,8 +140,20 @@ void TrackingSession::find_dynamic(const ReferenceMaps& model, const SE3& world_
   in.residual_sigmas = d.residual_sigmas;
   in.free_space = d.free_space_truncations * (volume_ ? volume_->params().truncation : p_.volume.truncation);
   in.search_radius = d.search_radius;
+  const bool views = d.free_space_evidence == FreeSpaceEvidence::views;
+  in.undecided_without_model = views;
+  kernels::PastViews past;
+  if (views) {
+    past.K = K_.level(std::min(d.evidence_view_level, pyr_.levels() - 1));
+    for (std::size_t k = 0; k < dyn_views_.size(); ++k)
+      past.depth[k] = dyn_views_[k].cview(), past.view_T_world[k] = dyn_view_T_world_[k];
+    past.count = static_cast<int>(dyn_views_.size());
+  }
   with_exec(device_, [&]<class E>(const E& ex) {
     kernels::Dynamic<E>::classify_dynamic(ex, in, dyn_candidates_.view());
+    if (views)
+      kernels::Dynamic<E>::views_evidence(ex, in, world_T_camera, past, dyn_prev_.cview(), dyn_prev_depth_.cview(),
+                                          dyn_prev_pose_.inverse() * world_T_camera, dyn_candidates_.view());
     // Evidence of free space: the volume at the measured points (world frame; the model maps are in
     // the reference camera's).
     if (d.free_space_evidence != FreeSpaceEvidence::none && volume_)
@@ -155,6 +167,23 @@ void TrackingSession::find_dynamic(const ReferenceMaps& model, const SE3& world_
                                         d.support_radius, d.min_support, d.dilate_max_step, dyn_kept_.view(),
                                         dyn_mask_.view());
   });
+}
+
+// Every evidence_view_interval-th frame with a pose, its depth at evidence_view_level (unmasked: a
+// mover's readings saw through the space in front of it too) replaces the oldest kept view.
+void TrackingSession::remember_view(const SE3& world_T_camera) {
+  const DynamicParams& d = p_.dynamic;
+  if (dyn_view_frames_++ % std::max(d.evidence_view_interval, 1) != 0) return;
+  const PyramidLevel& lv = pyr_.level(std::min(d.evidence_view_level, pyr_.levels() - 1));
+  const std::size_t n = static_cast<std::size_t>(std::clamp(d.evidence_views, 1, kernels::PastViews::kMax));
+  if (dyn_views_.size() < n) {
+    dyn_views_.emplace_back(lv.depth.width(), lv.depth.height(), device_);
+    dyn_view_T_world_.push_back(SE3::identity());
+    dyn_view_next_ = dyn_views_.size() - 1;
+  }
+  dyn_views_[dyn_view_next_].buffer().copy_from(lv.depth.buffer());
+  dyn_view_T_world_[dyn_view_next_] = world_T_camera.inverse();
+  dyn_view_next_ = (dyn_view_next_ + 1) % n;
 }
 
 TrackingSession::~TrackingSession() = default;
@@ -424,6 +453,11 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
     // grown border reaches static neighbours at the mover's depth, which are then never fused and,
     // from the mask, would support themselves frame after frame (a line left on the desk's edge).
     dyn_prev_.buffer().copy_from(dyn_kept_.buffer());
+    if (p_.dynamic.free_space_evidence == FreeSpaceEvidence::views) {
+      if (dyn_prev_depth_.width() != K_.width) dyn_prev_depth_ = Image<float>(K_.width, K_.height, device_);
+      dyn_prev_depth_.buffer().copy_from(pyr_.level(0).depth.buffer());
+      dyn_prev_pose_ = rec.result.world_T_camera;
+    }
     if (p_.dynamic.static_after_frames > 0) {
       std::swap(dyn_prev_age_, dyn_age_);  // the next frame's previous ages and anchors
       std::swap(dyn_prev_anchor_, dyn_anchor_);
@@ -432,6 +466,8 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
   } else if (p_.dynamic.enabled) {
     rec.dynamic_fraction = 0;  // the first frame, or a lost one: nothing masked, nothing fused
   }
+  if (p_.dynamic.enabled && p_.dynamic.free_space_evidence == FreeSpaceEvidence::views && rec.result.ok())
+    remember_view(rec.result.world_T_camera);
   marks_.mark(kTracked);
   if (rec.result.ok()) {
     if (lost_run_ > 0)

@@ -54,7 +54,25 @@ TEST(Ghost, CountsVerticesInsideTheMoversButNotTheRoomsOwnSurfaces) {
   for (vec3 q : {torso, floor, beside, later}) m.positions.push_back(world_T_room * q);
   const auto g = ghost_vertices(m, in, est, gt, 0.02f);
   ASSERT_TRUE(g.has_value());
-  EXPECT_EQ(*g, 1);
+  EXPECT_EQ(g->total, 1);
+  EXPECT_EQ(g->by_mover, std::vector<std::int64_t>{1});
+  // A second mover, a ball rolling 2 m from the person's path: a vertex inside it at 0.5 s counts
+  // for the ball (mover 2), the torso's still for the person.
+  InputParams two = in;
+  MoverParams ball;
+  ball.kind = MoverKind::ball, ball.path = {{-1.f, 3.2f, 0.f}, {1.f, 3.2f, 0.f}}, ball.speed = 0.5f, ball.radius = 0.2f;
+  two.synthetic.movers.push_back(ball);
+  const kernels::movers::Scene both = pose_movers(two.synthetic.movers, 0.5);
+  int ball_capsule = -1;
+  for (int i = 0; i < both.count; ++i)
+    if (both.c[i].mover == 2) ball_capsule = i;
+  ASSERT_GE(ball_capsule, 0);
+  Mesh m2 = m;
+  m2.positions.push_back(world_T_room * ((both.c[ball_capsule].a + both.c[ball_capsule].b) * 0.5f));
+  const auto g2 = ghost_vertices(m2, two, est, gt, 0.02f);
+  ASSERT_TRUE(g2.has_value());
+  EXPECT_EQ(g2->total, 2);
+  EXPECT_EQ(g2->by_mover, (std::vector<std::int64_t>{1, 1}));
   // Without movers, or with no common timestamp, there is no measure.
   InputParams none = in;
   none.synthetic.movers.clear();
