@@ -112,7 +112,9 @@ SEAMLESS_HD inline ViewEvidence view_evidence(const DynamicInput& in, const Past
     const View2D<const float>& d = views.depth[k];
     if (!d.inside(u0 - 1, v0 - 1) || !d.inside(u0 + 1, v0 + 1)) continue;
     const float threshold = dynamic_threshold(in, p.z);
-    if (fabsf(d(u0, v0) - p.z) <= threshold) e = ViewEvidence::seen_at;
+    const float centre = d(u0, v0);
+    if (fabsf(centre - p.z) <= threshold) e = ViewEvidence::seen_at;
+    if (!(centre > p.z + threshold)) continue;  // the usual case of a static point: decided by one read
     bool through = true;
     for (int dy = -1; dy <= 1 && through; ++dy)
       for (int dx = -1; dx <= 1 && through; ++dx) through = d(u0 + dx, v0 + dy) > p.z + threshold;

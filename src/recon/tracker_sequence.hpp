@@ -128,10 +128,11 @@ class TrackingSession {
   void update_reference(const SE3& pose);
   // Dynamic pixels (issue 22): the model to compare with (ref_ when tracking frame to model, else
   // a raycast of the volume from the last good pose; nullptr without a volume), and the mask of the
-  // current frame at pose world_T_camera into dyn_mask_.
+  // current frame at pose world_T_camera into dyn_mask_: the frame's (final, at the tracked pose)
+  // or the tracker's (before tracking: without the evidence of the past views).
   const ReferenceMaps* dynamic_reference();
   const ReferenceMaps* mask_before_tracking();  // dynamic_reference(), and the tracker's pixels masked
-  void find_dynamic(const ReferenceMaps& model, const SE3& world_T_camera);
+  void find_dynamic(const ReferenceMaps& model, const SE3& world_T_camera, bool final);
   void remember_view(const SE3& world_T_camera);  // free_space_evidence views: keep this frame's depth
 
   TrackSequenceParams p_;

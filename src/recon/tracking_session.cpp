@@ -101,7 +101,7 @@ const ReferenceMaps* TrackingSession::mask_before_tracking() {
   const ReferenceMaps* model = dynamic_reference();
   if (!model) return nullptr;
   if (!tracker_ || odometry_ || lost_run_ > 0) return model;
-  find_dynamic(*model, p_.tracker.constant_velocity ? last_good_ * last_motion(1) : last_good_);
+  find_dynamic(*model, p_.tracker.constant_velocity ? last_good_ * last_motion(1) : last_good_, false);
   if (p_.keep_unmasked_level >= 0 && p_.keep_unmasked_level < pyr_.levels()) {
     const PyramidLevel& lv = pyr_.level(p_.keep_unmasked_level);
     kept_vertices_ = lv.vertices.clone(device_), kept_normals_ = lv.normals.clone(device_);
@@ -116,7 +116,7 @@ const ReferenceMaps* TrackingSession::mask_before_tracking() {
   return model;
 }
 
-void TrackingSession::find_dynamic(const ReferenceMaps& model, const SE3& world_T_camera) {
+void TrackingSession::find_dynamic(const ReferenceMaps& model, const SE3& world_T_camera, bool final) {
   const DynamicParams& d = p_.dynamic;
   if (dyn_mask_.width() != K_.width) {
     for (Image<std::uint8_t>* im : {&dyn_candidates_, &dyn_kept_, &dyn_mask_, &dyn_prev_, &dyn_age_, &dyn_prev_age_})
@@ -140,7 +140,11 @@ void TrackingSession::find_dynamic(const ReferenceMaps& model, const SE3& world_
   in.residual_sigmas = d.residual_sigmas;
   in.free_space = d.free_space_truncations * (volume_ ? volume_->params().truncation : p_.volume.truncation);
   in.search_radius = d.search_radius;
-  const bool views = d.free_space_evidence == FreeSpaceEvidence::views;
+  // The views' evidence decides the frame's mask (final). Before tracking, the model test alone
+  // masks a superset of its candidates among the pixels the tracker can pair with the model (those
+  // with a model surface near): for the pose, a static pixel left out costs little, a mover kept
+  // in drags it; and the pass costs no more than without views.
+  const bool views = final && d.free_space_evidence == FreeSpaceEvidence::views;
   in.undecided_without_model = views;
   kernels::PastViews past;
   if (views) {
@@ -442,7 +446,7 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
   }
   if (dyn_model && rec.result.ok()) {
     // The mask at the tracked pose is the frame's: fusion skips it, the next frame's filter reads it.
-    find_dynamic(*dyn_model, rec.result.world_T_camera);
+    find_dynamic(*dyn_model, rec.result.world_T_camera, true);
     with_exec(device_, [&]<class E>(const E& ex) {
       kernels::Dynamic<E>::mask_depth(ex, dyn_mask_.cview(), depth_.view());
       rec.dynamic_fraction = static_cast<double>(kernels::Dynamic<E>::count_dynamic(ex, dyn_mask_.cview())) /
