@@ -185,7 +185,7 @@ void TrackingSession::remember_view(const SE3& world_T_camera) {
     dyn_view_T_world_.push_back(SE3::identity());
     dyn_view_next_ = dyn_views_.size() - 1;
   }
-  dyn_views_[dyn_view_next_].buffer().copy_from(lv.depth.buffer());
+  dyn_views_[dyn_view_next_].buffer().copy_from_async(lv.depth.buffer());
   dyn_view_T_world_[dyn_view_next_] = world_T_camera.inverse();
   dyn_view_next_ = (dyn_view_next_ + 1) % n;
 }
@@ -447,19 +447,15 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
   if (dyn_model && rec.result.ok()) {
     // The mask at the tracked pose is the frame's: fusion skips it, the next frame's filter reads it.
     find_dynamic(*dyn_model, rec.result.world_T_camera, true);
-    with_exec(device_, [&]<class E>(const E& ex) {
-      kernels::Dynamic<E>::mask_depth(ex, dyn_mask_.cview(), depth_.view());
-      rec.dynamic_fraction = static_cast<double>(kernels::Dynamic<E>::count_dynamic(ex, dyn_mask_.cview())) /
-                             static_cast<double>(K_.width * K_.height);
-    });
-    masked = true;
     // The next frame's temporal support is what this frame kept, not the mask grown from it: the
     // grown border reaches static neighbours at the mover's depth, which are then never fused and,
     // from the mask, would support themselves frame after frame (a line left on the desk's edge).
-    dyn_prev_.buffer().copy_from(dyn_kept_.buffer());
+    // The copies go on the kernels' stream (ordered after this frame's kernels, before the next
+    // frame's) ahead of the count below, whose read-back waits for the GPU.
+    dyn_prev_.buffer().copy_from_async(dyn_kept_.buffer());
     if (p_.dynamic.free_space_evidence == FreeSpaceEvidence::views) {
       if (dyn_prev_depth_.width() != K_.width) dyn_prev_depth_ = Image<float>(K_.width, K_.height, device_);
-      dyn_prev_depth_.buffer().copy_from(pyr_.level(0).depth.buffer());
+      dyn_prev_depth_.buffer().copy_from_async(pyr_.level(0).depth.buffer());
       dyn_prev_pose_ = rec.result.world_T_camera;
     }
     if (p_.dynamic.static_after_frames > 0) {
@@ -467,11 +463,17 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
       std::swap(dyn_prev_anchor_, dyn_anchor_);
       dyn_prev_pose_ = rec.result.world_T_camera;
     }
+    with_exec(device_, [&]<class E>(const E& ex) {
+      kernels::Dynamic<E>::mask_depth(ex, dyn_mask_.cview(), depth_.view());
+      rec.dynamic_fraction = static_cast<double>(kernels::Dynamic<E>::count_dynamic(ex, dyn_mask_.cview())) /
+                             static_cast<double>(K_.width * K_.height);
+    });
+    masked = true;
   } else if (p_.dynamic.enabled) {
     rec.dynamic_fraction = 0;  // the first frame, or a lost one: nothing masked, nothing fused
   }
   if (p_.dynamic.enabled && p_.dynamic.free_space_evidence == FreeSpaceEvidence::views && rec.result.ok())
-    remember_view(rec.result.world_T_camera);
+    remember_view(rec.result.world_T_camera);  // an asynchronous copy every evidence_view_interval frames
   marks_.mark(kTracked);
   if (rec.result.ok()) {
     if (lost_run_ > 0)
