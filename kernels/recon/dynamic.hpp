@@ -166,6 +166,11 @@ template <Executor Exec> struct Dynamic {
   // - a model candidate that no view saw at all (out of the views, or hidden): 2, dynamic this frame
   //   but not continued by the next (it needs evidence of its own by then: once the views hold
   //   it, it is seen through, or seen at, i.e. static);
+  // - an undecided pixel that continues a mover (as above): 2. Where no model lies near a mover's
+  //   edge (the floor its own body hid), the model test cannot call the edge's pixels candidates;
+  //   fused, they become model that explains the mover frame after frame as it moves on (a ball's
+  //   trailing side). 2, not 1: a static surface a mover reveals is never continued from itself,
+  //   so its mask cannot outlive the mover's neighbourhood;
   // - else 0.
   // So a surface first seen in front of one seen before (a chair's seat after the floor beneath
   // it) is masked at most until a view holds it, then fused; a person walking into space the

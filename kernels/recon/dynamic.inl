@@ -68,7 +68,7 @@ void Dynamic<Exec>::views_evidence(const Exec& ex, DynamicInput in, SE3 world_T_
     }
     bool continued = false;
     const vec3 p = prev_T_cur * p_cur;
-    if (c == 1 && has_prev && p.z > 0.f) {
+    if (has_prev && p.z > 0.f) {
       const vec2 uv = in.K.project(p);
       const int u0 = floor_int(uv.x + 0.5f), v0 = floor_int(uv.y + 0.5f);
       const float threshold = dynamic_threshold(in, p.z);
@@ -78,7 +78,11 @@ void Dynamic<Exec>::views_evidence(const Exec& ex, DynamicInput in, SE3 world_T_
           continued = prev_kept.inside(u, v) && prev_kept(u, v) == 1 && fabsf(prev_depth(u, v) - p.z) <= threshold;
         }
     }
-    candidates(x, y) = continued ? 1 : c == 1 && e == ViewEvidence::none ? 2 : 0;
+    if (c == 2) {  // undecided: masked this frame where it continues a mover, never continued itself
+      candidates(x, y) = continued ? 2 : 0;
+      return;
+    }
+    candidates(x, y) = continued ? 1 : e == ViewEvidence::none ? 2 : 0;
   });
 }
 

@@ -158,9 +158,11 @@ void TrackingSession::find_dynamic(const ReferenceMaps& model, const SE3& world_
     if (views)
       kernels::Dynamic<E>::views_evidence(ex, in, world_T_camera, past, dyn_prev_.cview(), dyn_prev_depth_.cview(),
                                           dyn_prev_pose_.inverse() * world_T_camera, dyn_candidates_.view());
-    // Evidence of free space: the volume at the measured points (world frame; the model maps are in
-    // the reference camera's).
-    if (d.free_space_evidence != FreeSpaceEvidence::none && volume_)
+    // Evidence of free space stored in the volume: the volume at the measured points (world frame;
+    // the model maps are in the reference camera's). `views` keeps its record outside the volume.
+    const bool volume_evidence = d.free_space_evidence == FreeSpaceEvidence::seen_free ||
+                                 d.free_space_evidence == FreeSpaceEvidence::not_occupied;
+    if (volume_evidence && volume_)
       volume_->require_free_space(l0.depth, K_, world_T_camera, d.evidence_min_weight,
                                   d.free_space_evidence == FreeSpaceEvidence::seen_free, dyn_candidates_);
     if (d.static_after_frames > 0)  // 0: no ageing (and no cost)
