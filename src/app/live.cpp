@@ -110,7 +110,7 @@ class LiveLoop : public FrameLoop {
     if (e_.output.particles_every > 0 && (k + 1) % e_.output.particles_every == 0)
       write_particles_ply(ctx_.out_path("particles_" + std::to_string(k + 1) + ".ply"), solver_.download_state());
     records_.push_back(rec);
-    progress_.update(k + 1, to_string(rec.result.status));
+    progress_.update(k + 1, "tracking " + std::string(to_string(rec.result.status)));
     return true;
   }
   void spawn_next() override { solver_.spawn_next(); }

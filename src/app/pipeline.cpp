@@ -92,7 +92,7 @@ ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
     ctx.timer().add(f.frame, "fuse", f.fuse_ms);
     ctx.timer().add(f.frame, "frame", f.frame_ms);
     if (n == 0) r.first_frame = host_copy(frame);
-    progress.update(++n, to_string(f.result.status));
+    progress.update(++n, "tracking " + std::string(to_string(f.result.status)));
   };
   TrackSequenceParams tp = tracking_params(e, volume_stages);
   std::unique_ptr<OnlineCorrector> online;  // refine.online: the keyframe graph solved while tracking runs
@@ -112,7 +112,8 @@ ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
       "{} frames from {} ({} unreadable, skipped); {} lost by tracking; median track {:.3f} ms, frame {:.3f} ms",
       r.tracking.frames.size(), source->name(), source->skipped_frames(), r.tracking.lost_frames,
       r.tracking.median_track_ms, r.tracking.median_frame_ms);
-  ctx.report_tracking(static_cast<std::int64_t>(r.tracking.frames.size()), r.tracking.lost_frames);
+  ctx.report_tracking(static_cast<std::int64_t>(r.tracking.frames.size()), r.tracking.lost_frames,
+                      r.volume ? r.volume->stats().failed_insertions : 0);
   if (r.volume) {
     log_volume(r.volume->stats());
     r.mesh = r.volume->extract_mesh();

@@ -264,9 +264,17 @@ std::unique_ptr<RunRenderer> RunRenderer::make(RunContext& ctx) {
 #else
     const std::string why = "this build has no GLFW (apt-get install libglfw3-dev, then reconfigure)";
 #endif
-    spdlog::warn("render.mode is window but no window can be opened: {}; rendering headless into {}/frames instead",
-                 why, ctx.out_dir());
+    spdlog::warn("render.mode is window but no window can be opened: {}; rendering headless instead", why);
   }
+  // What headless rendering writes is the render section's choice: say which, so that a missing
+  // frames/ folder or video is never a surprise (docs/RENDERING.md).
+  std::string what = "preview.png (the last frame)";
+  if (p.write_frames) what += ", frames/NNNNNN.png";
+  if (p.video) what += ", video.mp4";
+  if (p.stage_images) what += ", stages/";
+  spdlog::info(
+      "rendering headless into {}: {}{}", ctx.out_dir(), what,
+      p.write_frames || p.video ? "" : " (render.write_frames: true adds every frame, render.video: true a video)");
   return std::make_unique<GlRunRenderer>(ctx);
 #else
   spdlog::warn(

@@ -5,6 +5,7 @@
 
 #include "app/json_file.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "core/output_file.hpp"
 #include "eval/trajectory_eval.hpp"
 #include "seamless/build_config.hpp"
@@ -111,6 +112,15 @@ Json mask_json(const MaskQuality& q) {
 
 void write_summary(const std::string& path, const RunSummary& s) {
   Json j;
+  const int sig = interrupt_signal();
+  j["status"] = !s.status.empty() ? s.status : sig != 0 ? "interrupted" : "complete";
+  if (sig != 0) j["signal"] = signal_name(sig);
+  j["reached"] = {{"frames", s.reached_frames >= 0 ? s.reached_frames : s.frames_read},
+                  {"steps", s.reached_steps >= 0 ? s.reached_steps
+                            : s.physics          ? s.physics->steps
+                                                 : 0}};
+  if (!s.error.empty()) j["error"] = s.error;
+  if (s.exit_code >= 0) j["exit_code"] = s.exit_code;
   j["seamless_version"] = SEAMLESS_VERSION;
   j["commit"] = SEAMLESS_GIT_COMMIT;
   j["command"] = s.command, j["config"] = s.config, j["device"] = s.device;

@@ -76,10 +76,18 @@ std::vector<vec4> voxel_sdf(const std::vector<int3>& cells, float d) {
 }
 
 ParticleBatch rigid_from_cells(const std::vector<int3>& cells, const SpawnParams& s, const SolverParams& p) {
+  if (cells.empty() && s.shape == RigidShape::mesh && std::min({s.size.x, s.size.y, s.size.z}) >= p.particle_diameter)
+    // Big enough to hold particles: the mesh has no inside (voxelize_obj fills what a closed
+    // surface encloses), and no size would change that.
+    throw ConfigError("spawn rigid: the mesh " + s.mesh +
+                      " encloses no volume: it is open (a single triangle, a sheet, or a surface with holes). A "
+                      "rigid body is filled with particles, so its mesh must be closed (watertight); close it in "
+                      "a mesh editor, or use shape: box or sphere");
   if (cells.empty())
     throw ConfigError("spawn rigid: shape '" + std::string(enum_name(s.shape)) + "' of size (" +
                       std::to_string(s.size.x) + ", " + std::to_string(s.size.y) + ", " + std::to_string(s.size.z) +
-                      ") holds no particle of diameter " + std::to_string(p.particle_diameter) + "; make it larger");
+                      ") holds no particle of diameter " + std::to_string(p.particle_diameter) +
+                      "; make every extent at least one diameter");
   const float d = p.particle_diameter;
   ParticleBatch b;
   b.kind = ParticleBatch::kRigid;

@@ -164,13 +164,25 @@ void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTime
         "voxel hashing: hash table too crowded in frame {}; rehashed it from {} into {} slots (set "
         "volume.hash_buckets: {} to avoid this pause)",
         frames_, slots_before, keys_.size(), keys_.size());
-  if (failed_ > 0)  // volume.grow_when_full is off
+  if (failed_ > 0) {  // volume.grow_when_full is off
+    // The advice from this frame's numbers: the blocks it holds plus those it could not get (each
+    // block that found the pool empty is counted once per frame), a quarter more for the next
+    // frames' new surface; the table is sized like growing does it (twice the slots).
+    const std::int64_t pool = free_list_.size();
+    const std::int64_t needed = blocks_in_use(pool, last_) + last_.pool_failures;
+    std::string advice;
+    if (last_.pool_failures > 0)
+      advice += "volume.capacity >= " + std::to_string(needed + needed / 4) + " (this frame needed about " +
+                std::to_string(needed) + " blocks)";
+    if (last_.probe_failures > 0)
+      advice += std::string(advice.empty() ? "" : " and ") + "volume.hash_buckets >= " +
+                std::to_string(std::max<std::int64_t>(2 * static_cast<std::int64_t>(keys_.size()), 4 * needed));
     spdlog::warn(
         "voxel hashing: {} block insertion attempts failed in frame {} ({} found no hash slot within {} probes, "
-        "{} found the pool of {} blocks full); that part of the frame is not fused. Set volume.capacity >= {} and "
-        "volume.hash_buckets >= {}, or volume.grow_when_full: true",
-        failed_, frames_, last_.probe_failures, kMaxProbe, last_.pool_failures, free_list_.size(),
-        2 * free_list_.size(), 2 * keys_.size());
+        "{} found the pool of {} blocks full); that part of the frame is not fused. Set {}, or "
+        "volume.grow_when_full: true",
+        failed_, frames_, last_.probe_failures, kMaxProbe, last_.pool_failures, pool, advice);
+  }
 }
 
 void VoxelHashVolume::handle_failures(const HashCounters& c) {

@@ -141,15 +141,16 @@ class ExitCodes(unittest.TestCase):
                                     "output.max_lost_fraction=1"), "--force")
             self.assertEqual(r.returncode, 0, r.stderr)
 
-    @unittest.skipUnless(os.path.isdir(TUM), f"no test data at {TUM}")
-    def test_zero_tracker_iterations_lose_every_frame(self):
-        # Found 3: tracker.iterations [0,0,0] lost every frame but the first, exit 0.
+    def test_zero_tracker_iterations_are_a_config_error(self):
+        # Found 3: tracker.iterations [0,0,0] lost every frame but the first, exit 0. Since then it
+        # is refused when the config is loaded, before anything is written.
         with tempfile.TemporaryDirectory() as d:
             out = os.path.join(d, "trk")
-            r = seamless(*track_tum(TUM, out, "frames=10", "tracker.iterations=[0,0,0]"))
-            self.assertEqual(r.returncode, LOST, r.stderr)
-            stats = rows(os.path.join(out, "tracking_stats.csv"))
-            self.assertEqual([s["status"] == "ok" for s in stats], [True] + [False] * 9)
+            r = seamless("track", DEMO, "--device", "cpu", "--out", out, "--set", "input.synthetic.frames=3",
+                         "--set", "tracker.iterations=[0,0,0]")
+            self.assertEqual(r.returncode, CONFIG, r.stderr)
+            self.assertIn("tracker.iterations: no level has an iteration", r.stderr)
+            self.assertFalse(os.path.exists(out))
 
 
 class Interrupted(unittest.TestCase):
@@ -275,7 +276,9 @@ class OutputFolder(unittest.TestCase):
                 self.assertEqual(f.read(), first)  # refused before writing anything
             r = seamless(*args, "--set", "name=second", "--force")
             self.assertEqual(r.returncode, 0, r.stderr)
-            self.assertFalse(os.path.exists(os.path.join(out, "stale.txt")))
+            # --force removes the earlier run's files, never one seamless did not write (it says so).
+            self.assertTrue(os.path.exists(os.path.join(out, "stale.txt")))
+            self.assertIn("kept 1 files", r.stderr)
             with open(os.path.join(out, "config.yaml")) as f:
                 self.assertIn("name: second", f.read())
 
@@ -325,6 +328,336 @@ class Limits(unittest.TestCase):
             err = simulate("far", "{kind: fluid_block, position: [1000, 1000, 1000], size: [0.1, 0.1, 0.1]}")
             self.assertRegex(err, r"spawn fluid_block at \(1000.00, 1000.00, 1000.00\): ([0-9]+) of \1 particles start "
                                   r"inside the scene's solid")
+
+
+# ---- A day's recording trusted to the tool: output folders, every config problem at once, honest
+# interrupted runs (synthetic room, 2-3 frames, coarse volumes: seconds each).
+
+SMALL = ["--device", "cpu", "--set", "tracker.kind=ground_truth", "--set", "volume.voxel_size=0.02",
+         "--set", "volume.truncation=0.08", "--set", "render.mode=none"]
+
+
+def small_recon(out, frames=2, *extra):
+    return ["reconstruct", DEMO, "--out", out, "--set", f"input.synthetic.frames={frames}", *SMALL, *extra]
+
+
+def record_room(dest, frames=3):
+    r = seamless("record", "--source", "synthetic", "--out", dest, "--frames", str(frames), "--device", "cpu")
+    assert r.returncode == 0, r.stderr
+    return dest
+
+
+def tree(path):
+    """Every file below path with its size: a folder compared before and after."""
+    out = {}
+    for root, _, files in os.walk(path):
+        for f in files:
+            full = os.path.join(root, f)
+            out[os.path.relpath(full, path)] = os.path.getsize(full)
+    return out
+
+
+def summary(out):
+    import json
+    with open(os.path.join(out, "summary.json")) as f:
+        return json.load(f)
+
+
+class ForceNeverDeletesInputs(unittest.TestCase):
+    def test_out_holding_the_input_is_refused(self):
+        # Found 1: --force wiped a folder holding log.txt recursively, the dataset inside it too.
+        with tempfile.TemporaryDirectory() as d:
+            proj = os.path.join(d, "proj")
+            data = record_room(os.path.join(proj, "room"))
+            with open(os.path.join(proj, "log.txt"), "w") as f:
+                f.write("old\n")
+            before = tree(proj)
+            r = seamless("track", DEMO, "--device", "cpu", "--set", "input.source=tum", "--set", f"input.path={data}",
+                         "--set", "tracker.kind=ground_truth", "--out", proj, "--force")
+            self.assertEqual(r.returncode, USAGE, r.stderr)
+            self.assertIn("contains the input", r.stderr)
+            self.assertEqual(tree(proj), before)
+            # record --path X --out X --force: the source itself.
+            r = seamless("record", "--source", "tum", "--path", data, "--out", data, "--frames", "3", "--force")
+            self.assertEqual(r.returncode, USAGE, r.stderr)
+            self.assertIn(" is the input", r.stderr)
+            self.assertEqual(tree(proj), before)
+
+    def test_force_removes_only_what_seamless_wrote(self):
+        with tempfile.TemporaryDirectory() as d:
+            out = os.path.join(d, "run")
+            self.assertEqual(seamless(*small_recon(out)).returncode, 0)
+            with open(os.path.join(out, "manifest.txt")) as f:
+                listed = {l.strip() for l in f if l.strip() and not l.startswith("#")}
+            for name in ["config.yaml", "log.txt", "summary.json", "mesh.ply", "trajectory.txt"]:
+                self.assertIn(name, listed)
+            os.makedirs(os.path.join(out, "notes"))
+            for rel in ["notes/today.txt", "mesh_edited.ply"]:
+                with open(os.path.join(out, rel), "w") as f:
+                    f.write("mine\n")
+            r = seamless(*small_recon(out), "--force")
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertIn("kept 2 files", r.stderr)
+            self.assertIn("mesh_edited.ply", r.stderr)
+            for rel in ["notes/today.txt", "mesh_edited.ply"]:
+                self.assertTrue(os.path.exists(os.path.join(out, rel)), rel)
+            # A run killed outright leaves no manifest: --force then removes the names seamless
+            # writes, still nothing else.
+            os.remove(os.path.join(out, "manifest.txt"))
+            with open(os.path.join(out, "particles_25.ply"), "w") as f:
+                f.write("stale\n")
+            r = seamless(*small_recon(out), "--force")
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertFalse(os.path.exists(os.path.join(out, "particles_25.ply")))
+            for rel in ["notes/today.txt", "mesh_edited.ply"]:
+                self.assertTrue(os.path.exists(os.path.join(out, rel)), rel)
+
+
+class OneRunPerFolder(unittest.TestCase):
+    def test_a_second_run_into_a_busy_folder_is_refused(self):
+        # Found 2: two runs into one folder raced; with --force the second deleted the first's files.
+        with tempfile.TemporaryDirectory() as d:
+            out = os.path.join(d, "run")
+            first = subprocess.Popen([EXE, *small_recon(out, 60)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                     text=True)
+            t0 = time.monotonic()
+            while not os.path.exists(os.path.join(out, "summary.json")) and time.monotonic() - t0 < 120:
+                time.sleep(0.05)
+            for extra in [[], ["--force"]]:
+                r = seamless(*small_recon(out), *extra)
+                self.assertEqual(r.returncode, USAGE, r.stderr)
+                self.assertIn("another seamless run (process %d) is writing into" % first.pid, r.stderr)
+            self.assertIsNone(first.poll(), "the first run ended before the second was tried")
+            first.send_signal(signal.SIGTERM)
+            _, err = first.communicate(timeout=300)
+            self.assertEqual(first.returncode, 128 + signal.SIGTERM, err)
+            # Found 5: after SIGTERM summary.json had no mark, log.txt no line.
+            s = summary(out)
+            self.assertEqual(s["status"], "interrupted")
+            self.assertEqual(s["signal"], "SIGTERM")
+            n = len(poses(os.path.join(out, "trajectory.txt")))
+            self.assertEqual(s["reached"]["frames"], n)
+            self.assertLess(n, 60)
+            with open(os.path.join(out, "log.txt")) as f:
+                log = f.read()
+            self.assertIn("SIGTERM received", log)
+            self.assertIn("stopped by SIGTERM", log)
+
+
+class HonestStatus(unittest.TestCase):
+    def test_complete_track_writes_summary(self):
+        # `track` writes summary.json as `run` does; --frames is the key `frames`, and with
+        # input.max_frames the smaller wins, saying so.
+        with tempfile.TemporaryDirectory() as d:
+            out = os.path.join(d, "trk")
+            r = seamless("track", DEMO, "--out", out, *SMALL, "--frames", "3", "--set", "input.max_frames=2")
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertIn("frames = 3 and input.max_frames = 2: the run reads at most 2 frames", r.stderr)
+            s = summary(out)
+            self.assertEqual(s["status"], "complete")
+            self.assertEqual(s["command"], "track")
+            self.assertEqual(s["frames"]["read"], 2)
+            self.assertEqual(s["reached"]["frames"], 2)
+            self.assertLess(s["ate"]["rmse_m"], 1e-4)  # ground-truth tracker against its own poses
+            self.assertRegex(r.stderr, r"scan: 2/2 .* tracking ok")  # the progress line says what "ok" is
+
+    def test_second_signal_leaves_a_clear_mark(self):
+        # Found 5: Ctrl-C twice 50 ms apart left only .partial files and exit 130.
+        with tempfile.TemporaryDirectory() as d:
+            out = os.path.join(d, "run")
+            p = subprocess.Popen([EXE, *small_recon(out, 60)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                 text=True)
+            t0 = time.monotonic()
+            while count_poses(os.path.join(out, "trajectory.txt.partial")) < 2 and time.monotonic() - t0 < 120:
+                time.sleep(0.02)
+            p.send_signal(signal.SIGINT)
+            time.sleep(0.05)
+            if p.poll() is None:
+                p.send_signal(signal.SIGINT)
+            _, err = p.communicate(timeout=300)
+            status = summary(out)["status"]
+            if p.returncode == -signal.SIGINT:  # stopped at once by the second signal
+                self.assertEqual(status, "incomplete")
+                self.assertIn("second signal: stopping at once", err)
+            else:  # it had finished writing before the second signal came
+                self.assertEqual(p.returncode, SIGINT_CODE, err)
+                self.assertEqual(status, "interrupted")
+
+    def test_failure_after_start_up_does_not_block_the_corrected_run(self):
+        # Found 4: a problem found after start-up (here the particle budget) left config.yaml and
+        # log.txt, and the corrected re-run was refused.
+        with tempfile.TemporaryDirectory() as d:
+            out = os.path.join(d, "sim")
+            args = ["simulate", DEMO, "--device", "cpu", "--out", out, "--set", "duration=0.02",
+                    "--set", "render.mode=none", "--set", "output.particles_every=0"]
+            r = seamless(*args, "--set", "solver.max_particles=10")
+            self.assertEqual(r.returncode, CONFIG, r.stderr)
+            s = summary(out)
+            self.assertEqual(s["status"], "failed")
+            self.assertEqual(s["exit_code"], CONFIG)
+            self.assertIn("max_particles", s["error"])
+            self.assertEqual(s["reached"], {"frames": 0, "steps": 0})
+            r = seamless(*args)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertIn("the earlier run failed before computing anything", r.stderr)
+            self.assertEqual(summary(out)["status"], "complete")
+
+    def test_partial_file_removed_when_a_write_fails(self):
+        # Found 7: a mesh.ply.partial left on a full disk kept it full. A file size limit stands in
+        # for the full disk: the mesh write fails part way.
+        import resource
+
+        def limit():
+            signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails with EFBIG
+            resource.setrlimit(resource.RLIMIT_FSIZE, (200_000, 200_000))
+
+        with tempfile.TemporaryDirectory() as d:
+            out = os.path.join(d, "rec")
+            r = subprocess.run([EXE, *small_recon(out)], capture_output=True, text=True, preexec_fn=limit)
+            self.assertNotEqual(r.returncode, 0, r.stderr)
+            self.assertEqual(glob.glob(os.path.join(out, "**", "*.partial"), recursive=True), [])
+            self.assertIn("removed 1 incomplete files", r.stderr)
+            self.assertEqual(summary(out)["status"], "failed")
+
+
+class EveryProblemAtOnce(unittest.TestCase):
+    def test_key_errors_and_rules_in_one_run_nothing_written(self):
+        # Found 4: key errors hid the rules across keys, which then came one per run.
+        with tempfile.TemporaryDirectory() as d:
+            bad = os.path.join(d, "bad.yaml")
+            with open(bad, "w") as f:
+                f.write("volume:\n  voxel_sise: 0.01\n  truncation: 0.001\n"
+                        "render: {zoom: 2}\n"
+                        "spawn:\n  - {kind: fluid_block, size: [0, 0, 0]}\n")
+            out = os.path.join(d, "run")
+            r = seamless("run", bad, "--device", "cpu", "--out", out)
+            self.assertEqual(r.returncode, CONFIG, r.stderr)
+            for text in ["4 problems", "volume.voxel_sise: unknown key", "volume.truncation (0.001000 m) must be",
+                         "render.zoom and render.zoom_at", "spawn.0.size: every extent must be positive"]:
+                self.assertIn(text, r.stderr)
+            self.assertFalse(os.path.exists(out))
+
+    def test_nonsense_values(self):
+        # Found 6: accepted, then failing later or never.
+        cases = {"solver.gravity=[0,-1e30,0]": "beyond the sanity bound",
+                 "spawn=[{kind: fluid_block, size: [-0.2, 0.2, 0.2]}]": "every extent must be positive",
+                 "spawn=[{kind: fluid_block, size: [0, 0, 0]}]": "every extent must be positive",
+                 "tracker.iterations=[]": "tracker.iterations: empty",
+                 "solver.gravity=[.nan,0,0]": "got NaN ('.nan')",
+                 "input.intrinsics={preset: custom, fx: 0}": "fx and fy must not be 0"}
+        for setting, text in cases.items():
+            r = seamless("run", DEMO, "--dry-run", "--set", setting)
+            self.assertEqual(r.returncode, CONFIG, setting + ": " + r.stderr)
+            self.assertIn(text, r.stderr, setting)
+        with tempfile.TemporaryDirectory() as d:
+            r = seamless("record", "--source", "synthetic", "--out", os.path.join(d, "rec"), "--frames", "-1")
+            self.assertEqual(r.returncode, USAGE, r.stderr)
+            self.assertFalse(os.path.exists(os.path.join(d, "rec")))
+
+    def test_huge_spawn_list_is_refused_in_bounded_memory(self):
+        # Found 7: a 700k-entry spawn list took 4.7 GB and died with std::bad_alloc.
+        with tempfile.TemporaryDirectory() as d:
+            big = os.path.join(d, "big.yaml")
+            with open(big, "w") as f:
+                f.write("spawn:\n" + "  - {kind: fluid_block}\n" * 700_000)
+            # The peak memory of this one command: a Python of its own runs it and reports its child's.
+            probe = ("import resource, subprocess, sys; r = subprocess.run(sys.argv[1:], capture_output=True, text=True); "
+                     "sys.stderr.write(r.stderr); print(r.returncode, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)")
+            r = subprocess.run([sys.executable, "-c", probe, EXE, "run", big, "--dry-run"], capture_output=True, text=True,
+                               timeout=300)
+            code, peak_kib = map(int, r.stdout.split())
+            self.assertEqual(code, CONFIG, r.stderr[-2000:])
+            self.assertIn("at most 10000 entries", r.stderr)
+            self.assertLess(peak_kib, 200_000)  # refused before the YAML tree is built: not the 4.7 GB of before
+
+
+class Advice(unittest.TestCase):
+    def test_full_block_pool_advice_comes_from_the_numbers(self):
+        # Found 3: a full pool advised capacity >= 128, then 256 (8192 were needed), and exit 6
+        # blamed input.depth_scale.
+        import re
+        with tempfile.TemporaryDirectory() as d:
+            base = ["reconstruct", DEMO, "--device", "cpu", "--set", "input.synthetic.frames=3",
+                    "--set", "volume.hash_buckets=2097152", "--set", "volume.grow_when_full=false"]
+            r = seamless(*base, "--out", os.path.join(d, "small"), "--set", "volume.capacity=128")
+            advised = [int(x) for x in re.findall(r"volume.capacity >= (\d+)", r.stderr)]
+            self.assertTrue(advised, r.stderr)
+            if r.returncode == LOST:
+                self.assertIn("volume.capacity", r.stderr.split("tracking lost")[-1])
+                self.assertNotIn("depth_scale", r.stderr.split("tracking lost")[-1])
+            # Truth: with the advised capacity, nothing is dropped.
+            r = seamless(*base, "--out", os.path.join(d, "advised"), "--set", f"volume.capacity={max(advised)}")
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertNotIn("insertion attempts failed", r.stderr)
+
+    def test_unwritable_out_is_named(self):
+        # Found 7: "internal error: Failed opening file".
+        if os.geteuid() == 0:
+            self.skipTest("root writes anywhere")
+        with tempfile.TemporaryDirectory() as d:
+            locked = os.path.join(d, "locked")
+            os.makedirs(locked)
+            os.chmod(locked, 0o555)
+            try:
+                for out in [locked, os.path.join(locked, "run")]:
+                    r = seamless(*small_recon(out))
+                    self.assertEqual(r.returncode, USAGE, r.stderr)
+                    self.assertIn("ermission denied", r.stderr)
+                    self.assertNotIn("internal error", r.stderr)
+            finally:
+                os.chmod(locked, 0o755)
+
+    def test_eval_never_overwrites_its_inputs(self):
+        with tempfile.TemporaryDirectory() as d:
+            gt, est = os.path.join(d, "groundtruth.txt"), os.path.join(d, "trajectory.txt")
+            for path in [gt, est]:
+                with open(path, "w") as f:
+                    for i in range(40):
+                        f.write(f"{i / 10:.1f} {i / 100:.2f} 0 0 0 0 0 1\n")
+            before = tree(d)
+            for args in [["--json", gt], ["--aligned", est], ["--json", est, "--aligned", gt]]:
+                r = seamless("eval", gt, est, *args)
+                self.assertEqual(r.returncode, USAGE, r.stderr)
+                self.assertIn("eval never writes over its inputs", r.stderr)
+            self.assertEqual(tree(d), before)
+            self.assertEqual(seamless("eval", gt, est, "--json", os.path.join(d, "ate.json")).returncode, 0)
+
+    def test_open_mesh_gets_the_right_advice(self):
+        # Found 7: a single OBJ triangle was advised "make it larger", which fails at 1 m too.
+        with tempfile.TemporaryDirectory() as d:
+            obj = os.path.join(d, "triangle.obj")
+            with open(obj, "w") as f:
+                f.write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+            r = seamless("simulate", DEMO, "--device", "cpu", "--out", os.path.join(d, "sim"), "--set", "duration=0.02",
+                         "--set", "render.mode=none", "--set",
+                         f"spawn=[{{kind: rigid, shape: mesh, mesh: {obj}, size: [1, 1, 1], position: [0, 0, 1]}}]")
+            self.assertEqual(r.returncode, CONFIG, r.stderr)
+            self.assertIn("encloses no volume", r.stderr)
+            self.assertNotIn("make it larger", r.stderr)
+
+
+class CommandLine(unittest.TestCase):
+    def test_config_list_section(self):
+        r = seamless("config", "--list", "tracker")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        keys = [l.split("`")[1] for l in r.stdout.splitlines() if l.startswith("| `")]
+        self.assertTrue(keys)
+        self.assertTrue(all(k.startswith("tracker.") for k in keys), keys)
+        self.assertEqual(seamless("config", "--list", "trackre").returncode, USAGE)
+
+    @unittest.skipUnless(shutil.which("ffprobe"), "no ffprobe (Debian package ffmpeg)")
+    def test_video_path_with_a_quote(self):
+        # ffmpeg gets an argument vector, never a shell string: a path with a quote works.
+        with tempfile.TemporaryDirectory() as d:
+            out = os.path.join(d, "it's a run")
+            r = seamless("simulate", DEMO, "--device", "cpu", "--out", out, "--set", "duration=0.1",
+                         "--set", "render.mode=headless", "--set", "render.video=true", "--set", "render.width=64",
+                         "--set", "render.height=48", "--set", "output.particles_every=0")
+            if "no renderer" in r.stderr or "no OpenGL" in r.stderr or "EGL" in r.stderr and r.returncode != 0:
+                self.skipTest("no renderer here: " + r.stderr[-300:])
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertIn("rendering headless into", r.stderr)
+            self.assertGreater(os.path.getsize(os.path.join(out, "video.mp4")), 0)
 
 
 if __name__ == "__main__":
