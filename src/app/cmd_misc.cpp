@@ -234,7 +234,7 @@ void add_record_command(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--frames", a->frames,
                   "stop after this many frames, at least 1 (left out: until the source ends; Ctrl-C stops after the "
                   "frame being written, leaving a folder that loads)")
-      ->check(CLI::PositiveNumber);
+      ->check(frame_count(1, "leave it out to record until the source ends"));
   cmd->add_flag("--force", a->force, "write into a folder that holds an earlier recording after clearing it");
   cmd->add_option("--set", a->sets, "override a config key, e.g. --set input.synthetic.frames=30");
   cmd->add_option("--device", a->device, "where the synthetic room renders: cpu, cuda or auto");

@@ -36,7 +36,23 @@ void add_frames_option(CLI::App& cmd, CommonOptions& o) {
   cmd.add_option("--frames", o.frames,
                  "process this many input frames (the key `frames`; 0: all the input has; with input.max_frames "
                  "also set, the smaller of the two)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(frame_count(0, "0 or leaving it out: all the input has"));
+}
+
+CLI::Validator frame_count(std::int64_t min, const std::string& hint) {
+  return CLI::Validator(
+      [min, hint](const std::string& s) {
+        std::int64_t v = 0;
+        std::size_t used = 0;
+        try {
+          v = std::stoll(s, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used == s.size() && v >= min) return std::string();
+        return "is " + s + "; give a whole number of frames, at least " + std::to_string(min) + " (" + hint + ")";
+      },
+      "FRAMES >= " + std::to_string(min));
 }
 
 std::vector<std::string> overrides(const CommonOptions& o) {

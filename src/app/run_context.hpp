@@ -38,6 +38,8 @@ std::vector<std::string> overrides(const CommonOptions& o);
 void add_common_options(CLI::App& cmd, CommonOptions& o, bool config_required = true);
 // Adds --frames N (the key `frames`; input.max_frames, when also set, is a second limit).
 void add_frames_option(CLI::App& cmd, CommonOptions& o);
+// A --frames check: a whole number of at least `min` frames; `hint` says what leaving it out does.
+CLI::Validator frame_count(std::int64_t min, const std::string& hint);
 
 class RunContext {
  public:

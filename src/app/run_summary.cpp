@@ -1,5 +1,7 @@
 #include "app/run_summary.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <cmath>
 #include <set>
 
@@ -58,7 +60,13 @@ void add_tracking(RunSummary& s, const TrackSequenceResult& r, std::int64_t unre
   for (const FrameRecord& f : r.frames) s.frames_fused += f.fused;
   s.dynamic_masked_fraction = mean_dynamic_fraction(r.frames);
   if (groundtruth.empty() || r.trajectory.empty()) return;
-  const AteResult ate = compute_ate(r.trajectory, read_tum_trajectory(groundtruth));
+  AteResult ate;
+  try {
+    ate = compute_ate(r.trajectory, read_tum_trajectory(groundtruth));
+  } catch (const Error& e) {  // too few poses for an alignment (a 2-frame run): no ATE, not a failed run
+    spdlog::info("summary.json: no ATE ({})", e.what());
+    return;
+  }
   if (ate.trans.count == 0) return;
   s.ate_rmse_m = ate.trans.rmse;
   s.ate_pairs = static_cast<std::int64_t>(ate.trans.count);

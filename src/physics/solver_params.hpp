@@ -100,7 +100,8 @@ struct SolverParams {
   static constexpr float kMaxGravity = 100.f;  // m/s^2
   // Rules across keys and physical sanity, checked when a config is loaded (Experiment::validate).
   void check(std::vector<std::string>& problems) const {
-    const float g = std::sqrt(gravity.x * gravity.x + gravity.y * gravity.y + gravity.z * gravity.z);
+    const double x = gravity.x, y = gravity.y, z = gravity.z;  // in double: 1e30 squared overflows a float
+    const double g = std::sqrt(x * x + y * y + z * z);
     if (!(g <= kMaxGravity)) {
       char got[128];
       std::snprintf(got, sizeof got, "[%g, %g, %g] (|g| = %g m/s^2)", gravity.x, gravity.y, gravity.z, g);
