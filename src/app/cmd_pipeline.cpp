@@ -70,7 +70,7 @@ void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
       kernels::SceneSdf sdf{};
       sdf.synthetic_room = 1;
       ctx.experiment().solver.gravity = kernels::room::gravity();  // the room's world is z up
-      simulate(ctx, nullptr, &sdf);
+      ctx.summary().physics = simulate(ctx, nullptr, &sdf).stats;
       return ctx.exit_code();
     };
   });

@@ -85,14 +85,33 @@ bool remove_file(const fs::path& dir, const std::string& rel) {
   return true;
 }
 
-// The earlier run's manifest (relative paths), or nothing when it left none.
-std::vector<std::string> read_manifest(const fs::path& dir, bool& found) {
-  std::vector<std::string> files;
+// manifest.txt: the files a run wrote, one per line. Written at the start as "in progress", with
+// the files that were there before ("! name": never removed), and complete at the end.
+struct Manifest {
+  bool found = false, complete = false;
+  std::set<std::string> written, before;
+};
+constexpr const char* kInProgress = "# in progress";
+
+Manifest read_manifest(const fs::path& dir) {
+  Manifest m;
   std::ifstream in(dir / kManifest);
-  found = static_cast<bool>(in);
-  for (std::string line; std::getline(in, line);)
-    if (!line.empty() && line[0] != '#') files.push_back(line);
-  return files;
+  m.found = static_cast<bool>(in);
+  m.complete = m.found;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind(kInProgress, 0) == 0) m.complete = false;
+    else if (line.rfind("! ", 0) == 0) m.before.insert(line.substr(2));
+    else if (!line.empty() && line[0] != '#') m.written.insert(line);
+  }
+  return m;
+}
+
+// What a recording holds (io/record.cpp): without a manifest, never taken for seamless's own,
+// since a TUM folder from elsewhere has the same names.
+bool recording_name(const std::string& rel) {
+  static const std::regex names(
+      R"(((rgb|depth|associations|calibration|movers|accelerometer|groundtruth)\.txt|(rgb|depth|mask)/.*)(\.partial)?)");
+  return std::regex_match(rel, names);
 }
 
 }  // namespace
@@ -160,25 +179,49 @@ OutputFolder::OutputFolder(std::string dir, bool force, const std::vector<std::s
       throw UsageError("the output folder " + dir_ + " holds an earlier run (" + first_names(found) +
                        "); choose another --out, or add --force to remove that run's files first");
     }
-    bool have_manifest = false;
-    const std::vector<std::string> listed = read_manifest(dir_, have_manifest);
-    std::size_t removed = 0;
-    for (const std::string& rel : have_manifest ? listed : std::vector<std::string>{})
-      removed += remove_file(dir_, rel) + remove_file(dir_, partial_path(rel));
-    std::vector<std::string> kept;
+    // Plan first, remove after: a folder whose marks would survive (a file seamless cannot tell
+    // for its own) is refused with nothing removed, and never written over.
+    const Manifest m = read_manifest(dir_);
+    std::vector<std::string> remove, kept;
     for (const std::string& rel : list_files(dir_)) {
-      const bool ours = have_manifest ? rel == kManifest || rel == "summary.json.partial" : written_by_seamless(rel);
-      if (ours && remove_file(dir_, rel)) ++removed;
-      else kept.push_back(rel);
+      const bool infrastructure = rel == kManifest || rel == partial_path(kManifest) || rel == "summary.json.partial";
+      bool ours = infrastructure;
+      if (m.complete)
+        ours = ours || m.written.count(rel) || (rel.size() > 8 && m.written.count(rel.substr(0, rel.size() - 8)));
+      else if (m.found) ours = ours || (written_by_seamless(rel) && !m.before.count(rel));  // killed part way
+      else ours = ours || (written_by_seamless(rel) && !recording_name(rel));
+      (ours ? remove : kept).push_back(rel);
     }
+    std::vector<std::string> blocking;
+    for (const std::string& mark : found)
+      if (std::find(kept.begin(), kept.end(), mark) != kept.end()) blocking.push_back(mark);
+    if (!blocking.empty()) {
+      ::close(lock_fd_);
+      lock_fd_ = -1;
+      throw UsageError("the output folder " + dir_ + " holds " + first_names(blocking) +
+                       ", which no manifest.txt of seamless lists as its own (another tool's data, or a "
+                       "recording from before seamless wrote manifests): --force removes only what seamless "
+                       "wrote; move it away or choose another --out");
+    }
+    std::size_t removed = 0;
+    for (const std::string& rel : remove) removed += remove_file(dir_, rel);
     const char* why = failed_empty ? "the earlier run failed before computing anything" : "--force";
     spdlog::info("{}: removed {} files of the earlier run from {} ({})", why, removed, dir_,
-                 have_manifest ? "those its manifest.txt lists" : "it left no manifest: the names seamless writes");
+                 m.complete ? "those its manifest.txt lists"
+                 : m.found  ? "it was stopped part way: the names seamless writes"
+                            : "it left no manifest: the names seamless writes");
     if (!kept.empty())
       spdlog::warn("{}: kept {} files in {} that seamless did not write there: {}", why, kept.size(), dir_,
                    first_names(kept));
   }
   before_ = list_files(dir_);
+  // The manifest of a run in progress: a run killed outright leaves it so, with the files that
+  // were here before it, which a later --force keeps.
+  std::ofstream start(fs::path(dir_) / kManifest);
+  start << kInProgress << ": a seamless run writes into this folder (or was stopped before its end)\n";
+  for (const std::string& rel : before_)
+    if (rel != kManifest) start << "! " << rel << "\n";
+  if (!start) spdlog::warn("cannot write {}/{}", dir_, kManifest);
 }
 
 OutputFolder::~OutputFolder() {
@@ -192,6 +235,8 @@ void OutputFolder::write_manifest(const std::string& command) const noexcept {
     out << "# files written by `seamless " << command << "` into this folder (--force removes these, and only these)\n";
     for (const std::string& rel : list_files(dir_))
       if (!before_.count(rel) && rel != kManifest && rel != partial_path(kManifest)) out << rel << "\n";
+    for (const std::string& rel : before_)
+      if (rel != kManifest) out << "! " << rel << "\n";  // there before the run: never removed
     out.close();
     if (!out) throw Error("cannot write " + path.string());
     commit_partial(path.string());

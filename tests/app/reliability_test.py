@@ -412,6 +412,23 @@ class ForceNeverDeletesInputs(unittest.TestCase):
             for rel in ["notes/today.txt", "mesh_edited.ply"]:
                 self.assertTrue(os.path.exists(os.path.join(out, rel)), rel)
 
+    def test_force_never_takes_a_foreign_recording_for_its_own(self):
+        # A TUM folder from elsewhere has the names a recording has: without seamless's manifest,
+        # `record --force` refuses it and removes nothing.
+        with tempfile.TemporaryDirectory() as d:
+            tum = record_room(os.path.join(d, "tum"))
+            os.remove(os.path.join(tum, "manifest.txt"))
+            before = tree(tum)
+            r = seamless("record", "--source", "synthetic", "--out", tum, "--frames", "2", "--force", "--device", "cpu")
+            self.assertEqual(r.returncode, USAGE, r.stderr)
+            self.assertIn("which no manifest.txt of seamless lists as its own", r.stderr)
+            self.assertEqual(tree(tum), before)
+            # With its manifest (seamless wrote it), --force replaces the recording.
+            rec = record_room(os.path.join(d, "rec"))
+            r = seamless("record", "--source", "synthetic", "--out", rec, "--frames", "2", "--force", "--device", "cpu")
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertEqual(len(list_lines(os.path.join(rec, "rgb.txt"))), 2)
+
 
 class OneRunPerFolder(unittest.TestCase):
     def test_a_second_run_into_a_busy_folder_is_refused(self):
