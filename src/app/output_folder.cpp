@@ -143,7 +143,8 @@ OutputFolder::OutputFolder(std::string dir, bool force, const std::vector<std::s
                        ": a run never writes over its input; choose another --out");
   }
   fs::create_directories(dir_, ec);
-  if (ec == std::errc::permission_denied || ec == std::errc::read_only_file_system)
+  if (ec == std::errc::permission_denied || ec == std::errc::operation_not_permitted ||
+      ec == std::errc::read_only_file_system)
     throw UsageError("cannot create the output folder " + dir_ + ": " + ec.message() +
                      " (choose an --out you can write to)");
   if (ec) throw Error("cannot create the output folder " + dir_ + ": " + ec.message());

@@ -82,7 +82,9 @@ ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
   ScanResult r;
   if (with_volume) r.volume = make_volume(e.volume, ctx.device());
 
-  std::int64_t total = e.frames > 0 ? e.frames : source->size().value_or(0);
+  // frames and input.max_frames both limit the frames read (the source applies the latter).
+  std::int64_t total = source->size().value_or(0);
+  if (e.frames > 0 && (total == 0 || e.frames < total)) total = e.frames;
   Progress progress("scan", total);
   std::int64_t n = 0;
   r.intrinsics = source->intrinsics();

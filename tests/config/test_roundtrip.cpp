@@ -29,6 +29,7 @@ Experiment unusual_experiment() {
   e.volume.voxel_size = std::nextafter(0.005f, 1.f);  // one ulp off a short decimal
   e.volume.truncation = 0.0123456789f;
   e.volume.dense_origin = {-0.f, 1e-7f, -123.456f};
+  e.tracker.kind = "ground_truth";  // an empty iteration list is valid only for a tracker that does not iterate
   e.tracker.iterations = {};
   e.solver.gravity = {0.1f, 0.2f, 0.3f};
   e.render.mode = RenderMode::none;
