@@ -1,4 +1,4 @@
-// Kinematic collider particles from a depth camera's view (issue 22, solver.dynamic_colliders): a
+// Kinematic collider particles from a depth camera's view (solver.dynamic_colliders, docs/DYNAMIC.md): a
 // person or object the camera sees moving becomes, each frame, a set of infinitely heavy particles
 // at its measured surface, so that the solver's ordinary scene contacts push fluid, cloth and rigid
 // bodies out of it (Macklin et al. 2014's particle contacts, section 4.3; colliding particles with

@@ -75,7 +75,7 @@ void write_objects(const std::string& path, const SceneObjects& o) {
 
 SceneObjects read_objects(const std::string& path) {
   std::ifstream in(path);
-  if (!in) throw Error("cannot open '" + path + "' (written by `seamless run` since the renderer's issue 7)");
+  if (!in) throw Error("cannot open '" + path + "' (`seamless run` writes it; older runs have none)");
   SceneObjects o;
   std::string line;
   int lineno = 0;

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Issue 19: every #include of src/ and kernels/ against the allowed layer matrix.
+"""Every #include of src/ and kernels/ against the allowed layer matrix.
 
     core  <-  kernels  <-  io, recon, physics, render, eval  <-  app        (config beside)
 

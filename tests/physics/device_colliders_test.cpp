@@ -1,4 +1,4 @@
-// Issue 19: the depth camera's colliders computed on the device (DeviceColliders,
+// The depth camera's colliders computed on the device (DeviceColliders,
 // kernels/physics/depth_colliders.hpp) give what the host code gives (depth_surface, the app's
 // block_any and MovingColliders): on the CPU bit for bit; DeviceCollidersParity (ctest label gpu)
 // on CUDA within float rounding.

@@ -180,7 +180,7 @@ TEST(TsdfMeshParity, CpuAndCudaMeshesAgree) {
   EXPECT_EQ(unmatched, 0);
 }
 
-// The PLY reader on files it did not write (issue 20: fuzzing found face indices past the vertices
+// The PLY reader on files it did not write (fuzzing found face indices past the vertices
 // accepted, and normals with ny but no nx written out of bounds). Scalar types other than float
 // and uchar were read as 0; a header's counts allocated before the data was checked.
 std::string ply_file(const std::string& name, const std::string& header, const std::string& data) {

@@ -1,4 +1,4 @@
-// Issue #18 ("Looks real") on a real Kinect frame: frame 130 of tum_fr1_rpy_000-149 (a desk with
+// The realistic look on a real Kinect frame: frame 130 of tum_fr1_rpy_000-149 (a desk with
 // papers and a keyboard at about 1 m), read with the TUM reader (undistorted, freiburg1
 // intrinsics), pose identity (world = camera frame). The desk's plane is fitted to the frame's
 // depth; a cube and a puddle of fluid rest on it.
@@ -284,8 +284,8 @@ TEST(RenderLooks, CubeShadowOnTheRealDesk) {
 
 // A resting body of water on the desk below pixel (u, v): particles on a lattice of one diameter
 // (PBF's rest spacing) inside half an ellipsoid (semi-axes A along t1, B along t2, height H along
-// n), the shape surface tension gives a puddle with a rounded rim. 2 cm particles (issue #18:
-// 2-3 cm at 1-2 m): a few hundred of them.
+// n), the shape surface tension gives a puddle with a rounded rim. 2 cm particles (the
+// realistic look's 2-3 cm at 1-2 m): a few hundred of them.
 struct Puddle {
   std::vector<vec3> x;
   std::vector<std::uint32_t> ph;
