@@ -6,7 +6,7 @@
 #include <cstring>
 #include <type_traits>
 
-#include "core/camera.hpp"
+#include "core/intrinsics.hpp"
 #include "core/exec.hpp"
 #include "core/math.hpp"
 #include "core/view.hpp"

@@ -6,7 +6,7 @@
 #include <optional>
 #include <vector>
 
-#include "core/geometry.hpp"
+#include "core/mesh.hpp"
 #include "io/input_params.hpp"
 #include "io/trajectory.hpp"
 

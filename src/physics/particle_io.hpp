@@ -3,7 +3,7 @@
 #pragma once
 #include <string>
 
-#include "core/geometry.hpp"
+#include "core/particles.hpp"
 
 namespace seamless {
 

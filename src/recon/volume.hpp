@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "core/buffer.hpp"
-#include "core/camera.hpp"
-#include "core/geometry.hpp"  // Mesh
+#include "core/intrinsics.hpp"
+#include "core/mesh.hpp"  // Mesh
 #include "core/math.hpp"
 #include "core/timing.hpp"
 #include "recon/scene_particles.hpp"

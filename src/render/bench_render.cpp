@@ -9,7 +9,7 @@
 
 #include "core/buffer.hpp"
 #include "core/device.hpp"
-#include "core/geometry.hpp"
+#include "core/mesh.hpp"
 #include "kernels/physics/particle_math.hpp"
 #include "seamless/build_config.hpp"
 #if SEAMLESS_HAS_CUDA

@@ -6,7 +6,7 @@
 #include <span>
 #include <vector>
 
-#include "core/geometry.hpp"
+#include "core/particles.hpp"
 #include "core/math.hpp"
 
 namespace seamless {

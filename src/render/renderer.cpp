@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "core/error.hpp"
-#include "core/geometry.hpp"
+#include "core/mesh.hpp"
 #include "core/log.hpp"
 #include "kernels/physics/particle_math.hpp"
 #include "render/renderer_impl.hpp"

@@ -13,7 +13,7 @@
 #include <optional>
 #include <string>
 
-#include "core/camera.hpp"
+#include "core/intrinsics.hpp"
 #include "core/math.hpp"
 #include "io/frame_source.hpp"
 #include "recon/tracker_params.hpp"

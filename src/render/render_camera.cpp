@@ -1,4 +1,4 @@
-#include "render/camera.hpp"
+#include "render/render_camera.hpp"
 
 #include <cmath>
 
