@@ -15,7 +15,7 @@ namespace seamless {
 struct ParticleState {
   std::vector<vec3> x, v;
   std::vector<float> inv_mass;
-  std::vector<std::uint32_t> phase;  // kernels::phase flags and group
+  std::vector<std::uint32_t> phase;  // phase flags and group (core/phase.hpp)
 };
 
 // One rigid body's frame: x = R q + c for its rest offsets q.
