@@ -8,6 +8,7 @@
 #include <map>
 #include <sstream>
 
+#include "core/basis.hpp"
 #include "core/error.hpp"
 #include "kernels/physics/constraints.hpp"
 #include "kernels/physics/particle_math.hpp"
@@ -23,11 +24,13 @@ vec3 up_from_gravity(vec3 g) {
   return l > 0.f ? -g / l : vec3{0.f, 1.f, 0.f};
 }
 
-// Two unit vectors spanning the plane normal to n.
+// Two unit vectors spanning the plane normal to n, (u, w, -n) right-handed: u is the projection of
+// the x axis (the y axis where n is near x) onto the plane, so that a cloth hung under gravity -y
+// spans x (its rows) and z (its columns). In the terms of core's basis (t1, t2, n): u = -t2, w = -t1.
 void plane_basis(vec3 n, vec3& u, vec3& w) {
-  vec3 a = std::fabs(n.x) < 0.9f ? vec3{1.f, 0.f, 0.f} : vec3{0.f, 1.f, 0.f};
-  u = normalize(a - n * dot(a, n));
-  w = cross(u, n);
+  vec3 t1, t2;
+  orthonormal_basis(n, t1, t2);
+  u = -t2, w = -t1;
 }
 
 // Exact distance of every occupied cell to the nearest empty one (searching shells of growing
