@@ -170,7 +170,7 @@ class LiveLoop : public FrameLoop {
   // the full-resolution pixels it averages is). On the run's device, from the tracker's maps to
   // the solver (DeviceColliders).
   // frame_time: the simulation time this frame's steps end at; the steps between the last frame
-  // and this one move the colliders with their estimated velocities (MovingColliders).
+  // and this one move the colliders with their estimated velocities.
   void update_colliders(const SE3& world_T_camera, double frame_time) {
     StageScope s(ctx_.timer(), "colliders");
     const auto [vertices, normals] = session_.unmasked_level();

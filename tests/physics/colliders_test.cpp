@@ -1,4 +1,4 @@
-// Kinematic colliders from a depth camera's view (physics/depth_colliders.hpp) against
+// Kinematic colliders from a depth camera's view (the host oracle, host_colliders.hpp) against
 // the exact geometry of a walking person's torso (a capsule, kernels/scene/movers.hpp).
 #include <gtest/gtest.h>
 
@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "host_colliders.hpp"
 #include "kernels/scene/movers.hpp"
 #include "physics/builders.hpp"
-#include "physics/depth_colliders.hpp"
 #include "physics/particle_solver.hpp"
 #include "physics_test_util.hpp"
 
