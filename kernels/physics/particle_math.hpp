@@ -125,6 +125,17 @@ template <class F> SEAMLESS_HD inline F slab_gap(F v, int i, float cs, float pad
   return select(g > 0.f, g, F(0.f));
 }
 
+// The squared distances along y and along z from p (in cell c) to the slabs of cells c.y + d - reach
+// and c.z + d - reach, d in [0, 2 reach], made smaller by pad: a row of cells (dy, dz) is at
+// squared y-z distance ey2[dy] + ez2[dz] (for_each_run_in_radius).
+SEAMLESS_HD inline void slab_gaps2(const GridSpec& g, vec3 p, int3 c, float pad, float* ey2, float* ez2) {
+  constexpr int kReach = GridSpec::reach;
+  for (int d = 0; d <= 2 * kReach; ++d) {
+    const float ey = slab_gap(p.y, c.y + d - kReach, g.cell, pad), ez = slab_gap(p.z, c.z + d - kReach, g.cell, pad);
+    ey2[d] = ey * ey, ez2[d] = ez * ez;
+  }
+}
+
 // The cells [lo, hi] along x (not yet wrapped) of the row of cells at squared y-z distance d2
 // from p that the sphere of radius R2 = R^2 around p crosses, within reach of p's cell cx, made
 // larger by pad (for_each_run_in_radius). F, I: float and int, or the CPU's SIMD lanes.
@@ -155,10 +166,7 @@ SEAMLESS_HD inline void for_each_run_in_radius(const GridSpec& g, const int* sta
   const float R2 = R * R, pad = 1e-3f * g.cell;
   const std::uint32_t m = (1u << g.bits) - 1u;
   float ey2[kWidth], ez2[kWidth];
-  for (int d = 0; d < kWidth; ++d) {
-    const float ey = slab_gap(p.y, c.y + d - kReach, g.cell, pad), ez = slab_gap(p.z, c.z + d - kReach, g.cell, pad);
-    ey2[d] = ey * ey, ez2[d] = ez * ez;
-  }
+  slab_gaps2(g, p, c, pad, ey2, ez2);
   for (int dz = 0; dz < kWidth; ++dz) {
     const std::uint32_t slab = (static_cast<std::uint32_t>(c.z + dz - kReach) & m) << (2 * g.bits);
     for (int dy = 0; dy < kWidth; ++dy) {
