@@ -6,8 +6,8 @@
 #include <cstring>
 #include <type_traits>
 
-#include "core/intrinsics.hpp"
 #include "core/exec.hpp"
+#include "core/intrinsics.hpp"
 #include "core/math.hpp"
 #include "core/view.hpp"
 #include "kernels/recon/voxel_hash.hpp"

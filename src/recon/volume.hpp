@@ -7,8 +7,8 @@
 
 #include "core/buffer.hpp"
 #include "core/intrinsics.hpp"
-#include "core/mesh.hpp"  // Mesh
 #include "core/math.hpp"
+#include "core/mesh.hpp"  // Mesh
 #include "core/timing.hpp"
 #include "recon/scene_particles.hpp"
 #include "recon/volume_params.hpp"
