@@ -1,7 +1,7 @@
 #!/usr/bin/python3
-"""Issue 20 (reliability): exit codes that tell the truth, runs stopped by Ctrl-C or by a bad
+"""Reliability: exit codes that tell the truth, runs stopped by Ctrl-C or by a bad
 frame keep what they computed, an output folder holds one run, and limits that used to act
-silently are reported. Each test is a case of the issue's "Found" list.
+silently are reported. Each test is one way a run used to fail.
 usage: reliability_test.py SEAMLESS_BINARY SOURCE_DIR DATA_DIR"""
 import csv
 import glob
@@ -102,7 +102,7 @@ class ExitCodes(unittest.TestCase):
         r = seamless("run", DEMO, "--dry-run", "--set", "volume.voxel_sise=0.01")
         self.assertEqual(r.returncode, CONFIG, r.stderr)
         self.assertIn("did you mean 'voxel_size'", r.stderr)
-        # Found 6: one --set that cannot be applied hid the file's other errors; all are listed now.
+        # Regression: one --set that cannot be applied hid the file's other errors; all are listed now.
         with tempfile.TemporaryDirectory() as d:
             bad = os.path.join(d, "bad.yaml")
             with open(bad, "w") as f:
@@ -115,12 +115,12 @@ class ExitCodes(unittest.TestCase):
 
     @unittest.skipUnless(os.path.isdir(TUM), f"no test data at {TUM}")
     def test_wrong_depth_scale_loses_frames_and_says_so(self):
-        # Found 3: 9 of 10 frames lost at depth_scale 1000 (TUM is 5000), exit 0. The median depth of
+        # Regression: 9 of 10 frames lost at depth_scale 1000 (TUM is 5000), exit 0. The median depth of
         # 6 m passes the reader's 0.2-10 m plausibility check. The depth-scale check (the Kinect's
-        # disparity steps, issue 17) now stops it as a config error naming the right scale; with that
+        # disparity steps) now stops it as a config error naming the right scale; with that
         # check off, tracking is what tells, and the lost frames give their own exit code. Frame to
         # model: depth five times too far falls beyond volume.max_depth, the model stays empty and the
-        # frames are lost (frame to frame, configs/tum_fr1.yaml's tracker since issue 24, tracks the
+        # frames are lost (frame to frame, configs/tum_fr1.yaml's tracker, tracks the
         # scaled room consistently and loses nothing; only the depth-scale check can tell there).
         fm = "tracker.mode=frame_to_model"
         with tempfile.TemporaryDirectory() as d:
@@ -142,8 +142,8 @@ class ExitCodes(unittest.TestCase):
             self.assertEqual(r.returncode, 0, r.stderr)
 
     def test_zero_tracker_iterations_are_a_config_error(self):
-        # Found 3: tracker.iterations [0,0,0] lost every frame but the first, exit 0. Since then it
-        # is refused when the config is loaded, before anything is written.
+        # Regression: tracker.iterations [0,0,0] lost every frame but the first, exit 0. Now it is
+        # refused when the config is loaded, before anything is written.
         with tempfile.TemporaryDirectory() as d:
             out = os.path.join(d, "trk")
             r = seamless("track", DEMO, "--device", "cpu", "--out", out, "--set", "input.synthetic.frames=3",
@@ -155,7 +155,7 @@ class ExitCodes(unittest.TestCase):
 
 class Interrupted(unittest.TestCase):
     def test_record_stopped_by_ctrl_c_loads(self):
-        # Found 1: the lists were written only at the end; a stopped recording did not load.
+        # Regression: the lists were written only at the end; a stopped recording did not load.
         with tempfile.TemporaryDirectory() as d:
             room = os.path.join(d, "room")
             code, err = interrupt_when(
@@ -196,7 +196,7 @@ class Interrupted(unittest.TestCase):
             self.assertEqual(glob.glob(os.path.join(out, "*.partial")), [])
 
     def test_run_stopped_by_ctrl_c_writes_everything(self):
-        # Found 1: `run` stopped by SIGINT left log.txt empty and no timings.csv or tracking_stats.csv.
+        # Regression: `run` stopped by SIGINT left log.txt empty and no timings.csv or tracking_stats.csv.
         with tempfile.TemporaryDirectory() as d:
             out = os.path.join(d, "run")
             code, err = interrupt_when(
@@ -242,7 +242,7 @@ class Interrupted(unittest.TestCase):
 class FailedMidway(unittest.TestCase):
     @unittest.skipUnless(os.path.isdir(TUM), f"no test data at {TUM}")
     def test_corrupt_png_keeps_the_frames_before_it(self):
-        # Found 2: a corrupt PNG in frame 4 stopped the run (good) but frames 0-3 were not written.
+        # Regression: a corrupt PNG in frame 4 stopped the run (good) but frames 0-3 were not written.
         with tempfile.TemporaryDirectory() as d:
             seq, out = os.path.join(d, "seq"), os.path.join(d, "trk")
             tum_copy(seq, 6, corrupt_depth_of=4)
@@ -257,7 +257,7 @@ class FailedMidway(unittest.TestCase):
 
 class OutputFolder(unittest.TestCase):
     def test_a_folder_holds_one_run(self):
-        # Found 2: a run into an existing folder left the old run's other files beside its own.
+        # Regression: a run into an existing folder left the old run's other files beside its own.
         with tempfile.TemporaryDirectory() as d:
             out = os.path.join(d, "run")
             args = ["reconstruct", DEMO, "--device", "cpu", "--out", out, "--set", "input.synthetic.frames=2",
@@ -285,7 +285,7 @@ class OutputFolder(unittest.TestCase):
 
 class Limits(unittest.TestCase):
     def test_hash_table_keeps_up_with_a_tiny_capacity(self):
-        # Found 4: capacity 64 doubled 4 times in frame 0, then dropped 530,045 insertions, advised
+        # Regression: capacity 64 doubled 4 times in frame 0, then dropped 530,045 insertions, advised
         # grow_when_full: true (already on) and lost every later frame, exit 0.
         with tempfile.TemporaryDirectory() as d:
             out = os.path.join(d, "rec")
@@ -297,7 +297,7 @@ class Limits(unittest.TestCase):
             self.assertTrue(all(s["status"] == "ok" for s in rows(os.path.join(out, "tracking_stats.csv"))))
 
     def test_emitters_and_spawns_report_what_they_change(self):
-        # Found 6: an emitter asking for 100000 particles/s gave 15 without a word; an emitter past
+        # Regression: an emitter asking for 100000 particles/s gave 15 without a word; an emitter past
         # solver.max_particles dropped particles silently; a spawn at (1000, 1000, 1000) was moved
         # into the room silently.
         with tempfile.TemporaryDirectory() as d:
@@ -365,7 +365,7 @@ def summary(out):
 
 class ForceNeverDeletesInputs(unittest.TestCase):
     def test_out_holding_the_input_is_refused(self):
-        # Found 1: --force wiped a folder holding log.txt recursively, the dataset inside it too.
+        # Regression: --force wiped a folder holding log.txt recursively, the dataset inside it too.
         with tempfile.TemporaryDirectory() as d:
             proj = os.path.join(d, "proj")
             data = record_room(os.path.join(proj, "room"))
@@ -432,7 +432,7 @@ class ForceNeverDeletesInputs(unittest.TestCase):
 
 class OneRunPerFolder(unittest.TestCase):
     def test_a_second_run_into_a_busy_folder_is_refused(self):
-        # Found 2: two runs into one folder raced; with --force the second deleted the first's files.
+        # Regression: two runs into one folder raced; with --force the second deleted the first's files.
         with tempfile.TemporaryDirectory() as d:
             out = os.path.join(d, "run")
             first = subprocess.Popen([EXE, *small_recon(out, 60)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
@@ -448,7 +448,7 @@ class OneRunPerFolder(unittest.TestCase):
             first.send_signal(signal.SIGTERM)
             _, err = first.communicate(timeout=300)
             self.assertEqual(first.returncode, 128 + signal.SIGTERM, err)
-            # Found 5: after SIGTERM summary.json had no mark, log.txt no line.
+            # Regression: after SIGTERM summary.json had no mark, log.txt no line.
             s = summary(out)
             self.assertEqual(s["status"], "interrupted")
             self.assertEqual(s["signal"], "SIGTERM")
@@ -479,7 +479,7 @@ class HonestStatus(unittest.TestCase):
             self.assertRegex(r.stderr, r"scan: 3/\d+ .*tracking ok")  # the progress line says what "ok" is
 
     def test_second_signal_leaves_a_clear_mark(self):
-        # Found 5: Ctrl-C twice 50 ms apart left only .partial files and exit 130.
+        # Regression: Ctrl-C twice 50 ms apart left only .partial files and exit 130.
         with tempfile.TemporaryDirectory() as d:
             out = os.path.join(d, "run")
             p = subprocess.Popen([EXE, *small_recon(out, 60)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
@@ -501,7 +501,7 @@ class HonestStatus(unittest.TestCase):
                 self.assertEqual(status, "interrupted")
 
     def test_failure_after_start_up_does_not_block_the_corrected_run(self):
-        # Found 4: a problem found after start-up (here the particle budget) left config.yaml and
+        # Regression: a problem found after start-up (here the particle budget) left config.yaml and
         # log.txt, and the corrected re-run was refused.
         with tempfile.TemporaryDirectory() as d:
             out = os.path.join(d, "sim")
@@ -520,7 +520,7 @@ class HonestStatus(unittest.TestCase):
             self.assertEqual(summary(out)["status"], "complete")
 
     def test_partial_file_removed_when_a_write_fails(self):
-        # Found 7: a mesh.ply.partial left on a full disk kept it full. A file size limit stands in
+        # Regression: a mesh.ply.partial left on a full disk kept it full. A file size limit stands in
         # for the full disk: the mesh write fails part way.
         import resource
 
@@ -539,7 +539,7 @@ class HonestStatus(unittest.TestCase):
 
 class EveryProblemAtOnce(unittest.TestCase):
     def test_key_errors_and_rules_in_one_run_nothing_written(self):
-        # Found 4: key errors hid the rules across keys, which then came one per run.
+        # Regression: key errors hid the rules across keys, which then came one per run.
         with tempfile.TemporaryDirectory() as d:
             bad = os.path.join(d, "bad.yaml")
             with open(bad, "w") as f:
@@ -555,7 +555,7 @@ class EveryProblemAtOnce(unittest.TestCase):
             self.assertFalse(os.path.exists(out))
 
     def test_nonsense_values(self):
-        # Found 6: accepted, then failing later or never.
+        # Regression: accepted, then failing later or never.
         cases = {"solver.gravity=[0,-1e30,0]": "beyond the sanity bound",
                  "spawn=[{kind: fluid_block, size: [-0.2, 0.2, 0.2]}]": "every extent must be positive",
                  "spawn=[{kind: fluid_block, size: [0, 0, 0]}]": "every extent must be positive",
@@ -572,7 +572,7 @@ class EveryProblemAtOnce(unittest.TestCase):
             self.assertFalse(os.path.exists(os.path.join(d, "rec")))
 
     def test_huge_spawn_list_is_refused_in_bounded_memory(self):
-        # Found 7: a 700k-entry spawn list took 4.7 GB and died with std::bad_alloc.
+        # Regression: a 700k-entry spawn list took 4.7 GB and died with std::bad_alloc.
         with tempfile.TemporaryDirectory() as d:
             big = os.path.join(d, "big.yaml")
             with open(big, "w") as f:
@@ -590,7 +590,7 @@ class EveryProblemAtOnce(unittest.TestCase):
 
 class Advice(unittest.TestCase):
     def test_full_block_pool_advice_comes_from_the_numbers(self):
-        # Found 3: a full pool advised capacity >= 128, then 256 (8192 were needed), and exit 6
+        # Regression: a full pool advised capacity >= 128, then 256 (8192 were needed), and exit 6
         # blamed input.depth_scale.
         import re
         with tempfile.TemporaryDirectory() as d:
@@ -608,7 +608,7 @@ class Advice(unittest.TestCase):
             self.assertNotIn("insertion attempts failed", r.stderr)
 
     def test_unwritable_out_is_named(self):
-        # Found 7: "internal error: Failed opening file".
+        # Regression: "internal error: Failed opening file".
         if os.geteuid() == 0:  # root writes anywhere a mode forbids; sysfs refuses new folders even to root
             if not os.path.isdir("/sys/kernel"):
                 self.skipTest("root, and no /sys")
@@ -646,7 +646,7 @@ class Advice(unittest.TestCase):
             self.assertEqual(seamless("eval", gt, est, "--json", os.path.join(d, "ate.json")).returncode, 0)
 
     def test_open_mesh_gets_the_right_advice(self):
-        # Found 7: a single OBJ triangle was advised "make it larger", which fails at 1 m too.
+        # Regression: a single OBJ triangle was advised "make it larger", which fails at 1 m too.
         with tempfile.TemporaryDirectory() as d:
             obj = os.path.join(d, "triangle.obj")
             with open(obj, "w") as f:
