@@ -14,6 +14,7 @@
 #include "core/device.hpp"
 #include "core/log.hpp"
 #include "core/timing.hpp"
+#include "io/frame_source.hpp"
 
 namespace seamless::app {
 
@@ -55,6 +56,13 @@ class RunContext {
   // render.mode window: close the window after this many frames (0: when the user closes it).
   int window_frames() const { return window_frames_; }
 
+  // The input: the source set_source() gave (once: a stream cannot be read twice), else a new
+  // source of the config's input section. Throws seamless::UsageError when the given source was
+  // taken already (a replay reads the input a second time).
+  std::unique_ptr<FrameSource> open_source();
+  // Frames from the caller (the Python module's frame source) instead of input.source.
+  void set_source(std::unique_ptr<FrameSource> source);
+
   // Tracking's outcome: when more than output.max_lost_fraction of `frames` were lost, logs an
   // error naming the likely causes and exit_code() becomes kExitLostFrames.
   void report_tracking(std::int64_t frames, std::int64_t lost);
@@ -72,7 +80,12 @@ class RunContext {
   int exit_code_ = kExitOk;
   std::unique_ptr<StageTimer> timer_;
   std::shared_ptr<spdlog::sinks::sink> log_file_;
+  std::unique_ptr<FrameSource> given_source_;
+  bool source_given_ = false;
 };
+
+// The output folder when --out is not given: <output.dir>/<config file's stem>-<date-time>.
+std::string default_out_dir(const Experiment& e, const std::string& config);
 
 // An output folder holds one run's files only: when `out` holds any of `marks` (files an earlier
 // run wrote), throws seamless::UsageError naming them, or with `force` removes everything in it.
