@@ -154,7 +154,7 @@ py::dict timing_arrays(const std::vector<StageTimer::Row>& rows) {
   return d;
 }
 
-py::dict scan_arrays(ScanResult&& r) {
+py::dict scan_arrays(app::ScanResult&& r) {
   py::dict d = trajectory_arrays(r.tracking.trajectory);
   d["frames"] = frame_records(r.tracking.frames);
   d["lost_frames"] = r.tracking.lost_frames;
@@ -185,12 +185,24 @@ template <class T> void copy_image(const py::array& a, Image<T>& im) {
 
 // Each call of next() on the Python iterator gives (timestamp, depth float32 HxW, colour uint8
 // HxWx3, accelerometer or None, camera-to-world 4x4 or None), checked on the Python side.
+// A Python object that C++ may let go of without holding the GIL (the frame source is destroyed
+// inside the run, which releases it).
+struct Held {
+  py::object object;
+  explicit Held(py::object o) : object(std::move(o)) {}
+  ~Held() {
+    py::gil_scoped_acquire gil;
+    object = py::object();
+  }
+};
+
 CallbackSource::Fetch python_fetch(py::object iterator) {
-  return [iterator](RgbdFrame& frame) {
+  auto held = std::make_shared<Held>(std::move(iterator));
+  return [held](RgbdFrame& frame) {
     py::gil_scoped_acquire gil;
     py::object item;
     try {
-      item = iterator.attr("__next__")();
+      item = held->object.attr("__next__")();
     } catch (py::error_already_set& e) {
       if (e.matches(PyExc_StopIteration)) return false;
       throw;
@@ -295,8 +307,8 @@ py::dict run_call(Call& c) {
   int exit_code = 0;
   bool stopped = false;
   {
-    std::optional<ScanResult> scan;
-    std::optional<SimulationResult> sim;
+    std::optional<app::ScanResult> scan;
+    std::optional<app::SimulationResult> sim;
     std::optional<app::RunOutputs> run;
     std::vector<StageTimer::Row> timings;
     std::string out_dir;
