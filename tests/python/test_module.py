@@ -135,7 +135,7 @@ def test_numpy_frames_give_the_tum_source_poses(fr1_rpy, fr1_config, tmp_path):
 
 def test_reconstruct_mesh_arrays_are_the_mesh_ply(fr1_rpy, fr1_config, tmp_path):
     calls = []
-    r = seamless.reconstruct(fr1_config, {"input.path": fr1_rpy, "frames": 5, "device": "cpu", "volume.capacity": 8192,
+    r = seamless.reconstruct(fr1_config, {"input.path": fr1_rpy, "frames": 5, "device": "cpu", "volume.capacity": 16384,
                                           "volume.voxel_size": 0.02, "volume.truncation": 0.08},
                              out=tmp_path / "rec", progress=lambda *a: calls.append(a))
     m = r.mesh
@@ -192,10 +192,10 @@ def read_particles(path):
 
 
 def test_run_equals_the_cli(seamless_cli, source_dir, tmp_path):
-    """The demo experiment, reduced (8 synthetic frames, 0.1 s of physics, no rendering), through
+    """The demo experiment, reduced (4 synthetic frames, 0.05 s of physics, no rendering), through
     `seamless run` and seamless.run: the same particles, written and returned."""
     config = os.path.join(source_dir, "configs", "demo.yaml")
-    overrides = {"device": "cpu", "input.synthetic.frames": 8, "duration": 0.1, "render.mode": "none",
+    overrides = {"device": "cpu", "input.synthetic.frames": 4, "duration": 0.05, "render.mode": "none",
                  "volume.capacity": 16384}
     seamless_cli("run", config, *as_sets(overrides), "--out", tmp_path / "cli")
     r = seamless.run(config, overrides, out=tmp_path / "py")
@@ -206,6 +206,6 @@ def test_run_equals_the_cli(seamless_cli, source_dir, tmp_path):
     assert r.solver["particles"] == len(x) > 0
     scene, _, _ = read_particles(tmp_path / "py" / "scene_particles.ply")
     np.testing.assert_array_equal(r.scene_particles, scene)
-    assert r.summary["frames"]["read"] == 8 and r.poses.shape == (8, 4, 4) and len(r.mesh.faces) > 0
+    assert r.summary["frames"]["read"] == 4 and r.poses.shape == (4, 4, 4) and len(r.mesh.faces) > 0
     for name in ("particles.ply", "scene_particles.ply", "trajectory.txt"):
         assert (tmp_path / "cli" / name).read_bytes() == (tmp_path / "py" / name).read_bytes(), name
