@@ -79,7 +79,8 @@ int main() {
   };
   const double y0 = mean_height();
   for (int i = 0; i < 10; ++i) solver.step();
-  check(y0 > 0.9 && std::fabs((y0 - mean_height()) - 0.0491) < 0.006, "physics: ParticleSolver, a rigid box in free fall");
+  check(y0 > 0.9 && std::fabs((y0 - mean_height()) - 0.0491) < 0.006,
+        "physics: ParticleSolver, a rigid box in free fall");
 
   // build_config: the installed headers carry the version find_package(seamless) reported.
   check(std::string(SEAMLESS_VERSION) == SEAMLESS_PACKAGE_VERSION, "build_config: SEAMLESS_VERSION");
