@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <optional>
 
+#include "app/api.hpp"
 #include "app/commands.hpp"
 #include "app/json_file.hpp"
 #include "app/run_context.hpp"
@@ -91,27 +92,65 @@ void refuse_overwriting_inputs(const EvalArgs& a) {
     throw UsageError("--json and --aligned name the same file " + a.json + "; give two file names");
 }
 
+// The figures of one estimate against ground truth: ATE, RPE per frame and, when the trajectory
+// lasts a second or more, RPE over 1 s (TUM's; m/s, deg/s).
+struct EvalFigures {
+  Trajectory gt, est;
+  AteResult ate;
+  RpeResult rpe_f;
+  std::optional<RpeResult> rpe_s;
+  std::string no_rpe_s;  // why there is no RPE over 1 s
+};
+
+EvalFigures compute_eval(const std::string& gt_path, const std::string& est_path, const EvalOptions& opt) {
+  EvalFigures f;
+  f.gt = read_tum_trajectory(gt_path), f.est = read_tum_trajectory(est_path);
+  warn_if_swapped(gt_path, est_path, f.gt, f.est);
+  f.ate = compute_ate(f.est, f.gt, opt);
+  f.rpe_f = compute_rpe(f.est, f.gt, 1, "frames", opt);
+  try {
+    f.rpe_s = compute_rpe(f.est, f.gt, 1.0, "seconds", opt);
+  } catch (const Error& e) {
+    f.no_rpe_s = e.what();
+  }
+  return f;
+}
+
+// Schema: docs/TRACKING.md, "seamless eval".
+Json eval_json(const std::string& gt_path, const std::string& est_path, const EvalOptions& opt, const EvalFigures& f) {
+  Json j = {{"schema", "seamless-eval/1"},      {"seamless_version", SEAMLESS_VERSION},
+            {"groundtruth", gt_path},           {"estimate", est_path},
+            {"groundtruth_poses", f.gt.size()}, {"estimate_poses", f.est.size()},
+            {"t_max_diff_s", opt.t_max_diff},   {"offset_s", opt.offset},
+            {"align", to_string(opt.align)},    {"scale", f.ate.scale},
+            {"pairs", f.ate.trans.count}};
+  add_stats(j, "ate", f.ate.trans, "m");
+  j["rpe_frame_pairs"] = f.rpe_f.trans.count;
+  add_stats(j, "rpe_frame_trans", f.rpe_f.trans, "m");
+  add_stats(j, "rpe_frame_rot", f.rpe_f.rot, "deg");
+  j["rpe_second_delta_s"] = 1.0;
+  if (f.rpe_s) {
+    j["rpe_second_pairs"] = f.rpe_s->trans.count;
+    add_stats(j, "rpe_second_trans", f.rpe_s->trans, "m");  // metres over 1 s: m/s
+    add_stats(j, "rpe_second_rot", f.rpe_s->rot, "deg");    // deg/s
+  } else {
+    j["rpe_second_pairs"] = 0;
+    for (const char* k : {"rpe_second_trans_rmse_m", "rpe_second_rot_rmse_deg"}) j[k] = nullptr;
+  }
+  return j;
+}
+
 int run_eval(const EvalArgs& a) {
   refuse_overwriting_inputs(a);
   EvalOptions opt = a.opt;
   opt.align = parse_alignment(a.align);
   const std::string &gt_path = a.files[0], &est_path = a.files[1];
-  const Trajectory gt = read_tum_trajectory(gt_path), est = read_tum_trajectory(est_path);
-  warn_if_swapped(gt_path, est_path, gt, est);
-  const AteResult ate = compute_ate(est, gt, opt);
-  const RpeResult rpe_f = compute_rpe(est, gt, 1, "frames", opt);
-  // TUM's RPE over 1 s (m/s, deg/s); a trajectory shorter than that has none.
-  std::optional<RpeResult> rpe_s;
-  std::string no_rpe_s;
-  try {
-    rpe_s = compute_rpe(est, gt, 1.0, "seconds", opt);
-  } catch (const Error& e) {
-    no_rpe_s = e.what();
-  }
-  std::printf("ground truth %s (%zu poses), estimate %s (%zu poses)\n", gt_path.c_str(), gt.size(), est_path.c_str(),
-              est.size());
+  const EvalFigures f = compute_eval(gt_path, est_path, opt);
+  const AteResult& ate = f.ate;
+  std::printf("ground truth %s (%zu poses), estimate %s (%zu poses)\n", gt_path.c_str(), f.gt.size(), est_path.c_str(),
+              f.est.size());
   std::printf("%zu of %zu estimated poses matched ground truth within %.3f s (offset %g s); alignment %s",
-              ate.trans.count, est.size(), opt.t_max_diff, opt.offset, to_string(opt.align));
+              ate.trans.count, f.est.size(), opt.t_max_diff, opt.offset, to_string(opt.align));
   if (opt.align == Alignment::sim3) std::printf(", scale %.6f", ate.scale);
   std::printf("\n%-24s %10s %10s %10s %10s %10s\n", "", "rmse", "mean", "median", "std", "max");
   auto row = [](const char* name, const ErrorStats& s, double scale) {
@@ -119,41 +158,23 @@ int run_eval(const EvalArgs& a) {
                 s.std * scale, s.max * scale);
   };
   row("ATE (cm)", ate.trans, 100);
-  row("RPE/frame trans (cm)", rpe_f.trans, 100);
-  row("RPE/frame rot (deg)", rpe_f.rot, 1);
-  if (rpe_s) {
-    row("RPE/1 s trans (cm/s)", rpe_s->trans, 100);
-    row("RPE/1 s rot (deg/s)", rpe_s->rot, 1);
+  row("RPE/frame trans (cm)", f.rpe_f.trans, 100);
+  row("RPE/frame rot (deg)", f.rpe_f.rot, 1);
+  if (f.rpe_s) {
+    row("RPE/1 s trans (cm/s)", f.rpe_s->trans, 100);
+    row("RPE/1 s rot (deg/s)", f.rpe_s->rot, 1);
   } else {
-    std::printf("no RPE over 1 s: %s\n", no_rpe_s.c_str());
+    std::printf("no RPE over 1 s: %s\n", f.no_rpe_s.c_str());
   }
   if (!a.aligned.empty()) write_tum_trajectory(a.aligned, ate.aligned);
-  if (!a.json.empty()) {
-    // Schema: docs/TRACKING.md, "seamless eval".
-    Json j = {{"schema", "seamless-eval/1"},    {"seamless_version", SEAMLESS_VERSION},
-              {"groundtruth", gt_path},         {"estimate", est_path},
-              {"groundtruth_poses", gt.size()}, {"estimate_poses", est.size()},
-              {"t_max_diff_s", opt.t_max_diff}, {"offset_s", opt.offset},
-              {"align", to_string(opt.align)},  {"scale", ate.scale},
-              {"pairs", ate.trans.count}};
-    add_stats(j, "ate", ate.trans, "m");
-    j["rpe_frame_pairs"] = rpe_f.trans.count;
-    add_stats(j, "rpe_frame_trans", rpe_f.trans, "m");
-    add_stats(j, "rpe_frame_rot", rpe_f.rot, "deg");
-    j["rpe_second_delta_s"] = 1.0;
-    if (rpe_s) {
-      j["rpe_second_pairs"] = rpe_s->trans.count;
-      add_stats(j, "rpe_second_trans", rpe_s->trans, "m");  // metres over 1 s: m/s
-      add_stats(j, "rpe_second_rot", rpe_s->rot, "deg");    // deg/s
-    } else {
-      j["rpe_second_pairs"] = 0;
-      for (const char* k : {"rpe_second_trans_rmse_m", "rpe_second_rot_rmse_deg"}) j[k] = nullptr;
-    }
-    write_json_file(a.json, j);
-  }
+  if (!a.json.empty()) write_json_file(a.json, eval_json(gt_path, est_path, opt, f));
   return 0;
 }
 }  // namespace
+
+std::string eval_report(const std::string& groundtruth, const std::string& estimate, const EvalOptions& options) {
+  return json_text(eval_json(groundtruth, estimate, options, compute_eval(groundtruth, estimate, options)));
+}
 
 void add_eval_command(CLI::App& app, std::function<int()>& action) {
   auto a = std::make_shared<EvalArgs>();

@@ -1,6 +1,7 @@
 // reconstruct, track, simulate: the pipeline's parts run on their own (render: cmd_render.cpp).
 #include <spdlog/spdlog.h>
 
+#include "app/api.hpp"
 #include "app/commands.hpp"
 #include "app/pipeline.hpp"
 #include "app/run_context.hpp"
@@ -12,6 +13,47 @@
 
 namespace seamless::app {
 
+ScanResult reconstruct_experiment(RunContext& ctx) {
+  ScanResult s = scan(ctx, true);
+  add_tracking(ctx.summary(), s.tracking, s.unreadable, groundtruth_path(ctx));
+  ctx.summary().intrinsics = s.intrinsics;
+  return s;
+}
+
+ScanResult track_experiment(RunContext& ctx) {
+  const Experiment& e = ctx.experiment();
+  require_refine(e.refine);  // before tracking: a missing Ceres is not found out 150 frames later
+  ScanResult r = scan(ctx, false);
+  if (e.refine.enabled && e.refine.online)
+    spdlog::info("refine: refine.online refined while tracking; the offline stage (refine.enabled) is skipped");
+  const bool offline = e.refine.enabled && !e.refine.online;
+  if (offline && interrupted()) spdlog::warn("refine: skipped (interrupted)");
+  if (offline && !interrupted()) {
+    std::vector<bool> tracked;
+    for (const FrameRecord& f : r.tracking.frames) tracked.push_back(f.result.ok());
+    r.tracking.trajectory =
+        refine_run(e.input, r.tracking.trajectory, tracked, e.refine, e.preprocess, ctx.device(), ctx.out_dir())
+            .trajectory;
+  }
+  // summary.json as `run` writes it, for the trajectory.txt written (refined, when refine is on).
+  add_tracking(ctx.summary(), r.tracking, r.unreadable, groundtruth_path(ctx));
+  ctx.summary().intrinsics = r.intrinsics;
+  return r;
+}
+
+SimulationResult simulate_experiment(RunContext& ctx) {
+  if (ctx.experiment().input.source != InputSource::synthetic)
+    throw ConfigError(
+        "seamless simulate runs on the synthetic room's analytic scene (input.source: synthetic); to "
+        "simulate on a scanned scene use `seamless run` with mode: scan_then_simulate");
+  kernels::SceneSdf sdf{};
+  sdf.synthetic_room = 1;
+  ctx.experiment().solver.gravity = kernels::room::gravity();  // the room's world is z up
+  SimulationResult result = simulate(ctx, nullptr, &sdf);
+  ctx.summary().physics = result.stats;
+  return result;
+}
+
 void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
   auto rec = std::make_shared<CommonOptions>();
   auto* r = app.add_subcommand("reconstruct",
@@ -22,9 +64,7 @@ void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
   r->callback([&action, rec] {
     action = [rec] {
       RunContext ctx(*rec);
-      ScanResult s = scan(ctx, true);
-      add_tracking(ctx.summary(), s.tracking, s.unreadable, groundtruth_path(ctx));
-      ctx.summary().intrinsics = s.intrinsics;
+      reconstruct_experiment(ctx);
       return ctx.exit_code();
     };
   });
@@ -35,23 +75,7 @@ void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
   t->callback([&action, trk] {
     action = [trk] {
       RunContext ctx(*trk);
-      const Experiment& e = ctx.experiment();
-      require_refine(e.refine);  // before tracking: a missing Ceres is not found out 150 frames later
-      ScanResult r = scan(ctx, false);
-      if (e.refine.enabled && e.refine.online)
-        spdlog::info("refine: refine.online refined while tracking; the offline stage (refine.enabled) is skipped");
-      const bool offline = e.refine.enabled && !e.refine.online;
-      if (offline && interrupted()) spdlog::warn("refine: skipped (interrupted)");
-      if (offline && !interrupted()) {
-        std::vector<bool> tracked;
-        for (const FrameRecord& f : r.tracking.frames) tracked.push_back(f.result.ok());
-        r.tracking.trajectory =
-            refine_run(e.input, r.tracking.trajectory, tracked, e.refine, e.preprocess, ctx.device(), ctx.out_dir())
-                .trajectory;
-      }
-      // summary.json as `run` writes it, for the trajectory.txt written (refined, when refine is on).
-      add_tracking(ctx.summary(), r.tracking, r.unreadable, groundtruth_path(ctx));
-      ctx.summary().intrinsics = r.intrinsics;
+      track_experiment(ctx);
       return ctx.exit_code();
     };
   });
@@ -63,14 +87,7 @@ void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
   m->callback([&action, sim] {
     action = [sim] {
       RunContext ctx(*sim);
-      if (ctx.experiment().input.source != InputSource::synthetic)
-        throw ConfigError(
-            "seamless simulate runs on the synthetic room's analytic scene (input.source: synthetic); to "
-            "simulate on a scanned scene use `seamless run` with mode: scan_then_simulate");
-      kernels::SceneSdf sdf{};
-      sdf.synthetic_room = 1;
-      ctx.experiment().solver.gravity = kernels::room::gravity();  // the room's world is z up
-      ctx.summary().physics = simulate(ctx, nullptr, &sdf).stats;
+      simulate_experiment(ctx);
       return ctx.exit_code();
     };
   });

@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 
+#include "app/api.hpp"
 #include "app/commands.hpp"
 #include "app/ghost.hpp"
 #include "app/pipeline.hpp"
@@ -80,22 +81,25 @@ std::vector<vec3> camera_positions(const Trajectory& tr) {
   return out;
 }
 
-int run(const CommonOptions& o) {
-  if (o.dry_run) return dry_run(o);
-  RunContext ctx(o);
+}  // namespace
+
+RunOutputs run_experiment(RunContext& ctx, const std::string& config) {
+  RunOutputs out;
   Experiment& e = ctx.experiment();
   // The rules across keys (placements, render camera and zoom, ...) were checked when the config was
   // loaded (Experiment::validate), so a malformed config costs no scan.
   auto renderer = RunRenderer::make(ctx);
-  RunSummary summary;
-  summary.command = "run", summary.config = o.config, summary.device = device_name(ctx.device());
+  RunSummary& summary = out.summary;
+  summary.command = "run", summary.config = config, summary.device = device_name(ctx.device());
   if (ctx.device() == Device::CUDA) summary.device += std::string(" (") + cuda_device_description() + ")";
   if (e.mode == ExperimentMode::live) {
-    live(ctx, renderer.get());
+    out.live = true;
+    out.live_frames = live(ctx, renderer.get());
     spdlog::info("outputs in {}", ctx.out_dir());
-    return ctx.exit_code();
+    return out;
   }
-  ScanResult scan_result = scan(ctx, true);
+  out.scan = scan(ctx, true);
+  ScanResult& scan_result = out.scan;
   const Trajectory& traj = scan_result.tracking.trajectory;
   summary.intrinsics = scan_result.intrinsics;
   add_tracking(summary, scan_result.tracking, scan_result.unreadable, groundtruth_path(ctx));
@@ -152,14 +156,25 @@ int run(const CommonOptions& o) {
   const bool replaying = e.render.camera == RenderCameraMode::recorded && renderer;
   // The scene particles go to the solver on the volume's device (the host copy above is for the
   // PLY and the placement); with solver.scene_collision: sdf the TSDF replaces them.
-  SimulationResult sim = simulate(ctx, grid ? nullptr : &scene, floor ? &*floor : nullptr, renderer.get(),
-                                  grid ? &*grid : nullptr, replaying ? &replay : nullptr);
+  out.simulation = simulate(ctx, grid ? nullptr : &scene, floor ? &*floor : nullptr, renderer.get(),
+                            grid ? &*grid : nullptr, replaying ? &replay : nullptr);
+  const SimulationResult& sim = out.simulation;
   summary.physics = sim.stats;
   summary.escaped = count_escaped(sim.state, bounds, e.solver.particle_diameter);
   log_escaped(*summary.escaped, sim.state.x.size());
   add_stage_medians(summary, ctx.timer());
   write_summary(ctx.out_path("summary.json"), summary);
   spdlog::info("outputs in {}", ctx.out_dir());
+  out.scene_particles = std::move(points);
+  return out;
+}
+
+namespace {
+
+int run(const CommonOptions& o) {
+  if (o.dry_run) return dry_run(o);
+  RunContext ctx(o);
+  run_experiment(ctx, o.config);
   return ctx.exit_code();
 }
 

@@ -37,7 +37,7 @@ namespace {
 class LiveLoop : public FrameLoop {
  public:
   LiveLoop(RunContext& ctx, RunRenderer* renderer, StageTimer* volume_stages)
-      : ctx_(ctx), e_(ctx.experiment()), renderer_(renderer), source_(make_source(e_.input, ctx.device())),
+      : ctx_(ctx), e_(ctx.experiment()), renderer_(renderer), source_(ctx.open_source()),
         volume_(make_volume(e_.volume, ctx.device())),
         session_(tracking_params(e_, volume_stages), ctx.device(), source_->intrinsics(), volume_.get()),
         solver_(e_.solver, ctx.device()), total_(e_.frames > 0 ? e_.frames : source_->size().value_or(0)),

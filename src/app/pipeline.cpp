@@ -77,7 +77,7 @@ using namespace detail;
 ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
   const Experiment& e = ctx.experiment();
   require_tracker(e.tracker.kind);
-  auto source = make_source(e.input, ctx.device());
+  auto source = ctx.open_source();
   record_intrinsics(ctx, *source);
   ScanResult r;
   if (with_volume) r.volume = make_volume(e.volume, ctx.device());
@@ -136,8 +136,7 @@ class ReplayFrames {
  public:
   static constexpr std::int64_t kMaxKept = 64;  // frames kept for playing back and forth (~2 MB each)
 
-  ReplayFrames(const Experiment& e, Device d, const Replay& r)
-      : source_(make_source(e.input, d)), traj_(*r.trajectory), start_(r.start) {
+  ReplayFrames(RunContext& ctx, const Replay& r) : source_(ctx.open_source()), traj_(*r.trajectory), start_(r.start) {
     const auto n = static_cast<std::int64_t>(traj_.size());
     if (start_ >= n)
       throw ConfigError("render.replay_start is " + std::to_string(start_) + " but the scan tracked " +
@@ -198,7 +197,7 @@ class SimulationLoop : public FrameLoop {
       : ctx_(ctx), e_(ctx.experiment()), solver_(solver), renderer_(renderer),
         steps_(static_cast<std::int64_t>(std::ceil(e_.duration / e_.solver.dt))),
         render_every_(std::max<std::int64_t>(1, std::llround(1.0 / (e_.render.fps * e_.solver.dt)))),
-        replay_(replay ? std::make_unique<ReplayFrames>(e_, ctx.device(), *replay) : nullptr),
+        replay_(replay ? std::make_unique<ReplayFrames>(ctx, *replay) : nullptr),
         progress_(replay_ ? "replay" : "simulate", replay_ ? replay_->frames() : steps_, true,
                   replay_ ? "fps" : "steps/s") {}
 

@@ -92,7 +92,7 @@ RunContext::RunContext(const CommonOptions& o) : RunContext(o, load_experiment(o
 RunContext::RunContext(const CommonOptions& o, Experiment e) : exp_(std::move(e)), window_frames_(o.window_frames) {
   device_ = resolve_device(exp_.device);
 
-  out_ = o.out.empty() ? exp_.output.dir + "/" + fs::path(o.config).stem().string() + "-" + timestamp() : o.out;
+  out_ = o.out.empty() ? default_out_dir(exp_, o.config) : o.out;
   // What every run writes first: a folder holding one of these holds another run.
   folder_ = std::make_unique<OutputFolder>(out_, o.force, input_paths(exp_),
                                            std::vector<std::string>{"config.yaml", "log.txt", "summary.json"});
@@ -115,6 +115,24 @@ RunContext::RunContext(const CommonOptions& o, Experiment e) : exp_(std::move(e)
 
   std::string gpu = device_ == Device::CUDA ? " (" + cuda_device_description() + ")" : "";
   spdlog::info("experiment '{}' from {}, device {}{}, output {}", exp_.name, o.config, device_name(device_), gpu, out_);
+}
+
+std::string default_out_dir(const Experiment& e, const std::string& config) {
+  return e.output.dir + "/" + fs::path(config).stem().string() + "-" + timestamp();
+}
+
+std::unique_ptr<FrameSource> RunContext::open_source() {
+  if (!source_given_) return make_source(exp_.input, device_);
+  if (!given_source_)
+    throw UsageError(
+        "the frames given to this run were read already, and this run reads its input twice (render.camera: "
+        "recorded replays it): give the frames through input.source instead");
+  return std::move(given_source_);
+}
+
+void RunContext::set_source(std::unique_ptr<FrameSource> source) {
+  given_source_ = std::move(source);
+  source_given_ = true;
 }
 
 void RunContext::report_tracking(std::int64_t frames, std::int64_t lost, std::int64_t dropped_blocks) {

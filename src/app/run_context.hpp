@@ -16,6 +16,7 @@
 #include "core/device.hpp"
 #include "core/log.hpp"
 #include "core/timing.hpp"
+#include "io/frame_source.hpp"
 
 namespace seamless::app {
 
@@ -67,6 +68,13 @@ class RunContext {
   // render.mode window: close the window after this many frames (0: when the user closes it).
   int window_frames() const { return window_frames_; }
 
+  // The input: the source set_source() gave (once: a stream cannot be read twice), else a new
+  // source of the config's input section. Throws seamless::UsageError when the given source was
+  // taken already (a replay reads the input a second time).
+  std::unique_ptr<FrameSource> open_source();
+  // Frames from the caller (the Python module's frame source) instead of input.source.
+  void set_source(std::unique_ptr<FrameSource> source);
+
   // Tracking's outcome: when more than output.max_lost_fraction of `frames` were lost, logs an
   // error naming the likely causes and exit_code() becomes kExitLostFrames. `dropped_blocks`: block
   // insertions the volume could not make (a full pool with volume.grow_when_full off): then the
@@ -95,7 +103,12 @@ class RunContext {
   RunSummary summary_;
   std::string command_;
   int uncaught_ = 0;  // std::uncaught_exceptions() at construction: more at destruction = failed
+  std::unique_ptr<FrameSource> given_source_;
+  bool source_given_ = false;
 };
+
+// The output folder when --out is not given: <output.dir>/<config file's stem>-<date-time>.
+std::string default_out_dir(const Experiment& e, const std::string& config);
 
 // The input's ground truth for ATE, when it has one ("" otherwise): the scan writes it beside
 // trajectory.txt in the same frame (any source with poses), else a TUM folder's own groundtruth.txt.

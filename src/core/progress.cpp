@@ -20,7 +20,14 @@ std::string duration_text(double s) {
   return b;
 }
 
+ProgressObserver& observer() {
+  static ProgressObserver o;
+  return o;
+}
+
 }  // namespace
+
+void set_progress_observer(ProgressObserver o) { observer() = std::move(o); }
 
 std::string progress_rate_text(std::int64_t done, std::int64_t total, double secs, const std::string& unit) {
   if (done <= 0 || !(secs > 0)) return "";
@@ -40,6 +47,7 @@ Progress::Progress(std::string what, std::int64_t total, bool enabled, std::stri
 Progress::~Progress() { finish(); }
 
 void Progress::update(std::int64_t done, const std::string& status) {
+  if (observer()) observer()(what_, done, total_, status);
   if (!enabled_) return;
   auto now = std::chrono::steady_clock::now();
   double secs = std::chrono::duration<double>(now - start_).count();

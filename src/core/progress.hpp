@@ -4,6 +4,7 @@
 #pragma once
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <string>
 
 namespace seamless {
@@ -13,6 +14,13 @@ namespace seamless {
 // and "1:02:03" from an hour. Nothing is said of a rate before anything is done (or no time has
 // passed), nor of the time left without a total.
 std::string progress_rate_text(std::int64_t done, std::int64_t total, double secs, const std::string& unit = "fps");
+
+// A program that embeds seamless (the Python module) follows progress here: every update of every
+// Progress calls it (what, done, total, status), on the thread of the loop, besides the bar or the
+// log lines. Empty (the default): none.
+using ProgressObserver =
+    std::function<void(const std::string& what, std::int64_t done, std::int64_t total, const std::string& status)>;
+void set_progress_observer(ProgressObserver observer);
 
 class Progress {
  public:

@@ -181,7 +181,9 @@ std::vector<TumPair> tum_folder_pairs(const std::string& folder, const InputPara
 TumSource::TumSource(const InputParams& params, bool pinned) : params_(params), folder_(params.path), pinned_(pinned) {
   if (folder_.empty()) throw InputError("input.path is empty: set it to a TUM RGB-D folder (source: tum)");
   if (!fs::is_directory(folder_))
-    throw InputError("input.path '" + folder_ + "' is not a folder: download one with datasets/download_tum.sh");
+    throw InputError("input.path '" + folder_ +
+                     "' is not a folder: give the unpacked folder of a TUM RGB-D sequence (the one holding rgb.txt "
+                     "and depth.txt; sequences at https://cvg.cit.tum.de/data/datasets/rgbd-dataset/download)");
   const IntrinsicsChoice choice = resolve_intrinsics(params.intrinsics, folder_);
   K_ = choice.K, flip_x_ = choice.flip_x, flip_y_ = choice.flip_y;
   fs::path dir(folder_);

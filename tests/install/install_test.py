@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """`cmake --install` gives PREFIX/bin/seamless, the configs and docs under
 PREFIX/share/seamless and a CMake package that a project outside the tree builds on
-(tests/install/consumer: find_package(seamless), seamless::core, ::kernels, ::io, ::eval, each
-used once against a known answer).
+(tests/install/consumer: find_package(seamless), seamless::core, ::kernels, ::io, ::eval, ::recon,
+::physics, each used once against a known answer); the installed binary's messages name no file of
+the repository that is not installed, and the Python module (when built) imports from the prefix.
 
 usage: install_test.py BUILD_DIR SOURCE_DIR WORK_DIR VERSION   (about a minute on 2 cores)
 """
@@ -29,6 +30,16 @@ def main():
     for f in ("configs/demo.yaml", "configs/tum_fr2.yaml", "docs/ARCHITECTURE.md", "LICENSE", "CHANGELOG.md",
               "README.md"):
         assert os.path.isfile(os.path.join(share, f)), f"{f} is not installed under {share}"
+    # Its messages point at nothing the installation lacks (the repository's scripts and datasets/).
+    binary = open(exe, "rb").read()
+    for repo_only in (b"datasets/download_tum.sh", b"scripts/packages", b"scripts/setup"):
+        assert repo_only not in binary, f"the installed seamless mentions {repo_only.decode()}, which is not installed"
+    # The Python module, where the build has it, imports from the prefix.
+    module = os.path.join(prefix, "lib", "python3", "dist-packages")
+    if os.path.isfile(os.path.join(build, "python", "seamless", "__init__.py")):
+        out = run(sys.executable, "-c", "import seamless; print(seamless.__version__)", capture_output=True,
+                  env={**os.environ, "PYTHONPATH": module}).stdout
+        assert out.strip() == version, f"the installed module says {out!r}, expected {version}"
     # The installed binary finds its configs without the source tree.
     run(exe, "config", os.path.join(share, "configs", "demo.yaml"), stdout=subprocess.DEVNULL)
     consumer = os.path.join(work, "consumer")

@@ -72,8 +72,8 @@ bool refine_available() { return SEAMLESS_HAS_CERES != 0; }
 void require_refine(const RefineParams& params) {
   if ((params.enabled || params.online) && !refine_available())
     throw ConfigError(std::string("refine.") + (params.enabled ? "enabled" : "online") +
-                      " is true but this build has no Ceres: install libceres-dev (scripts/packages.txt) and "
-                      "reconfigure, or set it to false");
+                      " is true but this build has no Ceres: install libceres-dev and build seamless again, or set it "
+                      "to false");
 }
 
 // ---- keyframes ----------------------------------------------------------------------------------
@@ -356,7 +356,7 @@ RefineResult refine_trajectory(FrameSource& source, const Trajectory& odometry, 
                  "fewer than two keyframes (" + std::to_string(odometry.size()) + " frames, refine.keyframe_every " +
                      std::to_string(params.keyframe_every) + ")");
   if (!refine_available())
-    throw ConfigError("refine: this build has no Ceres; install libceres-dev (scripts/packages.txt) and reconfigure");
+    throw ConfigError("refine: this build has no Ceres; install libceres-dev and build seamless again");
   std::vector<KeyframeData> kf =
       load_keyframes(source, odometry, r.keyframes, preprocess, params.pair_tracker == PairTracker::rgbd, device);
   const double t_load = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -1,0 +1,36 @@
+# The Python module: built when SEAMLESS_PYTHON is ON, or AUTO and the Python headers and pybind11
+# are found (Debian: python3-dev pybind11-dev; pip: pyproject.toml, where scikit-build-core names
+# the interpreter). The module links the same static libraries as the `seamless` command, so with
+# it every library is compiled as position-independent code (one compile serves both).
+macro(seamless_optional_python)
+  set(seamless_python_why "")
+  if(SEAMLESS_PYTHON STREQUAL "OFF")
+    set(seamless_python_why "SEAMLESS_PYTHON=OFF")
+  elseif(SEAMLESS_SANITIZE OR SEAMLESS_FUZZ)
+    set(seamless_python_why "not with sanitizers (SEAMLESS_SANITIZE, SEAMLESS_FUZZ)")
+  else()
+    # Debian's interpreter where nothing names one: the tests run with /usr/bin/python3 and Debian's
+    # python3-pytest and python3-numpy (as the other Python tests do), not a python3 earlier on PATH.
+    if(NOT Python_EXECUTABLE AND NOT SKBUILD AND EXISTS /usr/bin/python3)
+      set(Python_EXECUTABLE /usr/bin/python3)
+    endif()
+    find_package(Python 3.8 QUIET COMPONENTS Interpreter Development.Module)
+    if(Python_FOUND)
+      find_package(pybind11 2.6 CONFIG QUIET)
+    endif()
+    if(NOT Python_FOUND)
+      set(seamless_python_why "Python headers not found (apt-get install python3-dev)")
+    elseif(NOT pybind11_FOUND)
+      set(seamless_python_why "pybind11 not found (apt-get install pybind11-dev)")
+    endif()
+  endif()
+  if(seamless_python_why STREQUAL "")
+    seamless_module_status(PYTHON ON "Python ${Python_VERSION} (${Python_EXECUTABLE}), pybind11 ${pybind11_VERSION}")
+    set(CMAKE_POSITION_INDEPENDENT_CODE ON)
+  else()
+    if(SEAMLESS_PYTHON STREQUAL "ON")
+      message(FATAL_ERROR "SEAMLESS_PYTHON=ON: ${seamless_python_why}")
+    endif()
+    seamless_module_status(PYTHON OFF "${seamless_python_why}")
+  endif()
+endmacro()
