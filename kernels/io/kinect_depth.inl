@@ -29,8 +29,10 @@ void KinectDepth<Exec>::register_to_colour(const Exec& ex, const KinectDisparity
     const float z = kinect_raw_to_metres(m, raw(x, y));
     const vec2 t = table(x, y);
     if (z <= 0.f || t.x < 0.f) return;
-    const int u = static_cast<int>(floorf(t.x + kinect_parallax(m, z))), v = static_cast<int>(t.y);
-    if (!zbuf.inside(u, v)) return;
+    const float uf = floorf(t.x + kinect_parallax(m, z));
+    if (!(uf >= 0.f && uf < static_cast<float>(zbuf.width) && t.y >= 0.f && t.y < static_cast<float>(zbuf.height)))
+      return;
+    const int u = static_cast<int>(uf), v = static_cast<int>(t.y);
     // Micrometres: integers order like depths, and atomic_min keeps the nearest surface.
     atomic_min(&zbuf(u, v), static_cast<std::uint32_t>(z * 1e6f + 0.5f));
   });

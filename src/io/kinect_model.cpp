@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -36,15 +38,28 @@ KinectCalibration read_kinect_device_json(const std::string& path) {
   } catch (const nlohmann::json::parse_error& e) {
     throw InputError("Kinect calibration '" + path + "' is not valid JSON: " + e.what());
   }
-  auto need = [&](const nlohmann::json& obj, const char* key, const std::string& where) -> const nlohmann::json& {
-    if (!obj.is_object() || !obj.contains(key) || !(obj[key].is_number() || obj[key].is_object()))
-      throw InputError("Kinect calibration '" + path + "' has no number '" + where + key +
-                       "' (fakenect-record's device.json: reg_info{...}, const_shift)");
+  auto missing = [&](const std::string& key, const char* what) {
+    return InputError("Kinect calibration '" + path + "' has no " + what + " '" + key +
+                      "' (fakenect-record's device.json: reg_info{...} with zero_plane_info{...}, const_shift)");
+  };
+  auto object = [&](const nlohmann::json& obj, const char* key, const std::string& where) -> const nlohmann::json& {
+    if (!obj.is_object() || !obj.contains(key) || !obj[key].is_object()) throw missing(where + key, "section");
     return obj[key];
   };
-  const nlohmann::json& r = need(j, "reg_info", "");
+  auto number = [&](const nlohmann::json& obj, const char* key, const std::string& where) {
+    if (!obj.contains(key) || !obj[key].is_number()) throw missing(where + key, "number");
+    const double v = obj[key].get<double>();
+    if (!std::isfinite(v) || std::abs(v) > 1e12) throw missing(where + key, "finite number");
+    return v;
+  };
+  const nlohmann::json& r = object(j, "reg_info", "");
   KinectCalibration c;
-  auto i32 = [&](const char* key) { return need(r, key, "reg_info.").get<std::int32_t>(); };
+  // The registration fields are 32-bit registers of the device.
+  auto i32 = [&](const char* key) {
+    const double v = number(r, key, "reg_info.");
+    if (v != std::floor(v) || v < -2147483648.0 || v > 4294967295.0) throw missing(std::string("reg_info.") + key, "32-bit integer");
+    return static_cast<std::int32_t>(static_cast<std::uint32_t>(static_cast<std::int64_t>(v)));
+  };
   c.ax = i32("ax"), c.bx = i32("bx"), c.cx = i32("cx"), c.dx = i32("dx");
   c.ay = i32("ay"), c.by = i32("by"), c.cy = i32("cy"), c.dy = i32("dy");
   c.dx_start = i32("dx_start"), c.dy_start = i32("dy_start");
@@ -53,19 +68,24 @@ KinectCalibration read_kinect_device_json(const std::string& path) {
   c.dxdxdx_start = i32("dxdxdx_start"), c.dydxdx_start = i32("dydxdx_start");
   c.dxdxdy_start = i32("dxdxdy_start"), c.dydxdy_start = i32("dydxdy_start");
   c.dydydx_start = i32("dydydx_start"), c.dydydy_start = i32("dydydy_start");
-  if (r.contains("pad_info") && r["pad_info"].is_object() && r["pad_info"].contains("start_lines"))
-    c.pad_start_lines = r["pad_info"]["start_lines"].get<int>();
-  const nlohmann::json& z = need(r, "zero_plane_info", "reg_info.");
-  auto num = [&](const char* key) { return need(z, key, "reg_info.zero_plane_info.").get<double>(); };
-  c.emitter_cm = num("dcmos_emitter_distance");
-  c.rgb_cm = num("dcmos_rcmos_distance");
-  c.reference_distance = num("reference_distance");
-  c.reference_pixel_size = num("reference_pixel_size");
-  c.const_shift = need(j, "const_shift", "").get<double>();
-  if (!(c.emitter_cm > 0 && c.reference_distance > 0 && c.reference_pixel_size > 0 && c.rgb_cm >= 0))
+  if (r.contains("pad_info") && r["pad_info"].is_object() && r["pad_info"].contains("start_lines") &&
+      r["pad_info"]["start_lines"].is_number_integer())
+    c.pad_start_lines = static_cast<int>(std::clamp<std::int64_t>(r["pad_info"]["start_lines"].get<std::int64_t>(), -1000, 1000));
+  const nlohmann::json& z = object(r, "zero_plane_info", "reg_info.");
+  const std::string zw = "reg_info.zero_plane_info.";
+  c.emitter_cm = number(z, "dcmos_emitter_distance", zw);
+  c.rgb_cm = number(z, "dcmos_rcmos_distance", zw);
+  c.reference_distance = number(z, "reference_distance", zw);
+  c.reference_pixel_size = number(z, "reference_pixel_size", zw);
+  c.const_shift = number(j, "const_shift", "");
+  // Every Kinect v1: 7.5 cm, 2.3-2.4 cm, 120 mm, 0.1042 mm, const_shift about 200.
+  if (!(c.emitter_cm > 0.1 && c.emitter_cm < 100 && c.rgb_cm >= 0 && c.rgb_cm < 100 && c.reference_distance > 1 &&
+        c.reference_distance < 10000 && c.reference_pixel_size > 1e-3 && c.reference_pixel_size < 10 &&
+        std::abs(c.const_shift) < 1e4))
     throw InputError("Kinect calibration '" + path +
-                     "': zero_plane_info needs positive dcmos_emitter_distance, reference_distance and "
-                     "reference_pixel_size");
+                     "': zero_plane_info or const_shift out of any Kinect's range (dcmos_emitter_distance 7.5 cm, "
+                     "dcmos_rcmos_distance 2.4 cm, reference_distance 120 mm, reference_pixel_size 0.1042 mm, "
+                     "const_shift 200 are typical)");
   c.origin = path;
   return c;
 }
