@@ -16,14 +16,14 @@ namespace seamless {
 
 KinectCalibration kinect_default_calibration() {
   KinectCalibration c;
-  c.ax = 1964, c.bx = 56, c.cx = -26, c.dx = 600, c.ay = -13, c.by = 2825, c.cy = 684, c.dy = 5;
-  c.dx_start = 6161, c.dy_start = 6434;
-  c.dxdx_start = 2095986, c.dxdy_start = 890, c.dydx_start = 763, c.dydy_start = 2096378;
-  c.dxdxdx_start = 134215474, c.dydxdx_start = 134217093, c.dxdxdy_start = 134216989;
-  c.dydxdy_start = 134216925, c.dydydx_start = 134216984, c.dydydy_start = 134214659;
-  c.emitter_cm = 7.5, c.rgb_cm = 2.3, c.reference_distance = 120, c.reference_pixel_size = 0.1042;
+  c.ax = 1830, c.bx = 11, c.cx = 31, c.dx = 497, c.ay = 56, c.by = 2582, c.cy = 641, c.dy = 77;
+  c.dx_start = 3269, c.dy_start = 8447;
+  c.dxdx_start = 2096139, c.dxdy_start = 1537, c.dydx_start = 8, c.dydy_start = 2096178;
+  c.dxdxdx_start = 134215349, c.dydxdx_start = 134217225, c.dxdxdy_start = 134216993;
+  c.dydxdy_start = 134216795, c.dydydx_start = 134217133, c.dydydy_start = 134215132;
+  c.emitter_cm = 7.5, c.rgb_cm = 2.4, c.reference_distance = 120, c.reference_pixel_size = 0.1042;
   c.const_shift = 200;
-  c.origin = "factory-typical defaults (libfreenect's built-in unit)";
+  c.origin = "factory-typical defaults (the OpenISS 2017 recording's unit)";
   return c;
 }
 

@@ -32,9 +32,11 @@ struct KinectCalibration {
   std::string origin;  // where the values came from, for the log
 };
 
-// Values of one production unit, published as libfreenect's built-in defaults (registration.c of
-// libfreenect 0.1, "default values ripped from my Kinect"; const_shift 200 as libfreenect assumed
-// before it read it from the device). Units differ by a few pixels of registration.
+// The factory calibration of one production unit, saved by fakenect-record with a public recording
+// (OpenISS, 2017, Apache-2.0; ../shared/data/kinect_v1_planes/device.json), the only complete one
+// published with its recording. Units differ: libfreenect 0.1's built-in unit, applied to that
+// recording, puts depth edges 18 px from their colour edges (docs/INPUT.md), so a unit's own values
+// are always preferred.
 KinectCalibration kinect_default_calibration();
 
 // device.json as fakenect-record writes it (keys reg_info{...}, reg_info.zero_plane_info{...},

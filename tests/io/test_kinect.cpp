@@ -111,14 +111,14 @@ TEST(KinectModel, DisparityToMetresMatchesLibfreenect) {
 }
 
 TEST(KinectModel, DefaultsAreAKinect) {
-  // The built-in unit: IR focal length 120 / (2 x 0.1042) = 575.8 px, the colour camera 2.3 cm away,
-  // depth of raw 700 within 2% of this unit's (the same const_shift and zero plane but the baseline).
+  // The built-in unit: IR focal length 120 / (2 x 0.1042) = 575.8 px, the colour camera 2.4 cm away,
+  // raw 700 at libfreenect's 887 mm (truncated), and a rectification that keeps 90% of the depth
+  // image inside the colour frame.
   float f = 0;
   const auto m = kinect_disparity_model(kinect_default_calibration(), &f);
   EXPECT_NEAR(f, 575.8, 0.1);
-  EXPECT_NEAR(m.fb, 575.8 * 0.023, 0.01);
-  EXPECT_NEAR(kernels::kinect_raw_to_metres(m, 700), 0.887, 0.02);
-  // The default polynomial keeps most of the image inside the colour frame.
+  EXPECT_NEAR(m.fb, 575.8 * 0.024, 0.01);
+  EXPECT_NEAR(kernels::kinect_raw_to_metres(m, 700), 0.8875, 0.0006);
   const auto t = kinect_registration_table(kinect_default_calibration());
   std::size_t inside = 0;
   for (const auto& v : t) inside += v.x >= 0;
