@@ -86,8 +86,11 @@ TEST(KinectDepth, RegistrationShiftsByParallaxAndKeepsTheNearest) {
   }
   // Pixel (3, 1): the nearer of 1/1.00125 and 1/1.04125 m.
   EXPECT_NEAR(z[1 * w + 3], 1.f / 1.04125f, 1e-6);
-  for (int x = 0; x < w; ++x)
-    if (x != 3) EXPECT_EQ(z[1 * w + x], 0.f) << x;
+  for (int x = 0; x < w; ++x) {
+    if (x != 3) {
+      EXPECT_EQ(z[1 * w + x], 0.f) << x;
+    }
+  }
 }
 
 // Both backends evaluate the same float expressions; CUDA may contract them into fused
