@@ -228,8 +228,9 @@ void KinectSource::decide_replay_content(const std::vector<std::uint16_t>& depth
 }
 
 bool KinectSource::next(RgbdFrame& frame) {
+  if (params_.max_frames > 0 && delivered_ >= params_.max_frames) return false;
   Raw raw;
-  {
+  for (;;) {
     std::unique_lock lock(mutex_);
     auto timeout = std::chrono::duration<double>(params_.kinect.timeout_s);
     if (!ready_.wait_for(lock, timeout, [&] { return !queue_.empty() || ended_; }))
@@ -241,6 +242,8 @@ bool KinectSource::next(RgbdFrame& frame) {
     }
     raw = std::move(queue_.front());
     queue_.pop_front();
+    if (discarded_ >= params_.first_frame) break;
+    ++discarded_;  // input.first_frame: frames before it are read and dropped
   }
   if (replay_ && delivered_ == 0) decide_replay_content(raw.depth);
   frame.index = delivered_++;

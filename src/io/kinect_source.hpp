@@ -95,6 +95,7 @@ class KinectSource : public FrameSource {
   bool ended_ = false;
   std::string end_reason_;
   std::int64_t delivered_ = 0;
+  std::int64_t discarded_ = 0;  // input.first_frame
 };
 
 // Writes frames of `source` as a fakenect recording (the format Debian's libfreenect-bin replays

@@ -2,7 +2,9 @@
 """A real Kinect v1 recording made by libfreenect's fakenect-record (../shared/data/kinect_v1_planes:
 raw 11-bit disparity, colour, accelerometer, device.json) through `seamless track` twice: read
 directly (input.source: fakenect) and replayed by Debian's fakenect library into the live Kinect
-source (input.source: kinect, FAKENECT_PATH, LD_LIBRARY_PATH). Both register depth with the same
+source (input.source: kinect, FAKENECT_PATH, LD_LIBRARY_PATH; render.camera: fixed, since a live
+source cannot be replayed after the scan; a queue that holds the whole recording, since fakenect
+replays at 30 Hz and a slower tracker would otherwise see the live source drop frames). Both register depth with the same
 code and pair colour and accelerometer records by the same rule, so they must give the same
 trajectory; the camera stood still on a table, so every pose must stay near the identity and no
 frame may be lost.
@@ -16,14 +18,14 @@ degrees of the first frame.
 usage: kinect_fakenect_test.py SEAMLESS SOURCE_DIR DATA_DIR OUT FAKENECT_LIB_DIR; exit 77 (skip)
 without the data folder or without fakenect's library (apt-get install libfreenect-bin).
 """
-import json
+import csv
 import math
 import os
 import shutil
 import subprocess
 import sys
 
-FRAMES = 6
+FRAMES = 4
 
 
 def read_tum(path):
@@ -61,9 +63,9 @@ def main():
     direct, log = track(exe, root, os.path.join(out, "direct"), ["--set", f"input.path={planes}"])
     assert "stored little-endian" in log, log[-2000:]
     assert len(direct) == FRAMES, f"direct reader: {len(direct)} poses for {FRAMES} frames"
-    summary = json.load(open(os.path.join(out, "direct", "summary.json")))
-    lost = summary.get("lost_frames", summary.get("tracking", {}).get("lost_frames"))
-    assert lost == 0, f"lost frames: {lost}"
+    with open(os.path.join(out, "direct", "tracking_stats.csv")) as f:
+        status = [row["status"] for row in csv.DictReader(f)]
+    assert status == ["ok"] * FRAMES, f"frames not tracked: {status}"
     r0 = rotation(direct[0][4:8])
     for p in direct:
         dt = math.dist(p[1:4], direct[0][1:4])
@@ -77,7 +79,9 @@ def main():
         return 77
     env = dict(os.environ, FAKENECT_PATH=planes, LD_LIBRARY_PATH=lib)
     replay, log = track(exe, root, os.path.join(out, "fakenect"), ["--set", "input.source=kinect",
-                                                                     "--set", "input.path="], env)
+                                                                     "--set", "input.path=",
+                                                                     "--set", "render.camera=fixed",
+                                                                     "--set", "input.kinect.queue_size=64"], env)
     assert "raw 11-bit disparity" in log, log[-2000:]
     assert len(replay) == FRAMES, f"fakenect: {len(replay)} poses for {FRAMES} frames"
     worst_t = worst_r = 0.0
