@@ -147,7 +147,7 @@ struct SyntheticParams {
   }
 };
 
-// A live Kinect v1 through libfreenect (source: kinect).
+// A Kinect v1 through libfreenect (source: kinect) and its recordings (source: fakenect).
 struct KinectParams {
   int device_index = 0;
   int queue_size = 4;
@@ -160,6 +160,12 @@ struct KinectParams {
     v("queue_size", queue_size, "frames buffered between capture and processing; a full queue drops the oldest",
       Range{1, 1000});
     v("timeout_s", timeout_s, "give up when no frame arrives for this long, seconds", Range{0.1, 3600.0});
+    v("depth_mode", depth_mode,
+      "raw: 11-bit disparity registered to colour by seamless (the same code as recordings); registered: "
+      "libfreenect's registered millimetres (a live Kinect only)");
+    v("calibration", calibration,
+      "the unit's registration as a device.json (fakenect-record's format); empty: read from the device, the "
+      "recording's device.json, else factory-typical defaults");
   }
 };
 

@@ -1,4 +1,5 @@
-// one-off: replay a fakenect folder through libfreenect's fakenect in a given depth mode, dump frames
+// One-off reference tool (tests/io/data/README.md): replays a fakenect folder through a fakenect
+// library in the depth mode its second argument names (reg, mm, 11) and writes each depth frame.
 #include <libfreenect.h>
 #include <stdio.h>
 #include <stdlib.h>
