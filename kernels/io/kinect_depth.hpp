@@ -32,11 +32,11 @@ inline constexpr std::uint16_t kKinectNoReading = 2047;
 inline constexpr std::uint32_t kKinectEmptyDepth = 0xffffffffu;
 
 struct KinectDisparityModel {
-  float inv_z0 = 0.f;        // 1 / z0, 1/m
-  float inv_2fe = 0.f;       // 1 / (2 f e), 1/m per raw quarter-step (f pixels, e metres)
-  float const_shift = 0.f;   // c of (1)
-  float fb = 0.f;            // f b, pixel metres: colour-camera parallax of (2)
-  float max_depth = 10.f;    // metres; libfreenect's FREENECT_DEPTH_MM_MAX_VALUE
+  float inv_z0 = 0.f;       // 1 / z0, 1/m
+  float inv_2fe = 0.f;      // 1 / (2 f e), 1/m per raw quarter-step (f pixels, e metres)
+  float const_shift = 0.f;  // c of (1)
+  float fb = 0.f;           // f b, pixel metres: colour-camera parallax of (2)
+  float max_depth = 10.f;   // metres; libfreenect's FREENECT_DEPTH_MM_MAX_VALUE
 };
 
 // (1): metres, 0 for no reading.

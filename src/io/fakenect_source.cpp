@@ -77,8 +77,7 @@ std::size_t pnm_header(const std::vector<std::uint8_t>& b, const std::string& fi
     while (p < b.size() && (std::isspace(b[p]) || b[p] == '#')) {
       if (b[p] == '#')
         while (p < b.size() && b[p] != '\n') ++p;
-      else
-        ++p;
+      else ++p;
     }
     std::string t;
     while (p < b.size() && !std::isspace(b[p]) && t.size() < 16) t += static_cast<char>(b[p++]);
@@ -122,7 +121,9 @@ std::vector<std::uint16_t> read_kinect_raw_pgm(const std::string& file, std::opt
   int w = 0, h = 0, maxval = 0;
   const std::size_t off = pnm_header(b, file, "P5", w, h, maxval);
   check_size(file, w, h, "depth");
-  if (maxval < 256) throw InputError("'" + file + "' has 8-bit samples (maxval " + std::to_string(maxval) + "); raw Kinect depth is 16-bit");
+  if (maxval < 256)
+    throw InputError("'" + file + "' has 8-bit samples (maxval " + std::to_string(maxval) +
+                     "); raw Kinect depth is 16-bit");
   const std::size_t n = static_cast<std::size_t>(w) * h;
   check_payload(file, b.size() - off, 2 * n);
   const std::uint8_t* s = b.data() + off;
@@ -181,8 +182,8 @@ FakenectSource::FakenectSource(const InputParams& params, bool pinned)
     std::optional<std::size_t> after;
     if (j < records_.size() && records_[j].type == 'r') after = j;
     Frame f{i, last_colour, accel};
-    if (after && (!last_colour ||
-                  kinect_next_colour_is_nearer(records_[i].ticks, records_[*last_colour].ticks, records_[*after].ticks)))
+    if (after && (!last_colour || kinect_next_colour_is_nearer(records_[i].ticks, records_[*last_colour].ticks,
+                                                               records_[*after].ticks)))
       f.colour = after;
     if (!f.colour && n_colour > 0) {
       ++no_colour;  // a live Kinect drops such a frame too
@@ -192,15 +193,18 @@ FakenectSource::FakenectSource(const InputParams& params, bool pinned)
   }
   if (frames_.empty())
     throw InputError("'" + dir_ + "/INDEX.txt' lists no depth record (d-*.pgm) with a colour record next to it");
-  if (no_colour > 0) spdlog::info("fakenect folder '{}': {} depth records before any colour record left out", dir_, no_colour);
+  if (no_colour > 0)
+    spdlog::info("fakenect folder '{}': {} depth records before any colour record left out", dir_, no_colour);
   if (n_colour == 0)
     spdlog::warn("fakenect folder '{}' has no colour records (r-*.ppm): the frames get a uniform grey colour image",
                  dir_);
   if (n_accel == 0)
-    spdlog::warn("fakenect folder '{}' has no accelerometer records (a-*.dump): frames carry no gravity "
-                 "(tracker.gravity: auto finds it from the scene)",
-                 dir_);
-  const auto first = static_cast<std::size_t>(std::min<std::int64_t>(params.first_frame, static_cast<std::int64_t>(frames_.size())));
+    spdlog::warn(
+        "fakenect folder '{}' has no accelerometer records (a-*.dump): frames carry no gravity "
+        "(tracker.gravity: auto finds it from the scene)",
+        dir_);
+  const auto first =
+      static_cast<std::size_t>(std::min<std::int64_t>(params.first_frame, static_cast<std::int64_t>(frames_.size())));
   frames_.erase(frames_.begin(), frames_.begin() + static_cast<std::ptrdiff_t>(first));
   if (params.max_frames > 0 && static_cast<std::int64_t>(frames_.size()) > params.max_frames)
     frames_.resize(static_cast<std::size_t>(params.max_frames));
@@ -223,7 +227,8 @@ bool FakenectSource::read(const Frame& f, RgbdFrame& frame) {
     int w = 0, h = 0, maxval = 0;
     const std::size_t off = pnm_header(rgb_scratch_, file, "P6", w, h, maxval);
     check_size(file, w, h, "colour");
-    if (maxval != 255) throw InputError("'" + file + "' has maxval " + std::to_string(maxval) + "; Kinect colour is 8-bit (255)");
+    if (maxval != 255)
+      throw InputError("'" + file + "' has maxval " + std::to_string(maxval) + "; Kinect colour is 8-bit (255)");
     check_payload(file, rgb_scratch_.size() - off, 3 * n);
     std::memcpy(rgb, rgb_scratch_.data() + off, 3 * n);
   } else {
@@ -234,7 +239,9 @@ bool FakenectSource::read(const Frame& f, RgbdFrame& frame) {
     const std::string file = (fs::path(dir_) / records_[*f.accel].file).string();
     const std::vector<std::uint8_t> a = read_bytes(file);
     // freenect_raw_tilt_state: int16 x, y, z little-endian, then the tilt angle and status.
-    if (a.size() < 6) throw InputError("accelerometer record '" + file + "' has " + std::to_string(a.size()) + " bytes; freenect_raw_tilt_state has 12");
+    if (a.size() < 6)
+      throw InputError("accelerometer record '" + file + "' has " + std::to_string(a.size()) +
+                       " bytes; freenect_raw_tilt_state has 12");
     auto s16 = [&](int k) { return static_cast<std::int16_t>(a[2 * k] | a[2 * k + 1] << 8); };
     // All zero: fakenect-record saved the state before the first reading (a live Kinect's too).
     if (s16(0) || s16(1) || s16(2)) frame.accelerometer = kinect_accel_to_camera(s16(0), s16(1), s16(2));

@@ -20,10 +20,10 @@
 namespace seamless {
 
 struct FakenectRecord {
-  char type = 0;              // 'd' depth, 'r' colour, 'a' accelerometer
-  double seconds = 0.0;       // host clock when it arrived
-  std::uint32_t ticks = 0;    // device clock (60 MHz)
-  std::string file;           // name in the folder
+  char type = 0;            // 'd' depth, 'r' colour, 'a' accelerometer
+  double seconds = 0.0;     // host clock when it arrived
+  std::uint32_t ticks = 0;  // device clock (60 MHz)
+  std::string file;         // name in the folder
 };
 
 // INDEX.txt's records. Throws InputError naming INDEX.txt and the line that does not parse.
@@ -54,7 +54,7 @@ class FakenectSource : public FrameSource {
 
  private:
   struct Frame {
-    std::size_t depth;        // record indices into records_
+    std::size_t depth;  // record indices into records_
     std::optional<std::size_t> colour, accel;
   };
   bool read(const Frame& f, RgbdFrame& frame);

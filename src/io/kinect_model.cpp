@@ -57,7 +57,8 @@ KinectCalibration read_kinect_device_json(const std::string& path) {
   // The registration fields are 32-bit registers of the device.
   auto i32 = [&](const char* key) {
     const double v = number(r, key, "reg_info.");
-    if (v != std::floor(v) || v < -2147483648.0 || v > 4294967295.0) throw missing(std::string("reg_info.") + key, "32-bit integer");
+    if (v != std::floor(v) || v < -2147483648.0 || v > 4294967295.0)
+      throw missing(std::string("reg_info.") + key, "32-bit integer");
     return static_cast<std::int32_t>(static_cast<std::uint32_t>(static_cast<std::int64_t>(v)));
   };
   c.ax = i32("ax"), c.bx = i32("bx"), c.cx = i32("cx"), c.dx = i32("dx");
@@ -70,7 +71,8 @@ KinectCalibration read_kinect_device_json(const std::string& path) {
   c.dydydx_start = i32("dydydx_start"), c.dydydy_start = i32("dydydy_start");
   if (r.contains("pad_info") && r["pad_info"].is_object() && r["pad_info"].contains("start_lines") &&
       r["pad_info"]["start_lines"].is_number_integer())
-    c.pad_start_lines = static_cast<int>(std::clamp<std::int64_t>(r["pad_info"]["start_lines"].get<std::int64_t>(), -1000, 1000));
+    c.pad_start_lines =
+        static_cast<int>(std::clamp<std::int64_t>(r["pad_info"]["start_lines"].get<std::int64_t>(), -1000, 1000));
   const nlohmann::json& z = object(r, "zero_plane_info", "reg_info.");
   const std::string zw = "reg_info.zero_plane_info.";
   c.emitter_cm = number(z, "dcmos_emitter_distance", zw);
@@ -94,9 +96,9 @@ kernels::KinectDisparityModel kinect_disparity_model(const KinectCalibration& c,
   // libfreenect's zero-plane numbers in their own units: the reference plane lies at
   // 10 reference_distance millimetres, the IR focal length is reference_distance / (2 pixel size) in
   // 640-pixel units (the 1280-wide sensor is binned by 2), the baselines are in centimetres.
-  const double z0 = 0.01 * c.reference_distance;                     // metres
+  const double z0 = 0.01 * c.reference_distance;                         // metres
   const double f = c.reference_distance / (2 * c.reference_pixel_size);  // pixels
-  const double e = 0.01 * c.emitter_cm, b = 0.01 * c.rgb_cm;          // metres
+  const double e = 0.01 * c.emitter_cm, b = 0.01 * c.rgb_cm;             // metres
   kernels::KinectDisparityModel m;
   m.inv_z0 = static_cast<float>(1 / z0);
   m.inv_2fe = static_cast<float>(1 / (2 * f * e));
@@ -168,8 +170,7 @@ std::vector<vec2> kinect_registration_table(const KinectCalibration& c) {
 KinectRegistrar::KinectRegistrar(const KinectCalibration& c)
     : model_(kinect_disparity_model(c)),
       table_(Image<vec2>::from_host(kinect_registration_table(c), kKinectWidth, kKinectHeight, Device::CPU)),
-      raw_(kKinectWidth, kKinectHeight, Device::CPU),
-      zbuf_(kKinectWidth, kKinectHeight, Device::CPU) {
+      raw_(kKinectWidth, kKinectHeight, Device::CPU), zbuf_(kKinectWidth, kKinectHeight, Device::CPU) {
   if (c.pad_start_lines != 0)
     spdlog::warn("Kinect calibration ({}): pad_info.start_lines {} is not applied (0 on every unit seen)", c.origin,
                  c.pad_start_lines);
@@ -178,8 +179,7 @@ KinectRegistrar::KinectRegistrar(const KinectCalibration& c)
 void KinectRegistrar::register_depth(const std::uint16_t* raw, Image<float>& out) {
   raw_.buffer().copy_from_host(raw, raw_.buffer().size());
   CpuExec ex;
-  kernels::KinectDepth<CpuExec>::register_to_colour(ex, model_, raw_.cview(), table_.cview(), zbuf_.view(),
-                                                   out.view());
+  kernels::KinectDepth<CpuExec>::register_to_colour(ex, model_, raw_.cview(), table_.cview(), zbuf_.view(), out.view());
 }
 
 vec3 kinect_accel_to_camera(std::int16_t ax, std::int16_t ay, std::int16_t az) {

@@ -220,8 +220,8 @@ void KinectSource::decide_replay_content(const std::vector<std::uint16_t>& depth
     return;
   }
   // fakenect hands the file's bytes over unchanged: look at them as stored.
-  const SampleOrder o =
-      kinect_sample_order(reinterpret_cast<const std::uint8_t*>(depth.data()), depth.size(), where + ", first depth frame");
+  const SampleOrder o = kinect_sample_order(reinterpret_cast<const std::uint8_t*>(depth.data()), depth.size(),
+                                            where + ", first depth frame");
   swap_bytes_ = (o == SampleOrder::big_endian) != (std::endian::native == std::endian::big);
   spdlog::info("{}: raw 11-bit disparity, 16-bit samples stored {}", where, sample_order_name(o));
   make_registrar();

@@ -80,9 +80,9 @@ class KinectSource : public FrameSource {
   std::thread thread_;
   std::atomic<bool> stop_{false};
   std::atomic<std::int64_t> dropped_{0};
-  bool replay_ = false;                   // running under fakenect (FAKENECT_PATH set)
-  bool raw_depth_ = true;                 // frames hold 11-bit disparity (else millimetres)
-  bool swap_bytes_ = false;               // a replayed recording stored its samples big-endian
+  bool replay_ = false;      // running under fakenect (FAKENECT_PATH set)
+  bool raw_depth_ = true;    // frames hold 11-bit disparity (else millimetres)
+  bool swap_bytes_ = false;  // a replayed recording stored its samples big-endian
   std::optional<KinectRegistrar> registrar_;
   // Capture thread only (callbacks run there).
   std::vector<std::uint8_t> latest_rgb_;

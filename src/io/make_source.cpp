@@ -1,7 +1,7 @@
+#include <spdlog/spdlog.h>
 #include "core/buffer.hpp"
 #include "core/device.hpp"
 #include "core/error.hpp"
-#include <spdlog/spdlog.h>
 
 #include "io/fakenect_source.hpp"
 #include "io/frame_folder_source.hpp"

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
-#include <functional>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <sstream>
 
@@ -86,7 +86,7 @@ TEST(KinectModel, DisparityToMetresMatchesLibfreenect) {
   // frames replayed through its fakenect with this device.json (tests/io/data/README.md). It
   // truncates to whole millimetres: ours lies within [0, 1) mm above, plus float rounding (1e-6
   // relative: 6 um at 6 m).
-  const int pairs[][2] = {{403, 503},  {437, 529},  {500, 586},   {600, 705},   {700, 887},
+  const int pairs[][2] = {{403, 503},  {437, 529},   {500, 586},   {600, 705},  {700, 887},
                           {800, 1193}, {1000, 3864}, {1025, 5364}, {1033, 6124}};
   for (const auto& p : pairs) {
     const float z = kernels::kinect_raw_to_metres(m, static_cast<std::uint16_t>(p[0]));
@@ -150,7 +150,7 @@ TEST(KinectModel, ByteOrderIsToldByTheValues) {
 TEST(KinectModel, ColourPairingTakesTheNearerFrameAcrossTheClockWrap) {
   EXPECT_FALSE(kinect_next_colour_is_nearer(1000, 900, 1200));
   EXPECT_TRUE(kinect_next_colour_is_nearer(1000, 700, 1200));
-  EXPECT_FALSE(kinect_next_colour_is_nearer(1000, 800, 1200));  // a tie: the earlier
+  EXPECT_FALSE(kinect_next_colour_is_nearer(1000, 800, 1200));             // a tie: the earlier
   EXPECT_TRUE(kinect_next_colour_is_nearer(0xfffffff0u, 0xffff0000u, 5));  // wrapped clock
 }
 

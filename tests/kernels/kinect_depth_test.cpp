@@ -26,17 +26,15 @@ KinectDisparityModel round_model() {
   return m;
 }
 
-std::vector<float> run(const KinectDisparityModel& m, const std::vector<std::uint16_t>& raw, const std::vector<vec2>& table,
-                       int w, int h, Device dev, bool registered) {
+std::vector<float> run(const KinectDisparityModel& m, const std::vector<std::uint16_t>& raw,
+                       const std::vector<vec2>& table, int w, int h, Device dev, bool registered) {
   auto r = Image<std::uint16_t>::from_host(raw, w, h, dev);
   auto t = Image<vec2>::from_host(table, w, h, dev);
   Image<std::uint32_t> zbuf(w, h, dev);
   Image<float> out(w, h, dev);
   with_exec(dev, [&]<class E>(const E& ex) {
-    if (registered)
-      kernels::KinectDepth<E>::register_to_colour(ex, m, r.cview(), t.cview(), zbuf.view(), out.view());
-    else
-      kernels::KinectDepth<E>::raw_to_metres(ex, m, r.cview(), out.view());
+    if (registered) kernels::KinectDepth<E>::register_to_colour(ex, m, r.cview(), t.cview(), zbuf.view(), out.view());
+    else kernels::KinectDepth<E>::raw_to_metres(ex, m, r.cview(), out.view());
   });
   return out.to_host();
 }
