@@ -140,6 +140,7 @@ TEST(Fakenect, RealRecordingReplayEqualsTheDirectReader) {
   InputParams p;
   p.source = InputSource::fakenect;
   p.path = planes;
+  p.max_frames = n;
   FakenectSource direct(p);
   ASSERT_EQ(replay.size(), n);
   ASSERT_EQ(direct.size(), n);
