@@ -35,7 +35,7 @@ KinectCalibration read_kinect_device_json(const std::string& path) {
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(text.str());
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {  // parse_error, and out_of_range for a number overflow
     throw InputError("Kinect calibration '" + path + "' is not valid JSON: " + e.what());
   }
   auto missing = [&](const std::string& key, const char* what) {
