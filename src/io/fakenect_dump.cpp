@@ -1,7 +1,9 @@
 // The fakenect recording format, as Debian's libfreenect 0.5 replays it: FAKENECT_PATH/INDEX.txt
 // lists one file a line, `<type>-<seconds>-<device timestamp>-<anything>`; each file's payload is
 // handed to the application unchanged (after the one-line PGM/PPM header for images), and 'a'
-// files are a raw freenect_raw_tilt_state. Replay pauses between lines as the seconds say.
+// files are a raw freenect_raw_tilt_state. Replay pauses between lines as the seconds say. Each frame
+// is written colour, depth, accelerometer, the order fakenect-record writes them in (a depth frame
+// takes the accelerometer state received before the next colour frame: kinect_source.hpp).
 #include <libfreenect.h>
 
 #include <cerrno>
@@ -62,7 +64,7 @@ std::int64_t write_fakenect_dump(FrameSource& source, const std::string& dir, st
       mm[i] = (z[i] > 0.f && v <= FREENECT_DEPTH_MM_MAX_VALUE) ? static_cast<std::uint16_t>(v) : 0;
     }
     write_file(fs::path(dir) / d, "P5 640 480 65535\n", mm.data(), mm.size() * 2);
-    index << a << '\n' << r << '\n' << d << '\n';
+    index << r << '\n' << d << '\n' << a << '\n';
     ++n;
   }
   if (!index.flush()) throw Error("cannot write '" + dir + "/INDEX.txt'");

@@ -10,12 +10,21 @@
 
 namespace seamless {
 
-enum class InputSource { synthetic, tum, frames, kinect };
+enum class InputSource { synthetic, tum, frames, kinect, fakenect };
 inline std::span<const EnumName<InputSource>> enum_names(InputSource) {
   static constexpr EnumName<InputSource> names[] = {{InputSource::synthetic, "synthetic"},
                                                     {InputSource::tum, "tum"},
                                                     {InputSource::frames, "frames"},
-                                                    {InputSource::kinect, "kinect"}};
+                                                    {InputSource::kinect, "kinect"},
+                                                    {InputSource::fakenect, "fakenect"}};
+  return names;
+}
+// How a Kinect v1 delivers depth: raw 11-bit disparity turned into registered metres by seamless
+// (kernels/io/kinect_depth.hpp), or libfreenect's own registered millimetres.
+enum class KinectDepthMode { raw, registered };
+inline std::span<const EnumName<KinectDepthMode>> enum_names(KinectDepthMode) {
+  static constexpr EnumName<KinectDepthMode> names[] = {{KinectDepthMode::raw, "raw"},
+                                                        {KinectDepthMode::registered, "registered"}};
   return names;
 }
 enum class MoverKind { person, ball };
@@ -138,17 +147,25 @@ struct SyntheticParams {
   }
 };
 
-// A live Kinect v1 through libfreenect (source: kinect).
+// A Kinect v1 through libfreenect (source: kinect) and its recordings (source: fakenect).
 struct KinectParams {
   int device_index = 0;
   int queue_size = 4;
   double timeout_s = 5.0;
+  KinectDepthMode depth_mode = KinectDepthMode::raw;
+  std::string calibration;  // a device.json; empty: the device's, the recording's, or the defaults
 
   template <class V> void visit(V& v) {
     v("device_index", device_index, "which Kinect (libfreenect device index)", Range{0, 16});
     v("queue_size", queue_size, "frames buffered between capture and processing; a full queue drops the oldest",
       Range{1, 1000});
     v("timeout_s", timeout_s, "give up when no frame arrives for this long, seconds", Range{0.1, 3600.0});
+    v("depth_mode", depth_mode,
+      "raw: 11-bit disparity registered to colour by seamless (the same code as recordings); registered: "
+      "libfreenect's registered millimetres (a live Kinect only)");
+    v("calibration", calibration,
+      "the unit's registration as a device.json (fakenect-record's format); empty: read from the device, the "
+      "recording's device.json, else factory-typical defaults");
   }
 };
 
@@ -176,7 +193,8 @@ struct InputParams {
     v("source", source, "frame source");
     v("path", path,
       "dataset folder: a TUM folder (source: tum), e.g. rgbd_dataset_freiburg1_desk, or a frame folder of "
-      "frame-NNNNNN.color/depth/pose files (source: frames)");
+      "frame-NNNNNN.color/depth/pose files (source: frames), or a fakenect-record folder with INDEX.txt "
+      "(source: fakenect; also chosen for any source whose path holds an INDEX.txt)");
     v("depth_scale", depth_scale,
       "depth units per metre in the depth PNGs; 0: the layout's convention (tum 5000, frames 1000 = millimetres)",
       Range{0.0, 1e6});
@@ -204,7 +222,7 @@ struct InputParams {
     v("association_offset", association_offset, "auto association: seconds added to depth timestamps",
       Range{-10.0, 10.0});
     v("synthetic", synthetic, "synthetic room settings (source: synthetic)");
-    v("kinect", kinect, "live Kinect v1 settings (source: kinect)");
+    v("kinect", kinect, "Kinect v1 settings (source: kinect, and fakenect for depth_mode/calibration)");
   }
 };
 

@@ -1,22 +1,30 @@
-// A live Kinect v1 through libfreenect (only built when SEAMLESS_HAS_FREENECT). Depth registered to
-// the RGB camera (FREENECT_DEPTH_REGISTERED, millimetres), RGB 640x480, accelerometer.
+// A live Kinect v1 through libfreenect (only built when SEAMLESS_HAS_FREENECT): depth registered to
+// the RGB camera, RGB 640x480, accelerometer. input.kinect.depth_mode raw (the default) reads the
+// 11-bit disparity and registers it with the unit's calibration (freenect_copy_registration) through
+// the same code as a fakenect-record folder (io/kinect_model.hpp); registered takes libfreenect's
+// FREENECT_DEPTH_REGISTERED millimetres.
 //
 // libfreenect delivers frames through callbacks from freenect_process_events(), which runs on a
-// capture thread owned by the source. Each depth frame is paired with the latest RGB frame and
-// pushed onto a bounded queue; when the consumer is slower than 30 Hz the queue drops its oldest
+// capture thread owned by the source. Each depth frame waits for the next colour frame and takes
+// whichever of it and the previous one is nearer in device time (kinect_next_colour_is_nearer), then
+// goes onto a bounded queue; when the consumer is slower than 30 Hz the queue drops its oldest
 // frame instead of blocking the capture (so the next frame is always recent) and counts the drop.
-// Works unchanged under Debian's fakenect (a replay libfreenect; see write_fakenect_dump()).
+// Works unchanged under fakenect (a replay libfreenect, FAKENECT_PATH): it replays a fakenect-record
+// folder's raw disparity (registered with its device.json) or a dump of registered millimetres
+// written by write_fakenect_dump(); the first frame's values tell which.
 #pragma once
 #include <atomic>
 #include <condition_variable>
 #include <deque>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "io/frame_source.hpp"
 #include "io/input_params.hpp"
+#include "io/kinect_model.hpp"
 
 struct _freenect_context;
 struct _freenect_device;
@@ -43,18 +51,26 @@ class KinectSource : public FrameSource {
 
  private:
   struct Raw {
-    double timestamp;
-    std::vector<std::uint16_t> depth_mm;
+    double timestamp = 0;
+    std::vector<std::uint16_t> depth;  // as delivered: 11-bit disparity or millimetres
     std::vector<std::uint8_t> rgb;
-    bool has_accel;
-    vec3 accel;
+    bool has_accel = false;
+    vec3 accel{};
+  };
+  // A depth frame waiting for the colour frame after it.
+  struct Pending {
+    Raw raw;
+    std::uint32_t ticks = 0, colour_before_ticks = 0;
   };
   static void on_depth(_freenect_device* dev, void* data, std::uint32_t timestamp);
   static void on_video(_freenect_device* dev, void* data, std::uint32_t timestamp);
   void capture_loop();
+  void finish_pending();
   void push(Raw&& raw);
   void close() noexcept;
-  void check_replay_is_millimetres(const std::vector<std::uint16_t>& depth) const;
+  KinectCalibration calibration() const;
+  void make_registrar();
+  void decide_replay_content(const std::vector<std::uint16_t>& depth);
 
   InputParams params_;
   bool pinned_ = false;  // frames in page-locked host memory
@@ -64,8 +80,14 @@ class KinectSource : public FrameSource {
   std::thread thread_;
   std::atomic<bool> stop_{false};
   std::atomic<std::int64_t> dropped_{0};
-  bool replay_ = false;                   // running under fakenect (FAKENECT_PATH set)
-  std::vector<std::uint8_t> latest_rgb_;  // capture thread only (callbacks run there)
+  bool replay_ = false;      // running under fakenect (FAKENECT_PATH set)
+  bool raw_depth_ = true;    // frames hold 11-bit disparity (else millimetres)
+  bool swap_bytes_ = false;  // a replayed recording stored its samples big-endian
+  std::optional<KinectRegistrar> registrar_;
+  // Capture thread only (callbacks run there).
+  std::vector<std::uint8_t> latest_rgb_;
+  std::uint32_t latest_rgb_ticks_ = 0;
+  std::optional<Pending> pending_;
   // Shared with the consumer.
   std::mutex mutex_;
   std::condition_variable ready_;
@@ -73,6 +95,7 @@ class KinectSource : public FrameSource {
   bool ended_ = false;
   std::string end_reason_;
   std::int64_t delivered_ = 0;
+  std::int64_t discarded_ = 0;  // input.first_frame
 };
 
 // Writes frames of `source` as a fakenect recording (the format Debian's libfreenect-bin replays

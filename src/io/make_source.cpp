@@ -1,6 +1,9 @@
+#include <spdlog/spdlog.h>
 #include "core/buffer.hpp"
 #include "core/device.hpp"
 #include "core/error.hpp"
+
+#include "io/fakenect_source.hpp"
 #include "io/frame_folder_source.hpp"
 #include "io/frame_source.hpp"
 #include "io/input_params.hpp"
@@ -15,6 +18,13 @@ namespace seamless {
 
 std::unique_ptr<FrameSource> make_source(const InputParams& params, Device device) {
   const bool pinned = device == Device::CUDA;
+  if (params.source == InputSource::fakenect) return std::make_unique<FakenectSource>(params, pinned);
+  // A fakenect-record folder is told by its INDEX.txt whatever source names it.
+  if (params.source != InputSource::synthetic && is_fakenect_folder(params.path)) {
+    spdlog::info("input.path '{}' holds INDEX.txt: read as a fakenect-record folder (input.source: fakenect)",
+                 params.path);
+    return std::make_unique<FakenectSource>(params, pinned);
+  }
   if (params.source == InputSource::tum) return std::make_unique<TumSource>(params, pinned);
   if (params.source == InputSource::frames) return std::make_unique<FrameFolderSource>(params, pinned);
   if (params.source == InputSource::synthetic) return std::make_unique<SyntheticSource>(params, device);
@@ -27,7 +37,7 @@ std::unique_ptr<FrameSource> make_source(const InputParams& params, Device devic
 #endif
   }
   throw ConfigError("unknown input.source '" + std::string(enum_name(params.source)) +
-                    "': use synthetic, tum, frames or kinect");
+                    "': use synthetic, tum, frames, kinect or fakenect");
 }
 
 namespace {

@@ -9,6 +9,7 @@
 
 #include "config/config.hpp"
 #include "fuzz_util.hpp"
+#include "io/fakenect_source.hpp"
 #include "io/frame_folder_source.hpp"
 #include "io/jpeg_io.hpp"
 #include "io/ply.hpp"
@@ -102,6 +103,35 @@ inline void frames(const std::uint8_t* data, std::size_t size) {
   params.path = dir;
   expect_error_or_success([&] {
     FrameFolderSource src(params);
+    RgbdFrame frame;
+    for (int i = 0; i < 2 && src.next(frame); ++i) {
+    }
+  });
+}
+
+// A fakenect-record folder (FakenectSource: INDEX.txt, device.json, the first two frames' depth
+// PGM, colour PPM and accelerometer records). Input: INDEX.txt, then the contents given to every
+// d-, r- and a- file it names and device.json, separated by `--8<--`.
+inline void fakenect(const std::uint8_t* data, std::size_t size) {
+  std::vector<std::string_view> p = parts(data, size, 5);
+  const std::string dir = fresh_folder("fakenect");
+  put("fakenect/INDEX.txt", p[0]);
+  std::string_view lines = p[0];
+  for (int count = 0; !lines.empty() && count < 64; ++count) {
+    std::size_t end = lines.find('\n');
+    std::string name;
+    for (char c : lines.substr(0, end))
+      if (std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-') name += c;
+    lines.remove_prefix(end == std::string_view::npos ? lines.size() : end + 1);
+    if (name.empty() || name[0] == '.' || name.size() > 100 || name == "INDEX.txt") continue;
+    put("fakenect/" + name, name[0] == 'd' ? p[1] : name[0] == 'r' ? p[2] : p[3]);
+  }
+  if (!p[4].empty()) put("fakenect/device.json", p[4]);
+  InputParams params;
+  params.source = InputSource::fakenect;
+  params.path = dir;
+  expect_error_or_success([&] {
+    FakenectSource src(params);
     RgbdFrame frame;
     for (int i = 0; i < 2 && src.next(frame); ++i) {
     }

@@ -44,6 +44,7 @@ std::size_t run_all(const std::string& target, Target f) {
 TEST(FuzzRegressions, Config) { EXPECT_GT(run_all("config", seamless::fuzz::config), 0u); }
 TEST(FuzzRegressions, Tum) { EXPECT_GT(run_all("tum", seamless::fuzz::tum), 0u); }
 TEST(FuzzRegressions, Frames) { EXPECT_GT(run_all("frames", seamless::fuzz::frames), 0u); }
+TEST(FuzzRegressions, Fakenect) { EXPECT_GT(run_all("fakenect", seamless::fuzz::fakenect), 0u); }
 TEST(FuzzRegressions, Png) { EXPECT_GT(run_all("png", seamless::fuzz::png), 0u); }
 TEST(FuzzRegressions, Jpeg) { EXPECT_GT(run_all("jpeg", seamless::fuzz::jpeg), 0u); }
 TEST(FuzzRegressions, Ply) { EXPECT_GT(run_all("ply", seamless::fuzz::ply), 0u); }
