@@ -95,7 +95,7 @@ class KinectFrames {
     if (!have_) return false;
     for (const TumPose& p : traj_)
       if (std::fabs(p.timestamp - frame_.timestamp) < 1e-6) {
-        r.set_kinect_view(frame_.rgb, frame_.depth, frame_.intrinsics, p.se3());
+        r.set_kinect_view(frame_.rgb, frame_.depth, frame_.intrinsics, p.se3(), frame_.colour_region);
         return true;
       }
     throw Error("trajectory.txt has no pose at the input's frame time " + std::to_string(frame_.timestamp) +

@@ -101,7 +101,7 @@ class GlRunRenderer : public RunRenderer {
 
   void set_kinect_frame(const RgbdFrame& frame, const SE3& world_T_camera) override {
     if (p_.view == RenderView::kinect) {
-      renderer_.set_kinect_view(frame.rgb, frame.depth, frame.intrinsics, world_T_camera);
+      renderer_.set_kinect_view(frame.rgb, frame.depth, frame.intrinsics, world_T_camera, frame.colour_region);
       camera_ = renderer_.kinect_camera();
     } else if (p_.camera == RenderCameraMode::recorded) {  // the mesh seen through the recorded camera
       camera_.K = scale_intrinsics(zoom_intrinsics(frame.intrinsics, p_.zoom, p_.zoom_at), p_.width, p_.height);
@@ -176,7 +176,7 @@ class WindowRunRenderer : public RunRenderer {
   }
   void set_kinect_frame(const RgbdFrame& frame, const SE3& world_T_camera) override {
     rgb_ = frame.rgb.clone(Device::CPU), depth_ = frame.depth.clone(Device::CPU);
-    K_ = frame.intrinsics, pose_ = world_T_camera, new_frame_ = true;
+    K_ = frame.intrinsics, region_ = frame.colour_region, pose_ = world_T_camera, new_frame_ = true;
   }
   void draw(const ParticleSolver&) override {}  // the window pulls its frames
   void finish() override {}
@@ -225,7 +225,7 @@ class WindowRunRenderer : public RunRenderer {
   }
   void hand_over(Renderer& r) {
     if (new_mesh_) r.set_scene_mesh(mesh_);
-    if (new_frame_) r.set_kinect_view(rgb_, depth_, K_, pose_);
+    if (new_frame_) r.set_kinect_view(rgb_, depth_, K_, pose_, region_);
     new_mesh_ = new_frame_ = false;
   }
 
@@ -236,6 +236,7 @@ class WindowRunRenderer : public RunRenderer {
   Image<uchar3> rgb_;
   Image<float> depth_;
   Intrinsics K_{};
+  PixelRect region_{};
   bool new_mesh_ = false, new_frame_ = false;
 };
 
