@@ -5,12 +5,6 @@
 
 namespace seamless {
 
-// A rectangle of whole pixels: columns x .. x + width - 1, rows y .. y + height - 1.
-struct PixelRect {
-  int x = 0, y = 0, width = 0, height = 0;
-  SEAMLESS_HD bool empty() const { return width <= 0 || height <= 0; }
-};
-
 struct Intrinsics {
   float fx = 525.f, fy = 525.f, cx = 319.5f, cy = 239.5f;
   int width = 640, height = 480;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "io/input_params.hpp"
+#include "io/intrinsics_presets.hpp"
 #include "kernels/io/undistort.hpp"
 
 namespace seamless {
@@ -64,6 +66,13 @@ PixelRect undistorted_colour_region(const Intrinsics& lens) {
       mask[std::size_t(y) * w + x] =
           kernels::colour_lookup_inside(kernels::distort_pixel(lens, float(x), float(y)), w, h) ? 1 : 0;
   return largest_rect_of_aspect(mask, w, h);
+}
+
+PixelRect input_colour_region(const InputParams& input) {
+  if (input.source != InputSource::tum || !input.undistort) return {};
+  const Intrinsics K = resolve_intrinsics(input.intrinsics, input.path).K;
+  if (K.dist[0] == 0.f) return {};  // as TumSource::load_frame decides
+  return undistorted_colour_region(K);
 }
 
 }  // namespace seamless

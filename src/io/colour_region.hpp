@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/camera.hpp"
+#include "core/pixel_rect.hpp"
 
 namespace seamless {
 
@@ -17,5 +18,11 @@ PixelRect largest_rect_of_aspect(const std::vector<std::uint8_t>& mask, int w, i
 // For images undistorted with `lens` (its dist non-zero; kernels/io/undistort.hpp): the largest
 // rectangle of the image's aspect where remap_rgb found colour. The whole image when dist is zero.
 PixelRect undistorted_colour_region(const Intrinsics& lens);
+
+struct InputParams;
+// Where the frames of `input` hold colour (the AR frames show only that part): for a TUM folder
+// undistorted on reading (TumSource: input.undistort and a lens with k1 != 0), the region above;
+// empty (the whole image) for every other source. Resolves the intrinsics as the source does.
+PixelRect input_colour_region(const InputParams& input);
 
 }  // namespace seamless

@@ -22,9 +22,6 @@ struct RgbdFrame {
   Image<float> depth;      // host image, metres, 0 = no reading; registered to rgb
   Image<uchar3> rgb;       // host image, 8-bit R, G, B
   Intrinsics intrinsics;   // of depth and rgb (undistorted: dist is zero when images are)
-  // Where rgb holds colour: undistortion leaves a black border where the lens saw nothing, and
-  // this is the largest rectangle of the image's aspect without it. Empty: the whole image.
-  PixelRect colour_region;
   // Specific force measured by the accelerometer, m/s^2, in the camera frame (x right, y down,
   // z forward): at rest it points up, e.g. (0, -9.81, 0) for a level camera.
   std::optional<vec3> accelerometer;

@@ -11,7 +11,6 @@
 #include "core/error.hpp"
 #include "core/exec.hpp"
 #include "core/log.hpp"
-#include "io/colour_region.hpp"
 #include "io/depth_scale.hpp"
 #include "io/intrinsics_presets.hpp"
 #include "io/jpeg_io.hpp"
@@ -184,9 +183,6 @@ TumSource::TumSource(const InputParams& params, bool pinned) : params_(params), 
     throw InputError("input.path '" + folder_ + "' is not a folder: download one with datasets/download_tum.sh");
   const IntrinsicsChoice choice = resolve_intrinsics(params.intrinsics, folder_);
   K_ = choice.K, flip_x_ = choice.flip_x, flip_y_ = choice.flip_y;
-  const Intrinsics K = intrinsics();
-  colour_region_ =
-      K.dist[0] == 0.f && K_.dist[0] != 0.f ? undistorted_colour_region(K_) : PixelRect{0, 0, K.width, K.height};
   fs::path dir(folder_);
   pairs_ = tum_folder_pairs(folder_, params);
   if (pairs_.empty())
@@ -276,7 +272,6 @@ void TumSource::load_frame(const TumPair& pair, RgbdFrame& frame) {
 void TumSource::fill_metadata(const TumPair& pair, RgbdFrame& frame) const {
   frame.timestamp = pair.rgb.timestamp;
   frame.intrinsics = intrinsics();
-  frame.colour_region = colour_region_;
   frame.accelerometer = accelerometer_at(pair.rgb.timestamp);
   frame.ground_truth.reset();
   if (auto p = interpolate_pose(groundtruth_, pair.rgb.timestamp, params_.max_gt_gap)) frame.ground_truth = p->se3();

@@ -62,7 +62,6 @@ class TumSource : public FrameSource {
   Trajectory groundtruth_;
   std::vector<std::pair<double, vec3>> accel_;    // camera-frame specific force
   Image<vec2> undistort_map_;                     // where each undistorted pixel comes from
-  PixelRect colour_region_;                       // of the undistorted frames (RgbdFrame::colour_region)
   Image<uchar3> rgb_scratch_;                     // undistortion's source
   Image<float> scratch_;                          // depth before undistortion
   Image<float> gap_scratch_;                      // input.fill_gaps: depth before its gaps are filled

@@ -7,6 +7,7 @@
 
 #include "core/camera.hpp"
 #include "core/math.hpp"
+#include "core/pixel_rect.hpp"
 
 namespace seamless {
 

@@ -245,24 +245,26 @@ TEST(ColourRegion, LargestRectangleOfTheAspectInADisc) {
 }
 
 // Undistorting freiburg1 images leaves a black border (remap_rgb writes 0, 0, 0 where the lens saw
-// nothing); the frames' colour_region is a 4:3 rectangle without it: on real frames, no black
-// pixel inside it, black pixels outside it. An image without distortion is all colour.
+// nothing); input_colour_region is a 4:3 rectangle without it: on the real frames the TUM reader
+// delivers, no black pixel inside it, black pixels outside it. Without undistortion (or another
+// source) it is empty: the whole image.
 TEST(ColourRegion, TumFramesLeaveOutTheUndistortionBorder) {
   std::string dir = data_dir("tum_fr1_rpy_000-149");
   REQUIRE_DATA(dir);
   InputParams p = tum_params(dir);
   p.max_frames = 3;
+  const PixelRect r = input_colour_region(p);
+  std::printf("colour region %dx%d at (%d, %d)\n", r.width, r.height, r.x, r.y);
+  ASSERT_FALSE(r.empty());
+  EXPECT_GE(r.x, 0);
+  EXPECT_GE(r.y, 0);
+  EXPECT_LE(r.x + r.width, 640);
+  EXPECT_LE(r.y + r.height, 480);
+  EXPECT_NEAR(static_cast<float>(r.width) / r.height, 4.f / 3.f, 0.01f);
+  EXPECT_GT(r.width, 500) << "the border is 6-25 pixels wide";
   TumSource src(p);
   RgbdFrame f;
   while (src.next(f)) {
-    const PixelRect r = f.colour_region;
-    ASSERT_FALSE(r.empty());
-    EXPECT_GE(r.x, 0);
-    EXPECT_GE(r.y, 0);
-    EXPECT_LE(r.x + r.width, 640);
-    EXPECT_LE(r.y + r.height, 480);
-    EXPECT_NEAR(static_cast<float>(r.width) / r.height, 4.f / 3.f, 0.01f);
-    EXPECT_GT(r.width, 500) << "the border is 6-25 pixels wide";
     const std::vector<uchar3> c = f.rgb.to_host();
     int black_in = 0, black_out = 0;
     for (int y = 0; y < 480; ++y)
@@ -272,14 +274,13 @@ TEST(ColourRegion, TumFramesLeaveOutTheUndistortionBorder) {
         const bool in = x >= r.x && x < r.x + r.width && y >= r.y && y < r.y + r.height;
         (in ? black_in : black_out) += black ? 1 : 0;
       }
-    std::printf("colour region %dx%d at (%d, %d); black pixels inside %d, outside %d\n", r.width, r.height, r.x, r.y,
-                black_in, black_out);
+    std::printf("black pixels inside %d, outside %d\n", black_in, black_out);
     EXPECT_EQ(black_in, 0);
     EXPECT_GT(black_out, 1000);
   }
   p.undistort = false;
-  TumSource raw(p);
-  ASSERT_TRUE(raw.next(f));
-  EXPECT_TRUE(f.colour_region.x == 0 && f.colour_region.y == 0 && f.colour_region.width == 640 &&
-              f.colour_region.height == 480);
+  EXPECT_TRUE(input_colour_region(p).empty());
+  p.undistort = true;
+  p.source = InputSource::frames;
+  EXPECT_TRUE(input_colour_region(p).empty());
 }
