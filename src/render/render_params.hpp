@@ -105,15 +105,14 @@ struct RenderParams {
   // four touching spheres close only above sqrt(2) (the gap centre is sqrt(2) r from each).
   float fluid_radius_scale = 1.5f;
   FluidFilter fluid_filter =
-      FluidFilter::narrow_range;     // depth smoothing: narrow_range (Truong & Yuksel 2018) or bilateral
-  int filter_iterations = 1;         // separable filter passes (x then y) over the depth
-  int filter_max_taps = 12;          // taps per side at most: wider kernels sample every k-th pixel
-  float filter_size = 3.f;           // filter half-width in particle radii (world), projected per pixel
+      FluidFilter::narrow_range;  // depth smoothing: narrow_range (Truong & Yuksel 2018) or bilateral
+  int filter_iterations = 2;      // separable filter passes (x then y) over the depth
+  int filter_max_taps = 12;       // taps per side at most: wider kernels sample every k-th pixel
+  // Filter half-width in particle radii (world), projected per pixel: three particle spacings
+  // (a diameter each), so that the spheres' bumps average out into one surface.
+  float filter_size = 6.f;
   int filter_max_px = 24;            // ... but at most this many pixels
   float filter_depth_sigma = 1.f;    // range sigma of the bilateral filter, in particle radii
-  // The depth filter closes gaps narrower than this (particle radii, world) between fluid on both
-  // sides: a spread puddle stays one surface instead of breaking into separate spheres.
-  float fill_gap = 2.f;
   vec3 absorption{25.f, 8.f, 3.5f};  // Beer-Lambert coefficients per colour channel, 1/m (tinted water)
   float ior = 1.33f;                 // refractive index (water): Snell's law bends the view into the fluid
   float fresnel_f0 = 0.02f;          // reflectance at normal incidence (water: ((1-1.33)/(1+1.33))^2)
@@ -211,8 +210,6 @@ struct RenderParams {
     v("filter_size", filter_size, "depth filter half-width, particle radii", Range{0.0, 50.0});
     v("filter_max_px", filter_max_px, "depth filter half-width limit, pixels", Range{1, 128});
     v("filter_depth_sigma", filter_depth_sigma, "bilateral range sigma, particle radii", Range{0.01, 100.0});
-    v("fill_gap", fill_gap, "fluid depth filter closes gaps up to this wide between fluid on both sides, particle radii",
-      Range{0.0, 20.0});
     v("absorption", absorption, "fluid absorption per channel (Beer-Lambert), 1/m");
     v("ior", ior, "fluid refractive index (Snell's law at the surface)", Range{1.0, 3.0});
     v("fresnel_f0", fresnel_f0, "fluid reflectance at normal incidence", Range{0.0, 1.0});

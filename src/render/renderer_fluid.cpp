@@ -184,7 +184,6 @@ void Renderer::Impl::thickness_blur(const RenderCamera& low) {
   glUniform1i(fp.loc("u_max_taps"), 3);
   glUniform1f(fp.loc("u_range_sigma"), 0.f);
   glUniform1i(fp.loc("u_skip_empty"), 0);
-  glUniform1f(fp.loc("u_fill_gap"), 0.f);
   filter_pass(thick[0], thick[1], thick_fbo[1], 1, 0, tw, th);
   filter_pass(thick[1], thick[0], thick_fbo[0], 0, 1, tw, th);
   glViewport(0, 0, w, h);
@@ -216,7 +215,6 @@ void Renderer::Impl::fluid_filter_passes(float radius, const RenderCamera& cam) 
   glUniform1i(fp.loc("u_max_taps"), p.filter_max_taps);
   glUniform1f(fp.loc("u_range_sigma"), p.filter_depth_sigma * radius);
   glUniform1i(fp.loc("u_skip_empty"), 1);
-  glUniform1f(fp.loc("u_fill_gap"), p.fill_gap * radius);
   glUniform1i(fp.loc("u_narrow_range"), p.fluid_filter == FluidFilter::narrow_range);
   for (int it = 0; it < p.filter_iterations; ++it) {
     filter_pass(fluid_depth[0], fluid_depth[1], fluid_filter_fbo[1], 1, 0, w, h);

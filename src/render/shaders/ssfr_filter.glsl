@@ -25,38 +25,10 @@ uniform int u_max_taps;
 uniform float u_range_sigma;    // metres; <= 0 disables the range weight
 uniform bool u_skip_empty;
 uniform bool u_narrow_range;
-uniform float u_fill_gap;       // metres; depth only: gaps narrower than this are closed (0: none)
-
-// An empty texel inside a run of empty texels along u_dir that has fluid at both ends, fewer than
-// u_fill_gap apart at their depth and within the narrow range 3 u_range_sigma of each other: the
-// depth interpolated linearly between the ends (the surface goes on across the gap between two
-// spheres that do not quite touch, as the fluid between the particles does). Else 0 (stays empty).
-// The x pass closes gaps along rows, the y pass along columns: a hole with fluid all round closes
-// in either, while an open edge (fluid on one side only) never grows.
-float fill_at(ivec2 p) {
-  ivec2 hi = textureSize(u_src, 0) - 1;
-  float za = 0.0, zb = 0.0;
-  int da = 0, db = 0;
-  for (int i = 1; i <= u_max_px && (za <= 0.0 || zb <= 0.0); ++i) {
-    ivec2 a = p - i * u_dir, b = p + i * u_dir;
-    if (za <= 0.0 && all(greaterThanEqual(a, ivec2(0)))) {
-      za = texelFetch(u_src, a, 0).r;
-      da = i;
-    }
-    if (zb <= 0.0 && all(lessThanEqual(b, hi))) {
-      zb = texelFetch(u_src, b, 0).r;
-      db = i;
-    }
-  }
-  if (za <= 0.0 || zb <= 0.0) return 0.0;
-  float f = u_dir.x != 0 ? u_K.x : u_K.y;
-  if (float(da + db - 1) > u_fill_gap * f / min(za, zb) || abs(za - zb) > 3.0 * u_range_sigma) return 0.0;
-  return (za * float(db) + zb * float(da)) / float(da + db);
-}
 
 float filter_at(ivec2 p) {
   float c = texelFetch(u_src, p, 0).r;
-  if (u_skip_empty && c <= 0.0) return u_fill_gap > 0.0 ? fill_at(p) : 0.0;
+  if (u_skip_empty && c <= 0.0) return 0.0;
   float f = u_dir.x != 0 ? u_K.x : u_K.y;
   int r = u_skip_empty ? int(min(float(u_max_px), u_world_radius * f / c)) : u_max_px;
   if (r < 1) return c;
