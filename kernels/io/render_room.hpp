@@ -15,8 +15,8 @@
 #pragma once
 #include <cstdint>
 
-#include "core/camera.hpp"
 #include "core/exec.hpp"
+#include "core/intrinsics.hpp"
 #include "core/math.hpp"
 #include "core/view.hpp"
 #include "kernels/scene/movers.hpp"

@@ -12,8 +12,8 @@
 #pragma once
 #include <cstdint>
 
-#include "core/camera.hpp"
 #include "core/exec.hpp"
+#include "core/intrinsics.hpp"
 #include "core/math.hpp"
 #include "core/view.hpp"
 

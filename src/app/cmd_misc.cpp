@@ -70,7 +70,29 @@ void add_stats(Json& j, const std::string& prefix, const ErrorStats& s, const ch
   j[prefix + "_min_" + unit] = s.min, j[prefix + "_max_" + unit] = s.max;
 }
 
+bool same_file(const std::string& a, const std::string& b) {
+  namespace fs = std::filesystem;
+  std::error_code e1, e2;
+  if (fs::equivalent(a, b, e1)) return true;
+  const fs::path ca = fs::weakly_canonical(a, e1), cb = fs::weakly_canonical(b, e2);
+  return !e1 && !e2 && ca == cb;
+}
+
+// `seamless eval gt est --json gt` would replace an input with the figures: refuse before reading.
+void refuse_overwriting_inputs(const EvalArgs& a) {
+  for (const auto& [option, out] : {std::pair{"--json", a.json}, std::pair{"--aligned", a.aligned}}) {
+    if (out.empty()) continue;
+    for (const std::string& in : a.files)
+      if (same_file(out, in))
+        throw UsageError(std::string(option) + " " + out + " is the input trajectory " + in +
+                         ": eval never writes over its inputs; give another file name");
+  }
+  if (!a.json.empty() && !a.aligned.empty() && same_file(a.json, a.aligned))
+    throw UsageError("--json and --aligned name the same file " + a.json + "; give two file names");
+}
+
 int run_eval(const EvalArgs& a) {
+  refuse_overwriting_inputs(a);
   EvalOptions opt = a.opt;
   opt.align = parse_alignment(a.align);
   const std::string &gt_path = a.files[0], &est_path = a.files[1];
@@ -177,12 +199,23 @@ int run_record(const RecordArgs& a) {
   if (!a.source.empty()) sets.push_back("input.source=" + a.source);
   if (!a.path.empty()) sets.push_back("input.path=" + a.path);
   Experiment e = a.config.empty() ? parse_experiment("{}", sets, "<defaults>") : load_experiment(a.config, sets);
+  // The folder first (lock, --out over the input refused), then the source: nothing is read or
+  // written for a folder that cannot be used.
+  OutputFolder folder(a.out, a.force, input_paths(e), {"rgb.txt", "depth.txt", "associations.txt", "manifest.txt"});
   auto source = make_source(e.input, resolve_device(a.device));
-  prepare_output_folder(a.out, a.force, {"rgb.txt", "depth.txt", "associations.txt"});
   install_interrupt_handlers();  // record() stops after the frame being written
   RecordOptions o;
   o.max_frames = a.frames;
-  std::int64_t n = record(*source, a.out, o);
+  std::int64_t n = 0;
+  try {
+    n = record(*source, a.out, o);
+  } catch (...) {
+    folder.remove_partial_files();
+    folder.write_manifest("record");
+    throw;
+  }
+  folder.remove_partial_files();
+  folder.write_manifest("record");
   spdlog::info("recorded {} frames from {} into {} (TUM format; read back with input.source: tum, input.path: {})", n,
                source->name(), a.out, a.out);
   return 0;
@@ -199,8 +232,9 @@ void add_record_command(CLI::App& app, std::function<int()>& action) {
   cmd->add_option("--path", a->path, "TUM folder when --source tum");
   cmd->add_option("--out", a->out, "folder to write")->required();
   cmd->add_option("--frames", a->frames,
-                  "stop after this many frames (0: until the source ends; Ctrl-C stops after the frame being written, "
-                  "leaving a folder that loads)");
+                  "stop after this many frames, at least 1 (left out: until the source ends; Ctrl-C stops after the "
+                  "frame being written, leaving a folder that loads)")
+      ->check(frame_count(1, "leave it out to record until the source ends"));
   cmd->add_flag("--force", a->force, "write into a folder that holds an earlier recording after clearing it");
   cmd->add_option("--set", a->sets, "override a config key, e.g. --set input.synthetic.frames=30");
   cmd->add_option("--device", a->device, "where the synthetic room renders: cpu, cuda or auto");
@@ -212,11 +246,18 @@ void add_config_command(CLI::App& app, std::function<int()>& action) {
   auto* cmd = app.add_subcommand("config", "check an experiment file, print its effective form, or list every key");
   add_common_options(*cmd, *o, false);
   auto list = std::make_shared<bool>(false);
-  cmd->add_flag("--list", *list, "print every key with type, default and meaning (Markdown)");
+  cmd->add_flag("--list", *list,
+                "print every key with type, default and meaning (Markdown); `config --list tracker`: the keys of "
+                "that section (or that key)");
   cmd->callback([&action, o, list] {
     action = [o, list] {
       if (*list) {
-        std::fputs(experiment_keys_markdown().c_str(), stdout);
+        // The positional argument names a section or key here, not a file.
+        const std::string md = experiment_keys_markdown(o->config);
+        if (md.empty())
+          throw UsageError("config --list " + o->config +
+                           ": no such section or key (`seamless config --list` prints them all)");
+        std::fputs(md.c_str(), stdout);
         return 0;
       }
       if (o->config.empty()) {

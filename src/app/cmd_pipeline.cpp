@@ -4,6 +4,7 @@
 #include "app/commands.hpp"
 #include "app/pipeline.hpp"
 #include "app/run_context.hpp"
+#include "app/run_summary.hpp"
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
 #include "kernels/scene/synthetic_room.hpp"
@@ -17,16 +18,20 @@ void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
                                "track and fuse the input into the TSDF volume; write mesh.ply, "
                                "trajectory.txt and tracking_stats.csv");
   add_common_options(*r, *rec);
+  add_frames_option(*r, *rec);
   r->callback([&action, rec] {
     action = [rec] {
       RunContext ctx(*rec);
-      scan(ctx, true);
+      ScanResult s = scan(ctx, true);
+      add_tracking(ctx.summary(), s.tracking, s.unreadable, groundtruth_path(ctx));
+      ctx.summary().intrinsics = s.intrinsics;
       return ctx.exit_code();
     };
   });
   auto trk = std::make_shared<CommonOptions>();
   auto* t = app.add_subcommand("track", "track the camera over the input; write trajectory.txt and tracking_stats.csv");
   add_common_options(*t, *trk);
+  add_frames_option(*t, *trk);
   t->callback([&action, trk] {
     action = [trk] {
       RunContext ctx(*trk);
@@ -40,8 +45,13 @@ void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
       if (offline && !interrupted()) {
         std::vector<bool> tracked;
         for (const FrameRecord& f : r.tracking.frames) tracked.push_back(f.result.ok());
-        refine_run(e.input, r.tracking.trajectory, tracked, e.refine, e.preprocess, ctx.device(), ctx.out_dir());
+        r.tracking.trajectory =
+            refine_run(e.input, r.tracking.trajectory, tracked, e.refine, e.preprocess, ctx.device(), ctx.out_dir())
+                .trajectory;
       }
+      // summary.json as `run` writes it, for the trajectory.txt written (refined, when refine is on).
+      add_tracking(ctx.summary(), r.tracking, r.unreadable, groundtruth_path(ctx));
+      ctx.summary().intrinsics = r.intrinsics;
       return ctx.exit_code();
     };
   });
@@ -60,7 +70,7 @@ void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
       kernels::SceneSdf sdf{};
       sdf.synthetic_room = 1;
       ctx.experiment().solver.gravity = kernels::room::gravity();  // the room's world is z up
-      simulate(ctx, nullptr, &sdf);
+      ctx.summary().physics = simulate(ctx, nullptr, &sdf).stats;
       return ctx.exit_code();
     };
   });

@@ -18,8 +18,8 @@
 #include "config/config.hpp"
 #include "core/error.hpp"
 #include "io/movers.hpp"
+#include "io/ply.hpp"
 #include "io/trajectory.hpp"
-#include "physics/particle_io.hpp"
 #include "physics/particle_solver.hpp"
 
 namespace seamless::app {
@@ -72,15 +72,6 @@ void log_escaped(const EscapedParticles& x, std::size_t dynamic) {
       "physics: {} of {} dynamic particles left the scene ({} below the floor, {} outside the scanned "
       "region, {} still falling): holes in the scan (see docs/PLACEMENT.md, 'Physics on real scans')",
       x.total(), dynamic, x.below_floor, x.outside, x.falling);
-}
-
-// The input's ground truth for ATE, when it has one: the scan writes it beside trajectory.txt in
-// the same frame (any source with poses), else a TUM folder's own groundtruth.txt.
-std::string groundtruth_path(const RunContext& ctx) {
-  if (std::filesystem::exists(ctx.out_path("groundtruth.txt"))) return ctx.out_path("groundtruth.txt");
-  const InputParams& in = ctx.experiment().input;
-  const std::string gt = in.path + "/groundtruth.txt";
-  return in.source == InputSource::tum && std::filesystem::exists(gt) ? gt : "";
 }
 
 std::vector<vec3> camera_positions(const Trajectory& tr) {
@@ -178,6 +169,7 @@ void add_run_command(CLI::App& app, std::function<int()>& action) {
   auto o = std::make_shared<CommonOptions>();
   auto* cmd = app.add_subcommand("run", "run an experiment end to end: input, reconstruction, physics, rendering");
   add_common_options(*cmd, *o);
+  add_frames_option(*cmd, *o);
   cmd->add_flag("--dry-run", o->dry_run, "validate the config and exit");
   cmd->add_option("--window-frames", o->window_frames,
                   "render.mode window: close the window after this many frames (scripted runs, tests); "

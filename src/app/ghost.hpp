@@ -1,4 +1,4 @@
-// The ghost measure of issue 22 (summary.json `dynamic.ghost_vertices`): how much of the synthetic
+// The ghost measure of dynamic scenes (summary.json `dynamic.ghost_vertices`): how much of the synthetic
 // room's movers stays in the map after they have gone. Needs the movers' exact geometry, so it
 // exists only for `input.source: synthetic` with `input.synthetic.movers`.
 #pragma once
@@ -6,7 +6,7 @@
 #include <optional>
 #include <vector>
 
-#include "core/geometry.hpp"
+#include "core/mesh.hpp"
 #include "io/input_params.hpp"
 #include "io/trajectory.hpp"
 

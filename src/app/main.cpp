@@ -2,9 +2,12 @@
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 
+#include <csignal>
+
 #include "app/bench.hpp"
 #include "app/commands.hpp"
 #include "app/exit_codes.hpp"
+#include "app/run_context.hpp"
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
 #include "core/log.hpp"
@@ -41,31 +44,38 @@ int main(int argc, char** argv) {
   }
   init_logging(quiet ? Verbosity::Quiet : verbose ? Verbosity::Verbose : Verbosity::Normal);
   spdlog::debug("seamless {} (commit {}), debug output on", SEAMLESS_VERSION, SEAMLESS_GIT_COMMIT);
+  // A writer whose reader went away (ffmpeg) gets EPIPE and says so, instead of the process
+  // being killed by SIGPIPE without a word.
+  std::signal(SIGPIPE, SIG_IGN);
   int code = app::kExitUsage;
+  auto fail = [&code](int c, const std::string& message) {
+    spdlog::error("{}", message);
+    app::annotate_failed_run(message, c);  // summary.json of the run, when one was started
+    code = c;
+  };
   try {
     if (action) code = action();
   } catch (const ConfigError& e) {
-    spdlog::error("{}", e.what());
-    code = app::kExitConfig;
+    fail(app::kExitConfig, e.what());
   } catch (const InputError& e) {
-    spdlog::error("{}", e.what());
-    code = app::kExitInput;
+    fail(app::kExitInput, e.what());
   } catch (const UsageError& e) {
-    spdlog::error("{}", e.what());
-    code = app::kExitUsage;
+    fail(app::kExitUsage, e.what());
   } catch (const Error& e) {
-    spdlog::error("{}", e.what());
-    code = app::kExitError;
+    fail(app::kExitError, e.what());
+  } catch (const std::bad_alloc&) {
+    fail(app::kExitError, "out of memory (the config asks for more than this machine has: see the log for the stage)");
   } catch (const std::exception& e) {
-    spdlog::error("internal error: {}", e.what());
-    code = app::kExitError;
+    fail(app::kExitError, std::string("internal error: ") + e.what());
   }
   // A failure keeps its own code; a run that was stopped early otherwise says so, whatever it
   // would have returned for the frames it did.
   const bool failed = code != app::kExitOk && code != app::kExitLostFrames;
   if (interrupted() && !failed) {
     code = app::kExitSignalBase + interrupt_signal();
-    spdlog::warn("stopped by a signal: the outputs hold what was computed (exit code {})", code);
+    if (!app::interruption_logged())
+      spdlog::warn("stopped by {}: the outputs hold what was computed (exit code {})", signal_name(interrupt_signal()),
+                   code);
   }
   spdlog::default_logger()->flush();
   return code;

@@ -16,12 +16,12 @@
 #include "core/progress.hpp"
 #include "io/frame_source.hpp"
 #include "io/intrinsics_presets.hpp"
+#include "io/ply.hpp"
 #include "io/trajectory.hpp"
 #include "physics/builders.hpp"
 #include "physics/depth_colliders.hpp"
 #include "physics/particle_io.hpp"
 #include "physics/particle_solver.hpp"
-#include "recon/ply.hpp"
 #include "recon/refine/online_refine.hpp"
 
 namespace seamless::app {
@@ -82,7 +82,9 @@ ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
   ScanResult r;
   if (with_volume) r.volume = make_volume(e.volume, ctx.device());
 
-  std::int64_t total = e.frames > 0 ? e.frames : source->size().value_or(0);
+  // frames and input.max_frames both limit the frames read (the source applies the latter).
+  std::int64_t total = source->size().value_or(0);
+  if (e.frames > 0 && (total == 0 || e.frames < total)) total = e.frames;
   Progress progress("scan", total);
   std::int64_t n = 0;
   r.intrinsics = source->intrinsics();
@@ -92,7 +94,7 @@ ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
     ctx.timer().add(f.frame, "fuse", f.fuse_ms);
     ctx.timer().add(f.frame, "frame", f.frame_ms);
     if (n == 0) r.first_frame = host_copy(frame);
-    progress.update(++n, to_string(f.result.status));
+    progress.update(++n, "tracking " + std::string(to_string(f.result.status)));
   };
   TrackSequenceParams tp = tracking_params(e, volume_stages);
   std::unique_ptr<OnlineCorrector> online;  // refine.online: the keyframe graph solved while tracking runs
@@ -112,12 +114,13 @@ ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
       "{} frames from {} ({} unreadable, skipped); {} lost by tracking; median track {:.3f} ms, frame {:.3f} ms",
       r.tracking.frames.size(), source->name(), source->skipped_frames(), r.tracking.lost_frames,
       r.tracking.median_track_ms, r.tracking.median_frame_ms);
-  ctx.report_tracking(static_cast<std::int64_t>(r.tracking.frames.size()), r.tracking.lost_frames);
+  ctx.report_tracking(static_cast<std::int64_t>(r.tracking.frames.size()), r.tracking.lost_frames,
+                      r.volume ? r.volume->stats().failed_insertions : 0);
   if (r.volume) {
     log_volume(r.volume->stats());
     r.mesh = r.volume->extract_mesh();
     if (e.output.write_mesh) {
-      write_ply(ctx.out_path("mesh.ply"), r.mesh);
+      write_mesh_ply(ctx.out_path("mesh.ply"), r.mesh);
       spdlog::info("mesh.ply: {} vertices, {} triangles", r.mesh.positions.size(), r.mesh.triangles.size());
     }
   }

@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <numbers>
 
 #include "core/error.hpp"
-#include "kernels/physics/particle_math.hpp"
 #include "seamless/build_config.hpp"
 #if SEAMLESS_HAS_GL
 #include "io/colour_region.hpp"
@@ -39,7 +39,7 @@ SceneCamera mesh_view_camera(const Mesh& mesh, const SE3& scan_camera, const Ren
 }
 
 SceneCamera orbit_camera(const SceneCamera& c, const RenderParams& p, float progress) {
-  const float a = p.orbit_deg * std::clamp(progress, 0.f, 1.f) * kernels::kPi / 180.f;
+  const float a = p.orbit_deg * std::clamp(progress, 0.f, 1.f) * std::numbers::pi_v<float> / 180.f;
   const vec3 r = c.eye - c.target;
   const float cs = std::cos(a), sn = std::sin(a);
   // A turn about +y by a: (x, z) -> (x cos a + z sin a, -x sin a + z cos a); a positive angle turns
@@ -271,9 +271,17 @@ std::unique_ptr<RunRenderer> RunRenderer::make(RunContext& ctx) {
 #else
     const std::string why = "this build has no GLFW (apt-get install libglfw3-dev, then reconfigure)";
 #endif
-    spdlog::warn("render.mode is window but no window can be opened: {}; rendering headless into {}/frames instead",
-                 why, ctx.out_dir());
+    spdlog::warn("render.mode is window but no window can be opened: {}; rendering headless instead", why);
   }
+  // What headless rendering writes is the render section's choice: say which, so that a missing
+  // frames/ folder or video is never a surprise (docs/RENDERING.md).
+  std::string what = "preview.png (the last frame)";
+  if (p.write_frames) what += ", frames/NNNNNN.png";
+  if (p.video) what += ", video.mp4";
+  if (p.stage_images) what += ", stages/";
+  spdlog::info(
+      "rendering headless into {}: {}{}", ctx.out_dir(), what,
+      p.write_frames || p.video ? "" : " (render.write_frames: true adds every frame, render.video: true a video)");
   return std::make_unique<GlRunRenderer>(ctx);
 #else
   spdlog::warn(

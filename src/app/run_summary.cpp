@@ -1,10 +1,13 @@
 #include "app/run_summary.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <cmath>
 #include <set>
 
 #include "app/json_file.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "core/output_file.hpp"
 #include "eval/trajectory_eval.hpp"
 #include "seamless/build_config.hpp"
@@ -57,7 +60,13 @@ void add_tracking(RunSummary& s, const TrackSequenceResult& r, std::int64_t unre
   for (const FrameRecord& f : r.frames) s.frames_fused += f.fused;
   s.dynamic_masked_fraction = mean_dynamic_fraction(r.frames);
   if (groundtruth.empty() || r.trajectory.empty()) return;
-  const AteResult ate = compute_ate(r.trajectory, read_tum_trajectory(groundtruth));
+  AteResult ate;
+  try {
+    ate = compute_ate(r.trajectory, read_tum_trajectory(groundtruth));
+  } catch (const Error& e) {  // too few poses for an alignment (a 2-frame run): no ATE, not a failed run
+    spdlog::info("summary.json: no ATE ({})", e.what());
+    return;
+  }
   if (ate.trans.count == 0) return;
   s.ate_rmse_m = ate.trans.rmse;
   s.ate_pairs = static_cast<std::int64_t>(ate.trans.count);
@@ -111,6 +120,15 @@ Json mask_json(const MaskQuality& q) {
 
 void write_summary(const std::string& path, const RunSummary& s) {
   Json j;
+  const int sig = interrupt_signal();
+  j["status"] = !s.status.empty() ? s.status : sig != 0 ? "interrupted" : "complete";
+  if (sig != 0) j["signal"] = signal_name(sig);
+  j["reached"] = {{"frames", s.reached_frames >= 0 ? s.reached_frames : s.frames_read},
+                  {"steps", s.reached_steps >= 0 ? s.reached_steps
+                            : s.physics          ? s.physics->steps
+                                                 : 0}};
+  if (!s.error.empty()) j["error"] = s.error;
+  if (s.exit_code >= 0) j["exit_code"] = s.exit_code;
   j["seamless_version"] = SEAMLESS_VERSION;
   j["commit"] = SEAMLESS_GIT_COMMIT;
   j["command"] = s.command, j["config"] = s.config, j["device"] = s.device;

@@ -7,7 +7,7 @@
 
 #include "app/ghost.hpp"
 #include "app/placement.hpp"
-#include "core/camera.hpp"
+#include "core/intrinsics.hpp"
 #include "physics/particle_solver.hpp"
 #include "recon/refine/online_refine.hpp"
 #include "recon/tracker_sequence.hpp"
@@ -33,6 +33,13 @@ constexpr float kFallSpeed = 0.5f;  // m/s: free fall reaches it in 0.05 s (12 m
 EscapedParticles count_escaped(const ParticleState& s, const SceneBounds& b, float diameter);
 
 struct RunSummary {
+  // complete | interrupted | failed | incomplete (README, "Exit codes and interrupted runs");
+  // empty: write_summary decides between complete and interrupted (core/interrupt.hpp).
+  std::string status;
+  std::string error;   // failed: the message
+  int exit_code = -1;  // failed: the command's exit code (-1: not written)
+  // How far the run got (failed and interrupted runs): -1 takes frames.read and the solver's steps.
+  std::int64_t reached_frames = -1, reached_steps = -1;
   std::string command, config, device;
   std::optional<Intrinsics> intrinsics;
   std::int64_t frames_read = 0, frames_lost = 0, frames_fused = 0, frames_unreadable = 0;

@@ -31,8 +31,9 @@ std::string write_effective_config(const Experiment& e, const std::string& path)
 
 // Every key of the experiment with type, default, doc and constraint (for `config --list` and docs).
 std::vector<config::KeyInfo> experiment_keys();
-// The key reference as a Markdown table (docs/CONFIG.md embeds it).
-std::string experiment_keys_markdown();
+// The key reference as a Markdown table (docs/CONFIG.md embeds it); with `prefix` ("tracker",
+// "volume.voxel_size") only that section's keys or that key, "" when there is none.
+std::string experiment_keys_markdown(const std::string& prefix = "");
 
 // Keys whose values differ ("path: a -> b"); empty when equal. Compares exactly.
 std::vector<std::string> diff_experiments(const Experiment& a, const Experiment& b);

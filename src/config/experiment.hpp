@@ -71,8 +71,10 @@ struct Experiment {
   RenderParams render;
   OutputParams output;
 
-  // Rules across keys and sections, checked once the whole file is read (parse_experiment), so a
-  // bad combination is a config error before any work starts (src/config/config.cpp).
+  // Rules across keys and sections and physical sanity, checked once the whole file is read
+  // (parse_experiment), so a bad combination is a config error before any work starts
+  // (src/config/config.cpp). check() appends every problem; validate() throws them all.
+  void check(std::vector<std::string>& problems) const;
   void validate() const;
 
   template <class V> void visit(V& v) {

@@ -117,6 +117,22 @@ std::string did_you_mean(const std::string& word, const std::vector<std::string>
   return best;
 }
 
+std::string nonfinite_name(const std::string& text) {
+  std::string l = lower(trim(text));
+  if (!l.empty() && (l[0] == '+' || l[0] == '-')) l.erase(0, 1);
+  if (!l.empty() && l[0] == '.') l.erase(0, 1);
+  if (l == "nan") return "NaN";
+  if (l == "inf" || l == "infinity") return "infinity";
+  return "";
+}
+
+std::string number_problem(const std::string& text, const std::string& expected) {
+  const std::string what = nonfinite_name(text);
+  if (!what.empty())
+    return "expected " + expected + ", got " + what + " ('" + text + "'), which is not a finite number";
+  return "expected " + expected + ", got '" + text + "'";
+}
+
 bool parse_bool(const std::string& s, bool& out) {
   std::string l = lower(s);
   if (l == "true" || l == "yes" || l == "on") return out = true, true;
@@ -164,6 +180,19 @@ void LoadContext::error(const YAML::Node& at, const std::string& path, const std
   std::string at_where = where(at, path);
   long pos = at_where.rfind("(from --set", 0) == 0 || at.Mark().pos < 0 ? 1L << 40 : at.Mark().pos;
   errors_.push_back({pos, at_where + ": " + path + ": " + what});
+  refused_.push_back(path);
+}
+
+bool LoadContext::names_refused_key(const std::string& message) const {
+  for (const std::string& key : refused_) {
+    for (std::size_t p = message.find(key); p != std::string::npos; p = message.find(key, p + 1)) {
+      const std::size_t end = p + key.size();
+      auto part_of_name = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+      if ((p == 0 || !part_of_name(message[p - 1])) && (end == message.size() || !part_of_name(message[end])))
+        return true;
+    }
+  }
+  return false;
 }
 
 void LoadContext::problem(const std::string& message) { errors_.push_back({1L << 40, message}); }

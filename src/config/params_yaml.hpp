@@ -33,6 +33,9 @@ class LoadContext {
   // Records a problem whose message says where it is already (a --set that cannot be applied).
   void problem(const std::string& message);
   bool ok() const { return errors_.empty(); }
+  // A message (a rule across keys) names a key whose value error() refused: that key kept its
+  // default, so the rule's verdict on it means nothing.
+  bool names_refused_key(const std::string& message) const;
   // Throws seamless::ConfigError listing every problem (one per line) if there was any.
   void throw_if_errors() const;
 
@@ -46,6 +49,7 @@ class LoadContext {
     std::string message;
   };
   std::vector<Problem> errors_;
+  std::vector<std::string> refused_;  // key paths error() reported
 };
 
 // Closest candidate within a small edit distance (optimal string alignment, case-insensitive),
@@ -63,6 +67,16 @@ Override apply_override(YAML::Node& root, const std::string& assignment);
 // ---- reading leaves ---------------------------------------------------------------------------
 
 bool parse_bool(const std::string& s, bool& out);
+
+// "NaN" or "infinity" when `text` spells one (YAML's .nan and .inf, C's nan and inf, any case),
+// "" otherwise: such a value is named for what it is, not as an unreadable number.
+std::string nonfinite_name(const std::string& text);
+// The message for a number that is not one: what was given and what is expected.
+std::string number_problem(const std::string& text, const std::string& expected);
+
+// A list of sections (spawn) holds at most this many entries (docs/CONFIG.md): each becomes
+// particles, and a list of a million entries was read into gigabytes before anything told.
+constexpr std::size_t kMaxSectionListEntries = 10000;
 
 template <class T> bool parse_number(std::string s, T& out) {
   if (!s.empty() && s.front() == '+') s.erase(0, 1);
@@ -119,8 +133,14 @@ bool read_leaf(LoadContext& ctx, const YAML::Node& n, const std::string& path, T
   } else if constexpr (std::same_as<T, vec3>) {
     float xyz[3];
     bool ok = n.IsSequence() && n.size() == 3;
-    for (std::size_t i = 0; ok && i < 3; ++i)
+    for (std::size_t i = 0; ok && i < 3; ++i) {
       ok = n[i].IsScalar() && parse_number(n[i].Scalar(), xyz[i]) && std::isfinite(xyz[i]);
+      if (!ok && n[i].IsScalar()) {
+        ctx.error(n, path,
+                  "element " + std::to_string(i) + ": " + number_problem(n[i].Scalar(), expected_text<float>()));
+        return false;
+      }
+    }
     if (!ok) {
       ctx.error(n, path, "expected " + expected_text<T>() + ", got " + describe(n));
       return false;
@@ -135,7 +155,9 @@ bool read_leaf(LoadContext& ctx, const YAML::Node& n, const std::string& path, T
     else if constexpr (std::floating_point<T>) ok = parse_number(text, out) && std::isfinite(out);
     else ok = parse_number(text, out);
     if (!ok) {
-      ctx.error(n, path, "expected " + expected_text<T>() + ", got " + describe(n));
+      if constexpr (std::same_as<T, bool>)
+        ctx.error(n, path, "expected " + expected_text<T>() + ", got " + describe(n));
+      else ctx.error(n, path, number_problem(text, expected_text<T>()));
       return false;
     }
     if constexpr (std::same_as<T, float>) check_constraint(ctx, n, path, out, c...);
@@ -203,6 +225,12 @@ void read_field(LoadContext& ctx, const YAML::Node& n, const std::string& path, 
                 "expected a list ([...] or '- ' items) of " +
                     std::string(SectionVector<T> ? "sections" : type_name<typename VectorOf<T>::type>()) + ", got " +
                     describe(n));
+      return;
+    }
+    if (SectionVector<T> && n.size() > kMaxSectionListEntries) {
+      ctx.error(n, path,
+                "a list of " + std::to_string(n.size()) + " entries; at most " +
+                    std::to_string(kMaxSectionListEntries) + " entries are allowed (docs/CONFIG.md)");
       return;
     }
     T result;

@@ -2,7 +2,7 @@
 // safe inside a signal handler); the frame loops ask interrupted() between frames, finish the
 // frame they are in and write their outputs, and the command exits with 128 + the signal number
 // (130 for Ctrl-C, 143 for SIGTERM, as shells report them). A second signal, while the outputs
-// are being written, stops the process at once: the handler resets itself after the first.
+// are being written, stops the process at once (killed by that signal), saying so on stderr.
 // README, section "Exit codes and interrupted runs".
 #pragma once
 
@@ -17,5 +17,8 @@ bool interrupted();
 
 // The signal that arrived (SIGINT, SIGTERM), 0 when none.
 int interrupt_signal();
+
+// "SIGINT", "SIGTERM" (summary.json, log lines); "" for 0.
+const char* signal_name(int sig);
 
 }  // namespace seamless

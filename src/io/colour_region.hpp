@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/camera.hpp"
+#include "core/intrinsics.hpp"
 #include "core/pixel_rect.hpp"
 
 namespace seamless {

@@ -7,8 +7,8 @@
 #include <string>
 
 #include "core/buffer.hpp"
-#include "core/camera.hpp"
 #include "core/device.hpp"
+#include "core/intrinsics.hpp"
 #include "core/math.hpp"
 #include "kernels/scene/movers.hpp"
 

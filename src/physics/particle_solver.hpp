@@ -19,8 +19,8 @@
 
 #include "core/buffer.hpp"
 #include "core/device.hpp"
-#include "core/geometry.hpp"
 #include "core/math.hpp"
+#include "core/particles.hpp"
 #include "kernels/physics/scene_sdf.hpp"
 #include "physics/builders.hpp"
 #include "physics/objects.hpp"

@@ -2,7 +2,9 @@
 // Macklin, Mueller, Chentanez and Kim 2014, with Position Based Fluids (Macklin & Mueller 2013)
 // and Akinci 2013 cohesion / surface tension.
 #pragma once
+#include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -86,11 +88,28 @@ struct SolverParams {
   float cloth_strain_omega = 1.5f;           // over-relaxation of strain limiting
   float cloth_strain_contact_weight = 0.3f;  // strain limiting: inverse-mass factor of particles on the scene
   bool cuda_graph = true;                    // CUDA: replay a step as one captured graph (docs/PHYSICS.md)
-  // Issue 22: the live depth camera's points as kinematic colliders each frame (people and moving
+  // Live colliders: the depth camera's points as kinematic colliders each frame (people and moving
   // objects push the simulation): none, the dynamic pixels only (dynamic.enabled), or every pixel.
   DynamicColliders dynamic_colliders = DynamicColliders::none;
   int collider_level = 2;           // pyramid level whose vertex map gives the points (2: 160x120)
   float collider_thickness = 0.1f;  // metres of colliders behind each seen surface point, along its ray
+
+  // |gravity| above this is refused (docs/CONFIG.md): ten times Earth's, four times Jupiter's
+  // surface gravity. At the default step (0.01 s) a particle then falls g dt^2 = 1 cm per step, a
+  // quarter of the default diameter; far beyond it particles pass through a particle-thin scene.
+  static constexpr float kMaxGravity = 100.f;  // m/s^2
+  // Rules across keys and physical sanity, checked when a config is loaded (Experiment::validate).
+  void check(std::vector<std::string>& problems) const {
+    const double x = gravity.x, y = gravity.y, z = gravity.z;  // in double: 1e30 squared overflows a float
+    const double g = std::sqrt(x * x + y * y + z * z);
+    if (!(g <= kMaxGravity)) {
+      char got[128];
+      std::snprintf(got, sizeof got, "[%g, %g, %g] (|g| = %g m/s^2)", gravity.x, gravity.y, gravity.z, g);
+      problems.push_back(std::string("solver.gravity: ") + got + " is beyond the sanity bound of " +
+                         std::to_string(static_cast<int>(kMaxGravity)) +
+                         " m/s^2 (Earth: 9.81); give it in m/s^2, e.g. [0, -9.81, 0]");
+    }
+  }
 
   template <class V> void visit(V& v) {
     v("particle_diameter", particle_diameter, "particle diameter, metres", Range{0.001, 1.0});
@@ -169,15 +188,21 @@ struct PlaceParams {
   // config is loaded (Experiment::validate) and before placing (app/placement.cpp, for code that
   // builds spawn entries without a config).
   void validate(const std::string& who) const {
+    std::vector<std::string> problems;
+    check(who, problems);
+    if (!problems.empty()) throw ConfigError(problems.front());
+  }
+  // The same, every problem appended to `problems` (config loading lists them all at once).
+  void check(const std::string& who, std::vector<std::string>& problems) const {
     if (!pixel.empty() && pixel.size() != 2)
-      throw ConfigError(who + ".pixel: expected [u, v] (two numbers), got " + std::to_string(pixel.size()));
+      problems.push_back(who + ".pixel: expected [u, v] (two numbers), got " + std::to_string(pixel.size()));
     if (!pixel.empty() && on != PlaceOn::none)
-      throw ConfigError(who + ": give either `on` (" + enum_name(on) + ") or `pixel`, not both");
+      problems.push_back(who + ": give either `on` (" + enum_name(on) + ") or `pixel`, not both");
     if (!offset.empty() && offset.size() != 2)
-      throw ConfigError(who + ".offset: expected [x, z] (two numbers), got " + std::to_string(offset.size()));
+      problems.push_back(who + ".offset: expected [x, z] (two numbers), got " + std::to_string(offset.size()));
     if (!offset.empty() && on == PlaceOn::none)
-      throw ConfigError(who +
-                        ".offset moves an `on:` placement across its surface; it needs `on: support` or `on: floor`");
+      problems.push_back(who +
+                         ".offset moves an `on:` placement across its surface; it needs `on: support` or `on: floor`");
   }
   template <class V> void visit(V& v) {
     v("on", on, "place on a scanned horizontal surface: support (largest that is not the floor), floor, or none");
@@ -219,11 +244,17 @@ struct SpawnParams {
   std::string label(int index) const { return "spawn[" + std::to_string(index) + "] (" + enum_name(kind) + ")"; }
   // Rules across keys, checked when a config is loaded (Experiment::validate). The builders check
   // the mesh path again (physics/builders.cpp) for code that builds entries without a config.
-  void validate(int index) const {
-    place.validate(label(index) + ".place");
+  void check(int index, std::vector<std::string>& problems) const {
+    place.check(label(index) + ".place", problems);
+    const std::string key = "spawn." + std::to_string(index);
     if (kind == SpawnKind::rigid && shape == RigidShape::mesh && mesh.empty())
-      throw ConfigError(label(index) + ": spawn." + std::to_string(index) + ".shape: mesh needs the key spawn." +
-                        std::to_string(index) + ".mesh (an OBJ file path)");
+      problems.push_back(label(index) + ": " + key + ".shape: mesh needs the key " + key + ".mesh (an OBJ file path)");
+    // A block or body of no extent (or a negative one) holds no particle: say so now, not after the scan.
+    if ((kind == SpawnKind::fluid_block || kind == SpawnKind::rigid) && !(size.x > 0 && size.y > 0 && size.z > 0)) {
+      char got[96];
+      std::snprintf(got, sizeof got, "[%g, %g, %g]", size.x, size.y, size.z);
+      problems.push_back(label(index) + ": " + key + ".size: every extent must be positive (metres), got " + got);
+    }
   }
 
   template <class V> void visit(V& v) {

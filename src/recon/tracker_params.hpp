@@ -106,8 +106,24 @@ struct TrackerParams {
   // Rules across keys, checked when a config is loaded (Experiment::validate); tracker_gravity.cpp
   // checks the vector again for code that builds TrackerParams without a config.
   void validate() const {
+    std::vector<std::string> problems;
+    check(problems);
+    if (!problems.empty()) throw ConfigError(problems.front());
+  }
+  // The same, every problem appended to `problems` (config loading lists them all at once).
+  void check(std::vector<std::string>& problems) const {
     if (gravity == GravitySource::fixed && length2(fixed_gravity) == 0.f)
-      throw ConfigError("tracker.gravity: fixed needs a direction, but tracker.fixed_gravity is the zero vector");
+      problems.push_back("tracker.gravity: fixed needs a direction, but tracker.fixed_gravity is the zero vector");
+    // Our own trackers align over the pyramid levels listed: none, or no iteration on any, tracks
+    // nothing and every frame after the first would be lost.
+    const bool own = kind == "icp" || kind == "rgbd";
+    bool any = false;
+    for (int n : iterations) any = any || n > 0;
+    if (own && !any)
+      problems.push_back(
+          "tracker.iterations: " + std::string(iterations.empty() ? "empty" : "no level has an iteration") +
+          "; give ICP iterations per pyramid level, finest first, at least one level above 0 "
+          "(default [10, 5, 4])");
   }
 
   template <class V> void visit(V& v) {

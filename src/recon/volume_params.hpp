@@ -39,11 +39,17 @@ struct VolumeParams {
   // Rules across keys, checked when a config is loaded (Experiment::validate) and by the volumes'
   // constructors (for code that builds a volume without a config).
   void validate() const {
+    std::vector<std::string> problems;
+    check(problems);
+    if (!problems.empty()) throw ConfigError(problems.front());
+  }
+  // The same, every problem appended to `problems` (config loading lists them all at once).
+  void check(std::vector<std::string>& problems) const {
     if (truncation < 2.f * voxel_size)
-      throw ConfigError("volume.truncation (" + std::to_string(truncation) + " m) must be at least two voxels (2 * " +
-                        "volume.voxel_size = " + std::to_string(2.f * voxel_size) +
-                        " m): the truncation band must reach the voxels on both sides of the surface");
-    if (capacity > (std::int64_t{1} << 30)) throw ConfigError("volume.capacity must be below 2^30 blocks");
+      problems.push_back("volume.truncation (" + std::to_string(truncation) + " m) must be at least two voxels (2 * " +
+                         "volume.voxel_size = " + std::to_string(2.f * voxel_size) +
+                         " m): the truncation band must reach the voxels on both sides of the surface");
+    if (capacity > (std::int64_t{1} << 30)) problems.push_back("volume.capacity must be below 2^30 blocks");
   }
 
   template <class V> void visit(V& v) {

@@ -29,6 +29,17 @@ constexpr std::int64_t kMaxSlots = std::int64_t{1} << 30;
 // Blocks of a pool of `pool` handed out, by the counters' free-list top.
 std::int64_t blocks_in_use(std::int64_t pool, const HashCounters& c) { return pool - std::max(c.free_top, 0); }
 
+// Keys in the table that hold no block: the distinct blocks a frame could not get from a full pool
+// (they stay in the table with value -1; the pool_failures counter counts every attempt, many per
+// block). A host copy of the table: only for the warning of a pool that may not grow.
+std::int64_t keys_without_block(const Buffer<kernels::HashKey>& keys, const Buffer<std::int32_t>& values) {
+  const std::vector<kernels::HashKey> k = keys.to_host();
+  const std::vector<std::int32_t> v = values.to_host();
+  std::int64_t n = 0;
+  for (std::size_t i = 0; i < k.size() && i < v.size(); ++i) n += kernels::is_live_key(k[i]) && v[i] < 0;
+  return n;
+}
+
 std::int64_t next_pow2(std::int64_t n) {
   std::int64_t p = 1;
   while (p < n) p <<= 1;
@@ -145,7 +156,7 @@ void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTime
     failed_ = last_.probe_failures + last_.pool_failures;
     if (failed_ == 0 || !params_.grow_when_full) break;
     // Grow as often as this frame needs: a frame that is only partly fused is a hole in the model
-    // that tracking then fails against (issue 20: a pool of 64 blocks doubled 4 times, then
+    // that tracking then fails against (a pool of 64 blocks doubled 4 times, then
     // dropped the rest of the frame and every later frame was lost).
     if (attempt == kMaxGrowths)
       throw Error("voxel hashing: " + std::to_string(failed_) + " block insertions still fail in frame " +
@@ -164,13 +175,26 @@ void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTime
         "voxel hashing: hash table too crowded in frame {}; rehashed it from {} into {} slots (set "
         "volume.hash_buckets: {} to avoid this pause)",
         frames_, slots_before, keys_.size(), keys_.size());
-  if (failed_ > 0)  // volume.grow_when_full is off
+  if (failed_ > 0) {  // volume.grow_when_full is off
+    // The advice from this frame's numbers: the blocks it holds plus the distinct blocks it could
+    // not get, a quarter more for the next frames' new surface; the table is sized like growing
+    // does it (twice the slots), and at least four slots a block (the load growing keeps).
+    const std::int64_t pool = free_list_.size();
+    const std::int64_t needed =
+        blocks_in_use(pool, last_) + (last_.pool_failures > 0 ? keys_without_block(keys_, values_) : 0);
+    std::string advice;
+    if (last_.pool_failures > 0)
+      advice += "volume.capacity >= " + std::to_string(needed + needed / 4) + " (this frame needed about " +
+                std::to_string(needed) + " blocks)";
+    if (last_.probe_failures > 0)
+      advice += std::string(advice.empty() ? "" : " and ") + "volume.hash_buckets >= " +
+                std::to_string(std::max<std::int64_t>(2 * static_cast<std::int64_t>(keys_.size()), 4 * needed));
     spdlog::warn(
         "voxel hashing: {} block insertion attempts failed in frame {} ({} found no hash slot within {} probes, "
-        "{} found the pool of {} blocks full); that part of the frame is not fused. Set volume.capacity >= {} and "
-        "volume.hash_buckets >= {}, or volume.grow_when_full: true",
-        failed_, frames_, last_.probe_failures, kMaxProbe, last_.pool_failures, free_list_.size(),
-        2 * free_list_.size(), 2 * keys_.size());
+        "{} found the pool of {} blocks full); that part of the frame is not fused. Set {}, or "
+        "volume.grow_when_full: true",
+        failed_, frames_, last_.probe_failures, kMaxProbe, last_.pool_failures, pool, advice);
+  }
 }
 
 void VoxelHashVolume::handle_failures(const HashCounters& c) {

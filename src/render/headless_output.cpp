@@ -1,14 +1,23 @@
 #include "render/headless_output.hpp"
 
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <sstream>
+#include <vector>
 
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "io/png_io.hpp"
 #include "render/renderer.hpp"
+
+extern char** environ;  // the environment ffmpeg inherits (POSIX)
 
 namespace seamless {
 namespace fs = std::filesystem;
@@ -48,6 +57,10 @@ HeadlessOutput::~HeadlessOutput() {
 }
 
 // ffmpeg reads raw RGB24 frames from stdin; H.264 in yuv420p wants even sizes, so pad by one.
+// It is started with an argument vector (posix_spawn), never through a shell: any output path,
+// quotes and spaces included, reaches it as given. It runs in a session of its own (setsid), so
+// that a Ctrl-C meant for the run (which then finishes its frame and writes its outputs) does not
+// kill the encoder mid-file.
 void HeadlessOutput::open_video(int w, int h) {
   const std::string ffmpeg = find_ffmpeg();
   if (ffmpeg.empty()) {
@@ -55,15 +68,47 @@ void HeadlessOutput::open_video(int w, int h) {
     video_failed_ = true;
     return;
   }
-  // setsid: ffmpeg in a session of its own, so that a Ctrl-C meant for the run (which then
-  // finishes its frame and writes its outputs) does not kill the encoder mid-file.
-  const std::string cmd = "exec setsid -w '" + ffmpeg + "' -loglevel error -y -f rawvideo -pix_fmt rgb24 -s " +
-                          std::to_string(w) + "x" + std::to_string(h) + " -r " + std::to_string(p_.fps) +
-                          " -i - -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' -pix_fmt yuv420p '" + video_path() + "'";
-  pipe_ = popen(cmd.c_str(), "w");
-  if (!pipe_) {
-    spdlog::warn("render.video: could not start ffmpeg ({}); writing no video", cmd);
+  const std::vector<std::string> args = {ffmpeg,      "-loglevel",
+                                         "error",     "-y",
+                                         "-f",        "rawvideo",
+                                         "-pix_fmt",  "rgb24",
+                                         "-s",        std::to_string(w) + "x" + std::to_string(h),
+                                         "-r",        std::to_string(p_.fps),
+                                         "-i",        "-",
+                                         "-vf",       "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+                                         "-pix_fmt",  "yuv420p",
+                                         video_path()};
+  std::vector<char*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  int fds[2];
+  if (pipe2(fds, O_CLOEXEC) != 0) {
+    spdlog::warn("render.video: cannot create a pipe to ffmpeg ({}); writing no video", std::strerror(errno));
     video_failed_ = true;
+    return;
+  }
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, fds[0], 0);  // the read end becomes ffmpeg's stdin
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSID);
+  const int rc = posix_spawn(&pid_, ffmpeg.c_str(), &actions, &attr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  posix_spawnattr_destroy(&attr);
+  ::close(fds[0]);
+  if (rc != 0) {
+    ::close(fds[1]);
+    spdlog::warn("render.video: could not start {} ({}); writing no video", ffmpeg, std::strerror(rc));
+    video_failed_ = true;
+    return;
+  }
+  pipe_ = fdopen(fds[1], "w");
+  if (!pipe_) {
+    ::close(fds[1]);
+    finish();
+    video_failed_ = true;
+    return;
   }
   w_ = w, h_ = h;
 }
@@ -77,7 +122,8 @@ void HeadlessOutput::add(const Image<uchar3>& frame) {
                   std::to_string(frame.width()) + "x" + std::to_string(frame.height()));
     const std::vector<uchar3> px = frame.to_host();
     if (std::fwrite(px.data(), sizeof(uchar3), px.size(), pipe_) != px.size())
-      throw Error("render.video: ffmpeg stopped accepting frames (writing " + video_path() + ")");
+      throw Error("render.video: ffmpeg stopped accepting frames (" + std::string(std::strerror(errno)) + ", writing " +
+                  video_path() + ")");
   }
   ++frames_;
 }
@@ -91,11 +137,18 @@ void HeadlessOutput::add(Renderer& r) {
 }
 
 void HeadlessOutput::finish() {
-  if (!pipe_) return;
-  const int rc = pclose(pipe_);
+  if (pipe_) std::fclose(pipe_);  // ffmpeg sees the end of its input and finishes the file
   pipe_ = nullptr;
-  if (rc != 0)
-    throw Error("render.video: ffmpeg failed (exit status " + std::to_string(rc) + ") writing " + video_path());
+  if (pid_ <= 0) return;
+  int status = 0;
+  while (waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+  }
+  pid_ = -1;
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    throw Error("render.video: ffmpeg failed (" +
+                (WIFEXITED(status) ? "exit status " + std::to_string(WEXITSTATUS(status))
+                                   : "killed by signal " + std::to_string(WTERMSIG(status))) +
+                ") writing " + video_path());
 }
 
 }  // namespace seamless

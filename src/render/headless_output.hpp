@@ -5,7 +5,9 @@
 //   for (...) { r.draw(list, cam); out.add(r); }
 //   out.finish();                          // closes the video; also done by the destructor
 #pragma once
+#include <sys/types.h>
 #include <cstdint>
+
 #include <cstdio>
 #include <string>
 
@@ -39,7 +41,8 @@ class HeadlessOutput {
   std::string dir_;
   RenderParams p_;
   std::int64_t frames_ = 0;
-  FILE* pipe_ = nullptr;
+  FILE* pipe_ = nullptr;  // ffmpeg's stdin
+  pid_t pid_ = -1;        // ffmpeg's process
   int w_ = 0, h_ = 0;
   bool video_failed_ = false;
 };

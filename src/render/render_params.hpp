@@ -133,18 +133,24 @@ struct RenderParams {
 
   // Rules across keys, checked when a config is loaded (Experiment::validate).
   void validate() const {
+    std::vector<std::string> problems;
+    check(problems);
+    if (!problems.empty()) throw ConfigError(problems.front());
+  }
+  // The same, every problem appended to `problems` (config loading lists them all at once).
+  void check(std::vector<std::string>& problems) const {
     for (const auto& [key, xyz] : {std::pair{"eye", &eye}, std::pair{"target", &target}})
       if (!xyz->empty() && xyz->size() != 3)
-        throw ConfigError(std::string("render.") + key + ": expected [x, y, z] (three numbers, world metres), got " +
-                          std::to_string(xyz->size()));
+        problems.push_back(std::string("render.") + key + ": expected [x, y, z] (three numbers, world metres), got " +
+                           std::to_string(xyz->size()));
     if (eye.size() == 3 && target.size() == 3 && eye == target)
-      throw ConfigError("render.eye and render.target are the same point: the camera would look nowhere");
+      problems.push_back("render.eye and render.target are the same point: the camera would look nowhere");
     // zoom / zoom_at crop the recorded camera of the mesh view (app/render_stage.cpp); elsewhere they
     // would be ignored silently.
     if (!zoom_at.empty() && zoom_at.size() != 2)
-      throw ConfigError("render.zoom_at: expected [u, v] (two numbers), got " + std::to_string(zoom_at.size()));
+      problems.push_back("render.zoom_at: expected [u, v] (two numbers), got " + std::to_string(zoom_at.size()));
     if ((zoom != 1.f || !zoom_at.empty()) && (camera != RenderCameraMode::recorded || view != RenderView::mesh))
-      throw ConfigError(
+      problems.push_back(
           "render.zoom and render.zoom_at magnify the recorded camera of the mesh view; they need "
           "render.camera: recorded and render.view: mesh (the mesh view's fixed camera has render.fov_y)");
   }

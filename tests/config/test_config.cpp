@@ -16,6 +16,7 @@ namespace seamless {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 // The message of the seamless::Error thrown by parsing `yaml`, or "" if nothing was thrown.
 std::string error_of(const std::string& yaml, const std::vector<std::string>& overrides = {}) {
@@ -140,6 +141,59 @@ TEST(ConfigErrors, RulesAcrossKeysAreCheckedAtLoad) {
   // depth without dynamic.enabled is allowed (no pixel is dynamic, so nothing collides: the live
   // loop says so), so that `--set dynamic.enabled=false` compares a run with and without.
   EXPECT_EQ(error_of("mode: live\nsolver: {dynamic_colliders: depth}"), "");
+}
+
+// Key errors and the rules across keys in one list: one run shows every problem of a file. A
+// rule on a key whose value was refused (it kept its default) is left out: it would only confuse.
+TEST(ConfigErrors, EveryProblemOfAFileAtOnce) {
+  const std::string msg = error_of(
+      "volume: {voxel_size: 0.01, truncation: 0.015, layout: hsah}\n"
+      "render: {eye: [0, 1]}\n"
+      "solver: {gravity: [0, -1e30, 0]}\n"
+      "spawn:\n  - {kind: fluid_block, size: [-0.2, 0.2, 0.2]}\n"
+      "tracker: {iterations: []}\n");
+  EXPECT_THAT(msg, HasSubstr("6 problems in the configuration"));
+  EXPECT_THAT(msg, HasSubstr("test.yaml:1:55: volume.layout: got 'hsah'"));
+  EXPECT_THAT(msg, HasSubstr("volume.truncation (0.015000 m) must be at least two voxels"));
+  EXPECT_THAT(msg, HasSubstr("render.eye: expected [x, y, z]"));
+  EXPECT_THAT(msg, HasSubstr("solver.gravity: [0, -1e+30, 0] (|g| = 1e+30 m/s^2) is beyond the sanity bound of 100"));
+  EXPECT_THAT(msg, HasSubstr("spawn.0.size: every extent must be positive (metres), got [-0.2, 0.2, 0.2]"));
+  EXPECT_THAT(msg, HasSubstr("tracker.iterations: empty"));
+  // voxel_size refused: the truncation rule, which would compare against the default, is left out.
+  const std::string refused = error_of("volume: {voxel_size: big, truncation: 0.001}");
+  EXPECT_THAT(refused, HasSubstr("volume.voxel_size: expected a number"));
+  EXPECT_THAT(refused, Not(HasSubstr("two voxels")));
+}
+
+// Values that parse but mean nothing physically, refused at load with the key and the value.
+TEST(ConfigErrors, PhysicalSanity) {
+  EXPECT_EQ(error_of("solver: {gravity: [0, -9.81, 0]}"), "");
+  EXPECT_EQ(error_of("solver: {gravity: [0, 0, 0]}"), "");     // no gravity: a valid experiment
+  EXPECT_EQ(error_of("solver: {gravity: [0, -100, 0]}"), "");  // the bound itself
+  EXPECT_THAT(error_of("solver: {gravity: [0, -101, 0]}"), HasSubstr("beyond the sanity bound of 100 m/s^2"));
+  EXPECT_THAT(error_of("spawn: [{kind: rigid, size: [0, 0, 0]}]"),
+              HasSubstr("spawn.0.size: every extent must be positive"));
+  EXPECT_EQ(error_of("spawn: [{kind: cloth, size: [0, 0, 0]}]"), "");  // cloth's extent is nx, ny and spacing
+  EXPECT_THAT(error_of("tracker: {iterations: [0, 0, 0]}"), HasSubstr("tracker.iterations: no level has an iteration"));
+  EXPECT_EQ(error_of("tracker: {iterations: [0, 5, 4]}"), "");               // skipping the finest level is a choice
+  EXPECT_EQ(error_of("tracker: {kind: ground_truth, iterations: []}"), "");  // it does not iterate
+  EXPECT_THAT(error_of("input: {intrinsics: {preset: custom, fx: 0}}"),
+              HasSubstr("input.intrinsics.fx and fy must not be 0"));
+}
+
+// NaN and infinity are named as such, in numbers and in vectors (YAML's .nan and .inf).
+TEST(ConfigErrors, NanIsNamedNan) {
+  EXPECT_THAT(error_of("solver: {dt: .nan}"), HasSubstr("solver.dt: expected a number (float), got NaN ('.nan')"));
+  EXPECT_THAT(error_of("solver: {dt: -.inf}"), HasSubstr("got infinity ('-.inf')"));
+  EXPECT_THAT(error_of("solver: {gravity: [.nan, 0, 0]}"),
+              HasSubstr("solver.gravity: element 0: expected a number (float), got NaN ('.nan')"));
+}
+
+// A list of sections beyond the documented limit is refused before its entries are read.
+TEST(ConfigErrors, SpawnListLimit) {
+  std::string many = "spawn:\n";
+  for (std::size_t i = 0; i <= config::kMaxSectionListEntries; ++i) many += "  - {kind: fluid_block}\n";
+  EXPECT_THAT(error_of(many), HasSubstr("spawn: a list of 10001 entries; at most 10000 entries are allowed"));
 }
 
 TEST(ConfigErrors, RenderCameraRulesAreCheckedAtLoad) {
@@ -276,7 +330,7 @@ TEST(ConfigFiles, DemoSaysWhatItShould) {
   Experiment e = load_experiment(std::string(SEAMLESS_SOURCE_DIR) + "/configs/demo.yaml");
   EXPECT_EQ(e.input.source, InputSource::synthetic);
   EXPECT_EQ(e.mode, ExperimentMode::scan_then_simulate);
-  // The demo of the issue: fluid on the desk, a cloth, cubes (plural) on the floor.
+  // The demo's scene: fluid on the desk, a cloth, cubes (plural) on the floor.
   auto count = [&](SpawnKind kind) {
     return std::count_if(e.spawn.begin(), e.spawn.end(), [&](const SpawnParams& s) { return s.kind == kind; });
   };
