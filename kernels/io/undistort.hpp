@@ -20,6 +20,13 @@ SEAMLESS_HD inline vec2 distort_pixel(const Intrinsics& K, float x, float y) {
   return {K.fx * xd + K.cx, K.fy * yd + K.cy};
 }
 
+// Whether remap_rgb's bilinear lookup at source pixel s finds all four pixels inside a w x h image
+// (it writes black, "no reading", where not).
+SEAMLESS_HD inline bool colour_lookup_inside(vec2 s, int w, int h) {
+  int x0 = floor_int(s.x), y0 = floor_int(s.y);
+  return x0 >= 0 && y0 >= 0 && x0 + 1 < w && y0 + 1 < h;
+}
+
 template <Executor Exec> struct Undistort {
   // map(x, y) = distort_pixel(K, x, y) for every output pixel: computed once per camera.
   static void undistort_map(const Exec& ex, Intrinsics K, View2D<vec2> map);

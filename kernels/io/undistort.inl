@@ -30,11 +30,11 @@ void Undistort<Exec>::remap_rgb(const Exec& ex, View2D<const vec2> map, View2D<c
   ex.for_each(out.count(), [=] SEAMLESS_HD(std::int64_t i) {
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
     vec2 s = map(x, y);
-    int x0 = floor_int(s.x), y0 = floor_int(s.y);
-    if (x0 < 0 || y0 < 0 || x0 + 1 >= in.width || y0 + 1 >= in.height) {
+    if (!colour_lookup_inside(s, in.width, in.height)) {
       out(x, y) = {0, 0, 0};
       return;
     }
+    int x0 = floor_int(s.x), y0 = floor_int(s.y);
     float ax = s.x - x0, ay = s.y - y0;
     uchar3 a = in(x0, y0), b = in(x0 + 1, y0), c = in(x0, y0 + 1), d = in(x0 + 1, y0 + 1);
     auto mix = [=](float va, float vb, float vc, float vd) {

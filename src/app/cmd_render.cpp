@@ -15,6 +15,7 @@
 #include "app/run_context.hpp"
 #include "config/config.hpp"
 #include "core/error.hpp"
+#include "io/colour_region.hpp"
 #include "io/ply.hpp"
 #include "io/trajectory.hpp"
 #include "physics/objects.hpp"
@@ -77,7 +78,7 @@ Experiment load_run_config(const RenderOptions& o) {
 class KinectFrames {
  public:
   KinectFrames(const Experiment& e, const std::string& run_dir)
-      : live_(e.mode == ExperimentMode::live), limit_(e.frames) {
+      : live_(e.mode == ExperimentMode::live), limit_(e.frames), region_(input_colour_region(e.input)) {
     traj_ = read_tum_trajectory(run_dir + "/trajectory.txt");
     source_ = make_source(e.input, Device::CPU);
   }
@@ -95,7 +96,7 @@ class KinectFrames {
     if (!have_) return false;
     for (const TumPose& p : traj_)
       if (std::fabs(p.timestamp - frame_.timestamp) < 1e-6) {
-        r.set_kinect_view(frame_.rgb, frame_.depth, frame_.intrinsics, p.se3());
+        r.set_kinect_view(frame_.rgb, frame_.depth, frame_.intrinsics, p.se3(), region_);
         return true;
       }
     throw Error("trajectory.txt has no pose at the input's frame time " + std::to_string(frame_.timestamp) +
@@ -105,6 +106,7 @@ class KinectFrames {
  private:
   bool live_;
   std::int64_t limit_, read_ = 0;
+  PixelRect region_;  // where the frames hold colour (undistortion's border left out)
   Trajectory traj_;
   std::unique_ptr<FrameSource> source_;
   RgbdFrame frame_;

@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "seamless/build_config.hpp"
 #if SEAMLESS_HAS_GL
+#include "io/colour_region.hpp"
 #include "io/png_io.hpp"
 #include "render/headless_output.hpp"
 #include "render/renderer.hpp"
@@ -73,7 +74,11 @@ class RunDrawState {
 class GlRunRenderer : public RunRenderer {
  public:
   explicit GlRunRenderer(RunContext& ctx)
-      : ctx_(ctx), p_(ctx.experiment().render), renderer_(p_, p_.width, p_.height), out_(ctx.out_dir(), p_) {
+      : ctx_(ctx),
+        p_(ctx.experiment().render),
+        region_(input_colour_region(ctx.experiment().input)),
+        renderer_(p_, p_.width, p_.height),
+        out_(ctx.out_dir(), p_) {
     spdlog::info("rendering {}x{} {} view with {} ({})", p_.width, p_.height, enum_name(p_.view),
                  renderer_.gl_info().renderer, renderer_.gl_info().version);
 #if SEAMLESS_HAS_CUDA
@@ -101,7 +106,7 @@ class GlRunRenderer : public RunRenderer {
 
   void set_kinect_frame(const RgbdFrame& frame, const SE3& world_T_camera) override {
     if (p_.view == RenderView::kinect) {
-      renderer_.set_kinect_view(frame.rgb, frame.depth, frame.intrinsics, world_T_camera);
+      renderer_.set_kinect_view(frame.rgb, frame.depth, frame.intrinsics, world_T_camera, region_);
       camera_ = renderer_.kinect_camera();
     } else if (p_.camera == RenderCameraMode::recorded) {  // the mesh seen through the recorded camera
       camera_.K = scale_intrinsics(zoom_intrinsics(frame.intrinsics, p_.zoom, p_.zoom_at), p_.width, p_.height);
@@ -151,6 +156,7 @@ class GlRunRenderer : public RunRenderer {
 
   RunContext& ctx_;
   RenderParams p_;
+  PixelRect region_;  // where the recorded frames hold colour (undistortion's border left out)
   Renderer renderer_;
   HeadlessOutput out_;
   RenderCamera camera_{};
@@ -169,7 +175,7 @@ class GlRunRenderer : public RunRenderer {
 // kept here and handed to the window's renderer before its next frame.
 class WindowRunRenderer : public RunRenderer {
  public:
-  explicit WindowRunRenderer(RunContext& ctx) : ctx_(ctx) {}
+  explicit WindowRunRenderer(RunContext& ctx) : ctx_(ctx), region_(input_colour_region(ctx.experiment().input)) {}
 
   void set_scene(const Mesh& mesh, const SE3& scan_camera) override {
     mesh_ = mesh, mesh_camera_ = scan_camera, new_mesh_ = true;
@@ -225,7 +231,7 @@ class WindowRunRenderer : public RunRenderer {
   }
   void hand_over(Renderer& r) {
     if (new_mesh_) r.set_scene_mesh(mesh_);
-    if (new_frame_) r.set_kinect_view(rgb_, depth_, K_, pose_);
+    if (new_frame_) r.set_kinect_view(rgb_, depth_, K_, pose_, region_);
     new_mesh_ = new_frame_ = false;
   }
 
@@ -236,6 +242,7 @@ class WindowRunRenderer : public RunRenderer {
   Image<uchar3> rgb_;
   Image<float> depth_;
   Intrinsics K_{};
+  PixelRect region_{};
   bool new_mesh_ = false, new_frame_ = false;
 };
 

@@ -1,5 +1,6 @@
 #include "render/render_camera.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/basis.hpp"
@@ -49,6 +50,26 @@ Intrinsics scale_intrinsics(const Intrinsics& K, int W, int H) {
   s.width = W;
   s.height = H;
   return s;
+}
+
+Intrinsics crop_intrinsics(const Intrinsics& K, const PixelRect& r) {
+  Intrinsics c = K;
+  c.cx = K.cx - static_cast<float>(r.x);
+  c.cy = K.cy - static_cast<float>(r.y);
+  c.width = r.width;
+  c.height = r.height;
+  return c;
+}
+
+PixelRect fit_aspect(const PixelRect& r, int W, int H) {
+  PixelRect f = r;
+  // Compare r.width / r.height with W / H in integers.
+  if (static_cast<long long>(r.width) * H > static_cast<long long>(W) * r.height)  // too wide
+    f.width = std::max(1, static_cast<int>(std::lround(static_cast<double>(r.height) * W / H)));
+  else f.height = std::max(1, static_cast<int>(std::lround(static_cast<double>(r.width) * H / W)));
+  f.x = r.x + (r.width - f.width) / 2;
+  f.y = r.y + (r.height - f.height) / 2;
+  return f;
 }
 
 Intrinsics zoom_intrinsics(const Intrinsics& K, float zoom, const std::vector<float>& at) {

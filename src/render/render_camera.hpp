@@ -7,6 +7,7 @@
 
 #include "core/intrinsics.hpp"
 #include "core/math.hpp"
+#include "core/pixel_rect.hpp"
 
 namespace seamless {
 
@@ -27,6 +28,13 @@ struct RenderCamera {
 
 // Intrinsics of an image of w x h pixels resampled to W x H (pixel centres at integers).
 Intrinsics scale_intrinsics(const Intrinsics& K, int W, int H);
+
+// The camera of the part r of K's image: the principal point moves by r's corner, the image
+// shrinks to r (the crop of an AR frame to where the recorded image holds colour).
+Intrinsics crop_intrinsics(const Intrinsics& K, const PixelRect& r);
+// The largest rectangle of aspect W:H inside r (to the pixel), centred in it: r cropped at two
+// opposite sides so that it scales to a W x H framebuffer without stretching.
+PixelRect fit_aspect(const PixelRect& r, int W, int H);
 
 // The same camera magnified `zoom` times about pixel `at` ([u, v] of K's image; empty: the image
 // centre), which lands on the image centre: a crop of the view, as a longer lens would see it.

@@ -32,6 +32,12 @@ inline std::span<const EnumName<FluidDraw>> enum_names(FluidDraw) {
   static constexpr EnumName<FluidDraw> names[] = {{FluidDraw::ssfr, "ssfr"}, {FluidDraw::particles, "particles"}};
   return names;
 }
+enum class ClothPattern { gingham, plain };
+inline std::span<const EnumName<ClothPattern>> enum_names(ClothPattern) {
+  static constexpr EnumName<ClothPattern> names[] = {{ClothPattern::gingham, "gingham"},
+                                                     {ClothPattern::plain, "plain"}};
+  return names;
+}
 enum class FluidFilter { narrow_range, bilateral };
 inline std::span<const EnumName<FluidFilter>> enum_names(FluidFilter) {
   static constexpr EnumName<FluidFilter> names[] = {{FluidFilter::narrow_range, "narrow_range"},
@@ -88,17 +94,23 @@ struct RenderParams {
   int shadow_map_size = 2048;    // texels per side
   float light_angle = 10.f;      // the light's angular diameter, degrees: penumbra growth
   vec3 rigid_color{0.85f, 0.3f, 0.2f};
-  vec3 cloth_color{0.9f, 0.75f, 0.3f};
+  vec3 cloth_color{0.6f, 0.1f, 0.12f};
+  // The dye over the sheet's particle grid: gingham (two-cell bands of cloth_color over white, so
+  // that the folds and the fabric's scale read) or plain cloth_color.
+  ClothPattern cloth_pattern = ClothPattern::gingham;
+  float cloth_sheen = 0.4f;  // fabric sheen (Charlie BRDF) reflectance: the bright rim of folds seen edge-on
   // Screen-space fluid rendering (van der Laan, Green, Sainz 2009).
   // Spheres of the fluid passes are drawn this much larger than the particle radius: at rest the
   // particles sit about one diameter apart, and on a cubic lattice seen face-on the gaps between
   // four touching spheres close only above sqrt(2) (the gap centre is sqrt(2) r from each).
   float fluid_radius_scale = 1.5f;
   FluidFilter fluid_filter =
-      FluidFilter::narrow_range;     // depth smoothing: narrow_range (Truong & Yuksel 2018) or bilateral
-  int filter_iterations = 1;         // separable filter passes (x then y) over the depth
-  int filter_max_taps = 12;          // taps per side at most: wider kernels sample every k-th pixel
-  float filter_size = 3.f;           // filter half-width in particle radii (world), projected per pixel
+      FluidFilter::narrow_range;  // depth smoothing: narrow_range (Truong & Yuksel 2018) or bilateral
+  int filter_iterations = 2;      // separable filter passes (x then y) over the depth
+  int filter_max_taps = 12;       // taps per side at most: wider kernels sample every k-th pixel
+  // Filter half-width in particle radii (world), projected per pixel: three particle spacings
+  // (a diameter each), so that the spheres' bumps average out into one surface.
+  float filter_size = 6.f;
   int filter_max_px = 24;            // ... but at most this many pixels
   float filter_depth_sigma = 1.f;    // range sigma of the bilateral filter, in particle radii
   vec3 absorption{25.f, 8.f, 3.5f};  // Beer-Lambert coefficients per colour channel, 1/m (tinted water)
@@ -193,6 +205,9 @@ struct RenderParams {
       Range{0.0, 60.0});
     v("rigid_color", rigid_color, "colour of rigid bodies, RGB 0..1");
     v("cloth_color", cloth_color, "colour of cloth, RGB 0..1");
+    v("cloth_pattern", cloth_pattern,
+      "cloth dye: gingham (bands of cloth_color over white, two particles wide) or plain");
+    v("cloth_sheen", cloth_sheen, "cloth sheen reflectance (fabric's grazing highlight), 0 = none", Range{0.0, 1.0});
     v("fluid_radius_scale", fluid_radius_scale, "fluid sphere size in the SSFR passes, particle radii",
       Range{0.5, 4.0});
     v("fluid_filter", fluid_filter, "fluid depth filter");

@@ -18,13 +18,18 @@ vec3 srgb_to_linear(vec3 c) {  // IEC 61966-2-1, as color.glsl
 
 namespace {
 
-// The mean of an sRGB image in linear radiance (what the fluid reflects in the Kinect view).
-vec3 mean_linear_color(const std::vector<uchar3>& c) {
+// The mean of an sRGB image (width w) over the rectangle a, in linear radiance (what the fluid
+// reflects in the Kinect view).
+vec3 mean_linear_color(const std::vector<uchar3>& c, int w, const PixelRect& a) {
   float lut[256];
   for (int i = 0; i < 256; ++i) lut[i] = srgb_to_linear(vec3{i / 255.f, 0.f, 0.f}).x;
   double r = 0, g = 0, b = 0;
-  for (const uchar3& q : c) r += lut[q.x], g += lut[q.y], b += lut[q.z];
-  const double n = std::max<double>(1.0, static_cast<double>(c.size()));
+  for (int y = a.y; y < a.y + a.height; ++y)
+    for (int x = a.x; x < a.x + a.width; ++x) {
+      const uchar3& q = c[static_cast<std::size_t>(y) * w + x];
+      r += lut[q.x], g += lut[q.y], b += lut[q.z];
+    }
+  const double n = std::max<double>(1.0, static_cast<double>(a.width) * a.height);
   return {static_cast<float>(r / n), static_cast<float>(g / n), static_cast<float>(b / n)};
 }
 
@@ -41,7 +46,7 @@ void Renderer::Impl::build_programs() {
   // Surfaces that receive the virtual objects' shadows (shadow.glsl).
   const std::vector<std::string> receiver = {"color.glsl", "shadow.glsl", "mesh.frag"};
   mesh_prog = Program("mesh", {vs({"mesh.vert"}), fs(receiver)});
-  cloth_prog = Program("cloth", {vs({"cloth.vert"}), fs(receiver)});
+  cloth_prog = Program("cloth", {vs({"cloth.vert"}), fs({"color.glsl", "shadow.glsl", "cloth.frag"})});
   particle_prog = Program("particles", {vs({"sphere.vert"}), fs(with(sphere_fs, "particle.frag"))});
   fluid_depth_prog = Program("fluid depth", {vs({"sphere.vert"}), fs(with(sphere_fs, "ssfr_depth.frag"))});
   fluid_thick_prog = Program("fluid thickness", {vs({"sphere.vert"}), fs(with(sphere_fs, "ssfr_thickness.frag"))});
@@ -152,6 +157,10 @@ void Renderer::Impl::draw_scene(const RenderCamera& cam) {
     glActiveTexture(GL_TEXTURE1), glBindTexture(GL_TEXTURE_2D, kin_depth);
     glUniform1i(kinect_prog.loc("u_rgb"), 0);
     glUniform1i(kinect_prog.loc("u_depth"), 1);
+    const PixelRect v = fit_aspect(kin_region, w, h);
+    glUniform4f(kinect_prog.loc("u_crop"), static_cast<float>(v.x), static_cast<float>(v.y),
+                static_cast<float>(v.width), static_cast<float>(v.height));
+    glUniform2f(kinect_prog.loc("u_image_size"), static_cast<float>(kin_K.width), static_cast<float>(kin_K.height));
     glBindVertexArray(empty_vao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glDepthFunc(GL_LESS);
@@ -214,6 +223,40 @@ const GlMesh& Renderer::Impl::body_mesh(const std::shared_ptr<const BodyMesh>& m
 }
 
 namespace {
+
+// Where each cloth vertex sits in its sheet's grid (cells), for the dye pattern: sheets are grids
+// (physics make_cloth: particle first + j nx + i, triangles (a, a + 1, a + nx + 1) and
+// (a, a + nx + 1, a + nx)), so each connected sheet's first id is its smallest and its row length
+// nx comes from a triangle whose second vertex follows its first. A sheet of another topology
+// gets (0, 0) everywhere: plain dye. Vertices lo .. hi.
+std::vector<vec2> cloth_grid_uv(const std::vector<int3>& tris, int lo, int hi) {
+  std::vector<int> root(static_cast<std::size_t>(hi - lo + 1));
+  for (std::size_t i = 0; i < root.size(); ++i) root[i] = static_cast<int>(i);
+  auto find = [&](int i) {
+    while (root[i] != i) i = root[i] = root[root[i]];
+    return i;
+  };
+  for (const int3& t : tris) {
+    const int a = find(t.x - lo);
+    root[find(t.y - lo)] = a, root[find(t.z - lo)] = a;
+  }
+  const int m = static_cast<int>(root.size());
+  std::vector<int> first(m, -1), nx(m, 0);  // per root
+  for (int i = 0; i < m; ++i)
+    if (first[find(i)] < 0) first[find(i)] = i;  // ascending: the smallest id of the sheet
+  for (const int3& t : tris) {
+    const int r = find(t.x - lo), k = t.z - t.x - 1;
+    if (t.y != t.x + 1 || k < 1) continue;
+    nx[r] = nx[r] == 0 || nx[r] == k ? k : -1;  // -1: inconsistent, not a grid
+  }
+  std::vector<vec2> uv(root.size(), vec2{0.f, 0.f});
+  for (int i = 0; i < m; ++i) {
+    const int r = find(i), k = nx[r];
+    if (k > 0) uv[i] = {static_cast<float>((i - first[r]) % k), static_cast<float>((i - first[r]) / k)};
+  }
+  return uv;
+}
+
 void buffer_texture(Texture& tex, GLuint buf, GLenum format) {
   if (!tex) tex = Texture(new_name(glGenTextures));
   glBindTexture(GL_TEXTURE_BUFFER, tex);
@@ -246,7 +289,7 @@ void Renderer::Impl::upload_cloth(const std::vector<int3>& tris, std::int64_t n)
   if (!cloth_vao) {
     cloth_vao = VertexArray(new_name(glGenVertexArrays));
     cloth_idx = GlBuffer(new_name(glGenBuffers)), cloth_ring_off = GlBuffer(new_name(glGenBuffers));
-    cloth_ring = GlBuffer(new_name(glGenBuffers));
+    cloth_ring = GlBuffer(new_name(glGenBuffers)), cloth_uv = GlBuffer(new_name(glGenBuffers));
   }
   glBindVertexArray(cloth_vao);
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, cloth_idx);
@@ -257,9 +300,13 @@ void Renderer::Impl::upload_cloth(const std::vector<int3>& tris, std::int64_t n)
   glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(off.size() * sizeof(int)), off.data(), GL_STATIC_DRAW);
   glBindBuffer(GL_TEXTURE_BUFFER, cloth_ring);
   glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(ring.size() * sizeof(int)), ring.data(), GL_STATIC_DRAW);
+  const std::vector<vec2> uv = cloth_grid_uv(tris, lo, hi);
+  glBindBuffer(GL_TEXTURE_BUFFER, cloth_uv);
+  glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(uv.size() * sizeof(vec2)), uv.data(), GL_STATIC_DRAW);
   glBindBuffer(GL_TEXTURE_BUFFER, 0);
   buffer_texture(ring_off_tbo, cloth_ring_off, GL_R32I);
   buffer_texture(ring_tbo, cloth_ring, GL_RG32I);
+  buffer_texture(uv_tbo, cloth_uv, GL_RG32F);
   cloth_tris = tris;
   cloth_first = lo;
 }
@@ -270,10 +317,12 @@ void Renderer::Impl::bind_cloth(const Program& prog) {
   glActiveTexture(GL_TEXTURE0), glBindTexture(GL_TEXTURE_BUFFER, pos_tbo);
   glActiveTexture(GL_TEXTURE1), glBindTexture(GL_TEXTURE_BUFFER, ring_off_tbo);
   glActiveTexture(GL_TEXTURE2), glBindTexture(GL_TEXTURE_BUFFER, ring_tbo);
+  glActiveTexture(GL_TEXTURE3), glBindTexture(GL_TEXTURE_BUFFER, uv_tbo);
   glActiveTexture(GL_TEXTURE0);
   glUniform1i(prog.loc("u_pos"), 0);
   glUniform1i(prog.loc("u_ring_off"), 1);
   glUniform1i(prog.loc("u_ring"), 2);
+  glUniform1i(prog.loc("u_uv"), 3);
   glUniform1i(prog.loc("u_first"), cloth_first);
 }
 
@@ -281,8 +330,10 @@ void Renderer::Impl::draw_cloth(const RenderCamera& cam) {
   set_camera_uniforms(cloth_prog, cam);
   bind_cloth(cloth_prog);
   glUniform3f(cloth_prog.loc("u_tint"), p.cloth_color.x, p.cloth_color.y, p.cloth_color.z);
-  glUniform1i(cloth_prog.loc("u_lit"), 1);
-  glUniform1i(cloth_prog.loc("u_two_sided"), 1);
+  glUniform1i(cloth_prog.loc("u_gingham"), p.cloth_pattern == ClothPattern::gingham);
+  glUniform1f(cloth_prog.loc("u_sheen"), p.cloth_sheen);
+  // Charlie alpha 0.5: a broad lobe (woven cotton); the sheen's colour is white (fibre surfaces).
+  glUniform1f(cloth_prog.loc("u_sheen_roughness"), 0.5f);
   glBindVertexArray(cloth_vao);
   glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * cloth_tris.size()), GL_UNSIGNED_INT, nullptr);
   glBindVertexArray(0);
@@ -430,7 +481,7 @@ void Renderer::set_scene_mesh(const Mesh& mesh) {
 }
 
 void Renderer::set_kinect_view(const Image<uchar3>& rgb, const Image<float>& depth, const Intrinsics& K,
-                               const SE3& world_T_camera) {
+                               const SE3& world_T_camera, const PixelRect& colour_region) {
   Impl& m = *impl_;
   if (rgb.device() != Device::CPU || depth.device() != Device::CPU)
     throw Error("render: set_kinect_view takes host images (download them first)");
@@ -450,16 +501,24 @@ void Renderer::set_kinect_view(const Image<uchar3>& rgb, const Image<float>& dep
   glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, K.width, K.height, GL_RGB, GL_UNSIGNED_BYTE, c.data());
   glBindTexture(GL_TEXTURE_2D, m.kin_depth);
   glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, K.width, K.height, GL_RED, GL_FLOAT, d.data());
+  const PixelRect whole{0, 0, K.width, K.height};
+  const PixelRect& r = colour_region.empty() ? whole : colour_region;
+  if (r.x < 0 || r.y < 0 || r.x + r.width > K.width || r.y + r.height > K.height)
+    throw Error("render: Kinect view colour region " + std::to_string(r.width) + "x" + std::to_string(r.height) +
+                " at (" + std::to_string(r.x) + ", " + std::to_string(r.y) + ") is not inside the " +
+                std::to_string(K.width) + "x" + std::to_string(K.height) + " image");
   m.kin_K = K;
+  m.kin_region = r;
   m.kin_pose = world_T_camera;
-  m.kin_mean = mean_linear_color(c);
+  m.kin_mean = mean_linear_color(c, K.width, r);
   m.has_kinect = true;
 }
 
 RenderCamera Renderer::kinect_camera() const {
   const Impl& m = *impl_;
   RenderCamera c;
-  c.K = scale_intrinsics(m.has_kinect ? m.kin_K : Intrinsics{}, m.w, m.h);
+  c.K = m.has_kinect ? scale_intrinsics(crop_intrinsics(m.kin_K, fit_aspect(m.kin_region, m.w, m.h)), m.w, m.h)
+                     : scale_intrinsics(Intrinsics{}, m.w, m.h);
   c.world_T_camera = m.kin_pose;
   c.znear = m.p.znear, c.zfar = m.p.zfar;
   return c;

@@ -56,10 +56,13 @@ class Renderer {
   // of the mesh's bounding box (dissertation 4.3.5: a camera in the middle of the scene).
   void set_scene_mesh(const Mesh& mesh);
   // The Kinect's point of view: RGB image and its registered depth (metres, 0 = none) with the
-  // exact intrinsics of both and the tracked pose (x right, y down, z forward).
+  // exact intrinsics of both and the tracked pose (x right, y down, z forward). The frame shows
+  // the part colour_region of the image (empty: all of it; RgbdFrame::colour_region leaves out
+  // undistortion's black border), cut to the framebuffer's aspect ratio.
   void set_kinect_view(const Image<uchar3>& rgb, const Image<float>& depth, const Intrinsics& K,
-                       const SE3& world_T_camera);
-  // The camera the Kinect view draws with: K scaled to the framebuffer, the tracked pose.
+                       const SE3& world_T_camera, const PixelRect& colour_region = {});
+  // The camera the Kinect view draws with: K cropped to the part shown and scaled to the
+  // framebuffer, the tracked pose.
   RenderCamera kinect_camera() const;
 
   // Draws one frame. In the Kinect view (params().view == RenderView::kinect) `camera` is ignored and

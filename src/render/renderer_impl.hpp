@@ -121,6 +121,7 @@ struct Renderer::Impl {
   bool has_cube = false;
   Texture kin_rgb, kin_depth;
   Intrinsics kin_K;
+  PixelRect kin_region;             // where the image holds colour; the frame shows it cut to the framebuffer's aspect
   vec3 kin_mean{0.5f, 0.5f, 0.5f};  // the image's mean colour, linear
   SE3 kin_pose = SE3::identity();
   bool has_kinect = false;
@@ -131,8 +132,8 @@ struct Renderer::Impl {
   std::vector<int3> cloth_tris;
   int cloth_first = 0;
   VertexArray cloth_vao;
-  GlBuffer cloth_idx, cloth_ring_off, cloth_ring;
-  Texture pos_tbo, ring_off_tbo, ring_tbo;
+  GlBuffer cloth_idx, cloth_ring_off, cloth_ring, cloth_uv;
+  Texture pos_tbo, ring_off_tbo, ring_tbo, uv_tbo;
   // Rigid body meshes, uploaded once each; an entry whose owner has gone is dropped.
   std::map<const BodyMesh*, std::pair<std::weak_ptr<const BodyMesh>, GlMesh>> body_meshes;
   VertexArray part_vao;

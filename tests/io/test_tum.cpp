@@ -9,6 +9,7 @@
 #include "core/buffer.hpp"
 #include "core/device.hpp"
 
+#include "io/colour_region.hpp"
 #include "io/input_params.hpp"
 #include "io/tum_source.hpp"
 
@@ -220,4 +221,66 @@ TEST(TumReader, PinnedFramesEqualOrdinaryOnesAndKeepTheirMemory) {
       }
     }
   }
+}
+
+// The largest rectangle of the mask's aspect inside a disc of radius R: its diagonal is the
+// diameter, so a 4:3 rectangle is 1.6 R x 1.2 R (to the pixel grid: within 2 pixels, and no
+// larger than the disc allows); a full mask gives the whole mask, an empty one nothing.
+TEST(ColourRegion, LargestRectangleOfTheAspectInADisc) {
+  const int w = 160, h = 120;
+  const float R = 50.f, cx = 90.f, cy = 55.f;  // off-centre on purpose
+  std::vector<std::uint8_t> disc(w * h), full(w * h, 1), none(w * h, 0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) disc[y * w + x] = std::hypot(x - cx, y - cy) <= R ? 1 : 0;
+  const PixelRect r = largest_rect_of_aspect(disc, w, h);
+  EXPECT_NEAR(r.width, 1.6f * R, 2.f);
+  EXPECT_NEAR(r.height, 1.2f * R, 2.f);
+  EXPECT_NEAR(static_cast<float>(r.width) / r.height, 4.f / 3.f, 0.03f);
+  for (int y = r.y; y < r.y + r.height; ++y)
+    for (int x = r.x; x < r.x + r.width; ++x) ASSERT_TRUE(disc[y * w + x]) << x << "," << y;
+  EXPECT_NEAR(r.x + 0.5f * r.width, cx + 0.5f, 1.f);  // pixel centres x .. x + w - 1 around cx
+  const PixelRect f = largest_rect_of_aspect(full, w, h);
+  EXPECT_TRUE(f.x == 0 && f.y == 0 && f.width == w && f.height == h);
+  EXPECT_TRUE(largest_rect_of_aspect(none, w, h).empty());
+}
+
+// Undistorting freiburg1 images leaves a black border (remap_rgb writes 0, 0, 0 where the lens saw
+// nothing); input_colour_region is a 4:3 rectangle without it: on the real frames the TUM reader
+// delivers, no black pixel inside it, black pixels outside it. Without undistortion (or another
+// source) it is empty: the whole image.
+TEST(ColourRegion, TumFramesLeaveOutTheUndistortionBorder) {
+  std::string dir = data_dir("tum_fr1_rpy_000-149");
+  REQUIRE_DATA(dir);
+  InputParams p = tum_params(dir);
+  p.max_frames = 3;
+  const PixelRect r = input_colour_region(p);
+  std::printf("colour region %dx%d at (%d, %d)\n", r.width, r.height, r.x, r.y);
+  ASSERT_FALSE(r.empty());
+  EXPECT_GE(r.x, 0);
+  EXPECT_GE(r.y, 0);
+  EXPECT_LE(r.x + r.width, 640);
+  EXPECT_LE(r.y + r.height, 480);
+  EXPECT_NEAR(static_cast<float>(r.width) / r.height, 4.f / 3.f, 0.01f);
+  EXPECT_GT(r.width, 500) << "the border is 6-25 pixels wide";
+  TumSource src(p);
+  RgbdFrame f;
+  while (src.next(f)) {
+    const std::vector<uchar3> c = f.rgb.to_host();
+    int black_in = 0, black_out = 0;
+    for (int y = 0; y < 480; ++y)
+      for (int x = 0; x < 640; ++x) {
+        const uchar3 q = c[y * 640 + x];
+        const bool black = q.x == 0 && q.y == 0 && q.z == 0;
+        const bool in = x >= r.x && x < r.x + r.width && y >= r.y && y < r.y + r.height;
+        (in ? black_in : black_out) += black ? 1 : 0;
+      }
+    std::printf("black pixels inside %d, outside %d\n", black_in, black_out);
+    EXPECT_EQ(black_in, 0);
+    EXPECT_GT(black_out, 1000);
+  }
+  p.undistort = false;
+  EXPECT_TRUE(input_colour_region(p).empty());
+  p.undistort = true;
+  p.source = InputSource::frames;
+  EXPECT_TRUE(input_colour_region(p).empty());
 }

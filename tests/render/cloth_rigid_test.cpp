@@ -1,5 +1,6 @@
 // Cloth is one two-sided mesh lit on whichever side is seen; rigid bodies are boxes in their
 // shape-matching frames.
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -36,14 +37,17 @@ struct Sheet {
 };
 
 // Light travelling along the view direction (from the camera onto the sheet): with the normal
-// turned to the visible side, diffuse = n . l = 1 at the centre, so the colour is the full cloth
-// colour on either face. Without the turn the back face would get the ambient part only (0.2 of
-// it). Tolerance: 8-bit rounding, 2 levels.
+// turned to the visible side, diffuse = n . l = 1 at the centre and the ambient part faces the
+// light (weight 1), and the sheen is zero where the half vector is the normal (Charlie: sin of
+// the half angle), so the colour is the plain dye on either face: in linear radiance
+// albedo ((1 - ambient) + ambient). Without the turn the back face would get half the ambient
+// part only. Tolerance: 8-bit rounding, 2 levels.
 TEST(RenderCloth, BothFacesAreLit) {
   SEAMLESS_REQUIRE_EGL();
   RenderParams p;
   p.light_dir = {0.f, 0.f, 1.f};
   p.ambient = 0.2f;
+  p.cloth_pattern = ClothPattern::plain;
   p.cloth_color = {200 / 255.f, 150 / 255.f, 50 / 255.f};
   const Intrinsics K = intrinsics(100.f, 79.5f, 59.5f, 160, 120);
   Renderer r(p, K.width, K.height);
@@ -56,20 +60,56 @@ TEST(RenderCloth, BothFacesAreLit) {
   }
 }
 
-// Light from behind the sheet: whichever face is seen, it faces away from the light and shows
-// the ambient part only, on both faces alike (one mesh, one rule).
+// sRGB level -> linear and back (IEC 61966-2-1, as color.glsl).
+float lin(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
+std::uint8_t srgb8(float l) {
+  const float c = l <= 0.0031308f ? 12.92f * l : 1.055f * std::pow(l, 1.f / 2.4f) - 0.055f;
+  return static_cast<std::uint8_t>(std::lround(255.f * std::clamp(c, 0.f, 1.f)));
+}
+
+// Light from behind the sheet: whichever face is seen, it faces away from the light (n . l = -1)
+// and shows the ambient part only, weighted 0.75 + 0.25 n . l = 0.5 (it faces the dark half of the
+// room), on both faces alike (one mesh, one rule): linear albedo * ambient * 0.5.
 TEST(RenderCloth, LightFromBehindGivesAmbientOnBothFaces) {
   SEAMLESS_REQUIRE_EGL();
   RenderParams p;
   p.light_dir = {0.f, 0.f, -1.f};
   p.ambient = 0.5f;
+  p.cloth_pattern = ClothPattern::plain;
   p.cloth_color = {200 / 255.f, 150 / 255.f, 50 / 255.f};
+  const uchar3 want{srgb8(0.25f * lin(200 / 255.f)), srgb8(0.25f * lin(150 / 255.f)), srgb8(0.25f * lin(50 / 255.f))};
   const Intrinsics K = intrinsics(100.f, 79.5f, 59.5f, 160, 120);
   Renderer r(p, K.width, K.height);
   for (bool flip : {false, true}) {
     Pixels img(r.render(Sheet(9, flip).list(), camera(K)));
-    EXPECT_LE(max_diff(img.at(80, 60), uchar3{100, 75, 25}), 2) << (flip ? "back" : "front");
+    EXPECT_LE(max_diff(img.at(80, 60), want), 2) << (flip ? "back" : "front");
   }
+}
+
+// The gingham dye follows the sheet's grid (texture coordinates found from its triangles: cell
+// (i, j) is particle j n + i): bands two cells wide, period four, in u and in v. Lit from the
+// camera the colour is the dye itself (as above). At grid point (2, 2) both bands cross: the cloth
+// colour; at (2, 4) one band: half way (in sRGB) to the white ground; at (4, 4) none: the white
+// ground (0.92, 0.91, 0.88). Grid point (i, j) of the 1 m sheet at z = 2 (cells of 6.25 pixels)
+// is at pixel (100 (i / 8 - 0.5) / 2 + 79.5, ...); 3 levels for rounding and the bands' one-pixel
+// anti-aliasing (these points are at least a cell from any band edge).
+TEST(RenderCloth, GinghamFollowsTheSheetsGrid) {
+  SEAMLESS_REQUIRE_EGL();
+  RenderParams p;
+  p.light_dir = {0.f, 0.f, 1.f};
+  p.cloth_color = {0.6f, 0.1f, 0.12f};
+  const Intrinsics K = intrinsics(100.f, 79.5f, 59.5f, 160, 120);
+  Renderer r(p, K.width, K.height);
+  Pixels img(r.render(Sheet(9, false).list(), camera(K)));
+  auto at = [&](float i, float j) {
+    return img.at(static_cast<int>(std::lround(50.f * (i / 8.f - 0.5f) + 79.5f)),
+                  static_cast<int>(std::lround(50.f * (j / 8.f - 0.5f) + 59.5f)));
+  };
+  const vec3 tint = p.cloth_color, ground{0.92f, 0.91f, 0.88f};
+  EXPECT_LE(max_diff(at(2, 2), to_rgb8(tint)), 3);
+  EXPECT_LE(max_diff(at(2, 4), to_rgb8(0.5f * (tint + ground))), 3);
+  EXPECT_LE(max_diff(at(4, 4), to_rgb8(ground)), 3);
+  EXPECT_LE(max_diff(at(6, 6), to_rgb8(tint)), 3);
 }
 
 // The rigid-body scenes: light from the camera, the rigid colour (180, 60, 40), black background.

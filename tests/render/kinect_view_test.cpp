@@ -29,13 +29,14 @@ struct KinectScene {
   uchar3 rgb_at(int u, int v) const { return rgb.to_host()[static_cast<std::size_t>(v) * K.width + u]; }
 };
 
-// Renders one sphere (a debug particle) at camera coordinates `c` and returns the frame.
-Pixels render_sphere(const KinectScene& s, vec3 c, float radius, int W, int H) {
+// Renders one sphere (a debug particle) at camera coordinates `c` and returns the frame, showing
+// the part `region` of the image (empty: all of it).
+Pixels render_sphere(const KinectScene& s, vec3 c, float radius, int W, int H, PixelRect region = {}) {
   RenderParams p;
   p.view = RenderView::kinect;
   p.fluid = FluidDraw::particles;
   Renderer r(p, W, H);
-  r.set_kinect_view(s.rgb, s.depth, s.K, s.world_T_camera);
+  r.set_kinect_view(s.rgb, s.depth, s.K, s.world_T_camera, region);
   const std::vector<vec3> x = {s.world_T_camera * c};
   const std::vector<std::uint32_t> ph = {phase::kFluid};
   DrawList list;
@@ -103,6 +104,46 @@ TEST(RenderKinectView, ScaledFramebufferKeepsAlignment) {
   EXPECT_GT(img.at(u, v).z, img.at(u, v).x + 40);
   const int off = static_cast<int>(std::ceil(1.5f * 240.f * 0.03f)) + 1;
   EXPECT_LT(img.at(u + off, v).z, 60) << "outside the sphere: the image (blue channel 40)";
+}
+
+// The frame shows a colour region (as undistortion leaves one) scaled up to the framebuffer: an
+// 80 x 60 part at (30, 20) of the 160 x 120 image, so each image pixel covers 2 x 2 framebuffer
+// pixels, and framebuffer pixel U shows image column x = 30 + (U + 0.5) / 2 - 0.5 (pixel edges
+// map to pixel edges). The image's red channel is its column and green twice its row, so the
+// bilinear lookup gives exactly those values (one level of rounding). A sphere lands where the
+// cropped and scaled intrinsics put it: U = 2 (u - 30 + 0.5) - 0.5.
+TEST(RenderKinectView, ColourRegionIsCroppedAndStaysAligned) {
+  SEAMLESS_REQUIRE_EGL();
+  KinectScene s;
+  const PixelRect region{30, 20, 80, 60};
+  const vec3 c{-0.35f, 0.1f, 1.f};  // in front of the wall (u ~ 41, v ~ 58)
+  const vec2 px = project(s, c);
+  Pixels img = render_sphere(s, c, 0.03f, s.K.width, s.K.height, region);
+  const float r = 120.f * 0.03f;  // the sphere's projected radius, image pixels
+  for (int V = 0; V < s.K.height; ++V)
+    for (int U = 0; U < s.K.width; ++U) {
+      const float x = 30.f + (U + 0.5f) / 2.f - 0.5f, y = 20.f + (V + 0.5f) / 2.f - 0.5f;
+      if (std::hypot(x - px.x, y - px.y) < 1.5f * r + 1.f) continue;  // the sphere
+      if (x < 30.f || y < 20.f || x > 109.f || y > 79.f) continue;    // the texture clamps at the image edge only
+      ASSERT_NEAR(img.at(U, V).x, x, 1.01f) << U << "," << V;
+      ASSERT_NEAR(img.at(U, V).y, 2.f * y, 1.01f) << U << "," << V;
+    }
+  const int u = static_cast<int>(std::lround(2.f * (px.x - 30.f + 0.5f) - 0.5f));
+  const int v = static_cast<int>(std::lround(2.f * (px.y - 20.f + 0.5f) - 0.5f));
+  EXPECT_GT(img.at(u, v).z, img.at(u, v).x + 40) << "the sphere at its cropped, scaled pixel";
+  const int off = static_cast<int>(std::ceil(2.f * 1.5f * r)) + 1;
+  for (auto [du, dv] : {std::pair{off, 0}, {-off, 0}, {0, off}, {0, -off}})
+    EXPECT_LT(img.at(u + du, v + dv).z, 60) << "outside the sphere: the image (blue channel 40)";
+}
+
+// A framebuffer of another aspect than the region: the region is cut at two sides (centred) to
+// the framebuffer's aspect, not stretched. 160 x 60 from the whole 160 x 120 image: rows 30..89.
+TEST(RenderKinectView, OtherAspectIsCutNotStretched) {
+  SEAMLESS_REQUIRE_EGL();
+  KinectScene s;
+  Pixels img = render_sphere(s, {0.f, 0.f, -5.f}, 0.05f, 160, 60);  // sphere behind the camera
+  for (int V = 0; V < 60; ++V)
+    for (int U = 0; U < 160; ++U) ASSERT_TRUE(same(img.at(U, V), s.rgb_at(U, V + 30))) << U << "," << V;
 }
 
 }  // namespace

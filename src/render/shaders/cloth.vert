@@ -8,6 +8,7 @@ uniform samplerBuffer u_pos;        // particle positions, world (RGB32F)
 uniform isamplerBuffer u_ring_off;  // per cloth vertex (id - u_first): first entry in u_ring; +1: end
 uniform isamplerBuffer u_ring;      // (j, k) for each triangle (i, j, k) around vertex i, winding kept
 uniform int u_first;                // lowest particle id of the sheets
+uniform samplerBuffer u_uv;         // per cloth vertex (id - u_first): its place in its sheet's grid, cells
 uniform mat4 u_view, u_proj;
 uniform vec3 u_tint;
 
@@ -15,6 +16,8 @@ out vec3 v_normal;
 out vec3 v_world;
 out vec3 v_world_normal;
 out vec3 v_color;
+out vec2 v_uv;
+out vec3 v_eye;
 
 void main() {
   int i = gl_VertexID;
@@ -29,9 +32,13 @@ void main() {
   v_world = p;
   v_world_normal = n;
   v_color = u_tint;
+  v_uv = texelFetch(u_uv, i - u_first).xy;
 #ifdef SEAMLESS_SHADOW_CASTER
+  v_eye = p;
   gl_Position = light_clip(p);
 #else
-  gl_Position = u_proj * (u_view * vec4(p, 1.0));
+  vec4 e = u_view * vec4(p, 1.0);
+  v_eye = e.xyz;
+  gl_Position = u_proj * e;
 #endif
 }

@@ -6,12 +6,16 @@
 uniform sampler2D u_rgb;
 uniform sampler2D u_depth;  // metres, registered to u_rgb
 uniform mat4 u_world_T_camera;
+uniform vec4 u_crop;        // the part of the image the frame shows: x, y, width, height (image pixels)
+uniform vec2 u_image_size;  // of u_rgb and u_depth
 
 layout(location = 0) out vec4 o_color;
 
 void main() {
   vec2 px = frag_pixel();
-  vec2 uv = (px + 0.5) / u_size;  // image rows run down, as uploaded
+  // The framebuffer covers the crop (scale_intrinsics: pixel edges map to pixel edges); image
+  // rows run down, as uploaded.
+  vec2 uv = (u_crop.xy + (px + 0.5) * u_crop.zw / u_size) / u_image_size;
   vec3 rgb = texture(u_rgb, uv).rgb;
   float z = texture(u_depth, uv).r;
   if (z > 0.0) {
