@@ -30,18 +30,7 @@ void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
   t->callback([&action, trk] {
     action = [trk] {
       RunContext ctx(*trk);
-      const Experiment& e = ctx.experiment();
-      require_refine(e.refine);  // before tracking: a missing Ceres is not found out 150 frames later
-      ScanResult r = scan(ctx, false);
-      if (e.refine.enabled && e.refine.online)
-        spdlog::info("refine: refine.online refined while tracking; the offline stage (refine.enabled) is skipped");
-      const bool offline = e.refine.enabled && !e.refine.online;
-      if (offline && interrupted()) spdlog::warn("refine: skipped (interrupted)");
-      if (offline && !interrupted()) {
-        std::vector<bool> tracked;
-        for (const FrameRecord& f : r.tracking.frames) tracked.push_back(f.result.ok());
-        refine_run(e.input, r.tracking.trajectory, tracked, e.refine, e.preprocess, ctx.device(), ctx.out_dir());
-      }
+      scan(ctx, false);  // refines too (refine.enabled / refine.online)
       return ctx.exit_code();
     };
   });

@@ -3,10 +3,13 @@
 // TUM freiburg1_rpy frames.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
+#include <tuple>
 
 #include "core/error.hpp"
 #include "io/synthetic_source.hpp"
@@ -133,6 +136,86 @@ TEST(TrackSequence, CutIsDetectedNotFusedAndTrackingResumes) {
   for (std::size_t i = 0; i < t.result.frames.size(); ++i)
     if (t.result.frames[i].result.ok()) est.push_back(t.result.trajectory[i]), gt.push_back(t.gt[i]);
   EXPECT_LE(compute_ate(est, gt).trans.rmse, 0.01);
+}
+
+// Sorted vertex positions of a mesh (two volumes may hold the same blocks in another order).
+std::vector<vec3> sorted_positions(Mesh m) {
+  std::sort(m.positions.begin(), m.positions.end(),
+            [](vec3 a, vec3 b) { return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z); });
+  return m.positions;
+}
+
+// tracker.kind trajectory: the poses of a TUM file, each frame's found by its timestamp. Fusing
+// the ground-truth tracker's own trajectory.txt gives the ground-truth tracker's mesh (the file's
+// 7 decimals move a vertex by far less than a micrometre); a frame missing from the file is
+// reported lost and not fused, unless its neighbours are within trajectory_max_gap (then it is
+// interpolated); poses given in memory (frame_poses) go to the frames in order.
+TEST(TrackSequence, TrajectoryTrackerFusesTheGivenPoses) {
+  constexpr int kFrames = 8;
+  InputParams in = test::synthetic_input(kFrames, false);
+  TrackSequenceParams p = default_params(TrackingMode::frame_to_frame);
+  p.tracker.kind = "ground_truth";
+  test::TmpOut out("given");
+  auto gt_volume = make_volume(p.volume, Device::CPU);
+  TrackSequenceResult gt = track_sequence(*make_source(in), p, Device::CPU, out.str(), gt_volume.get());
+  ASSERT_EQ(gt.lost_frames, 0);
+
+  TrackSequenceParams t = p;
+  t.tracker.kind = "trajectory";
+  t.tracker.trajectory = out.str() + "/trajectory.txt";
+  t.write_files = false;
+  auto volume = make_volume(t.volume, Device::CPU);
+  TrackSequenceResult given = track_sequence(*make_source(in), t, Device::CPU, "", volume.get());
+  ASSERT_EQ(given.lost_frames, 0);
+  const Trajectory file = read_tum_trajectory(t.tracker.trajectory);
+  for (int k = 0; k < kFrames; ++k) {
+    EXPECT_TRUE(given.frames[k].fused) << k;
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(given.trajectory[k].t[i], file[k].t[i], 1e-6) << k;
+  }
+  const std::vector<vec3> a = sorted_positions(gt_volume->extract_mesh()), b = sorted_positions(volume->extract_mesh());
+  ASSERT_GT(a.size(), 1000u);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) ASSERT_LE(length(a[i] - b[i]), 1e-5f) << i;
+
+  // Frames 3 and 5 left out of the file: their neighbours are 67 ms apart (30 frames a second).
+  Trajectory some;
+  for (int k = 0; k < kFrames; ++k)
+    if (k != 3 && k != 5) some.push_back(gt.trajectory[k]);
+  t.tracker.trajectory = out.str() + "/some.txt";
+  write_tum_trajectory(t.tracker.trajectory, some);
+  t.tracker.trajectory_max_gap = 0.05;  // below the 67 ms around frames 3 and 5: both lost
+  TrackSequenceResult gaps = track_sequence(*make_source(in), t, Device::CPU, "", nullptr);
+  EXPECT_EQ(gaps.lost_frames, 2);
+  for (const FrameRecord& r : gaps.frames)
+    EXPECT_EQ(r.result.status == TrackStatus::no_reference, r.frame == 3 || r.frame == 5) << r.frame;
+  t.tracker.trajectory_max_gap = 0.1;  // interpolated between the neighbours
+  TrackSequenceResult filled = track_sequence(*make_source(in), t, Device::CPU, "", nullptr);
+  EXPECT_EQ(filled.lost_frames, 0);
+  // The synthetic camera moves smoothly: the interpolated pose is within a millimetre of the truth.
+  for (int k : {3, 5})
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(filled.trajectory[k].t[i], gt.trajectory[k].t[i], 1e-3) << k;
+
+  // In memory, by order: frame 2 has no pose and is not fused; the others take theirs exactly.
+  auto list = std::make_shared<std::vector<std::optional<SE3>>>();
+  for (int k = 0; k < kFrames; ++k) list->push_back(k == 2 ? std::nullopt : std::optional<SE3>(gt.trajectory[k].se3()));
+  t.frame_poses = list;
+  t.tracker.trajectory.clear();
+  TrackSequenceResult ordered = track_sequence(*make_source(in), t, Device::CPU, "", nullptr);
+  EXPECT_EQ(ordered.lost_frames, 1);
+  for (int k = 0; k < kFrames; ++k) {
+    EXPECT_EQ(ordered.frames[k].result.ok(), k != 2) << k;
+    if (k != 2) EXPECT_EQ(ordered.trajectory[k].se3().t.x, (*list)[k]->t.x) << k;
+  }
+
+  // A trajectory kind without a file is a configuration error naming the key.
+  TrackerParams bad;
+  bad.kind = "trajectory";
+  try {
+    bad.validate();
+    FAIL() << "expected a ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("tracker.trajectory"), std::string::npos) << e.what();
+  }
 }
 
 TEST(TrackSequence, UnavailableTrackerSaysSo) {
