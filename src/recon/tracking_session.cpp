@@ -4,6 +4,7 @@
 // whole sequence and writes the outputs.
 #include "recon/tracker_sequence.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -328,6 +329,19 @@ TrackResult TrackingSession::track_frame(const RgbdFrame& frame) {
   return r;
 }
 
+namespace {
+// The pose of `tr` at time t: a sample within 10 us of t is t's own (TUM files print 6 decimals,
+// so a frame's time written and read back may differ from the frame's in the last digit: the
+// last frame would otherwise fall after the last sample), else interpolate_pose's.
+std::optional<TumPose> pose_at(const Trajectory& tr, double t, double max_gap) {
+  constexpr double kSameTime = 1e-5;
+  auto it = std::lower_bound(tr.begin(), tr.end(), t, [](const TumPose& p, double v) { return p.timestamp < v; });
+  if (it != tr.end() && it->timestamp - t <= kSameTime) return *it;
+  if (it != tr.begin() && t - (it - 1)->timestamp <= kSameTime) return *(it - 1);
+  return interpolate_pose(tr, t, max_gap);
+}
+}  // namespace
+
 // The given pose of the frame: params.frame_poses' by order, else the file's at the frame's time,
 // matched as TUM ground truth is (interpolated between samples at most
 // tracker.trajectory_max_gap apart). Without one the frame is reported as no_reference and not
@@ -338,7 +352,7 @@ TrackResult TrackingSession::given_pose(const RgbdFrame& frame) const {
   std::optional<SE3> pose;
   if (p_.frame_poses) {
     if (processed_ < static_cast<std::int64_t>(p_.frame_poses->size())) pose = (*p_.frame_poses)[processed_];
-  } else if (std::optional<TumPose> p = interpolate_pose(*given_, frame.timestamp, p_.tracker.trajectory_max_gap)) {
+  } else if (std::optional<TumPose> p = pose_at(*given_, frame.timestamp, p_.tracker.trajectory_max_gap)) {
     pose = p->se3();
   }
   if (pose) {

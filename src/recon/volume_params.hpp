@@ -52,9 +52,6 @@ struct VolumeParams {
   // Rules across keys, checked when a config is loaded (Experiment::validate) and by the volumes'
   // constructors (for code that builds a volume without a config).
   void validate() const {
-    if (capacity != 0 && capacity < 64)
-      throw ConfigError("volume.capacity is " + std::to_string(capacity) +
-                        ": it must be 0 (chosen by the device) or at least 64 blocks");
     if (truncation < 2.f * voxel_size)
       throw ConfigError("volume.truncation (" + std::to_string(truncation) + " m) must be at least two voxels (2 * " +
                         "volume.voxel_size = " + std::to_string(2.f * voxel_size) +
