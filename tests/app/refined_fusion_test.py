@@ -103,8 +103,10 @@ class RefinedFusion(unittest.TestCase):
             seamless("reconstruct", seq, plain, "refine.enabled=false")
             mesh_run, mesh_given, mesh_plain = (ply_positions(os.path.join(x, "mesh.ply")) for x in [run, given, plain])
             self.assertGreater(len(mesh_run), 1000)
-            self.assertEqual(len(mesh_run), len(mesh_given))
-            # The file's poses carry 7 decimals (0.1 um): the meshes agree far below a voxel (1 cm).
+            # The file's poses carry 7 decimals (0.1 um): a voxel whose TSDF is that close to zero may
+            # gain or lose its vertex (equal counts here; 2 in 108,767 in the synthetic C++ case), so
+            # the counts agree to 1e-4 and the bounds far below a voxel (1 cm).
+            self.assertLessEqual(abs(len(mesh_run) - len(mesh_given)), 1e-4 * len(mesh_run))
             for a, b in zip(bounds(mesh_run), bounds(mesh_given)):
                 self.assertAlmostEqual(a, b, delta=1e-5)
             # The unrefined poses give another mesh: the comparison above can tell them apart.
