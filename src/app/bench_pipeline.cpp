@@ -162,11 +162,13 @@ RepResult replay(const PipelineBenchOptions& o, const Experiment& e, const std::
   const bool rss_reset = reset_peak_rss();
   const auto t0 = std::chrono::steady_clock::now();
   {
-    RunContext ctx(co, e);
+    Experiment run_e = e;
+    if (o.mode == "scan") run_e.refine.enabled = false;  // scan() would refine: the pass is left out
+    RunContext ctx(co, run_e);
     StageTimer volume_stages(ctx.device());
     StageTimer* vs = o.volume_stages ? &volume_stages : nullptr;
     if (o.mode == "scan") {
-      const ScanResult s = scan(ctx, false, vs);  // what `seamless track` runs (its refinement comes after)
+      const ScanResult s = scan(ctx, false, vs);  // what `seamless track` runs, less its refinement
       add_tracking_stages(s.tracking.frames, o.volume_stages, e.dynamic.enabled, r);
     } else {
       std::unique_ptr<RunRenderer> renderer;

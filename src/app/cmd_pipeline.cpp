@@ -21,20 +21,7 @@ ScanResult reconstruct_experiment(RunContext& ctx) {
 }
 
 ScanResult track_experiment(RunContext& ctx) {
-  const Experiment& e = ctx.experiment();
-  require_refine(e.refine);  // before tracking: a missing Ceres is not found out 150 frames later
-  ScanResult r = scan(ctx, false);
-  if (e.refine.enabled && e.refine.online)
-    spdlog::info("refine: refine.online refined while tracking; the offline stage (refine.enabled) is skipped");
-  const bool offline = e.refine.enabled && !e.refine.online;
-  if (offline && interrupted()) spdlog::warn("refine: skipped (interrupted)");
-  if (offline && !interrupted()) {
-    std::vector<bool> tracked;
-    for (const FrameRecord& f : r.tracking.frames) tracked.push_back(f.result.ok());
-    r.tracking.trajectory =
-        refine_run(e.input, r.tracking.trajectory, tracked, e.refine, e.preprocess, ctx.device(), ctx.out_dir())
-            .trajectory;
-  }
+  ScanResult r = scan(ctx, false);  // refines too (refine.enabled / refine.online)
   // summary.json as `run` writes it, for the trajectory.txt written (refined, when refine is on).
   add_tracking(ctx.summary(), r.tracking, r.unreadable, groundtruth_path(ctx));
   ctx.summary().intrinsics = r.intrinsics;

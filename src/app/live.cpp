@@ -149,7 +149,7 @@ class LiveLoop : public FrameLoop {
     spdlog::info("live: {} frames ({} lost), median track {:.3f} ms, physics {:.3f} ms, extraction {:.3f} ms",
                  records_.size(), session_.lost_frames(), ctx_.timer().median_ms("track"),
                  ctx_.timer().median_ms("physics"), ctx_.timer().median_ms("extract"));
-    log_volume(volume_->stats());
+    log_volume(volume_->stats(), volume_->device());
     const Mesh mesh = volume_->extract_mesh();
     if (e_.output.write_mesh) write_mesh_ply(ctx_.out_path("mesh.ply"), mesh);
     write_live_summary(mesh, state);

@@ -3,7 +3,9 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <memory>
 #include <optional>
 
 #include "app/ghost.hpp"
@@ -23,6 +25,7 @@
 #include "physics/particle_io.hpp"
 #include "physics/particle_solver.hpp"
 #include "recon/refine/online_refine.hpp"
+#include "recon/refine/refine.hpp"
 
 namespace seamless::app {
 
@@ -57,12 +60,12 @@ RgbdFrame host_copy(const RgbdFrame& f) {
   return c;
 }
 
-void log_volume(const VolumeStats& s) {
+void log_volume(const VolumeStats& s, Device d) {
   spdlog::info(
-      "volume: {} blocks of {} bytes ({:.1f} MiB voxels, {:.1f} MiB on the device), hash fill {:.1f}%, "
+      "volume: {} blocks of {} bytes in a pool of {} ({:.1f} MiB voxels, {:.1f} MiB {} in all), hash fill {:.1f}%, "
       "{} failed insertions, {} retries",
-      s.allocated_blocks, s.bytes_per_block, s.voxel_bytes / 1048576.0, s.device_bytes / 1048576.0, 100 * s.hash_fill,
-      s.failed_insertions, s.retries);
+      s.allocated_blocks, s.bytes_per_block, s.block_capacity, s.voxel_bytes / 1048576.0, s.device_bytes / 1048576.0,
+      d == Device::CPU ? "of host memory" : "on the GPU", 100 * s.hash_fill, s.failed_insertions, s.retries);
 }
 
 void record_intrinsics(RunContext& ctx, const FrameSource& source) {
@@ -74,13 +77,71 @@ void record_intrinsics(RunContext& ctx, const FrameSource& source) {
 
 using namespace detail;
 
+namespace {
+
+// refine.enabled (the offline stage): the keyframe pose graph over the tracked trajectory;
+// refine_run writes the refined trajectory.txt and keeps the tracker's as trajectory_odometry.txt.
+void refine_offline(RunContext& ctx, ScanResult& r) {
+  const Experiment& e = ctx.experiment();
+  if (e.refine.enabled && e.refine.online)
+    spdlog::info("refine: refine.online refined while tracking; the offline stage (refine.enabled) is skipped");
+  if (!e.refine.enabled || e.refine.online) return;
+  if (interrupted()) return spdlog::warn("refine: skipped (interrupted)");
+  std::vector<bool> tracked;
+  for (const FrameRecord& f : r.tracking.frames) tracked.push_back(f.result.ok());
+  r.tracking.trajectory =
+      refine_run(e.input, r.tracking.trajectory, tracked, e.refine, e.preprocess, ctx.device(), ctx.out_dir())
+          .trajectory;
+}
+
+// With refinement on, the poses change after tracking (the offline stage), or while it runs
+// (refine.online: the final graph moves frames fused long before): the scene is fused in a second
+// pass over the input at the final poses, so that the mesh and the scene particles are those of
+// trajectory.txt. Each frame is read and preprocessed again, then fused (the trajectory tracker,
+// given the poses); frames that tracking lost stay out, as they did. Costs a read and preprocess
+// of every frame on top of the fusion that tracking no longer does.
+void fuse_at_final_poses(RunContext& ctx, ScanResult& r, StageTimer* volume_stages) {
+  const Experiment& e = ctx.experiment();
+  r.volume = make_volume(e.volume, ctx.device());
+  auto poses = std::make_shared<std::vector<std::optional<SE3>>>();
+  std::int64_t fused = 0;
+  for (std::size_t i = 0; i < r.tracking.frames.size(); ++i) {
+    const bool ok = r.tracking.frames[i].result.ok();
+    poses->push_back(ok ? std::optional<SE3>(r.tracking.trajectory[i].se3()) : std::nullopt);
+    fused += ok ? 1 : 0;
+  }
+  if (interrupted()) return spdlog::warn("fusion at the refined poses skipped (interrupted): the volume is empty");
+  TrackSequenceParams tp = tracking_params(e, volume_stages);
+  tp.tracker.kind = "trajectory";
+  tp.frame_poses = poses;  // the same frames in the same order
+  tp.write_files = false;
+  tp.keep_unmasked_level = -1;
+  tp.max_frames = static_cast<std::int64_t>(r.tracking.frames.size());
+  auto source = ctx.open_source();  // a second read: refused for frames given by the caller
+  Progress progress("fuse", tp.max_frames);
+  std::int64_t n = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  track_sequence(*source, tp, ctx.device(), ctx.out_dir(), r.volume.get(), [&](const RgbdFrame&, const FrameRecord& f) {
+    ctx.timer().add(f.frame, "fuse_refined", f.frame_ms);
+    progress.update(++n);
+  });
+  progress.finish();
+  spdlog::info("fused {} of {} frames at the refined poses in {:.1f} s (a second pass over the input)", fused, n,
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+}
+
+}  // namespace
+
 ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
   const Experiment& e = ctx.experiment();
   require_tracker(e.tracker.kind);
+  require_refine(e.refine);  // before tracking: a missing Ceres is not found out 150 frames later
   auto source = ctx.open_source();
   record_intrinsics(ctx, *source);
   ScanResult r;
-  if (with_volume) r.volume = make_volume(e.volume, ctx.device());
+  // Refined poses are known only after tracking: the scene is then fused afterwards (fuse_at_final_poses).
+  const bool fuse_after = with_volume && (e.refine.enabled || e.refine.online);
+  if (with_volume && !fuse_after) r.volume = make_volume(e.volume, ctx.device());
 
   // frames and input.max_frames both limit the frames read (the source applies the latter).
   std::int64_t total = source->size().value_or(0);
@@ -116,9 +177,12 @@ ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
       r.tracking.median_track_ms, r.tracking.median_frame_ms);
   ctx.report_tracking(static_cast<std::int64_t>(r.tracking.frames.size()), r.tracking.lost_frames,
                       r.volume ? r.volume->stats().failed_insertions : 0);
+  source.reset();  // the refinement and the fusion pass read the input again
+  refine_offline(ctx, r);
+  if (fuse_after) fuse_at_final_poses(ctx, r, volume_stages);
   if (r.volume) {
-    log_volume(r.volume->stats());
-    r.mesh = r.volume->extract_mesh();
+    log_volume(r.volume->stats(), r.volume->device());
+    r.mesh = r.volume->extract_mesh(true);
     if (e.output.write_mesh) {
       write_mesh_ply(ctx.out_path("mesh.ply"), r.mesh);
       spdlog::info("mesh.ply: {} vertices, {} triangles", r.mesh.positions.size(), r.mesh.triangles.size());

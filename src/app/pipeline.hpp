@@ -27,7 +27,10 @@ struct ScanResult {
 class RunRenderer;
 
 // Tracks the experiment's input (and fuses it into a new volume when with_volume), writing
-// trajectory.txt, tracking_stats.csv and, with a volume, mesh.ply (output.write_mesh).
+// trajectory.txt, tracking_stats.csv and, with a volume, mesh.ply (output.write_mesh). With
+// refine.enabled or refine.online, trajectory.txt and tracking.trajectory are the refined poses,
+// and the volume is fused at them in a second pass over the input (docs/TRACKING.md, "Refined
+// poses in the scene").
 // volume_stages: see TrackSequenceParams::volume_stages (`seamless bench pipeline`).
 ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages = nullptr);
 

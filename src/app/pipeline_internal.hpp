@@ -21,7 +21,8 @@ void finish_renderer(RunContext& ctx, RunRenderer& r);
 TrackSequenceParams tracking_params(const Experiment& e, StageTimer* volume_stages);
 // A frame with its images on the host.
 RgbdFrame host_copy(const RgbdFrame& f);
-void log_volume(const VolumeStats& s);
+// The volume's size after a scan; d: its device (the CPU's bytes are host memory).
+void log_volume(const VolumeStats& s, Device d);
 // The intrinsics the frames arrive with (after undistortion), in the log and in the run's folder
 // (intrinsics.txt, calibration.txt's format): a run says which camera model it tracked with.
 void record_intrinsics(RunContext& ctx, const FrameSource& source);

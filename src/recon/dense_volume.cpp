@@ -57,7 +57,9 @@ void DenseVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, Raycas
   if (timer) timer->end("raycast");
 }
 
-Mesh DenseVolume::extract_mesh() { return marching_cubes(device_, device_view(), block_coords_, block_coords_.size()); }
+Mesh DenseVolume::extract_mesh(bool progress) {
+  return marching_cubes(device_, device_view(), block_coords_, block_coords_.size(), progress);
+}
 
 SceneParticles DenseVolume::extract_scene_particles(const SceneParticleParams& p) {
   return seamless::extract_scene_particles(device_, device_view(), block_coords_, block_coords_.size(), p);

@@ -19,7 +19,8 @@ class DenseVolume final : public Volume {
                  StageTimer* timer = nullptr) override;
   void raycast(const Intrinsics& K, const SE3& world_T_camera, RaycastMaps& maps, StageTimer* timer = nullptr) override;
   using Volume::raycast;
-  Mesh extract_mesh() override;
+  Mesh extract_mesh(bool progress) override;
+  using Volume::extract_mesh;
   SceneParticles extract_scene_particles(const SceneParticleParams& p) override;
   std::vector<float> sample_sdf_grid(vec3 origin, int3 dims, float voxel) override;
   void require_free_space(const Image<float>& depth, const Intrinsics& K, const SE3& world_T_camera, float min_weight,

@@ -1,10 +1,12 @@
 #include "recon/marching_cubes.hpp"
 
 #include <algorithm>
+#include <string>
 #include <unordered_map>
 
 #include "core/error.hpp"
 #include "core/exec.hpp"
+#include "core/progress.hpp"
 #include "kernels/recon/tsdf.hpp"
 
 namespace seamless {
@@ -77,12 +79,15 @@ const std::vector<std::int8_t>& marching_cubes_table() {
   return t;
 }
 
-template <class Acc> Mesh marching_cubes(Device d, const Acc& a, const Buffer<int3>& blocks, std::int64_t block_count) {
+template <class Acc>
+Mesh marching_cubes(Device d, const Acc& a, const Buffer<int3>& blocks, std::int64_t block_count, bool progress) {
   Buffer<std::int8_t> table = Buffer<std::int8_t>::from_host(marching_cubes_table(), d);
   Mesh mesh;
   std::unordered_map<std::uint64_t, int> index;  // voxel edge -> vertex
   constexpr std::int64_t kChunk = 8192;          // blocks per pass: bounds the scratch memory
+  Progress bar("mesh", block_count, progress && block_count > kChunk, "blocks/s");
   for (std::int64_t first = 0; first < block_count; first += kChunk) {
+    if (first > 0) bar.update(first, std::to_string(mesh.positions.size()) + " vertices");
     std::int64_t nb = std::min(kChunk, block_count - first);
     View<const int3> chunk{blocks.data() + first, nb};
     Buffer<std::int32_t> offsets(nb * kernels::kBlockVoxels, d);
@@ -112,12 +117,13 @@ template <class Acc> Mesh marching_cubes(Device d, const Acc& a, const Buffer<in
       if (v % 3 == 2) mesh.triangles.push_back({tri[0], tri[1], tri[2]});
     }
   }
+  bar.update(block_count, std::to_string(mesh.positions.size()) + " vertices");
   return mesh;
 }
 
-template Mesh marching_cubes<kernels::HashAccess>(Device, const kernels::HashAccess&, const Buffer<int3>&,
-                                                  std::int64_t);
+template Mesh marching_cubes<kernels::HashAccess>(Device, const kernels::HashAccess&, const Buffer<int3>&, std::int64_t,
+                                                  bool);
 template Mesh marching_cubes<kernels::DenseAccess>(Device, const kernels::DenseAccess&, const Buffer<int3>&,
-                                                   std::int64_t);
+                                                   std::int64_t, bool);
 
 }  // namespace seamless

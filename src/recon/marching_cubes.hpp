@@ -17,7 +17,10 @@ const std::vector<std::int8_t>& marching_cubes_table();
 
 // Meshes the cells of the given blocks (block coordinates on device d) of a volume seen through
 // accessor a (kernels::HashAccess or kernels::DenseAccess). Vertices on the same voxel edge are
-// merged, so the mesh is indexed and shared across block seams.
-template <class Acc> Mesh marching_cubes(Device d, const Acc& a, const Buffer<int3>& blocks, std::int64_t block_count);
+// merged, so the mesh is indexed and shared across block seams. progress: report the passes
+// (core/progress) when there is more than one.
+template <class Acc>
+Mesh marching_cubes(Device d, const Acc& a, const Buffer<int3>& blocks, std::int64_t block_count,
+                    bool progress = false);
 
 }  // namespace seamless

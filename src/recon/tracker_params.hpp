@@ -102,6 +102,11 @@ struct TrackerParams {
   float relocalise_max_residual_ratio = 2.0f;
   GravitySource gravity = GravitySource::automatic;
   vec3 fixed_gravity{0.f, 1.f, 0.f};  // camera frame (y down), used when gravity: fixed
+  // kind trajectory: the poses to fuse from, a TUM trajectory file (world_T_camera), each frame's
+  // taken at its timestamp as the ground truth's is (interpolated between samples at most
+  // trajectory_max_gap apart; a frame outside the file is not fused).
+  std::string trajectory;
+  double trajectory_max_gap = 0.1;  // seconds, input.max_gt_gap's default
 
   // Rules across keys, checked when a config is loaded (Experiment::validate); tracker_gravity.cpp
   // checks the vector again for code that builds TrackerParams without a config.
@@ -124,12 +129,16 @@ struct TrackerParams {
           "tracker.iterations: " + std::string(iterations.empty() ? "empty" : "no level has an iteration") +
           "; give ICP iterations per pyramid level, finest first, at least one level above 0 "
           "(default [10, 5, 4])");
+    if (kind == "trajectory" && trajectory.empty())
+      problems.push_back(
+          "tracker.kind: trajectory fuses from a given trajectory, but tracker.trajectory names no file (a TUM "
+          "trajectory, e.g. a `seamless track` run's trajectory.txt)");
   }
 
   template <class V> void visit(V& v) {
     v("kind", kind, "tracker; opencv_* and pcl_gicp are external libraries, always frame to frame",
-      Choices{"icp", "rgbd", "ground_truth", "opencv_rgbd_odometry", "opencv_icp", "opencv_rgbd_icp", "opencv_fast_icp",
-              "pcl_gicp"});
+      Choices{"icp", "rgbd", "ground_truth", "trajectory", "opencv_rgbd_odometry", "opencv_icp", "opencv_rgbd_icp",
+              "opencv_fast_icp", "pcl_gicp"});
     v("mode", mode, "align to the model raycast or to the previous frame");
     v("iterations", iterations, "ICP iterations per pyramid level, finest first", Range{0, 1000});
     v("pixel_stride", pixel_stride,
@@ -191,6 +200,13 @@ struct TrackerParams {
       Range{0.0, 1000.0});
     v("gravity", gravity, "where 'down' comes from (auto: accelerometer if present, else floor plane)");
     v("fixed_gravity", fixed_gravity, "down direction in the first camera frame (gravity: fixed)");
+    v("trajectory", trajectory,
+      "kind trajectory: TUM trajectory file whose poses are fused (world_T_camera; timestamps matched like the "
+      "ground truth's)");
+    v("trajectory_max_gap", trajectory_max_gap,
+      "kind trajectory: interpolate a frame's pose only between samples at most this far apart, seconds; 0: "
+      "exact timestamps only",
+      Range{0.0, 1e6});
   }
 };
 

@@ -36,6 +36,7 @@ const std::vector<TrackerInfo>& tracker_registry() {
       {"icp", "point-to-plane ICP, projective association, 3-level pyramid (KinectFusion)", true, "", {}},
       {"rgbd", "ICP plus a photometric term in one Gauss-Newton solve", true, "", {}},
       {"ground_truth", "the source's ground-truth poses (upper bound for fusion and physics)", true, "", {}},
+      {"trajectory", "the poses of a TUM trajectory file (tracker.trajectory), e.g. a refined one", true, "", {}},
       external_entry("opencv_rgbd_odometry", "OpenCV contrib rgbd::RgbdOdometry (photometric), frame to frame",
                      external::opencv_factory(OpenCvMethod::rgbd), kOpenCvMissing),
       external_entry("opencv_icp", "OpenCV contrib rgbd::ICPOdometry, frame to frame",
@@ -156,7 +157,7 @@ TrackSequenceResult track_sequence(FrameSource& source, const TrackSequenceParam
       if (params.write_files && params.dynamic.write_masks) write_dynamic_mask(out_dir, frame.index, session);
       if (out.frames.size() > 0) track_ms.push_back(rec.track_ms);
       frame_ms.push_back(rec.frame_ms);
-      log_lost(rec);
+      if (!params.frame_poses) log_lost(rec);  // a fusion pass's skipped frames were reported when tracked
       if (on_frame) on_frame(frame, rec);
       out.frames.push_back(rec);
     }

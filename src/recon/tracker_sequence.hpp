@@ -51,6 +51,10 @@ struct TrackSequenceParams {
   StageTimer* volume_stages = nullptr;
   // refine.online: sees every frame; its corrections move the session's pose (track_sequence).
   PoseCorrector* corrector = nullptr;
+  // tracker.kind trajectory: the k-th frame processed takes pose k of this list instead of the
+  // pose at its timestamp in tracker.trajectory's file; none (or past the end): not fused. A
+  // scan's fusion pass at the refined poses (src/app/pipeline.cpp) sees the same frames again.
+  std::shared_ptr<const std::vector<std::optional<SE3>>> frame_poses;
   // >= 0: this pyramid level's vertex and normal maps are also kept as they were before the
   // dynamic mask zeroed them (TrackingSession::unmasked_level; the live colliders of solver.dynamic_colliders).
   int keep_unmasked_level = -1;
@@ -119,6 +123,7 @@ class TrackingSession {
   void first_frame(const RgbdFrame& frame, FrameRecord& rec);
   TrackResult track_frame(const RgbdFrame& frame);
   TrackResult track_external(const RgbdFrame& frame);
+  TrackResult given_pose(const RgbdFrame& frame) const;  // tracker.kind trajectory
   TrackResult relocalise(const RgbdFrame& frame);
   void check_cut(TrackResult& r) const;
   void check_relocalisation(const RgbdFrame& frame, TrackResult& r) const;
@@ -172,6 +177,10 @@ class TrackingSession {
   bool started_ = false;
   SE3 last_good_ = SE3::identity(), prev_good_ = SE3::identity();
   SE3 world_T_gt_ = SE3::identity();  // ground_truth tracker: maps the source's poses into our world
+  // trajectory tracker: the file's poses (in their own world frame), or params.frame_poses.
+  std::shared_ptr<const Trajectory> given_;
+  bool given_poses_ = false;
+  std::int64_t processed_ = 0;  // frames processed so far (the index into params.frame_poses)
   std::int64_t lost_ = 0;
   std::int64_t lost_run_ = 0;           // consecutive lost frames just before this one: > 0 means relocalising
   double last_good_time_ = 0;           // timestamp of the last good frame

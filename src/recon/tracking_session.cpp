@@ -4,6 +4,7 @@
 // whole sequence and writes the outputs.
 #include "recon/tracker_sequence.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -59,6 +60,15 @@ TrackingSession::TrackingSession(const TrackSequenceParams& params, Device devic
     if (p_.tracker.mode != TrackingMode::frame_to_frame)
       spdlog::info("tracker.kind {} is frame to frame (tracker.mode {} does not apply)", p_.tracker.kind,
                    enum_name(p_.tracker.mode));
+  } else if (p_.tracker.kind == "trajectory") {
+    given_poses_ = true;
+    if (!p_.frame_poses) {
+      if (p_.tracker.trajectory.empty())
+        throw ConfigError("tracker.kind: trajectory needs tracker.trajectory, a TUM trajectory file");
+      given_ = std::make_shared<const Trajectory>(read_tum_trajectory(p_.tracker.trajectory));
+      if (given_->empty()) throw InputError("tracker.trajectory '" + p_.tracker.trajectory + "' holds no pose");
+      spdlog::info("tracker: fusing at the {} poses of {}", given_->size(), p_.tracker.trajectory);
+    }
   } else if (p_.tracker.kind != "ground_truth") {
     tracker_ = std::make_unique<Tracker>(p_.tracker, device);
   }
@@ -277,6 +287,10 @@ void TrackingSession::accept(const RgbdFrame& frame, const SE3& pose, FrameRecor
 }
 
 void TrackingSession::first_frame(const RgbdFrame& frame, FrameRecord& rec) {
+  if (given_poses_) {  // the world is the given trajectory's: no gravity alignment of our own
+    rec.result = given_pose(frame);
+    return;
+  }
   gravity_ = estimate_gravity(p_.tracker, frame.accelerometer, pyr_);
   if (p_.tracker.gravity != GravitySource::none && !gravity_.found)
     spdlog::warn("tracker.gravity: {} gave no gravity direction; the world frame is the first camera's",
@@ -299,6 +313,7 @@ TrackResult TrackingSession::track_frame(const RgbdFrame& frame) {
     }
     return r;  // no ground truth for this frame: reported as no_reference
   }
+  if (given_poses_) return given_pose(frame);
   if (odometry_) return track_external(frame);
   if (lost_run_ > 0) return relocalise(frame);
   // KinectFusion starts from the last pose; a constant-velocity prediction helps fast motion.
@@ -311,6 +326,40 @@ TrackResult TrackingSession::track_frame(const RgbdFrame& frame) {
   }
   check_cut(r);
   if (r.ok()) last_inlier_ratio_ = r.inlier_ratio;
+  return r;
+}
+
+namespace {
+// The pose of `tr` at time t: a sample within 10 us of t is t's own (TUM files print 6 decimals,
+// so a frame's time written and read back may differ from the frame's in the last digit: the
+// last frame would otherwise fall after the last sample), else interpolate_pose's.
+std::optional<TumPose> pose_at(const Trajectory& tr, double t, double max_gap) {
+  constexpr double kSameTime = 1e-5;
+  auto it = std::lower_bound(tr.begin(), tr.end(), t, [](const TumPose& p, double v) { return p.timestamp < v; });
+  if (it != tr.end() && it->timestamp - t <= kSameTime) return *it;
+  if (it != tr.begin() && t - (it - 1)->timestamp <= kSameTime) return *(it - 1);
+  return interpolate_pose(tr, t, max_gap);
+}
+}  // namespace
+
+// The given pose of the frame: params.frame_poses' by order, else the file's at the frame's time,
+// matched as TUM ground truth is (interpolated between samples at most
+// tracker.trajectory_max_gap apart). Without one the frame is reported as no_reference and not
+// fused, like a ground-truth frame without ground truth.
+TrackResult TrackingSession::given_pose(const RgbdFrame& frame) const {
+  TrackResult r;
+  r.world_T_camera = last_good_;
+  std::optional<SE3> pose;
+  if (p_.frame_poses) {
+    if (processed_ < static_cast<std::int64_t>(p_.frame_poses->size())) pose = (*p_.frame_poses)[processed_];
+  } else if (std::optional<TumPose> p = pose_at(*given_, frame.timestamp, p_.tracker.trajectory_max_gap)) {
+    pose = p->se3();
+  }
+  if (pose) {
+    r.world_T_camera = *pose;
+    r.status = TrackStatus::ok;
+    r.inlier_ratio = 1.0;
+  }
   return r;
 }
 
@@ -478,7 +527,7 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
     remember_view(rec.result.world_T_camera);  // an asynchronous copy every evidence_view_interval frames
   marks_.mark(kTracked);
   if (rec.result.ok()) {
-    if (lost_run_ > 0)
+    if (lost_run_ > 0 && !given_poses_)
       spdlog::info("frame {}: relocalised after {} lost frames, {:.3f} m / {:.1f} deg from the last good pose",
                    frame.index, lost_run_, length((last_good_.inverse() * rec.result.world_T_camera).t),
                    rotation_angle_deg((last_good_.inverse() * rec.result.world_T_camera).R));
@@ -496,6 +545,7 @@ FrameRecord TrackingSession::process(const RgbdFrame& frame) {
     rec.result.world_T_camera = last_good_;  // the estimate was not trusted: keep the last good pose
   }
   started_ = true;
+  ++processed_;
   join_colour();  // a lost frame's colour copy too: the caller may reuse the frame after we return
   marks_.mark(kEnd);
   rec.preprocess_ms = marks_.ms(kStart, kPreprocessed);

@@ -66,8 +66,10 @@ class Volume {
     raycast(K, world_T_camera, m);
     return m;
   }
-  // Marching-cubes mesh of everything fused so far, with vertex colours and normals.
-  virtual Mesh extract_mesh() = 0;
+  // Marching-cubes mesh of everything fused so far, with vertex colours and normals. progress:
+  // report it (core/progress) when it takes more than one pass (a large scan: seconds on the CPU).
+  virtual Mesh extract_mesh(bool progress) = 0;
+  Mesh extract_mesh() { return extract_mesh(false); }
   // Static scene particles for the physics solver (positions and normals on the volume's device).
   virtual SceneParticles extract_scene_particles(const SceneParticleParams& p) = 0;
   // The SDF on a regular grid (x fastest) at origin + voxel * (x, y, z); unknown points read as

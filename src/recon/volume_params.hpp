@@ -22,7 +22,8 @@ struct VolumeParams {
   float truncation = 0.02f;   // metres (4 voxels at the default size)
   float max_weight = 100.f;   // running-average weight cap (lets the model adapt)
   std::int64_t hash_buckets = 1 << 20;
-  std::int64_t capacity = 1 << 18;         // 8^3-voxel blocks the pool can hold
+  // 8^3-voxel blocks the pool starts with; 0: by the device (start_capacity).
+  std::int64_t capacity = 0;
   int dense_resolution = 512;              // voxels per side of the dense cube
   vec3 dense_origin{-1.28f, -1.28f, 0.f};  // world position of the dense cube's min corner
   float min_depth = 0.3f;                  // Kinect v1 minimum range, metres
@@ -35,6 +36,18 @@ struct VolumeParams {
   int occlusion_tile = 8;      // pixels per side of the depth tiles that cull occluded blocks; 0: none
   float stream_radius = 0.f;   // blocks beyond this distance from the camera go to host memory; 0: off
   float stream_step = 0.25f;   // camera travel (metres) between two streaming passes
+
+  // The pool a voxel-hashed volume starts with. capacity 0 chooses by the device: on CUDA 2^18
+  // blocks (1.5 GiB of 12-byte voxels), reserved up front because growing there stops the frame
+  // and briefly holds the old and the new pool on the GPU; on the CPU 4096 blocks (24 MiB), grown
+  // by doubling as the scan needs them (grow_when_full), so a small scan does not reserve and zero
+  // 1.5 GiB of host memory. Without grow_when_full the CPU starts large as well.
+  static constexpr std::int64_t kDeviceCapacity = std::int64_t{1} << 18;
+  static constexpr std::int64_t kHostStartCapacity = 4096;
+  std::int64_t start_capacity(bool on_cuda) const {
+    if (capacity > 0) return capacity;
+    return on_cuda || !grow_when_full ? kDeviceCapacity : kHostStartCapacity;
+  }
 
   // Rules across keys, checked when a config is loaded (Experiment::validate) and by the volumes'
   // constructors (for code that builds a volume without a config).
@@ -58,7 +71,10 @@ struct VolumeParams {
     v("truncation", truncation, "TSDF truncation distance, metres", Range{0.001, 2.0});
     v("max_weight", max_weight, "maximum fusion weight per voxel", Range{1.0, 1e6});
     v("hash_buckets", hash_buckets, "hash table buckets (hash layout)", Range{1024, 1e9});
-    v("capacity", capacity, "voxel blocks in the pool (hash layout)", Range{64, 1e9});
+    v("capacity", capacity,
+      "voxel blocks the pool starts with (hash layout); 0: by the device, 262144 (1.5 GiB) on CUDA, 4096 (24 MiB) "
+      "on the CPU growing as needed (grow_when_full)",
+      Range{0, 1e9});
     v("dense_resolution", dense_resolution, "voxels per side (dense layout)", Range{8, 2048});
     v("dense_origin", dense_origin, "min corner of the dense cube in world coordinates, metres");
     v("min_depth", min_depth, "ignore depth closer than this, metres", Range{0.0, 100.0});

@@ -54,19 +54,22 @@ template <class F> void staged(StageTimer* timer, const char* stage, F&& fn) {
 }
 }  // namespace
 
-VoxelHashVolume::VoxelHashVolume(const VolumeParams& p, Device d) : params_(p), device_(d) {
+VoxelHashVolume::VoxelHashVolume(const VolumeParams& p, Device d)
+    : params_(p), device_(d), growing_start_(p.capacity == 0 && d == Device::CPU && p.grow_when_full) {
   p.validate();
+  params_.capacity = p.start_capacity(d == Device::CUDA);
   geom_ = {{0.f, 0.f, 0.f}, p.voxel_size, p.truncation};
   const std::int64_t slots = next_pow2(std::max<std::int64_t>(p.hash_buckets, 1024));
   keys_ = Buffer<kernels::HashKey>(slots, d);
   values_ = Buffer<std::int32_t>(slots, d);
   scratch_ = Buffer<std::int32_t>(slots, d);
-  voxels_ = Buffer<kernels::Voxel>(p.capacity * kBlockVoxels, d);
+  const std::int64_t capacity = params_.capacity;
+  voxels_ = Buffer<kernels::Voxel>(capacity * kBlockVoxels, d);
   voxels_.zero();
-  free_list_ = Buffer<std::int32_t>(p.capacity, d);
-  visible_ = Buffer<std::int32_t>(p.capacity, d);
-  keep_ = Buffer<std::int32_t>(p.capacity, d);
-  surface_ = Buffer<std::int32_t>(p.capacity, d);
+  free_list_ = Buffer<std::int32_t>(capacity, d);
+  visible_ = Buffer<std::int32_t>(capacity, d);
+  keep_ = Buffer<std::int32_t>(capacity, d);
+  surface_ = Buffer<std::int32_t>(capacity, d);
   surface_.zero();
   counters_ = Buffer<HashCounters>(1, d);
   with_exec(d, [&]<class E>(const E& ex) {
@@ -165,7 +168,10 @@ void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTime
     handle_failures(last_);
     ++retries_;
   }
-  if (free_list_.size() != pool_before)
+  if (free_list_.size() != pool_before && growing_start_)  // the CPU's small start grows by design
+    spdlog::debug("voxel hashing: grew the block pool from {} to {} blocks in frame {}", pool_before, free_list_.size(),
+                  frames_);
+  else if (free_list_.size() != pool_before)
     spdlog::warn(
         "voxel hashing: block pool full in frame {}; grew it from {} to {} blocks (set volume.capacity: {} to "
         "avoid this pause)",
@@ -436,10 +442,10 @@ std::int64_t VoxelHashVolume::live_block_coords(Buffer<int3>& coords) const {
   return n;
 }
 
-Mesh VoxelHashVolume::extract_mesh() {
+Mesh VoxelHashVolume::extract_mesh(bool progress) {
   Buffer<int3> coords;
   const std::int64_t n = live_block_coords(coords);
-  return marching_cubes(device_, device_view(), coords, n);
+  return marching_cubes(device_, device_view(), coords, n, progress);
 }
 
 SceneParticles VoxelHashVolume::extract_scene_particles(const SceneParticleParams& p) {

@@ -23,7 +23,8 @@ class VoxelHashVolume final : public Volume {
                  StageTimer* timer = nullptr) override;
   void raycast(const Intrinsics& K, const SE3& world_T_camera, RaycastMaps& maps, StageTimer* timer = nullptr) override;
   using Volume::raycast;
-  Mesh extract_mesh() override;
+  Mesh extract_mesh(bool progress) override;
+  using Volume::extract_mesh;
   SceneParticles extract_scene_particles(const SceneParticleParams& p) override;
   std::vector<float> sample_sdf_grid(vec3 origin, int3 dims, float voxel) override;
   void require_free_space(const Image<float>& depth, const Intrinsics& K, const SE3& world_T_camera, float min_weight,
@@ -119,6 +120,8 @@ class VoxelHashVolume final : public Volume {
   std::int64_t host_count_ = 0, streamed_out_ = 0, streamed_in_ = 0;
   vec3 stream_pos_{0.f, 0.f, 0.f};
   bool streamed_ = false;  // a pass has run (stream_pos_ is set)
+  // The pool started small on purpose (volume.capacity 0 on the CPU): growing it is no warning.
+  bool growing_start_ = false;
 };
 
 }  // namespace seamless

@@ -3,10 +3,13 @@
 // TUM freiburg1_rpy frames.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
+#include <tuple>
 
 #include "core/error.hpp"
 #include "io/synthetic_source.hpp"
@@ -133,6 +136,88 @@ TEST(TrackSequence, CutIsDetectedNotFusedAndTrackingResumes) {
   for (std::size_t i = 0; i < t.result.frames.size(); ++i)
     if (t.result.frames[i].result.ok()) est.push_back(t.result.trajectory[i]), gt.push_back(t.gt[i]);
   EXPECT_LE(compute_ate(est, gt).trans.rmse, 0.01);
+}
+
+// tracker.kind trajectory: the poses of a TUM file, each frame's found by its timestamp. Fusing
+// the ground-truth tracker's own trajectory.txt gives the ground-truth tracker's mesh (up to the
+// file's 7 decimals, below); a frame missing from the file is
+// reported lost and not fused, unless its neighbours are within trajectory_max_gap (then it is
+// interpolated); poses given in memory (frame_poses) go to the frames in order.
+TEST(TrackSequence, TrajectoryTrackerFusesTheGivenPoses) {
+  constexpr int kFrames = 6;
+  InputParams in = test::synthetic_input(kFrames, false);
+  TrackSequenceParams p = default_params(TrackingMode::frame_to_frame);
+  p.tracker.kind = "ground_truth";
+  test::TmpOut out("given");
+  auto gt_volume = make_volume(p.volume, Device::CPU);
+  TrackSequenceResult gt = track_sequence(*make_source(in), p, Device::CPU, out.str(), gt_volume.get());
+  ASSERT_EQ(gt.lost_frames, 0);
+
+  TrackSequenceParams t = p;
+  t.tracker.kind = "trajectory";
+  t.tracker.trajectory = out.str() + "/trajectory.txt";
+  t.write_files = false;
+  auto volume = make_volume(t.volume, Device::CPU);
+  TrackSequenceResult given = track_sequence(*make_source(in), t, Device::CPU, "", volume.get());
+  ASSERT_EQ(given.lost_frames, 0);
+  const Trajectory file = read_tum_trajectory(t.tracker.trajectory);
+  for (int k = 0; k < kFrames; ++k) {
+    EXPECT_TRUE(given.frames[k].fused) << k;
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(given.trajectory[k].t[i], file[k].t[i], 1e-6) << k;
+  }
+  // The file's 7 decimals move a pose by 0.1 um: a voxel whose TSDF sits that close to zero may
+  // gain or lose its vertex (2 of 108,767 here), so the count agrees to 1e-4 and the bounds to 10 um.
+  const Mesh a = gt_volume->extract_mesh(), b = volume->extract_mesh();
+  ASSERT_GT(a.positions.size(), 1000u);
+  EXPECT_LE(std::abs(static_cast<double>(a.positions.size()) - static_cast<double>(b.positions.size())),
+            1e-4 * static_cast<double>(a.positions.size()));
+  vec3 lo_a{1e9f, 1e9f, 1e9f}, hi_a = -lo_a, lo_b = lo_a, hi_b = hi_a;
+  for (vec3 v : a.positions) lo_a = vmin(lo_a, v), hi_a = vmax(hi_a, v);
+  for (vec3 v : b.positions) lo_b = vmin(lo_b, v), hi_b = vmax(hi_b, v);
+  EXPECT_LE(length(lo_a - lo_b), 1e-5f);
+  EXPECT_LE(length(hi_a - hi_b), 1e-5f);
+
+  // Frames 2 and 4 left out of the file: their neighbours are 67 ms apart (30 frames a second).
+  Trajectory some;
+  for (int k = 0; k < kFrames; ++k)
+    if (k != 2 && k != 4) some.push_back(gt.trajectory[k]);
+  t.tracker.trajectory = out.str() + "/some.txt";
+  write_tum_trajectory(t.tracker.trajectory, some);
+  t.tracker.trajectory_max_gap = 0.05;  // below the 67 ms around frames 2 and 4: both lost
+  TrackSequenceResult gaps = track_sequence(*make_source(in), t, Device::CPU, "", nullptr);
+  EXPECT_EQ(gaps.lost_frames, 2);
+  for (const FrameRecord& r : gaps.frames)
+    EXPECT_EQ(r.result.status == TrackStatus::no_reference, r.frame == 2 || r.frame == 4) << r.frame;
+  t.tracker.trajectory_max_gap = 0.1;  // interpolated between the neighbours
+  TrackSequenceResult filled = track_sequence(*make_source(in), t, Device::CPU, "", nullptr);
+  EXPECT_EQ(filled.lost_frames, 0);
+  // The synthetic camera moves smoothly: the interpolated pose is within a millimetre of the truth.
+  for (int k : {2, 4})
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(filled.trajectory[k].t[i], gt.trajectory[k].t[i], 1e-3) << k;
+
+  // In memory, by order: frame 1 has no pose and is not fused; the others take theirs exactly.
+  auto list = std::make_shared<std::vector<std::optional<SE3>>>();
+  for (int k = 0; k < kFrames; ++k) list->push_back(k == 1 ? std::nullopt : std::optional<SE3>(gt.trajectory[k].se3()));
+  t.frame_poses = list;
+  t.tracker.trajectory.clear();
+  TrackSequenceResult ordered = track_sequence(*make_source(in), t, Device::CPU, "", nullptr);
+  EXPECT_EQ(ordered.lost_frames, 1);
+  for (int k = 0; k < kFrames; ++k) {
+    EXPECT_EQ(ordered.frames[k].result.ok(), k != 1) << k;
+    if (k != 1) {
+      EXPECT_EQ(ordered.trajectory[k].se3().t.x, (*list)[k]->t.x) << k;
+    }
+  }
+
+  // A trajectory kind without a file is a configuration error naming the key.
+  TrackerParams bad;
+  bad.kind = "trajectory";
+  try {
+    bad.validate();
+    FAIL() << "expected a ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("tracker.trajectory"), std::string::npos) << e.what();
+  }
 }
 
 TEST(TrackSequence, UnavailableTrackerSaysSo) {

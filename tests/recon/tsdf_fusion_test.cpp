@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <numeric>
 #include <random>
+#include <tuple>
 
 #include "core/buffer.hpp"
 #include "core/device.hpp"
@@ -279,6 +280,52 @@ TEST(TsdfFusion, BlocksFreedAndAllocatedAgainDoNotGrowTheTable) {
   EXPECT_EQ(st.hash_slots, p.hash_buckets);
   EXPECT_EQ(st.failed_insertions, 0);
   EXPECT_EQ(st.block_capacity, p.capacity);
+}
+
+// volume.capacity 0 on the CPU: a pool of 4096 blocks (24 MiB) that grows as the scan needs,
+// instead of 2^18 blocks (1.5 GiB) reserved and zeroed up front. Growing moves no voxel: the mesh
+// equals that of a pool large enough from the start, vertex for vertex (sorted: the hash table's
+// order of the blocks may differ).
+TEST(TsdfFusion, CpuPoolStartsSmallAndGrowsToTheSameMesh) {
+  VolumeParams p = test::small_volume_params();
+  p.voxel_size = 0.005f, p.truncation = 0.02f, p.hash_buckets = 1 << 16;
+  p.capacity = 0;
+  EXPECT_EQ(p.start_capacity(false), VolumeParams::kHostStartCapacity);
+  EXPECT_EQ(p.start_capacity(true), VolumeParams::kDeviceCapacity);
+  VoxelHashVolume grown(p, Device::CPU);
+  EXPECT_EQ(grown.stats().block_capacity, VolumeParams::kHostStartCapacity);
+  VolumeParams big = p;
+  big.capacity = 1 << 15;
+  VoxelHashVolume roomy(big, Device::CPU);
+  Scene s;
+  s.wall_z = 2.9f;  // a wall filling the view (max_depth 3 m): more blocks than the small start holds
+  const Intrinsics K = test::camera(240, 180, 210.f);
+  const std::vector<SE3> poses = {translations()[0], translations()[1]};
+  fuse(grown, s, K, poses);
+  fuse(roomy, s, K, poses);
+  const VolumeStats g = grown.stats(), r = roomy.stats();
+  ASSERT_GT(g.allocated_blocks, VolumeParams::kHostStartCapacity);  // the premise: it had to grow
+  ASSERT_LE(r.allocated_blocks, big.capacity);                      // ... and the roomy one did not
+  EXPECT_EQ(r.block_capacity, big.capacity);
+  EXPECT_GT(g.block_capacity, VolumeParams::kHostStartCapacity);
+  EXPECT_LT(g.block_capacity, big.capacity);
+  EXPECT_EQ(g.failed_insertions, 0);
+  Mesh a = grown.extract_mesh(), b = roomy.extract_mesh();
+  ASSERT_GT(a.positions.size(), 10000u);
+  ASSERT_EQ(a.positions.size(), b.positions.size());
+  EXPECT_EQ(a.triangles.size(), b.triangles.size());
+  auto less = [](vec3 u, vec3 v) { return std::tie(u.x, u.y, u.z) < std::tie(v.x, v.y, v.z); };
+  std::sort(a.positions.begin(), a.positions.end(), less);
+  std::sort(b.positions.begin(), b.positions.end(), less);
+  for (std::size_t i = 0; i < a.positions.size(); ++i) {
+    ASSERT_EQ(a.positions[i].x, b.positions[i].x) << i;
+    ASSERT_EQ(a.positions[i].y, b.positions[i].y) << i;
+    ASSERT_EQ(a.positions[i].z, b.positions[i].z) << i;
+  }
+
+  // Without growth the CPU cannot start small: it starts as large as on CUDA.
+  p.grow_when_full = false;
+  EXPECT_EQ(p.start_capacity(false), VolumeParams::kDeviceCapacity);
 }
 
 TEST(TsdfFusion, RejectsTruncationBelowTwoVoxels) {

@@ -11,6 +11,7 @@
 #include "core/exec.hpp"
 #include "core/log.hpp"
 #include "core/output_file.hpp"
+#include "core/progress.hpp"
 #include "io/input_params.hpp"
 #include "kernels/recon/rgbd.hpp"
 #include "recon/preprocess.hpp"
@@ -135,13 +136,15 @@ std::vector<KeyframeData> load_keyframes(FrameSource& source, const Trajectory& 
   std::int64_t n = 0;
   std::size_t next = 0;
   const auto total = static_cast<std::int64_t>(odometry.size());
+  Progress progress("refine: reading the keyframes", total);
   while (n < total && source.next(f)) {
     if (next < kf.size() && n == kf[next]) {
       out.push_back({n, odometry[n].timestamp, to_pose(odometry[n]), build_pyramid(f, K, pre, colour, d)});
       ++next;
     }
-    ++n;
+    progress.update(++n);
   }
+  progress.finish();
   if (n != total)
     throw InputError("refine: the source '" + source.name() + "' gave " + std::to_string(n) +
                      " frames but the trajectory has " + std::to_string(total) +
@@ -291,6 +294,7 @@ Graph build_graph(const std::vector<KeyframeData>& kf, const RefineParams& p, De
   Tracker tracker(pair_tracker_params(p), d);
   const int level = finest_level(p, kf.front().pyr->levels());
   ReferenceMaps ref;
+  Progress progress("refine: aligning keyframe pairs", static_cast<std::int64_t>(kf.size()) - 1, true, "keyframes/s");
   for (int i = 0; i + 1 < static_cast<int>(kf.size()); ++i) {
     ref.set_from_frame(*kf[i].pyr, SE3::identity());
     add_odometry_edge(g, tracker, kf[i], kf[i + 1], ref, i, p, level);
@@ -298,6 +302,7 @@ Graph build_graph(const std::vector<KeyframeData>& kf, const RefineParams& p, De
     std::vector<int> js = partners(tracker, kf, ref, i, p);
     g.stats.candidate_pairs += static_cast<std::int64_t>(js.size());
     for (int j : js) add_pair_edge(g, tracker, kf[i], kf[j], ref, i, j, p, level);
+    progress.update(i + 1);
   }
   return g;
 }
