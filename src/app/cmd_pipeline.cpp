@@ -20,7 +20,8 @@ void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
   r->callback([&action, rec] {
     action = [rec] {
       RunContext ctx(*rec);
-      scan(ctx, true);
+      const ScanResult r = scan(ctx, true);
+      write_scan_summary(ctx, "reconstruct", r);
       return ctx.exit_code();
     };
   });
@@ -42,6 +43,7 @@ void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
         for (const FrameRecord& f : r.tracking.frames) tracked.push_back(f.result.ok());
         refine_run(e.input, r.tracking.trajectory, tracked, e.refine, e.preprocess, ctx.device(), ctx.out_dir());
       }
+      write_scan_summary(ctx, "track", r);
       return ctx.exit_code();
     };
   });

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <optional>
 
 #include "app/ghost.hpp"
@@ -74,6 +75,8 @@ void record_intrinsics(RunContext& ctx, const FrameSource& source) {
 
 using namespace detail;
 
+float seen_through_slack(const VolumeParams& v) { return v.truncation + 0.03f; }
+
 ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
   const Experiment& e = ctx.experiment();
   require_tracker(e.tracker.kind);
@@ -86,7 +89,9 @@ ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
   Progress progress("scan", total);
   std::int64_t n = 0;
   r.intrinsics = source->intrinsics();
+  SeenViews seen;  // what the tracked frames saw, for the seen-through ghost
   auto on_frame = [&](const RgbdFrame& frame, const FrameRecord& f) {
+    if (f.result.ok()) seen.add(frame.depth, r.intrinsics, f.result.world_T_camera);
     ctx.timer().add(f.frame, "preprocess", f.preprocess_ms);  // as it goes: a run that fails keeps them
     ctx.timer().add(f.frame, "track", f.track_ms);
     ctx.timer().add(f.frame, "fuse", f.fuse_ms);
@@ -95,6 +100,7 @@ ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
     progress.update(++n, to_string(f.result.status));
   };
   TrackSequenceParams tp = tracking_params(e, volume_stages);
+  tp.keep_model_mesh = !with_volume;  // tracking only: the tracker's own model, for the ghost measure
   std::unique_ptr<OnlineCorrector> online;  // refine.online: the keyframe graph solved while tracking runs
   if (e.refine.online) {
     online =
@@ -121,7 +127,28 @@ ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
       spdlog::info("mesh.ply: {} vertices, {} triangles", r.mesh.positions.size(), r.mesh.triangles.size());
     }
   }
+  const Mesh* model = r.volume ? &r.mesh : (r.tracking.model_mesh ? &*r.tracking.model_mesh : nullptr);
+  if (model && seen.size() > 0) {
+    r.seen_through = seen_through_vertices(*model, seen, seen_through_slack(e.volume));
+    spdlog::info("ghost: {} of the {} mesh's {} vertices lie where at least two of {} frames saw through them",
+                 r.seen_through->vertices, r.volume ? "volume" : "tracker's model", r.seen_through->mesh_vertices,
+                 r.seen_through->views);
+  }
   return r;
+}
+
+void write_scan_summary(RunContext& ctx, const std::string& command, const ScanResult& r) {
+  const Experiment& e = ctx.experiment();
+  RunSummary s;
+  s.command = command, s.config = e.name, s.device = device_name(ctx.device());
+  s.intrinsics = r.intrinsics;
+  // The ground truth in the run's world frame, as the scan wrote it beside trajectory.txt.
+  const std::string gt = ctx.out_path("groundtruth.txt");
+  add_tracking(s, r.tracking, r.unreadable, std::filesystem::exists(gt) ? gt : "");
+  s.seen_through = r.seen_through;
+  s.online_refine = r.online_refine;
+  add_stage_medians(s, ctx.timer());
+  write_summary(ctx.out_path("summary.json"), s);
 }
 
 namespace {
