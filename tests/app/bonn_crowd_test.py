@@ -8,15 +8,16 @@ recording's motion-capture poses and its own depth:
 
 Person-free reference. In the first frame (pair 220) the first person is only a strip at the left
 border (x < 100 pixels in its colour image; they walk in from there); right of REFERENCE_X0 = 128
-pixels it shows the empty room. A point of a later frame that this REFERENCE view saw THROUGH (every reading of the 3x3 pixels around its
-projection, with the ground-truth poses, lies behind it by more than the margin below) is in space
-that was empty then: something moved there. That is "dynamic by geometry" (D). A point the
-reference saw AT (its reading within the margin) is the room (S). Everything
-else (out of the reference views, hidden behind nearer readings) is not judged. The margin:
-3 sigma of the structured-light depth noise at that depth (sigma = 1.5e-3 z^2 m, Khoshelham &
-Elberink 2012) plus 3 cm for the ground truth's pose error (SOURCE.txt: depth warped with its poses
-agrees to under 1 cm per m^2) and the nearest-neighbour undistortion. So D misses people where they
-touch the room (feet on the floor within the margin) and where no reference frame looked: the check
+pixels it shows the empty room. A point of a later frame that this reference view saw THROUGH
+(every reading of the 3x3 pixels around its projection, with the ground-truth poses, lies behind
+it by more than the margin below) is in space that was empty then: something moved there. That is
+"dynamic by geometry" (D). A point the reference saw AT (its reading within the margin) is the
+room (S). Everything else (out of the reference view, hidden behind nearer readings, farther than
+4 m) is not judged. The margin: 3 sigma of the structured-light depth noise at that depth
+(sigma = 1.5e-3 z^2 m, Khoshelham & Elberink 2012) plus 3 cm for the ground truth's pose error
+(SOURCE.txt: depth warped with its poses agrees to under 1 cm per m^2) and the nearest-neighbour
+undistortion. So D misses people where they touch the room (feet on the floor within the margin)
+and where the reference did not look (the left border, where the second person enters): the check
 says nothing about those pixels.
 
 1. Precision of the mask: of the masked pixels that the reference judges (D or S), at least
@@ -29,20 +30,21 @@ says nothing about those pixels.
    (the failure this guards against) falls well under it.
 2. Recall: of the D pixels, at least RECALL_MIN are masked, over the frames where D covers at least
    1 % of the image (a sliver at the border has a handful of pixels). A D pixel lies in front of the
-   model the reference frames were fused into by more than the margin, which is more than the mask's
-   residual threshold at every depth (3 cm + 3 sigma against max(3 cm, 3 sigma + one depth step)),
-   and frame 0 is one of the kept views that saw through it: both of the mask's tests pass. What can
+   model frame 0 was fused into by more than the margin, which is more than the mask's residual
+   threshold at every depth (3 cm + 3 sigma against max(3 cm, 3 sigma + one depth step)), and
+   frame 0 is one of the kept views that saw through it: both of the mask's tests pass. What can
    drop it: the 3x3 support filter (isolated pixels), pixels where the tracked pose differs from the
    ground truth, and the person's near parts under the sensor's minimum depth (no reading: not D
    either). 0.8 leaves that a fifth.
-3. ATE: the trajectory against the ground truth after rigid alignment at most ATE_MAX_M. Derived
-   from the reference too: the RGB-D tracker's per-frame error on the person-free opening frames
-   (measured here: RPE per frame over the reference frames, e_static) accumulates over the run at
-   most linearly, ATE <= e_static * FRAMES / 2 (a drift growing linearly from 0 to e_static * FRAMES
-   has an RMS about the aligned line of a third of that; half leaves room), floored at 1 cm (the
-   ground truth's own consistency, SOURCE.txt, and the mesh of 1 cm voxels the tracker aligns to).
-   Tracking the people instead of the room, as with dynamic handling off, gives tens of centimetres
-   on these frames (docs/DYNAMIC.md).
+3. ATE: the trajectory against the ground truth after rigid alignment at most half the ground
+   truth's own spread: the RMS distance of the ground-truth camera positions from their mean (4.2 cm
+   over these 40 frames, computed here). That spread is exactly the ATE of a tracker that never
+   moved (one point aligned to a path lands on its mean), so the bound asks the tracker to explain
+   at least half of the camera's motion in the RMS sense while the people cross. Tracking the people
+   instead of the room, as with dynamic handling off, is dragged along with them: 22.7 cm over these
+   40 frames, 40 cm over all 60 (docs/DYNAMIC.md, "The Bonn crowd"); with it on, 1.3 cm.
+4. The checks can fail on this data: a mask over the whole image has a precision (D among the judged
+   pixels) under PRECISION_MIN, an empty one a recall of 0.
 
 Usage: bonn_crowd_test.py SEAMLESS ROOT DATA OUT; exit 77 (skip) without the data folder.
 """
@@ -165,16 +167,10 @@ def evaluate(exe, out):
         return json.load(f)
 
 
-def static_rpe_per_frame(out):
-    """The tracker's translation error per frame over the person-free reference frames (m)."""
-    est = [quat_pose(l[1:8]) for l in tum_lines(os.path.join(out, "trajectory.txt"))]
-    gt = [quat_pose(l[1:8]) for l in tum_lines(os.path.join(out, "groundtruth.txt"))]
-    errs = []
-    for k in range(1, REFERENCE):
-        de = np.linalg.inv(est[k - 1]) @ est[k]
-        dg = np.linalg.inv(gt[k - 1]) @ gt[k]
-        errs.append(np.linalg.norm((np.linalg.inv(dg) @ de)[:3, 3]))
-    return float(np.mean(errs))
+def spread(poses):
+    """RMS distance of the camera positions from their mean: the ATE of a tracker that never moved."""
+    P = np.array([T[:3, 3] for T in poses])
+    return float(np.sqrt(((P - P.mean(axis=0)) ** 2).sum(axis=1).mean()))
 
 
 def main():
@@ -202,6 +198,7 @@ def main():
     refs = [(ref, poses[0])]
 
     tp = fp = fn = 0
+    judged_all = d_all = 0
     rows = []
     for k in range(1, FRAMES):
         mask_path = os.path.join(out, "dynamic_mask", f"{k:06d}.png")
@@ -211,6 +208,8 @@ def main():
         d, s = lab == 1, lab == 2
         tp_k, fp_k, fn_k = int((mask & d).sum()), int((mask & s).sum()), int((~mask & d).sum())
         rows.append((k, d.mean(), mask.mean(), tp_k, fp_k, fn_k))
+        judged_all += int((d | s).sum())
+        d_all += int(d.sum())
         fp += fp_k
         if d.mean() >= 0.01:
             tp += tp_k
@@ -227,10 +226,14 @@ def main():
     assert precision >= PRECISION_MIN, f"mask precision {precision:.3f} < {PRECISION_MIN}"
     assert recall >= RECALL_MIN, f"mask recall {recall:.3f} < {RECALL_MIN}"
 
-    e_static = static_rpe_per_frame(out)
-    ate_max = max(0.01, e_static * FRAMES / 2)
+    # The premise of 4: a mask over every pixel would be judged by the same rule and fail it.
+    full_precision = d_all / max(1, judged_all)
+    print(f"a mask over the whole image: precision {full_precision:.3f}")
+    assert full_precision < PRECISION_MIN, f"the precision check cannot fail here ({full_precision:.3f})"
+
+    ate_max = 0.5 * spread(poses)
     ate = evaluate(exe, out)["ate_rmse_m"]
-    print(f"ATE {100 * ate:.2f} cm; person-free per-frame error {1000 * e_static:.2f} mm -> bound {100 * ate_max:.2f} cm")
+    print(f"ATE {100 * ate:.2f} cm (bound: half the ground truth's spread, {100 * ate_max:.2f} cm)")
     assert ate <= ate_max, f"ATE {100 * ate:.2f} cm > {100 * ate_max:.2f} cm"
     return 0
 
