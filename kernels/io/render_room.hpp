@@ -15,7 +15,7 @@
 #pragma once
 #include <cstdint>
 
-#include "core/camera.hpp"
+#include "core/intrinsics.hpp"
 #include "core/exec.hpp"
 #include "core/math.hpp"
 #include "core/view.hpp"

@@ -2,7 +2,7 @@
 // as published with the TUM RGB-D calibrations). The output is the ideal pinhole image with the
 // same fx fy cx cy: each output pixel looks up where the lens put it.
 #pragma once
-#include "core/camera.hpp"
+#include "core/intrinsics.hpp"
 #include "core/exec.hpp"
 #include "core/math.hpp"
 #include "core/view.hpp"

@@ -287,10 +287,7 @@ int scan_runs_simd(const SimViews& S, vec3 p, float R, int s, int* list, int cap
   const float R2 = R * R, pad = 1e-3f * g.cell;
   const std::uint32_t m = (1u << g.bits) - 1u;
   float ey2[kW], ez2[kW];
-  for (int d = 0; d < kW; ++d) {
-    const float ey = slab_gap(p.y, c.y + d - kReach, g.cell, pad), ez = slab_gap(p.z, c.z + d - kReach, g.cell, pad);
-    ey2[d] = ey * ey, ez2[d] = ez * ez;
-  }
+  slab_gaps2(g, p, c, pad, ey2, ez2);
   // Row r = dz kW + dy; lanes past the rows get R2 (no row).
   alignas(32) float d2[kVecs * simd::kWidth];
   for (int r = 0; r < kVecs * simd::kWidth; ++r) d2[r] = r < kRows ? ey2[r % kW] + ez2[r / kW] : R2;

@@ -1,4 +1,4 @@
-// Kernel family of the depth camera's collider particles (issue 22, solver.dynamic_colliders;
+// Kernel family of the depth camera's collider particles (solver.dynamic_colliders;
 // physics/depth_colliders.hpp says what they are and DeviceMovingColliders strings these together):
 // the level's dynamic mask, the seen surface compacted in pixel order, each point's velocity from
 // the previous frame's nearest point, and the thickened colliders at a time between two frames.

@@ -1,26 +1,16 @@
-// Per-element math of the particle solver (host and device): phase flags, SPH kernels, the
-// neighbour grid's cell keys, quaternions and the rotation extraction of shape matching.
+// Per-element math of the particle solver (host and device): SPH kernels, the neighbour grid's
+// cell keys and traversal, and the rotation extraction of shape matching. The phase flags
+// (core/phase.hpp) and quaternions (core/quaternion.hpp) are in core: the renderer reads them too.
 #pragma once
 #include <cstdint>
 #include <cstring>
 
 #include "core/hd.hpp"
 #include "core/math.hpp"
+#include "core/phase.hpp"
+#include "core/quaternion.hpp"
 
 namespace seamless::kernels {
-
-// Phase word of a dynamic particle (Macklin 2014, section 4.3): a group id in the low 24 bits
-// (rigid body id, cloth id) and flags above. Static scene particles live in their own arrays.
-namespace phase {
-constexpr std::uint32_t kGroupMask = 0x00FFFFFFu;
-constexpr std::uint32_t kFluid = 1u << 24;
-constexpr std::uint32_t kRigid = 1u << 25;
-constexpr std::uint32_t kCloth = 1u << 26;
-constexpr std::uint32_t kSelfCollide = 1u << 27;
-constexpr std::uint32_t kStatic = 1u << 28;
-SEAMLESS_HD inline std::uint32_t group(std::uint32_t ph) { return ph & kGroupMask; }
-SEAMLESS_HD inline bool is(std::uint32_t ph, std::uint32_t flag) { return (ph & flag) != 0u; }
-}  // namespace phase
 
 constexpr float kPi = 3.14159265358979f;
 
@@ -135,6 +125,17 @@ template <class F> SEAMLESS_HD inline F slab_gap(F v, int i, float cs, float pad
   return select(g > 0.f, g, F(0.f));
 }
 
+// The squared distances along y and along z from p (in cell c) to the slabs of cells c.y + d - reach
+// and c.z + d - reach, d in [0, 2 reach], made smaller by pad: a row of cells (dy, dz) is at
+// squared y-z distance ey2[dy] + ez2[dz] (for_each_run_in_radius).
+SEAMLESS_HD inline void slab_gaps2(const GridSpec& g, vec3 p, int3 c, float pad, float* ey2, float* ez2) {
+  constexpr int kReach = GridSpec::reach;
+  for (int d = 0; d <= 2 * kReach; ++d) {
+    const float ey = slab_gap(p.y, c.y + d - kReach, g.cell, pad), ez = slab_gap(p.z, c.z + d - kReach, g.cell, pad);
+    ey2[d] = ey * ey, ez2[d] = ez * ez;
+  }
+}
+
 // The cells [lo, hi] along x (not yet wrapped) of the row of cells at squared y-z distance d2
 // from p that the sphere of radius R2 = R^2 around p crosses, within reach of p's cell cx, made
 // larger by pad (for_each_run_in_radius). F, I: float and int, or the CPU's SIMD lanes.
@@ -165,10 +166,7 @@ SEAMLESS_HD inline void for_each_run_in_radius(const GridSpec& g, const int* sta
   const float R2 = R * R, pad = 1e-3f * g.cell;
   const std::uint32_t m = (1u << g.bits) - 1u;
   float ey2[kWidth], ez2[kWidth];
-  for (int d = 0; d < kWidth; ++d) {
-    const float ey = slab_gap(p.y, c.y + d - kReach, g.cell, pad), ez = slab_gap(p.z, c.z + d - kReach, g.cell, pad);
-    ey2[d] = ey * ey, ez2[d] = ez * ez;
-  }
+  slab_gaps2(g, p, c, pad, ey2, ez2);
   for (int dz = 0; dz < kWidth; ++dz) {
     const std::uint32_t slab = (static_cast<std::uint32_t>(c.z + dz - kReach) & m) << (2 * g.bits);
     for (int dy = 0; dy < kWidth; ++dy) {
@@ -209,22 +207,7 @@ SEAMLESS_HD inline int lower_bound_key(const std::uint32_t* keys, int n, std::ui
   return lo;
 }
 
-// ---- quaternions (x, y, z, w) ------------------------------------------------------------------
-SEAMLESS_HD inline vec4 quat_mul(vec4 a, vec4 b) {
-  return {a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y, a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x,
-          a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w, a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z};
-}
-SEAMLESS_HD inline vec4 quat_normalize(vec4 q) {
-  float l = sqrtf(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
-  return l > 0.f ? q * (1.f / l) : vec4{0.f, 0.f, 0.f, 1.f};
-}
-SEAMLESS_HD inline mat3 quat_to_mat(vec4 q) {
-  float x = q.x, y = q.y, z = q.z, w = q.w;
-  return {{{1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
-           {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)},
-           {2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)}}};
-}
-
+// ---- shape matching's rotation ------------------------------------------------------------------
 // Rotational part of A (Mueller, Bender, Chentanez, Macklin 2016, "A Robust Method to Extract the
 // Rotational Part of Deformations", eq. 7): rotate q towards the column-wise alignment of R(q)
 // with A until the angular step is negligible. Warm-started from the previous frame's q, it needs

@@ -1,4 +1,4 @@
-// Dynamic pixels from depth alone (issue 22; docs/DYNAMIC.md): which pixels of a frame see
+// Dynamic pixels from depth alone (docs/DYNAMIC.md): which pixels of a frame see
 // something that moves (a person walking, a ball rolling), found by comparing the measurement with
 // the model raycast, after ReFusion (Palazzolo et al., "ReFusion: 3D Reconstruction in Dynamic
 // Environments for RGB-D Cameras Exploiting Residuals", IROS 2019, sections III-C and III-D):
@@ -8,7 +8,7 @@
 #pragma once
 #include <cstdint>
 
-#include "core/camera.hpp"
+#include "core/intrinsics.hpp"
 #include "core/exec.hpp"
 #include "core/math.hpp"
 #include "core/view.hpp"

@@ -2,7 +2,7 @@
 // a pyramid that averages only across similar depths, vertex and normal maps. Depth is in metres,
 // 0 = no reading; an invalid vertex or normal is the zero vector.
 #pragma once
-#include "core/camera.hpp"
+#include "core/intrinsics.hpp"
 #include "core/exec.hpp"
 #include "core/math.hpp"
 #include "core/view.hpp"

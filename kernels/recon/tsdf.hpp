@@ -6,7 +6,7 @@
 #include <cstring>
 #include <type_traits>
 
-#include "core/camera.hpp"
+#include "core/intrinsics.hpp"
 #include "core/exec.hpp"
 #include "core/math.hpp"
 #include "core/view.hpp"
@@ -107,7 +107,7 @@ SEAMLESS_HD inline bool voxel_keeps_block(const Voxel& v, float keep_below) {
   return v.weight > 0.f && fabsf(v.sdf) < keep_below;
 }
 
-// The surface flag of each block of the pool (issue 22, docs/DYNAMIC.md "The surface flag"): 1
+// The surface flag of each block of the pool (docs/DYNAMIC.md "The surface flag"): 1
 // while one of its voxels is observed and near a surface (voxel_keeps_block with the band's
 // threshold below = 0.999 truncation, whatever the garbage collection keeps), else 0. It is the
 // band-only volume's garbage collection's decision (Niessner et al. 2013), kept for the blocks
@@ -118,7 +118,7 @@ struct SurfaceFlags {
   float below = 0.f;             // metres
 };
 
-// Free space in the voxel-hashed volume (issue 22, docs/DYNAMIC.md "Evidence of free space"): as in
+// Free space in the voxel-hashed volume (docs/DYNAMIC.md "Evidence of free space"): as in
 // ReFusion (Palazzolo et al. 2019), the blocks along the whole ray in front of a reading are
 // allocated, so fusion stores the free space (+truncation) there, not only the band around the
 // surface (Niessner et al. 2013, section 4.1). Only the pixels on a lattice of every stride-th
@@ -210,7 +210,7 @@ struct RayIntervals : TileGrid {
 constexpr std::int32_t kEmptyNear = 0x7f800000;  // +infinity
 constexpr std::int32_t kEmptyFar = 0;            // +0: no block splatted
 
-// Blocks without a surface (issue 22, docs/DYNAMIC.md "The surface flag"). A volume that stores
+// Blocks without a surface (docs/DYNAMIC.md "The surface flag"). A volume that stores
 // free space keeps the blocks in front of the surfaces, whose voxels all hold +truncation; the
 // raycast would march through them in truncation-sized steps where it skips an unallocated block
 // whole. The trilinear sample in the cell of voxel g0 reads the voxels g0 + {0,1}^3, which lie in
@@ -295,7 +295,7 @@ constexpr int kMcRow = 16;
 
 namespace seamless::kernels {
 
-// Static scene particles (DESIGN "Physics": scene particles come from the hash blocks), in two
+// Static scene particles, taken from the hash blocks of the volume, in two
 // passes over the listed blocks and a thinning (tsdf_extract.inl says why): the candidates of a
 // block are owned by the points of the lattice spacing * Z^3 inside it. Lattice point L gives the
 // zero crossings of the TSDF on the segments L -> L + spacing e_axis (axis x, y, z) where the

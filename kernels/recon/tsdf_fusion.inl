@@ -189,7 +189,7 @@ SEAMLESS_HD inline void set_keep(std::int32_t* flag) {
   if (atomic_load(flag) == 0) atomic_exch(flag, 1);
 }
 
-// Free-space carving (issue 22, after ReFusion, Palazzolo et al. 2019, section III-D): the voxel
+// Free-space carving (after ReFusion, Palazzolo et al. 2019, section III-D): the voxel
 // lies more than in.carve in front of the reading at its pixel and of the 3x3 readings around it,
 // so the ray saw through it: whatever surface it held (a person who stood there) is gone. The
 // running average alone would need as many free observations as the voxel had weight (up to

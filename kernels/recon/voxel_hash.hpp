@@ -357,8 +357,8 @@ SEAMLESS_HD inline vec3 tsdf_gradient(const Acc& a, vec3 q, float s0, BlockCache
 }
 
 // SDF value (metres) and gradient (unit-free, ~unit length near the surface) at world point p, for
-// collisions against the fused scene (DESIGN "Physics": the smoother alternative of the
-// dissertation's section 2.6.4). False where the TSDF is unknown (unallocated or unobserved).
+// collisions against the fused scene (the smoother alternative of the dissertation's section
+// 2.6.4). False where the TSDF is unknown (unallocated or unobserved).
 template <class Acc> SEAMLESS_HD inline bool sample_sdf(const Acc& a, vec3 p, float* value, vec3* gradient) {
   BlockCache c;
   vec3 q = a.geom.to_voxel(p);

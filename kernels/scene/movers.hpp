@@ -1,4 +1,4 @@
-// Things that move through the synthetic room (issue 22's test material): a person walking, a ball
+// Things that move through the synthetic room (test material of dynamic scenes): a person walking, a ball
 // rolling. Each is a handful of capsules (points within radius r of the segment a-b; a sphere is a
 // capsule with a = b), posed per frame on the host (src/io/movers.cpp) and intersected here exactly
 // by the renderer on either backend. World frame of synthetic_room.hpp: metres, z up.

@@ -15,10 +15,10 @@
 #include "app/run_context.hpp"
 #include "config/config.hpp"
 #include "core/error.hpp"
+#include "io/ply.hpp"
 #include "io/trajectory.hpp"
 #include "physics/objects.hpp"
 #include "physics/particle_io.hpp"
-#include "recon/ply.hpp"
 #include "seamless/build_config.hpp"
 #if SEAMLESS_HAS_GL
 #include "render/headless_output.hpp"
@@ -114,7 +114,7 @@ class KinectFrames {
 SceneCamera mesh_camera(Renderer& r, const RenderOptions& o, const RenderParams& p) {
   const std::string mesh_path = o.run_dir + "/mesh.ply", traj_path = o.run_dir + "/trajectory.txt";
   Mesh mesh;
-  if (fs::exists(mesh_path)) mesh = read_ply(mesh_path);
+  if (fs::exists(mesh_path)) mesh = read_mesh_ply(mesh_path);
   else spdlog::warn("{} is missing: drawing the objects without the scene", mesh_path);
   if (!mesh.triangles.empty()) r.set_scene_mesh(mesh);
   SE3 first = SE3::identity();

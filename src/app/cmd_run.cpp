@@ -18,8 +18,8 @@
 #include "config/config.hpp"
 #include "core/error.hpp"
 #include "io/movers.hpp"
+#include "io/ply.hpp"
 #include "io/trajectory.hpp"
-#include "physics/particle_io.hpp"
 #include "physics/particle_solver.hpp"
 
 namespace seamless::app {

@@ -10,7 +10,7 @@
 
 #include "core/buffer.hpp"
 #include "core/camera.hpp"
-#include "core/geometry.hpp"
+#include "core/mesh.hpp"
 #include "io/input_params.hpp"
 #include "io/trajectory.hpp"
 

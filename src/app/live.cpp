@@ -19,12 +19,12 @@
 #include "io/frame_source.hpp"
 #include "io/intrinsics_presets.hpp"
 #include "io/movers.hpp"
+#include "io/ply.hpp"
 #include "io/trajectory.hpp"
 #include "physics/builders.hpp"
 #include "physics/depth_colliders.hpp"
 #include "physics/particle_io.hpp"
 #include "physics/particle_solver.hpp"
-#include "recon/ply.hpp"
 #include "recon/refine/online_refine.hpp"
 
 namespace seamless::app {
@@ -152,7 +152,7 @@ class LiveLoop : public FrameLoop {
                  ctx_.timer().median_ms("physics"), ctx_.timer().median_ms("extract"));
     log_volume(volume_->stats());
     const Mesh mesh = volume_->extract_mesh();
-    if (e_.output.write_mesh) write_ply(ctx_.out_path("mesh.ply"), mesh);
+    if (e_.output.write_mesh) write_mesh_ply(ctx_.out_path("mesh.ply"), mesh);
     write_live_summary(mesh, state);
   }
 
@@ -171,7 +171,7 @@ class LiveLoop : public FrameLoop {
   // the full-resolution pixels it averages is). On the run's device, from the tracker's maps to
   // the solver (DeviceColliders).
   // frame_time: the simulation time this frame's steps end at; the steps between the last frame
-  // and this one move the colliders with their estimated velocities (MovingColliders).
+  // and this one move the colliders with their estimated velocities.
   void update_colliders(const SE3& world_T_camera, double frame_time) {
     StageScope s(ctx_.timer(), "colliders");
     const auto [vertices, normals] = session_.unmasked_level();

@@ -17,12 +17,12 @@
 #include "core/progress.hpp"
 #include "io/frame_source.hpp"
 #include "io/intrinsics_presets.hpp"
+#include "io/ply.hpp"
 #include "io/trajectory.hpp"
 #include "physics/builders.hpp"
 #include "physics/depth_colliders.hpp"
 #include "physics/particle_io.hpp"
 #include "physics/particle_solver.hpp"
-#include "recon/ply.hpp"
 #include "recon/refine/online_refine.hpp"
 
 namespace seamless::app {
@@ -123,7 +123,7 @@ ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
     log_volume(r.volume->stats());
     r.mesh = r.volume->extract_mesh();
     if (e.output.write_mesh) {
-      write_ply(ctx.out_path("mesh.ply"), r.mesh);
+      write_mesh_ply(ctx.out_path("mesh.ply"), r.mesh);
       spdlog::info("mesh.ply: {} vertices, {} triangles", r.mesh.positions.size(), r.mesh.triangles.size());
     }
   }

@@ -15,7 +15,7 @@ namespace detail {
 
 // Closes the renderer's outputs (the video encoder) after the run: a failed encoder (say, one
 // stopped by the same Ctrl-C) is reported, not thrown, so that the particles, trajectory, stats
-// and summary that follow are still written (issue 20).
+// and summary that follow are still written.
 void finish_renderer(RunContext& ctx, RunRenderer& r);
 // The tracking session's parameters from the experiment's sections.
 TrackSequenceParams tracking_params(const Experiment& e, StageTimer* volume_stages);

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "core/camera.hpp"
+#include "core/intrinsics.hpp"
 #include "core/math.hpp"
 #include "io/trajectory.hpp"
 #include "physics/solver_params.hpp"

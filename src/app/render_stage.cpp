@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <numbers>
 
 #include "core/error.hpp"
-#include "kernels/physics/particle_math.hpp"
 #include "seamless/build_config.hpp"
 #if SEAMLESS_HAS_GL
 #include "io/png_io.hpp"
@@ -38,7 +38,7 @@ SceneCamera mesh_view_camera(const Mesh& mesh, const SE3& scan_camera, const Ren
 }
 
 SceneCamera orbit_camera(const SceneCamera& c, const RenderParams& p, float progress) {
-  const float a = p.orbit_deg * std::clamp(progress, 0.f, 1.f) * kernels::kPi / 180.f;
+  const float a = p.orbit_deg * std::clamp(progress, 0.f, 1.f) * std::numbers::pi_v<float> / 180.f;
   const vec3 r = c.eye - c.target;
   const float cs = std::cos(a), sn = std::sin(a);
   // A turn about +y by a: (x, z) -> (x cos a + z sin a, -x sin a + z cos a); a positive angle turns

@@ -7,7 +7,7 @@
 
 #include "app/ghost.hpp"
 #include "app/placement.hpp"
-#include "core/camera.hpp"
+#include "core/intrinsics.hpp"
 #include "physics/particle_solver.hpp"
 #include "recon/refine/online_refine.hpp"
 #include "recon/tracker_sequence.hpp"

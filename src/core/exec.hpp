@@ -1,4 +1,11 @@
-// Executors: the one place where the two backends differ (see DESIGN, "One kernel, two backends").
+// Executors: the one place where the two backends differ. Every computation is written once: the
+// per-element math as SEAMLESS_HD inline functions (core/hd.hpp) in headers under kernels/, and each
+// kernel family as a template over an executor, instantiated twice by two small files: one compiled
+// as C++ with the OpenMP executor (exec_cpu.hpp), one compiled by nvcc with the CUDA executor
+// (exec_cuda.cuh, collectives from CUB). No algorithm is written twice; the same tests run on both
+// backends, and the Parity tests (ctest label gpu) compare their results on the same inputs. Memory
+// is a Buffer<T> (core/buffer.hpp) owning one allocation on one device; kernels see plain views
+// (core/view.hpp), transfers are explicit, and Eigen stays on the host side.
 //
 // A kernel family is a template over the executor type and uses only:
 //   ex.for_each(n, fn)                   fn(i) for i in [0, n), in parallel

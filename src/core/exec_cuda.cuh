@@ -117,7 +117,7 @@ template <int kQ> __device__ __forceinline__ void warp_reduce_scatter(float (&v)
 // while the others wait again; every block then reads the same stop flag, so the grid leaves
 // the loop together. A round costs two grid barriers instead of a launch and the "last block"
 // counter of transform_reduce_kernel, and the sums of a 30-float term take a few hundred cycles
-// where a block reduction of the struct took thousands (docs/PERFORMANCE.md, session 6). At least
+// where a block reduction of the struct took thousands (docs/PERFORMANCE.md). At least
 // 2 blocks per multiprocessor: the RGB-D term's pixel function and the double-precision solve
 // would otherwise take 175 registers, one block of 8 warps per SM, too few to hide the pixels'
 // gathers (faster with the bound despite a few spilled bytes, docs/PERFORMANCE.md; ICP fits in 126

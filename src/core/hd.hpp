@@ -1,5 +1,5 @@
-// SEAMLESS_HD marks a function usable on the host and in CUDA kernels (see DESIGN: one kernel, two
-// backends). Under g++ it expands to nothing.
+// SEAMLESS_HD marks a function usable on the host and in CUDA kernels: every computation is written
+// once and compiled for both backends (core/exec.hpp). Under g++ it expands to nothing.
 #pragma once
 #if defined(__CUDACC__)
 #define SEAMLESS_HD __host__ __device__

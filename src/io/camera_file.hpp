@@ -12,7 +12,7 @@
 #pragma once
 #include <string>
 
-#include "core/camera.hpp"
+#include "core/intrinsics.hpp"
 
 namespace seamless {
 

@@ -20,6 +20,7 @@
 #include "io/jpeg_io.hpp"
 #include "io/number_file.hpp"
 #include "io/png_io.hpp"
+#include "io/rgbd_pair.hpp"
 
 namespace seamless {
 namespace fs = std::filesystem;
@@ -195,32 +196,11 @@ void FrameFolderSource::load_frame(std::size_t i, RgbdFrame& frame) {
   const FrameFolderEntry& f = frames_[i];
   const fs::path dir(folder_);
   const std::string depth_path = (dir / f.depth).string(), colour_path = (dir / f.colour).string();
-  Image<std::uint16_t> raw = read_png_u16(depth_path);
-  Image<uchar3> rgb = read_colour_image(colour_path);                    // PNG or JPEG, by content
-  flip_image(raw, flip_x_, flip_y_), flip_image(rgb, flip_x_, flip_y_);  // a negative focal length
-  if (raw.width() != K_.width || raw.height() != K_.height)
-    throw InputError("depth image '" + depth_path + "' is " + std::to_string(raw.width()) + "x" +
-                     std::to_string(raw.height()) + " but input.intrinsics says " + std::to_string(K_.width) + "x" +
-                     std::to_string(K_.height));
-  if (rgb.width() != raw.width() || rgb.height() != raw.height())
-    throw InputError("colour image '" + colour_path + "' is " + std::to_string(rgb.width()) + "x" +
-                     std::to_string(rgb.height()) + ", its depth image '" + depth_path + "' " +
-                     std::to_string(raw.width()) + "x" + std::to_string(raw.height()) +
-                     " (the depth must be registered to the colour camera)");
-  reserve_frame_images(frame, raw.width(), raw.height(), pinned_);
-  if (params_.fill_gaps && gap_scratch_.width() != raw.width())
-    gap_scratch_ = Image<float>(raw.width(), raw.height(), Device::CPU);
-  Image<float>& depth = params_.fill_gaps ? gap_scratch_ : frame.depth;
-  const float inv = static_cast<float>(1.0 / scale_);
-  const std::uint16_t* r = raw.buffer().data();
-  float* d = depth.buffer().data();
-  // 0 and 65535 both mean "no reading" (7-Scenes writes 65535).
-  for (std::int64_t k = 0; k < raw.buffer().size(); ++k) d[k] = r[k] == 65535 ? 0.f : r[k] * inv;
-  if (params_.fill_gaps) fill_depth_gaps_host(gap_scratch_, frame.depth);
-  if (!params_.fill_gaps && delivered_ == 0) hint_depth_gaps(frame.depth, depth_path);
-  check_median_depth(frame.depth, scale_, depth_path);
-  scale_check_->check(raw, depth_path);
-  frame.rgb.buffer().copy_from(rgb.buffer());
+  RawRgbdPair pair = read_rgbd_pair(depth_path, colour_path, K_, flip_x_, flip_y_);
+  reserve_frame_images(frame, pair.depth.width(), pair.depth.height(), pinned_);
+  decode_depth(pair.depth, scale_, depth_path, params_.fill_gaps, delivered_ == 0, gap_scratch_, *scale_check_,
+               frame.depth);
+  frame.rgb.buffer().copy_from(pair.colour.buffer());
   frame.timestamp = static_cast<double>(f.number) / params_.fps;
   frame.intrinsics = K_;
   frame.ground_truth = poses_[i];

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "core/buffer.hpp"
-#include "core/camera.hpp"
+#include "core/intrinsics.hpp"
 #include "core/device.hpp"
 #include "core/math.hpp"
 #include "kernels/scene/movers.hpp"

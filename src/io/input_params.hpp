@@ -84,7 +84,7 @@ struct SyntheticNoiseParams {
   }
 };
 
-// Something that moves through the synthetic room (issue 22's test material): a person walking or
+// Something that moves through the synthetic room (test material of dynamic scenes): a person walking or
 // a ball rolling along a path on the floor, at constant speed, present from `start` until the
 // path's end (then gone, as if it left the room). Posed per frame by src/io/movers.cpp.
 struct MoverParams {

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "core/buffer.hpp"
-#include "core/camera.hpp"
+#include "core/intrinsics.hpp"
 
 namespace seamless {
 

@@ -19,7 +19,7 @@ PngInfo png_info(const std::string& path);
 
 // The largest image the readers decode (PNG and JPEG): 8192 x 8192 pixels, four times the largest
 // depth or colour camera image in use (4096 x 3072); a corrupt header that claims more would make
-// them allocate gigabytes before the data is found missing (issue 20, found by fuzzing).
+// them allocate gigabytes before the data is found missing (found by fuzzing).
 inline constexpr std::int64_t kMaxImagePixels = std::int64_t{8192} * 8192;
 // Throws an InputError naming `what` (the file) when width x height is larger or not positive.
 void check_image_size(std::int64_t width, std::int64_t height, const std::string& what);

@@ -15,6 +15,7 @@
 #include "io/intrinsics_presets.hpp"
 #include "io/jpeg_io.hpp"
 #include "io/png_io.hpp"
+#include "io/rgbd_pair.hpp"
 #include "kernels/io/undistort.hpp"
 
 namespace seamless {
@@ -226,34 +227,18 @@ std::optional<vec3> TumSource::accelerometer_at(double t) const {
 void TumSource::load_frame(const TumPair& pair, RgbdFrame& frame) {
   fs::path dir(folder_);
   std::string depth_path = (dir / pair.depth.file).string(), rgb_path = (dir / pair.rgb.file).string();
-  Image<std::uint16_t> raw = read_png_u16(depth_path);
-  Image<uchar3> rgb = read_colour_image(rgb_path);                       // PNG or JPEG, by content
-  flip_image(raw, flip_x_, flip_y_), flip_image(rgb, flip_x_, flip_y_);  // a negative focal length
-  if (raw.width() != K_.width || raw.height() != K_.height)
-    throw InputError("depth image '" + depth_path + "' is " + std::to_string(raw.width()) + "x" +
-                     std::to_string(raw.height()) + " but input.intrinsics says " + std::to_string(K_.width) + "x" +
-                     std::to_string(K_.height));
-  if (rgb.width() != raw.width() || rgb.height() != raw.height())
-    throw InputError("colour image '" + rgb_path + "' is " + std::to_string(rgb.width()) + "x" +
-                     std::to_string(rgb.height()) + ", its depth image '" + depth_path + "' " +
-                     std::to_string(raw.width()) + "x" + std::to_string(raw.height()));
+  RawRgbdPair raw = read_rgbd_pair(depth_path, rgb_path, K_, flip_x_, flip_y_);
+  const int w = raw.depth.width(), h = raw.depth.height();
   // Decoded straight into the frame's (reused, possibly page-locked) images; undistortion reads
   // from scratch images instead.
   Intrinsics K = intrinsics();
   const bool undistort = K.dist[0] == 0.f && K_.dist[0] != 0.f;
-  reserve_frame_images(frame, raw.width(), raw.height(), pinned_);
-  if (undistort && scratch_.width() != raw.width()) scratch_ = Image<float>(raw.width(), raw.height(), Device::CPU);
-  if (params_.fill_gaps && gap_scratch_.width() != raw.width())
-    gap_scratch_ = Image<float>(raw.width(), raw.height(), Device::CPU);
+  reserve_frame_images(frame, w, h, pinned_);
+  if (undistort && scratch_.width() != w) scratch_ = Image<float>(w, h, Device::CPU);
   Image<float>& depth = undistort ? scratch_ : frame.depth;
-  Image<float>& decoded = params_.fill_gaps ? gap_scratch_ : depth;
-  const double scale = effective_depth_scale(params_);
-  const float inv = static_cast<float>(1.0 / scale);
-  for (std::int64_t i = 0; i < depth.buffer().size(); ++i) decoded.buffer().data()[i] = raw.buffer().data()[i] * inv;
-  if (params_.fill_gaps) fill_depth_gaps_host(gap_scratch_, depth);
-  if (!params_.fill_gaps && delivered_ == 0) hint_depth_gaps(depth, depth_path);
-  check_median_depth(depth, scale, depth_path);
-  scale_check_->check(raw, depth_path);
+  decode_depth(raw.depth, effective_depth_scale(params_), depth_path, params_.fill_gaps, delivered_ == 0, gap_scratch_,
+               *scale_check_, depth);
+  const Image<uchar3>& rgb = raw.colour;
   if (undistort) {  // on the host: this is input decoding
     with_exec(Device::CPU, [&]<class E>(const E& ex) {
       if (undistort_map_.width() != depth.width()) {

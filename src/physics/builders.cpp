@@ -8,6 +8,7 @@
 #include <map>
 #include <sstream>
 
+#include "core/basis.hpp"
 #include "core/error.hpp"
 #include "kernels/physics/constraints.hpp"
 #include "kernels/physics/particle_math.hpp"
@@ -23,11 +24,13 @@ vec3 up_from_gravity(vec3 g) {
   return l > 0.f ? -g / l : vec3{0.f, 1.f, 0.f};
 }
 
-// Two unit vectors spanning the plane normal to n.
+// Two unit vectors spanning the plane normal to n, (u, w, -n) right-handed: u is the projection of
+// the x axis (the y axis where n is near x) onto the plane, so that a cloth hung under gravity -y
+// spans x (its rows) and z (its columns). In the terms of core's basis (t1, t2, n): u = -t2, w = -t1.
 void plane_basis(vec3 n, vec3& u, vec3& w) {
-  vec3 a = std::fabs(n.x) < 0.9f ? vec3{1.f, 0.f, 0.f} : vec3{0.f, 1.f, 0.f};
-  u = normalize(a - n * dot(a, n));
-  w = cross(u, n);
+  vec3 t1, t2;
+  orthonormal_basis(n, t1, t2);
+  u = -t2, w = -t1;
 }
 
 // Exact distance of every occupied cell to the nearest empty one (searching shells of growing
@@ -91,7 +94,7 @@ ParticleBatch rigid_from_cells(const std::vector<int3>& cells, const SpawnParams
   b.rotation = euler_to_quat(s.rotation);
   b.centre = s.position;
   b.stiffness = s.stiffness;
-  mat3 R = kernels::quat_to_mat(b.rotation);
+  mat3 R = quat_to_mat(b.rotation);
   float inv_m = 1.f / (s.density * d * d * d);
   for (int3 c : cells) {
     vec3 q{static_cast<float>((c.x - mean[0]) * d), static_cast<float>((c.y - mean[1]) * d),
@@ -112,7 +115,7 @@ vec4 euler_to_quat(vec3 deg) {
   vec4 qx{std::sin(deg.x * k), 0.f, 0.f, std::cos(deg.x * k)};
   vec4 qy{0.f, std::sin(deg.y * k), 0.f, std::cos(deg.y * k)};
   vec4 qz{0.f, 0.f, std::sin(deg.z * k), std::cos(deg.z * k)};
-  return kernels::quat_normalize(kernels::quat_mul(qz, kernels::quat_mul(qy, qx)));
+  return quat_normalize(quat_mul(qz, quat_mul(qy, qx)));
 }
 
 ParticleBatch make_fluid_block(const SpawnParams& s, const SolverParams& p) {
@@ -159,7 +162,7 @@ ParticleBatch make_cloth(const SpawnParams& s, const SolverParams& p) {
   b.self_collide = s.self_collide;
   vec3 up = up_from_gravity(p.gravity), u, w;
   plane_basis(up, u, w);
-  mat3 R = kernels::quat_to_mat(euler_to_quat(s.rotation));
+  mat3 R = quat_to_mat(euler_to_quat(s.rotation));
   float inv_m = 1.f / (s.density * d * d * d);
   auto id = [nx](int i, int j) { return j * nx + i; };
   for (int j = 0; j < ny; ++j)

@@ -1,4 +1,4 @@
-// Kinematic collider particles from a depth camera's view (issue 22, solver.dynamic_colliders): a
+// Kinematic collider particles from a depth camera's view (solver.dynamic_colliders, docs/DYNAMIC.md): a
 // person or object the camera sees moving becomes, each frame, a set of infinitely heavy particles
 // at its measured surface, so that the solver's ordinary scene contacts push fluid, cloth and rigid
 // bodies out of it (Macklin et al. 2014's particle contacts, section 4.3; colliding particles with
@@ -7,7 +7,6 @@
 // pushed through the front layer meets the next one instead of ending inside the body.
 #pragma once
 #include <cstdint>
-#include <vector>
 
 #include "core/buffer.hpp"
 #include "core/device.hpp"
@@ -15,67 +14,33 @@
 
 namespace seamless {
 
-// One frame's seen surface: a point per used pixel (world), the unit ray from the camera to it and
-// the surface normal there (world; zero where the vertex map has none).
-struct DepthSurface {
-  std::vector<vec3> points, rays, normals;
-};
-
-// camera_vertices, camera_normals: vertex and normal maps (camera coordinates, row-major, z <= 0 =
-// no reading, the zero vector = no normal), width x height; mask: empty (every pixel) or one byte
-// per pixel (nonzero = use it).
-DepthSurface depth_surface(const std::vector<vec3>& camera_vertices, const std::vector<vec3>& camera_normals, int width,
-                           int height, const SE3& world_T_camera, const std::vector<std::uint8_t>& mask = {});
-
-// Each surface point and, behind it along its ray, one more every `spacing` metres up to `thickness`.
-std::vector<vec3> thicken(const std::vector<vec3>& points, const std::vector<vec3>& rays, float spacing,
-                          float thickness);
-
-// The colliders between two frames. A depth camera gives no correspondences, so each point's
-// velocity is its displacement along the surface normal from the previous frame's nearest point
-// within max_speed * dt (point to plane, as in ICP: exact for a surface moving along its normal
-// whatever the pixels' positions on it; the motion along the surface, which pushes nothing, is
-// not seen).
-// The colliders then move with those velocities across the solver steps between the frames
-// instead of jumping once a frame: a position-based contact turns a jump into the pushed particle's
-// velocity over one step (a body walking at 1 m/s at 30 Hz would fling what it touches at
-// 3.3 m/s with 0.01 s steps).
-class MovingColliders {
- public:
-  MovingColliders(float spacing, float thickness, float max_speed)
-      : spacing_(spacing), thickness_(thickness), max_speed_(max_speed) {}
-  // A new frame's surface, seen at simulation time t (after the previous frame's).
-  void update(DepthSurface surface, double t);
-  // The colliders at time t in [previous frame's time, this frame's]: each point moved back from
-  // this frame's position by its velocity times (this frame's time - t).
-  std::vector<vec3> at(double t) const;
-  const std::vector<vec3>& velocities() const { return velocity_; }
-
- private:
-  float spacing_, thickness_, max_speed_;
-  DepthSurface last_;
-  std::vector<vec3> velocity_;  // one per point of last_
-  double time_ = 0.0;
-  bool have_ = false;
-};
-
-// MovingColliders on a device, from the maps the tracker leaves there (live mode): the level's mask
-// (block_any of the full-resolution dynamic mask), the seen surface, the velocities and the
-// thickened colliders are kernels (kernels/physics/depth_colliders.hpp) and the colliders go to the
-// solver as a device buffer (ParticleSolver::set_collider_particles), so no map passes through the
-// host. The same points, velocities and colliders as depth_surface + MovingColliders (on the CPU
-// bit for bit): the velocity's nearest-point search is one independent query per point, through a
-// grid of the previous frame's points sorted by cell.
+// The colliders between two frames, on a device, from the maps the tracker leaves there (live
+// mode). A depth camera gives no correspondences, so each point's velocity is its displacement
+// along the surface normal from the previous frame's nearest point within max_speed * dt (point to
+// plane, as in ICP: exact for a surface moving along its normal whatever the pixels' positions on
+// it; the motion along the surface, which pushes nothing, is not seen). The colliders then move
+// with those velocities across the solver steps between the frames instead of jumping once a
+// frame: a position-based contact turns a jump into the pushed particle's velocity over one step
+// (a body walking at 1 m/s at 30 Hz would fling what it touches at 3.3 m/s with 0.01 s steps).
+// The level's mask (block_any of the full-resolution dynamic mask), the seen surface, the
+// velocities and the thickened colliders are kernels (kernels/physics/depth_colliders.hpp) and the
+// colliders go to the solver as a device buffer (ParticleSolver::set_collider_particles), so no
+// map passes through the host; the nearest-point search is one independent query per point,
+// through a grid of the previous frame's points sorted by cell. tests/physics/host_colliders.hpp
+// is the same computation written plainly on the host, the tests' oracle (on the CPU bit for bit).
 class DeviceColliders {
  public:
   DeviceColliders(float spacing, float thickness, float max_speed, Device d);
-  // A new frame, seen at simulation time t: vertex and normal maps (camera coordinates, as
-  // depth_surface takes them) on the device; full_mask: null for every pixel, else the
+  // A new frame, seen at simulation time t: vertex and normal maps (camera coordinates, row-major,
+  // z <= 0 = no reading, the zero vector = no normal) on the device; full_mask: null for every pixel, else the
   // full-resolution dynamic mask (a pixel of the maps is used when any full-resolution pixel it
   // averages is nonzero; an empty image: none is).
   void update(const Image<vec3>& camera_vertices, const Image<vec3>& camera_normals, const SE3& world_T_camera,
               const Image<std::uint8_t>* full_mask, double t);
-  // The colliders at time t (MovingColliders::at) in points()[0, count), count returned.
+  // The colliders at time t, in [previous frame's time, this frame's], in points()[0, count), count
+  // returned: each surface point moved back from this frame's position by its velocity times (this
+  // frame's time - t), and behind it along its camera ray one more every `spacing` metres up to
+  // `thickness`.
   std::int64_t at(double t);
   const Buffer<vec3>& points() const { return out_; }
   // This frame's surface points and their velocities (first size() of each; tests).

@@ -9,7 +9,7 @@
 #include <optional>
 #include <vector>
 
-#include "core/geometry.hpp"
+#include "core/particles.hpp"
 #include "physics/solver_params.hpp"
 
 namespace seamless {

@@ -1,17 +1,12 @@
-// The files physics writes into a run's folder and `seamless render` reads back: particle states
-// (particles.ply, particles_<step>.ply, scene_particles.ply) and the objects they form (objects.txt).
+// The object file physics writes into a run's folder and `seamless render` reads back:
+// objects.txt, which particles form which objects. The particle states themselves are PLY files
+// (io/ply.hpp: write_particles_ply, read_particles_ply).
 #pragma once
 #include <string>
 
-#include "core/geometry.hpp"
+#include "core/particles.hpp"
 
 namespace seamless {
-
-// Writes particles as a binary little-endian PLY (x y z float, vx vy vz float, phase uint).
-void write_particles_ply(const std::string& path, const ParticleState& s);
-// Reads what write_particles_ply writes (inv_mass is not stored: 1). Throws seamless::Error naming
-// the file when it is not such a file or is cut short.
-ParticleState read_particles_ply(const std::string& path);
 
 // objects.txt: which particles form cloth sheets and rigid bodies, and the bodies' rest offsets.
 // Particle ids never change, so one file written at the end of a run serves every snapshot

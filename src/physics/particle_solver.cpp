@@ -392,7 +392,7 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
     body_shift = Buffer<vec3>(static_cast<std::int64_t>(c.size()), dev);
     body_q = Buffer<vec4>::from_host(q, dev);
     std::vector<mat3> R;
-    for (vec4 r : q) R.push_back(K::quat_to_mat(r));
+    for (vec4 r : q) R.push_back(quat_to_mat(r));
     body_R = Buffer<mat3>::from_host(R, dev);
     chunk_sum = Buffer<K::RigidSum>(static_cast<std::int64_t>(chunk_start.size()), dev);
     chunk_slip = Buffer<K::SlipSum>(static_cast<std::int64_t>(chunk_start.size()), dev);
@@ -499,14 +499,13 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
     ++generation;
     ensure_capacity(n + m);
     std::uint32_t flags = 0;
-    if (b.kind == ParticleBatch::kFluid) flags = K::phase::kFluid;
+    if (b.kind == ParticleBatch::kFluid) flags = phase::kFluid;
     if (b.kind == ParticleBatch::kRigid) {
-      if (body_start.size() >= K::phase::kGroupMask) throw Error("particle solver: too many rigid bodies (max 2^24)");
-      flags = K::phase::kRigid | static_cast<std::uint32_t>(body_start.size());
+      if (body_start.size() >= phase::kGroupMask) throw Error("particle solver: too many rigid bodies (max 2^24)");
+      flags = phase::kRigid | static_cast<std::uint32_t>(body_start.size());
     }
     if (b.kind == ParticleBatch::kCloth)
-      flags = K::phase::kCloth | static_cast<std::uint32_t>(cloth_groups++) |
-              (b.self_collide ? K::phase::kSelfCollide : 0u);
+      flags = phase::kCloth | static_cast<std::uint32_t>(cloth_groups++) | (b.self_collide ? phase::kSelfCollide : 0u);
     upload_at(x, first, b.x), upload_at(v, first, b.v), upload_at(w, first, b.inv_mass);
     upload_at(phase, first, std::vector<std::uint32_t>(static_cast<std::size_t>(m), flags));
     std::vector<int> ids(static_cast<std::size_t>(m));

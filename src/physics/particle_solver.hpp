@@ -19,7 +19,7 @@
 
 #include "core/buffer.hpp"
 #include "core/device.hpp"
-#include "core/geometry.hpp"
+#include "core/particles.hpp"
 #include "core/math.hpp"
 #include "kernels/physics/scene_sdf.hpp"
 #include "physics/builders.hpp"

@@ -86,7 +86,7 @@ struct SolverParams {
   float cloth_strain_omega = 1.5f;           // over-relaxation of strain limiting
   float cloth_strain_contact_weight = 0.3f;  // strain limiting: inverse-mass factor of particles on the scene
   bool cuda_graph = true;                    // CUDA: replay a step as one captured graph (docs/PHYSICS.md)
-  // Issue 22: the live depth camera's points as kinematic colliders each frame (people and moving
+  // Live colliders: the depth camera's points as kinematic colliders each frame (people and moving
   // objects push the simulation): none, the dynamic pixels only (dynamic.enabled), or every pixel.
   DynamicColliders dynamic_colliders = DynamicColliders::none;
   int collider_level = 2;           // pyramid level whose vertex map gives the points (2: 160x120)

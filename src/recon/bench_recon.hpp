@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "core/buffer.hpp"
-#include "core/camera.hpp"
+#include "core/intrinsics.hpp"
 #include "core/timing.hpp"
 #include "recon/volume.hpp"
 

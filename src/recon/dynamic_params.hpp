@@ -1,5 +1,5 @@
 // Dynamic section (`dynamic:`): people and moving objects kept out of tracking and fusion, and
-// free-space carving of what they left behind (issue 22, docs/DYNAMIC.md). Off by default: then
+// free-space carving of what they left behind (docs/DYNAMIC.md). Off by default: then
 // every run is bit for bit what it was without this section.
 #pragma once
 #include "core/params.hpp"

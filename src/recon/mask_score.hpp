@@ -1,5 +1,5 @@
-// How the dynamic mask agrees with the ground truth of the synthetic room's movers (issue 22's mask
-// test, docs/DYNAMIC.md): counted per frame by TrackingSession when the frame carries the movers'
+// How the dynamic mask agrees with the ground truth of the synthetic room's movers (the mask
+// test of docs/DYNAMIC.md): counted per frame by TrackingSession when the frame carries the movers'
 // mask, summed up over a run for summary.json (`dynamic.mask`) and the tests.
 #pragma once
 #include <cstdint>
@@ -31,7 +31,7 @@ struct MaskScore {
 MaskScore score_mask(const std::vector<std::uint8_t>& truth, const std::vector<std::uint8_t>& mask,
                      const kernels::movers::Scene& movers, vec3 eye);
 
-// Issue 22's condition for a frame to enter the IoU statistics: a person in the room, every person
+// The condition for a frame to enter the IoU statistics: a person in the room, every person
 // at least kMinMoverDistance from the camera (nearer, one fills the view and much of them lies
 // nearer than the sensor's minimum depth), and the movers on at least kMinTruthFraction of the
 // image (a sliver at the border has a handful of pixels, where one pixel of silhouette is already a
@@ -49,7 +49,7 @@ struct MaskQuality {
   std::vector<double> mover_recall;                    // index id - 1; NaN for a mover never seen
   double precision = 0;                                // masked pixels that see a mover; NaN when nothing was masked
 };
-constexpr double kGoodIou = 0.8;  // issue 22's bound on every scored frame
+constexpr double kGoodIou = 0.8;  // the mask test's bound on every scored frame
 
 // frame_scores: (frame index, its score) of every frame that has one. Nothing when none has.
 std::optional<MaskQuality> mask_quality(const std::vector<std::pair<std::int64_t, MaskScore>>& frame_scores,

@@ -1,4 +1,4 @@
-// Static scene particles for the physics solver, taken from the fused TSDF (DESIGN "Physics").
+// Static scene particles for the physics solver, taken from the fused TSDF's hash blocks.
 #pragma once
 #include <cstdint>
 #include <vector>

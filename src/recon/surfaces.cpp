@@ -7,6 +7,8 @@
 #include <set>
 #include <tuple>
 
+#include "core/basis.hpp"
+
 namespace seamless {
 namespace {
 
@@ -19,16 +21,9 @@ struct Cell {
   int component = -1;
 };
 
-// Two unit vectors spanning the plane orthogonal to up.
-void plane_basis(vec3 up, vec3& e1, vec3& e2) {
-  const vec3 a = std::fabs(up.x) < 0.9f ? vec3{1, 0, 0} : vec3{0, 1, 0};
-  e1 = normalize(cross(up, a));
-  e2 = cross(up, e1);
-}
-
 std::map<Key, Cell> bin_horizontal_pieces(const Mesh& mesh, vec3 up, const SurfaceParams& p) {
   vec3 e1, e2;
-  plane_basis(up, e1, e2);
+  orthonormal_basis(up, e1, e2);
   const float cos_tilt = std::cos(p.max_tilt_deg * 3.14159265f / 180.f);
   std::map<Key, Cell> cells;
   for (const int3& t : mesh.triangles) {
@@ -52,7 +47,7 @@ std::map<Key, Cell> bin_horizontal_pieces(const Mesh& mesh, vec3 up, const Surfa
 // Heights of the mesh's vertices in the surface grid's columns (i, j): what stands above a cell.
 std::map<std::pair<int, int>, std::vector<float>> vertex_columns(const Mesh& mesh, vec3 up, const SurfaceParams& p) {
   vec3 e1, e2;
-  plane_basis(up, e1, e2);
+  orthonormal_basis(up, e1, e2);
   std::map<std::pair<int, int>, std::vector<float>> cols;
   for (vec3 x : mesh.positions)
     cols[{static_cast<int>(std::floor(dot(x, e1) / p.cell)), static_cast<int>(std::floor(dot(x, e2) / p.cell))}]

@@ -1,4 +1,4 @@
-# Camera tracking (issue 5): ICP / RGB-D tracker, gravity, the sequence driver, the tracking
+# Camera tracking: ICP / RGB-D tracker, gravity, the sequence driver, the tracking
 # benchmark, and the external trackers of the comparison (src/recon/external/). See docs/TRACKING.md.
 include(${CMAKE_CURRENT_LIST_DIR}/external/external.cmake)
 add_library(seamless_tracker STATIC

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "core/buffer.hpp"
-#include "core/camera.hpp"
+#include "core/intrinsics.hpp"
 #include "core/math.hpp"
 #include "kernels/recon/icp.hpp"
 #include "kernels/recon/rgbd.hpp"

@@ -42,7 +42,7 @@ struct TrackSequenceParams {
   TrackerParams tracker;
   PreprocessParams preprocess;
   VolumeParams volume;
-  DynamicParams dynamic;        // issue 22: dynamic pixels out of tracking and fusion (off by default)
+  DynamicParams dynamic;        // dynamic pixels out of tracking and fusion (off by default)
   std::int64_t max_frames = 0;  // 0 = all the source has
   bool write_files = true;      // trajectory.txt and tracking_stats.csv into out_dir
   // When set, the volume's kernel steps (allocate, visible, fuse, remove_empty, raycast) are timed
@@ -52,7 +52,7 @@ struct TrackSequenceParams {
   // refine.online: sees every frame; its corrections move the session's pose (track_sequence).
   PoseCorrector* corrector = nullptr;
   // >= 0: this pyramid level's vertex and normal maps are also kept as they were before the
-  // dynamic mask zeroed them (TrackingSession::unmasked_level; the live colliders of issue 22).
+  // dynamic mask zeroed them (TrackingSession::unmasked_level; the live colliders of solver.dynamic_colliders).
   int keep_unmasked_level = -1;
   // The session's own model (frame-to-model tracking, or dynamic handling with another mode, and no
   // volume given) marched into TrackSequenceResult::model_mesh at the end (`seamless track`'s ghost
@@ -130,7 +130,7 @@ class TrackingSession {
   void accept(const RgbdFrame& frame, const SE3& pose, FrameRecord& rec);
   double volume_allocate_ms(std::size_t first_row) const;
   void update_reference(const SE3& pose);
-  // Dynamic pixels (issue 22): the model to compare with (ref_ when tracking frame to model, else
+  // Dynamic pixels: the model to compare with (ref_ when tracking frame to model, else
   // a raycast of the volume from the last good pose; nullptr without a volume), and the mask of the
   // current frame at pose world_T_camera into dyn_mask_: the frame's (final, at the tracked pose)
   // or the tracker's (before tracking: without the evidence of the past views).

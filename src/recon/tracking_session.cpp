@@ -1,6 +1,6 @@
 // TrackingSession (tracker_sequence.hpp): the per-frame state machine of tracking, one frame at a
 // time (upload, preprocess, track or relocalise, fuse, raycast the next reference), with the
-// dynamic-pixel masks (issue 22) and the external trackers. tracker_sequence.cpp drives it over a
+// dynamic-pixel masks (docs/DYNAMIC.md) and the external trackers. tracker_sequence.cpp drives it over a
 // whole sequence and writes the outputs.
 #include "recon/tracker_sequence.hpp"
 
@@ -78,7 +78,7 @@ TrackingSession::TrackingSession(const TrackSequenceParams& params, Device devic
   }
 }
 
-// ---- dynamic pixels (issue 22, docs/DYNAMIC.md) -------------------------------------------------
+// ---- dynamic pixels (docs/DYNAMIC.md) -------------------------------------------------------------
 
 const ReferenceMaps* TrackingSession::dynamic_reference() {
   if (tracker_ && p_.tracker.mode == TrackingMode::frame_to_model) return ref_.empty() ? nullptr : &ref_;
@@ -359,7 +359,7 @@ TrackResult TrackingSession::relocalise(const RgbdFrame& frame) {
 // After lost frames the tracker searches from the last good pose against the last good view, and
 // may settle in a wrong minimum that still passes the per-frame tests: five covered frames of
 // fr1_rpy were followed by a 23 cm / 11 degree "recovery" marked ok while the camera had moved
-// 1.6 cm, and every later frame was offset (issue 20). Two independent tests reject such a frame
+// 1.6 cm, and every later frame was offset. Two independent tests reject such a frame
 // (it is then lost like the others, and the next frame tries again):
 // - the pose moved no farther from the last good one than a handheld camera can in the time lost
 //   (tracker.relocalise_max_speed / _angular_speed_deg, TrackerParams says why those speeds);

@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "core/buffer.hpp"
-#include "core/camera.hpp"
-#include "core/geometry.hpp"  // Mesh
+#include "core/intrinsics.hpp"
+#include "core/mesh.hpp"  // Mesh
 #include "core/math.hpp"
 #include "core/timing.hpp"
 #include "recon/scene_particles.hpp"
@@ -73,7 +73,7 @@ class Volume {
   // The SDF on a regular grid (x fastest) at origin + voxel * (x, y, z); unknown points read as
   // +truncation (free space). For the solver's scene_collision: sdf.
   virtual std::vector<float> sample_sdf_grid(vec3 origin, int3 dims, float voxel) = 0;
-  // Dynamic pixels (issue 22, docs/DYNAMIC.md): clears the candidates (1 per pixel of depth, seen
+  // Dynamic pixels (docs/DYNAMIC.md): clears the candidates (1 per pixel of depth, seen
   // from world_T_camera) whose measured point the volume does not show in free space, i.e. not
   // seen through by earlier frames (require_seen_free) or occupied by a surface (otherwise);
   // kernels::DynamicSpace::require_free_space. Both images live on the volume's device.
@@ -82,10 +82,10 @@ class Volume {
   virtual VolumeStats stats() = 0;
   virtual Device device() const = 0;
   virtual const VolumeParams& params() const = 0;
-  // Free-space carving in later integrate() calls (issue 22, docs/DYNAMIC.md): voxels more than
+  // Free-space carving in later integrate() calls (docs/DYNAMIC.md): voxels more than
   // `metres` in front of the measurement are reset to free space; 0 (the default) turns it off.
   void set_free_space_carving(float metres) { carve_ = metres; }
-  // Evidence of free space (issue 22, docs/DYNAMIC.md): later integrate() calls also store the free
+  // Evidence of free space (docs/DYNAMIC.md): later integrate() calls also store the free
   // space in front of each reading, so that require_free_space can find space seen through. The
   // dense grid stores every voxel anyway; the voxel-hashed volume then allocates the blocks along
   // the rays in front of the readings (kernels::TsdfFusion::allocate_free_space) and keeps every

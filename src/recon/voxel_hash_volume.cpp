@@ -145,7 +145,7 @@ void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTime
     failed_ = last_.probe_failures + last_.pool_failures;
     if (failed_ == 0 || !params_.grow_when_full) break;
     // Grow as often as this frame needs: a frame that is only partly fused is a hole in the model
-    // that tracking then fails against (issue 20: a pool of 64 blocks doubled 4 times, then
+    // that tracking then fails against (a pool of 64 blocks doubled 4 times, then
     // dropped the rest of the frame and every later frame was lost).
     if (attempt == kMaxGrowths)
       throw Error("voxel hashing: " + std::to_string(failed_) + " block insertions still fail in frame " +

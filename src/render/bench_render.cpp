@@ -9,8 +9,8 @@
 
 #include "core/buffer.hpp"
 #include "core/device.hpp"
-#include "core/geometry.hpp"
-#include "kernels/physics/particle_math.hpp"
+#include "core/mesh.hpp"
+#include "core/phase.hpp"
 #include "seamless/build_config.hpp"
 #if SEAMLESS_HAS_CUDA
 #include "render/cuda_interop.hpp"
@@ -108,7 +108,7 @@ RenderBenchResult bench_render(int width, int height, std::int64_t particles, in
     for (int j = 0; j < side && static_cast<std::int64_t>(x.size()) < particles; ++j)
       for (int i = 0; i < side && static_cast<std::int64_t>(x.size()) < particles; ++i)
         x.push_back(vec3{(i - side / 2) * 2 * radius, (j + 0.5f) * 2 * radius, (k - side / 2) * 2 * radius});
-  std::vector<std::uint32_t> ph(x.size(), kernels::phase::kFluid);
+  std::vector<std::uint32_t> ph(x.size(), phase::kFluid);
   DrawList list;
   list.positions = x, list.phases = ph, list.particle_radius = radius;
   const float extent = side * 2 * radius;

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "kernels/physics/particle_math.hpp"
+#include "core/quaternion.hpp"
 
 namespace seamless {
 
@@ -14,7 +14,7 @@ std::vector<RigidDraw> rigid_draws(const SceneObjects& objects, const std::vecto
     for (const RigidBody& body : objects.bodies) {
       if (body.first != f.first) continue;
       RigidDraw r;
-      r.world_T_body = {kernels::quat_to_mat(f.rotation), f.centre};
+      r.world_T_body = {quat_to_mat(f.rotation), f.centre};
       vec3 hi{0.f, 0.f, 0.f};  // the box around the rest offsets, plus the particles' radius
       for (vec3 q : body.rest) hi = vmax(hi, vec3{std::fabs(q.x), std::fabs(q.y), std::fabs(q.z)});
       r.half_extents = hi + vec3{radius, radius, radius};

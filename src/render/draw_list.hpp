@@ -6,8 +6,8 @@
 #include <span>
 #include <vector>
 
-#include "core/geometry.hpp"
 #include "core/math.hpp"
+#include "core/particles.hpp"
 
 namespace seamless {
 
@@ -26,7 +26,7 @@ struct ClothDraw {
 
 struct DrawList {
   std::span<const vec3> positions;        // dynamic particles, solver id order
-  std::span<const std::uint32_t> phases;  // kernels::phase words, same length
+  std::span<const std::uint32_t> phases;  // phase words (core/phase.hpp), same length
   float particle_radius = 0.02f;          // metres
   std::vector<RigidDraw> rigids;
   std::vector<ClothDraw> cloths;

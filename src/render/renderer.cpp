@@ -4,9 +4,9 @@
 #include <cmath>
 
 #include "core/error.hpp"
-#include "core/geometry.hpp"
 #include "core/log.hpp"
-#include "kernels/physics/particle_math.hpp"
+#include "core/mesh.hpp"
+#include "core/phase.hpp"
 #include "render/renderer_impl.hpp"
 
 namespace seamless {
@@ -174,13 +174,13 @@ void Renderer::Impl::upload_particles(const DrawList& list) {
                  GL_STREAM_DRAW);
   }
   fluid_count = list.phases.empty() ? n : 0;
-  for (std::uint32_t ph : list.phases) fluid_count += kernels::phase::is(ph, kernels::phase::kFluid) ? 1 : 0;
+  for (std::uint32_t ph : list.phases) fluid_count += phase::is(ph, phase::kFluid) ? 1 : 0;
   if (n == 0) return;
   glBindBuffer(GL_ARRAY_BUFFER, part_pos);
   glBufferSubData(GL_ARRAY_BUFFER, 0, n * static_cast<GLsizeiptr>(sizeof(vec3)), list.positions.data());
   glBindBuffer(GL_ARRAY_BUFFER, part_phase);
   if (list.phases.empty()) {
-    std::vector<std::uint32_t> fluid(static_cast<std::size_t>(n), kernels::phase::kFluid);
+    std::vector<std::uint32_t> fluid(static_cast<std::size_t>(n), phase::kFluid);
     glBufferSubData(GL_ARRAY_BUFFER, 0, n * static_cast<GLsizeiptr>(sizeof(std::uint32_t)), fluid.data());
   } else {
     glBufferSubData(GL_ARRAY_BUFFER, 0, n * static_cast<GLsizeiptr>(sizeof(std::uint32_t)), list.phases.data());
@@ -303,7 +303,7 @@ void Renderer::Impl::draw_objects(const DrawList& list, std::int64_t n, const Re
     }
   const bool fluid_as_particles = p.show_fluid && p.fluid == FluidDraw::particles;
   if (n > 0 && (p.show_particles || fluid_as_particles)) {
-    const std::uint32_t mask = p.show_particles ? 0u : kernels::phase::kFluid;
+    const std::uint32_t mask = p.show_particles ? 0u : phase::kFluid;
     draw_spheres(particle_prog, n, mask, list.particle_radius, cam);
   }
 }

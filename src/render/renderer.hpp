@@ -15,9 +15,9 @@
 #include <vector>
 
 #include "core/buffer.hpp"
-#include "core/camera.hpp"
+#include "core/intrinsics.hpp"
 #include "core/math.hpp"
-#include "render/camera.hpp"
+#include "render/render_camera.hpp"
 #include "render/draw_list.hpp"
 #include "render/gl_context.hpp"
 #include "render/render_params.hpp"

@@ -2,9 +2,10 @@
 // stage images (the dissertation's Figure 4.5).
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "core/error.hpp"
-#include "kernels/physics/particle_math.hpp"
+#include "core/phase.hpp"
 #include "render/renderer_impl.hpp"
 
 namespace seamless {
@@ -138,7 +139,7 @@ void Renderer::Impl::fluid_depth_pass(std::int64_t n, float sphere_r, const Rend
   fluid_depth_prog.use();
   glUniform1i(fluid_depth_prog.loc("u_scene_depth"), 0);
   glUniform1i(fluid_depth_prog.loc("u_test_scene"), !p.depth_prepass);
-  draw_spheres(fluid_depth_prog, n, kernels::phase::kFluid, sphere_r, cam);
+  draw_spheres(fluid_depth_prog, n, phase::kFluid, sphere_r, cam);
 }
 
 // SSFR 2: every sphere's chord, added up, at 1 / thickness_downsample resolution; sprites wholly
@@ -166,8 +167,8 @@ void Renderer::Impl::fluid_thickness_pass(std::int64_t n, float sphere_r, const 
   fluid_thick_prog.use();
   glUniform1i(fluid_thick_prog.loc("u_scene_depth"), 0);
   const float s = p.fluid_radius_scale;
-  glUniform1f(fluid_thick_prog.loc("u_thickness_scale"), 6.f / (kernels::kPi * s * s * s));
-  draw_spheres(fluid_thick_prog, n, kernels::phase::kFluid, sphere_r, low);
+  glUniform1f(fluid_thick_prog.loc("u_thickness_scale"), 6.f / (std::numbers::pi_v<float> * s * s * s));
+  draw_spheres(fluid_thick_prog, n, phase::kFluid, sphere_r, low);
   glDisable(GL_BLEND);
   glDisable(GL_DEPTH_TEST);
   glDepthMask(GL_TRUE);

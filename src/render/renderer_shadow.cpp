@@ -13,10 +13,11 @@
 #include <cfloat>
 #include <cmath>
 #include <cstring>
+#include <numbers>
 
 #include "core/error.hpp"
 #include "core/log.hpp"
-#include "kernels/physics/particle_math.hpp"
+#include "core/phase.hpp"
 #include "render/renderer_impl.hpp"
 
 namespace seamless {
@@ -118,7 +119,7 @@ void Renderer::Impl::shadow_uniforms(const Program& prog) const {
   glUniform3f(prog.loc("u_shadow_absorption"), p.absorption.x, p.absorption.y, p.absorption.z);
   glUniformMatrix3fv(prog.loc("u_light_R"), 1, GL_FALSE, cols(light_R).data());
   glUniform1f(prog.loc("u_shadow_size"), static_cast<float>(shadow_size));
-  glUniform1f(prog.loc("u_light_tan"), std::tan(0.5f * p.light_angle * kernels::kPi / 180.f));
+  glUniform1f(prog.loc("u_light_tan"), std::tan(0.5f * p.light_angle * std::numbers::pi_v<float> / 180.f));
   glUniform1f(prog.loc("u_shadow_strength"), p.shadow_strength);
 }
 
@@ -172,7 +173,7 @@ void Renderer::Impl::shadow_pass(const DrawList& list, std::int64_t n) {
   glBindTexture(GL_TEXTURE_2D, light_bounds);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, 6, 1, GL_RED_INTEGER, GL_INT, init);
-  const std::uint32_t mask = (fluid ? kernels::phase::kFluid : 0u) | (cloth ? kernels::phase::kCloth : 0u);
+  const std::uint32_t mask = (fluid ? phase::kFluid : 0u) | (cloth ? phase::kCloth : 0u);
   if (mask != 0u) {
     light_uniforms(shadow_bounds_prog, light_R, light_bounds, shadow_size);
     glUniform1ui(shadow_bounds_prog.loc("u_count"), static_cast<GLuint>(n));
@@ -233,10 +234,10 @@ void Renderer::Impl::shadow_pass(const DrawList& list, std::int64_t n) {
     light_uniforms(sp, light_R, light_bounds, shadow_size);
     glUniform1f(sp.loc("u_radius"), sphere_r);
     const float s = p.fluid_radius_scale;  // path in fluid: chords over the spheres' volume fraction
-    glUniform1f(sp.loc("u_thickness_scale"), ssfr ? 6.f / (kernels::kPi * s * s * s) : 1.f);
+    glUniform1f(sp.loc("u_thickness_scale"), ssfr ? 6.f / (std::numbers::pi_v<float> * s * s * s) : 1.f);
     glUniform1f(sp.loc("u_fixed_per_metre"), kFixedPerMetre);
     glUniform1ui(sp.loc("u_count"), static_cast<GLuint>(n));
-    glUniform1ui(sp.loc("u_phase_mask"), kernels::phase::kFluid);
+    glUniform1ui(sp.loc("u_phase_mask"), phase::kFluid);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, part_pos);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, part_phase);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);

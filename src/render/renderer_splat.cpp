@@ -3,10 +3,11 @@
 // sprites through the rasteriser (docs/RENDERING.md, section Speed: GH100 has raster units on
 // only a few of its SMs, compute runs on all of them). Same images as the raster path.
 #include <algorithm>
+#include <numbers>
 #include <vector>
 
 #include "core/error.hpp"
-#include "kernels/physics/particle_math.hpp"
+#include "core/phase.hpp"
 #include "render/renderer_impl.hpp"
 
 namespace seamless {
@@ -78,7 +79,7 @@ void Renderer::Impl::splat_uniforms(const Program& prog, std::int64_t n, float s
   set_camera_uniforms(prog, cam);
   glUniform1f(prog.loc("u_radius"), sphere_r);
   glUniform1f(prog.loc("u_fmax"), std::max(cam.K.fx, cam.K.fy));
-  glUniform1ui(prog.loc("u_phase_mask"), kernels::phase::kFluid);
+  glUniform1ui(prog.loc("u_phase_mask"), phase::kFluid);
   glUniform1f(prog.loc("u_max_point_size"), p.max_point_size);
   glUniform1ui(prog.loc("u_count"), static_cast<GLuint>(n));
   glActiveTexture(GL_TEXTURE0);
@@ -122,7 +123,7 @@ void Renderer::Impl::fluid_depth_splat(std::int64_t n, float sphere_r, const Ren
 void Renderer::Impl::fluid_thickness_splat(std::int64_t n, float sphere_r, const RenderCamera& low) {
   splat_uniforms(thick_splat_prog, n, sphere_r, low);
   const float s = p.fluid_radius_scale;
-  glUniform1f(thick_splat_prog.loc("u_thickness_scale"), 6.f / (kernels::kPi * s * s * s));
+  glUniform1f(thick_splat_prog.loc("u_thickness_scale"), 6.f / (std::numbers::pi_v<float> * s * s * s));
   glUniform1f(thick_splat_prog.loc("u_fixed_per_metre"), kFixedPerMetre);
   glBindImageTexture(0, thick_fixed, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
   dispatch_particles(n);

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Issue 21: `seamless bench pipeline` on real frames (tum_fr1_rpy_000-149, CPU, a few frames).
+"""`seamless bench pipeline` on real frames (tum_fr1_rpy_000-149, CPU, a few frames).
 
 Scan mode must be `seamless track` itself: the trajectory it tracks equals track's on the same
 frames and config, its stage split adds up to the session's frame time and agrees with the
@@ -182,7 +182,7 @@ class BenchPipeline(unittest.TestCase):
         self.assertEqual(summary["particles"]["steps"], frames)
 
     def test_dynamic_stages(self):
-        """Issue 22's cost is its own stage: with dynamic.enabled the dynamic pixels' time is split off
+        """The dynamic pixels' cost is its own stage: with dynamic.enabled the dynamic pixels' time is split off
         the track stage ("dynamic", before it), the stages still partition the frame, and dynamic +
         track is the session's track_ms of tracking_stats.csv. In live mode with
         solver.dynamic_colliders the colliders are a stage of their own."""

@@ -83,7 +83,7 @@ class Cli(unittest.TestCase):
             self.assertIn("did you mean 'voxel_size'", r.stderr)
 
     def test_log_options_after_the_subcommand_and_usage_exit_codes(self):
-        # Issue 23: -q/--quiet and -v/--verbose work before or after the subcommand; usage errors
+        # -q/--quiet and -v/--verbose work before or after the subcommand; usage errors
         # exit 2 (README, "Exit codes and interrupted runs").
         demo = os.path.join(SRC, "configs", "demo.yaml")
         normal = seamless("run", demo, "--dry-run")
@@ -200,7 +200,7 @@ class Cli(unittest.TestCase):
                 self.assertFalse(os.path.exists(os.path.join(d, key, "trajectory.txt")))
 
     def check_preview(self, out, last_frame):
-        """preview.png (issue 18): the last frame at the demo config's own size (1280x720: the reduced
+        """preview.png: the last frame at the demo config's own size (1280x720: the reduced
         run overrides no render key), not blank."""
         img = read_png(os.path.join(out, "preview.png"))
         self.assertEqual((len(img[0]), len(img)), (1280, 720))
@@ -238,7 +238,7 @@ class Cli(unittest.TestCase):
             self.assertLess(ate["ate_rmse_m"], 0.01)
 
     def test_eval_json_escapes_names_and_warns_on_swapped_files(self):
-        # Issue 23: the JSON holds the paths as given, whatever characters they have (it was
+        # The JSON holds the paths as given, whatever characters they have (it was
         # built by string concatenation), and files in the old order (estimate first) get a warning.
         with tempfile.TemporaryDirectory() as d:
             odd = os.path.join(d, 'run "a"\\b\nc')

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Issue 23: scripts/compare_trackers gives every sequence its own camera's intrinsics and config
+"""Scripts/compare_trackers gives every sequence its own camera's intrinsics and config
 instead of freiburg1's for all, and refuses a folder whose camera it cannot tell unless --preset
 names it. A dry run (snakemake -n: nothing is tracked) over three folders made here, each holding
 only a groundtruth.txt, is enough: the choices are in OUT/grid.json and each cell's spec.json.

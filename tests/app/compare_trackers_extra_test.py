@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Issue 23: another system's trajectory in compare_trackers' tables (--extra NAME=FILE), with the
+"""Another system's trajectory in compare_trackers' tables (--extra NAME=FILE), with the
 field's figures: the row's ATE and RPE are checked against numbers computed by others on the same
 files, evo 1.38.1 (`evo_ape tum GT EST -a --t_max_diff 0.02`, `evo_rpe ... -d 1 -u f`) and TUM's
 evaluate_rpe.py (`--fixed_delta --delta 1 --delta_unit s`); their provenance is in
@@ -19,7 +19,7 @@ SKIP = 77
 SEQ = "tum_fr1_rpy_000-149"
 NAME = "other SLAM (v1)"
 # evo / TUM's script on the same two files; the JSON carries full doubles, the tolerance is far
-# below the 0.1 mm the issue asks for and far above rounding.
+# below the 0.1 mm the comparison asks for and far above rounding.
 REFERENCE = {"ate_rmse_m": 0.07952194358521113, "rpe_frame_trans_rmse_m": 0.009301277588343601,
              "rpe_frame_rot_rmse_deg": 0.6971432995627898, "rpe_second_trans_rmse_m": 0.14336711476163944,
              "rpe_second_rot_rmse_deg": 4.3116877057608045}

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Issue 8: scripts/compare_trackers on a Slurm cluster, with the exact command docs/REPRODUCE.md
+"""Scripts/compare_trackers on a Slurm cluster, with the exact command docs/REPRODUCE.md
 gives (snakemake 7's --slurm executor), against a stand-in Slurm: sbatch, sacct, srun and sacctmgr
 are small scripts in front of PATH that run each submitted job on this machine in the background
 and report its state the way Slurm's commands print it. It checks what this repository controls:

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Issue 8: in configs/demo.yaml no fluid may fall through the desk top (fluid poured on the desk
+"""In configs/demo.yaml no fluid may fall through the desk top (fluid poured on the desk
 fell through desk areas the scan never saw), end inside it, or end below the floor. Runs the demo
 on the CPU without pictures, saving the particles every 5 steps, and follows every fluid particle.
 usage: demo_surfaces_test.py SEAMLESS_BINARY SOURCE_DIR [RUN_DIR]   (RUN_DIR: check a finished run

@@ -1,4 +1,4 @@
-// Issue 22's ghost measure (src/app/ghost.cpp, summary.json dynamic.ghost_vertices) against mesh
+// The ghost measure of dynamic scenes (src/app/ghost.cpp, summary.json dynamic.ghost_vertices) against mesh
 // vertices placed by hand in and around a person's exact capsules (kernels/scene/movers.hpp).
 #include <gtest/gtest.h>
 

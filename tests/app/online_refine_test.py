@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Issue 24: online refinement (refine.online) on 30 real frames of tum_fr1_rpy_150-299 (frames the
+"""Online refinement (refine.online) on 30 real frames of tum_fr1_rpy_150-299 (frames the
 tracker was not tuned on), CPU, `seamless track` with configs/tum_fr1.yaml:
 - default (refine.online off, the offline stage off too): today's outputs, no online files;
 - online: trajectory.txt (the final online graph's) no worse than the odometry's ATE, solves done
@@ -79,7 +79,7 @@ class OnlineRefine(unittest.TestCase):
             self.assertIn("online refinement:", r.stderr + r.stdout)
             odometry, online = ate(off), ate(on)
             # No worse than the odometry alone, within one frame's tracking error of our tracker on
-            # these frames (RPE/frame 0.39 cm, docs/TRACKING.md "Issue 24"): when solutions arrive
+            # these frames (RPE/frame 0.39 cm, docs/TRACKING.md): when solutions arrive
             # depends on thread timing, so the online result is not bit-reproducible, but a graph
             # that made the trajectory worse by more than one frame's error would fail here.
             self.assertLessEqual(online, odometry + 0.004, f"online {online:.4f} m, odometry {odometry:.4f} m")

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Issue 18: the dissertation's figures on real recordings (configs/paper/real/) are complete,
+"""The dissertation's figures on real recordings (configs/paper/real/) are complete,
 point at recordings that exist, validate, and are in scripts/reproduce's plans and the report.
 
 usage: paper_real_test.py SEAMLESS ROOT DATA

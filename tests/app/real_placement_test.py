@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Issue 17 on real Kinect frames: configs/real/tum_desk.yaml (a fluid block, a cloth and a cube, each
+"""Placement on real Kinect frames: configs/real/tum_desk.yaml (a fluid block, a cloth and a cube, each
 `place: {on: support}`) on the first 60 frames of ../shared/data/tum_fr1_rpy_000-149, scanned with the
 config's own tracker, simulated for 3 s on the CPU without pictures. Checks, from the run's own outputs:
 

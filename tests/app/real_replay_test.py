@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Issue 17: the Kinect view of a scan-then-simulate run on real frames shows the recording.
+"""The Kinect view of a scan-then-simulate run on real frames shows the recording.
 
 configs/real/tum_desk.yaml on the first 12 frames of ../shared/data/tum_fr1_rpy_000-149 (ground-truth
 poses, so the test costs no tracking; no undistortion, so the view is the raw PNG), rendered headless

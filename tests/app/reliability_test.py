@@ -1,7 +1,7 @@
 #!/usr/bin/python3
-"""Issue 20 (reliability): exit codes that tell the truth, runs stopped by Ctrl-C or by a bad
+"""Reliability: exit codes that tell the truth, runs stopped by Ctrl-C or by a bad
 frame keep what they computed, an output folder holds one run, and limits that used to act
-silently are reported. Each test is a case of the issue's "Found" list.
+silently are reported. Each test is one way a run used to fail.
 usage: reliability_test.py SEAMLESS_BINARY SOURCE_DIR DATA_DIR"""
 import csv
 import glob
@@ -102,7 +102,7 @@ class ExitCodes(unittest.TestCase):
         r = seamless("run", DEMO, "--dry-run", "--set", "volume.voxel_sise=0.01")
         self.assertEqual(r.returncode, CONFIG, r.stderr)
         self.assertIn("did you mean 'voxel_size'", r.stderr)
-        # Found 6: one --set that cannot be applied hid the file's other errors; all are listed now.
+        # Regression: one --set that cannot be applied hid the file's other errors; all are listed now.
         with tempfile.TemporaryDirectory() as d:
             bad = os.path.join(d, "bad.yaml")
             with open(bad, "w") as f:
@@ -115,12 +115,12 @@ class ExitCodes(unittest.TestCase):
 
     @unittest.skipUnless(os.path.isdir(TUM), f"no test data at {TUM}")
     def test_wrong_depth_scale_loses_frames_and_says_so(self):
-        # Found 3: 9 of 10 frames lost at depth_scale 1000 (TUM is 5000), exit 0. The median depth of
+        # Regression: 9 of 10 frames lost at depth_scale 1000 (TUM is 5000), exit 0. The median depth of
         # 6 m passes the reader's 0.2-10 m plausibility check. The depth-scale check (the Kinect's
-        # disparity steps, issue 17) now stops it as a config error naming the right scale; with that
+        # disparity steps) now stops it as a config error naming the right scale; with that
         # check off, tracking is what tells, and the lost frames give their own exit code. Frame to
         # model: depth five times too far falls beyond volume.max_depth, the model stays empty and the
-        # frames are lost (frame to frame, configs/tum_fr1.yaml's tracker since issue 24, tracks the
+        # frames are lost (frame to frame, configs/tum_fr1.yaml's tracker, tracks the
         # scaled room consistently and loses nothing; only the depth-scale check can tell there).
         fm = "tracker.mode=frame_to_model"
         with tempfile.TemporaryDirectory() as d:
@@ -143,7 +143,7 @@ class ExitCodes(unittest.TestCase):
 
     @unittest.skipUnless(os.path.isdir(TUM), f"no test data at {TUM}")
     def test_zero_tracker_iterations_lose_every_frame(self):
-        # Found 3: tracker.iterations [0,0,0] lost every frame but the first, exit 0.
+        # Regression: tracker.iterations [0,0,0] lost every frame but the first, exit 0.
         with tempfile.TemporaryDirectory() as d:
             out = os.path.join(d, "trk")
             r = seamless(*track_tum(TUM, out, "frames=10", "tracker.iterations=[0,0,0]"))
@@ -154,7 +154,7 @@ class ExitCodes(unittest.TestCase):
 
 class Interrupted(unittest.TestCase):
     def test_record_stopped_by_ctrl_c_loads(self):
-        # Found 1: the lists were written only at the end; a stopped recording did not load.
+        # Regression: the lists were written only at the end; a stopped recording did not load.
         with tempfile.TemporaryDirectory() as d:
             room = os.path.join(d, "room")
             code, err = interrupt_when(
@@ -195,7 +195,7 @@ class Interrupted(unittest.TestCase):
             self.assertEqual(glob.glob(os.path.join(out, "*.partial")), [])
 
     def test_run_stopped_by_ctrl_c_writes_everything(self):
-        # Found 1: `run` stopped by SIGINT left log.txt empty and no timings.csv or tracking_stats.csv.
+        # Regression: `run` stopped by SIGINT left log.txt empty and no timings.csv or tracking_stats.csv.
         with tempfile.TemporaryDirectory() as d:
             out = os.path.join(d, "run")
             code, err = interrupt_when(
@@ -241,7 +241,7 @@ class Interrupted(unittest.TestCase):
 class FailedMidway(unittest.TestCase):
     @unittest.skipUnless(os.path.isdir(TUM), f"no test data at {TUM}")
     def test_corrupt_png_keeps_the_frames_before_it(self):
-        # Found 2: a corrupt PNG in frame 4 stopped the run (good) but frames 0-3 were not written.
+        # Regression: a corrupt PNG in frame 4 stopped the run (good) but frames 0-3 were not written.
         with tempfile.TemporaryDirectory() as d:
             seq, out = os.path.join(d, "seq"), os.path.join(d, "trk")
             tum_copy(seq, 6, corrupt_depth_of=4)
@@ -256,7 +256,7 @@ class FailedMidway(unittest.TestCase):
 
 class OutputFolder(unittest.TestCase):
     def test_a_folder_holds_one_run(self):
-        # Found 2: a run into an existing folder left the old run's other files beside its own.
+        # Regression: a run into an existing folder left the old run's other files beside its own.
         with tempfile.TemporaryDirectory() as d:
             out = os.path.join(d, "run")
             args = ["reconstruct", DEMO, "--device", "cpu", "--out", out, "--set", "input.synthetic.frames=2",
@@ -282,7 +282,7 @@ class OutputFolder(unittest.TestCase):
 
 class Limits(unittest.TestCase):
     def test_hash_table_keeps_up_with_a_tiny_capacity(self):
-        # Found 4: capacity 64 doubled 4 times in frame 0, then dropped 530,045 insertions, advised
+        # Regression: capacity 64 doubled 4 times in frame 0, then dropped 530,045 insertions, advised
         # grow_when_full: true (already on) and lost every later frame, exit 0.
         with tempfile.TemporaryDirectory() as d:
             out = os.path.join(d, "rec")
@@ -294,7 +294,7 @@ class Limits(unittest.TestCase):
             self.assertTrue(all(s["status"] == "ok" for s in rows(os.path.join(out, "tracking_stats.csv"))))
 
     def test_emitters_and_spawns_report_what_they_change(self):
-        # Found 6: an emitter asking for 100000 particles/s gave 15 without a word; an emitter past
+        # Regression: an emitter asking for 100000 particles/s gave 15 without a word; an emitter past
         # solver.max_particles dropped particles silently; a spawn at (1000, 1000, 1000) was moved
         # into the room silently.
         with tempfile.TemporaryDirectory() as d:

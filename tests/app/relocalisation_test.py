@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Issue 20, Found 5: relocalisation that checks itself. A covered sensor (frames 10-14 of real
+"""Relocalisation that checks itself. A covered sensor (frames 10-14 of real
 freiburg1_rpy with all-zero depth) loses tracking; the first frame accepted after the gap must
 agree with ground truth, and the run's ATE must stay near the ATE of the same frames without the
 gap. Before the fix, frame 15 "recovered" with a 22.8 cm / 11.4 degree jump marked ok (ground truth
@@ -57,7 +57,7 @@ def track(seq, out, kind):
     args = [EXE, "track", TUM_CFG, "--device", "cpu", "--out", out, "--set", f"input.path={seq}",
             "--set", "refine.enabled=false", "--set", f"tracker.kind={kind}", "--set", "output.max_lost_fraction=1",
             # 1 cm voxels instead of the config's 5 mm: fusion and raycast ~4 times cheaper (CI time);
-            # the false recovery of issue 20 happens the same way at both sizes (checked).
+            # the false recovery this test guards against happens the same way at both sizes (checked).
             "--set", "volume.voxel_size=0.01", "--set", "volume.truncation=0.04"]
     r = subprocess.run(args, capture_output=True, text=True, timeout=600)
     if r.returncode != 0:

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Issue 8: the split scripts/reproduce for a machine without Python's yaml or matplotlib (the GPU
+"""The split scripts/reproduce for a machine without Python's yaml or matplotlib (the GPU
 machine): `--plan FILE` writes the run's seamless commands as a bash script, the script runs with
 nothing but bash, mkdir, rm and the seamless binary on PATH, and `--from-runs DIR` builds the tables
 and figures from what it left. At the smoke size (one figure, the fluid case of table 5.1, a
@@ -13,7 +13,7 @@ Checks, against what the plan is meant to do rather than against printed numbers
 - --from-runs reports the run's own commit (the plan's) and device (host.txt), writes a table
   5.1 row with a positive time for the fluid case and one figure 5.8 row per layout and size;
 - a broken binary makes the plan exit non-zero and name the failed steps;
-- issue 18, with ../shared/data beside the source tree: the real set's smoke step (fig5_1 on the
+- with ../shared/data beside the source tree: the real set's smoke step (fig5_1 on the
   first 8 frames of tum_fr1_rpy_000-149) reads DATA, finishes, and --from-runs lists its settings
   as run: 8 frames (120-127), ground-truth poses and the config's 14 x 8 x 14 = 1568 water
   particles (a 0.28 x 0.16 x 0.28 m block of 2 cm particles); its figure is there whenever the

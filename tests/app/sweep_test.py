@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Issue 8: the Snakemake sweep (scripts/sweep/Snakefile) runs locally end to end on a tiny case and
+"""The Snakemake sweep (scripts/sweep/Snakefile) runs locally end to end on a tiny case and
 its table is right. Exits 77 (skipped) when snakemake is not installed (it is optional:
 `apt-get install snakemake`).
 usage: sweep_test.py SEAMLESS_BINARY SOURCE_DIR WORK_DIR

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""`seamless run` with render.mode: window (issue 8): under a virtual X server (xvfb-run) the run
+"""`seamless run` with render.mode: window: under a virtual X server (xvfb-run) the run
 opens the GLFW window, which drives the simulation, and --window-frames closes it after N frames
 with exit code 0; without a display it says so and renders headless instead.
 usage: window_run_test.py SEAMLESS_BINARY SOURCE_DIR. Exits 77 (skipped) without GLFW or xvfb-run."""

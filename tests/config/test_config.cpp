@@ -276,7 +276,7 @@ TEST(ConfigFiles, DemoSaysWhatItShould) {
   Experiment e = load_experiment(std::string(SEAMLESS_SOURCE_DIR) + "/configs/demo.yaml");
   EXPECT_EQ(e.input.source, InputSource::synthetic);
   EXPECT_EQ(e.mode, ExperimentMode::scan_then_simulate);
-  // The demo of the issue: fluid on the desk, a cloth, cubes (plural) on the floor.
+  // The demo's scene: fluid on the desk, a cloth, cubes (plural) on the floor.
   auto count = [&](SpawnKind kind) {
     return std::count_if(e.spawn.begin(), e.spawn.end(), [&](const SpawnParams& s) { return s.kind == kind; });
   };

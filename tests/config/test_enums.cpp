@@ -88,7 +88,7 @@ TEST(ConfigEnums, EveryEnumFieldRoundTripsItsNamesAndRejectsOthers) {
   Experiment e;
   EnumWalker walker{"", &found};
   e.visit(walker);
-  // The enums made so far (issue 19); a new one is checked here without being listed.
+  // The enums made so far; a new one is checked here without being listed.
   for (const char* path : {"mode",
                            "input.source",
                            "input.association",

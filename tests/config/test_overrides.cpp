@@ -96,7 +96,7 @@ TEST(ConfigOverride, MalformedOptions) {
   EXPECT_THAT(error_of(kBase, {"solver.gravity=[0,1"}), HasSubstr("cannot parse"));
 }
 
-// Issue 20: an option that cannot be applied at all (malformed, or a path through a value) was
+// An option that cannot be applied at all (malformed, or a path through a value) was
 // thrown on its own and hid every problem of the file; now they are all listed together, and the
 // error is a ConfigError (exit code 4).
 TEST(ConfigOverride, UnusableOptionIsListedWithTheFilesProblems) {

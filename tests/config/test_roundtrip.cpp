@@ -81,7 +81,7 @@ TEST(ConfigRoundTrip, UnusualValuesThroughAFile) {
 TEST(ConfigRoundTrip, EffectiveConfigListsEveryKeyWithItsDoc) {
   Experiment e;
   e.spawn.resize(1);                   // so the spawn entry keys are written too
-  e.input.synthetic.movers.resize(1);  // and the movers' (issue 22)
+  e.input.synthetic.movers.resize(1);  // and the movers'
   std::string yaml = to_yaml(e);
   for (const auto& k : experiment_keys()) {
     std::string leaf = k.path.substr(k.path.rfind('.') + 1);  // npos + 1 == 0

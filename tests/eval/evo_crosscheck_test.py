@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Issue 23: `seamless eval GT EST` against evo (Grupp, github.com/MichaelGrupp/evo) on the same files,
+"""`seamless eval GT EST` against evo (Grupp, github.com/MichaelGrupp/evo) on the same files,
 where evo is installed (`pip install evo`, optional: exit 77, ctest "skipped", without it). The
 files: the shared tum_fr1_rpy_000-149 ground truth and tests/eval/data/tum_fr1_rpy_000-149_icp.txt
 (a drifting ICP estimate). evo_ape with -a / -as / no alignment and evo_rpe per frame

@@ -11,11 +11,11 @@
 #include "fuzz_util.hpp"
 #include "io/frame_folder_source.hpp"
 #include "io/jpeg_io.hpp"
+#include "io/ply.hpp"
 #include "io/png_io.hpp"
 #include "io/trajectory.hpp"
 #include "io/tum_source.hpp"
 #include "physics/builders.hpp"
-#include "recon/ply.hpp"
 
 namespace seamless::fuzz {
 
@@ -127,16 +127,16 @@ inline void jpeg(const std::uint8_t* data, std::size_t size) {
   expect_error_or_success([&] { (void)read_colour_image(path); });
 }
 
-// The PLY mesh reader (src/recon/ply.hpp). A mesh that loads must be usable: every triangle's
+// The PLY mesh reader (src/io/ply.hpp: every encoding). A mesh that loads must be usable: every triangle's
 // indices name one of its vertices.
 inline void ply(const std::uint8_t* data, std::size_t size) {
   const std::string path = put("in.ply", {reinterpret_cast<const char*>(data), size});
   expect_error_or_success([&] {
-    Mesh m = read_ply(path);
+    Mesh m = read_mesh_ply(path);
     const auto n = static_cast<int>(m.positions.size());
     for (const int3& t : m.triangles)
       if (t.x < 0 || t.y < 0 || t.z < 0 || t.x >= n || t.y >= n || t.z >= n)
-        throw Violation("read_ply accepted a triangle with a vertex index out of range");
+        throw Violation("read_mesh_ply accepted a triangle with a vertex index out of range");
   });
 }
 

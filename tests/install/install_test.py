@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Issue 23: `cmake --install` gives PREFIX/bin/seamless, the configs and docs under
+"""`cmake --install` gives PREFIX/bin/seamless, the configs and docs under
 PREFIX/share/seamless and a CMake package that a project outside the tree builds on
 (tests/install/consumer: find_package(seamless), seamless::core, ::kernels, ::io, ::eval, each
 used once against a known answer).

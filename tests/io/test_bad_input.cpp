@@ -174,7 +174,7 @@ TEST(BadInput, MalformedListLine) {
   EXPECT_MENTIONS(msg, "line 4");
 }
 
-// Issue 20: a line repeated in a TUM list (same timestamp twice) made one frame two, fused twice
+// A line repeated in a TUM list (same timestamp twice) made one frame two, fused twice
 // with two poses at one time. It is dropped, with a warning naming the file and line.
 TEST(BadInput, RepeatedListLinesAreDroppedWithAWarning) {
   TmpDir dir("bad_repeat");
@@ -207,7 +207,7 @@ TEST(BadInput, RepeatedListLinesAreDroppedWithAWarning) {
   }
 }
 
-// Issue 20: the readers' errors are InputErrors, so that `seamless` exits with its input-error code.
+// The readers' errors are InputErrors, so that `seamless` exits with its input-error code.
 TEST(BadInput, ReadersThrowInputErrors) {
   TmpDir dir("bad_kind");
   make_folder(dir);

@@ -1,5 +1,5 @@
 // input.intrinsics: which camera model a folder gets, and that preset auto says what it chose
-// (issue 23: freiburg2/3 sequences were run with freiburg1's calibration without a word).
+// (freiburg2/3 sequences were run with freiburg1's calibration without a word).
 #include <gtest/gtest.h>
 #include <spdlog/sinks/ringbuffer_sink.h>
 #include <spdlog/spdlog.h>

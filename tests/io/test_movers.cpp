@@ -1,4 +1,4 @@
-// Issue 22's test material: movers in the synthetic room, against exact geometry. The capsule
+// Test material of dynamic scenes: movers in the synthetic room, against exact geometry. The capsule
 // intersection against hand-solved rays; the posed person and ball against their definition; the
 // rendered depth and mask against the capsules' distance function; the recording's mask/ and
 // movers.txt.

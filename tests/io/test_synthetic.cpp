@@ -269,7 +269,7 @@ TEST(SyntheticRoomParity, CpuAndCudaRenderTheSameFrames) {
   }
 }
 
-// Issue 22: the movers and their mask through the same kernel on both backends (a person in front
+// The movers and their mask through the same kernel on both backends (a person in front
 // of the still camera and a ball on the floor; the silhouettes may flip a pixel as above).
 TEST(SyntheticRoomParity, CpuAndCudaRenderTheSameMovers) {
   if (!cuda_available()) GTEST_SKIP() << "no CUDA device";

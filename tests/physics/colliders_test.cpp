@@ -1,4 +1,4 @@
-// Issue 22: kinematic colliders from a depth camera's view (physics/depth_colliders.hpp) against
+// Kinematic colliders from a depth camera's view (the host oracle, host_colliders.hpp) against
 // the exact geometry of a walking person's torso (a capsule, kernels/scene/movers.hpp).
 #include <gtest/gtest.h>
 
@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "host_colliders.hpp"
 #include "kernels/scene/movers.hpp"
 #include "physics/builders.hpp"
-#include "physics/depth_colliders.hpp"
 #include "physics/particle_solver.hpp"
 #include "physics_test_util.hpp"
 
@@ -158,7 +158,7 @@ Walk walk_through_cube(bool interpolate) {
 }
 
 TEST(DepthColliders, WalkingTorsoPushesACubeAndNothingEndsInsideIt) {
-  // Issue 22's physics test: a cube resting in a person's path is pushed at least 0.2 m, and no
+  // The live colliders' physics test: a cube resting in a person's path is pushed at least 0.2 m, and no
   // particle ever ends inside the person by more than half a particle diameter.
   const float d = SolverParams{}.particle_diameter;
   const Walk moving = walk_through_cube(true), jumping = walk_through_cube(false);
@@ -226,7 +226,7 @@ Pour pour_on_person(bool with_colliders) {
 }
 
 TEST(DepthColliders, WaterPouredOnAPersonRunsOffThem) {
-  // Issue 22: fluid poured on a person (seen by the camera, as solver.dynamic_colliders gives them
+  // Fluid poured on a person (seen by the camera, as solver.dynamic_colliders gives them
   // to the solver) lands on them, never sinks into them by more than half a particle diameter, and
   // runs off onto the floor.
   const float d = SolverParams{}.particle_diameter;

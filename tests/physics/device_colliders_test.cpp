@@ -1,7 +1,7 @@
-// Issue 19: the depth camera's colliders computed on the device (DeviceColliders,
-// kernels/physics/depth_colliders.hpp) give what the host code gives (depth_surface, the app's
-// block_any and MovingColliders): on the CPU bit for bit; DeviceCollidersParity (ctest label gpu)
-// on CUDA within float rounding.
+// The depth camera's colliders computed on the device (DeviceColliders,
+// kernels/physics/depth_colliders.hpp) give what the host oracle gives (host_colliders.hpp:
+// depth_surface, the app's block_any and MovingColliders): on the CPU bit for bit; DeviceCollidersParity (ctest label
+// gpu) on CUDA within float rounding.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -14,6 +14,7 @@
 #include "core/buffer.hpp"
 #include "core/device.hpp"
 #include "core/error.hpp"
+#include "host_colliders.hpp"
 #include "physics/depth_colliders.hpp"
 
 namespace seamless {

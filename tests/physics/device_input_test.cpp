@@ -1,4 +1,4 @@
-// Issue 19: the solver takes scene and collider particles as device buffers (what
+// The solver takes scene and collider particles as device buffers (what
 // Volume::extract_scene_particles and the depth colliders leave on the device), copied device to
 // device, with the same result as the host vectors: the same points in the same order.
 // DeviceInputParity: a CUDA buffer in (ctest label gpu; skipped without a CUDA device).

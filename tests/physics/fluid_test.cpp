@@ -59,7 +59,7 @@ RestResult fluid_at_rest(int iterations, int W) {
   return r;
 }
 
-// Thresholds from the issue (4 iterations): mean interior density error <= 2 %, max <= 5 %.
+// Acceptance thresholds of the fluid solver (4 iterations): mean interior density error <= 2 %, max <= 5 %.
 TEST(PhysicsFluid, AtRestInBoxKeepsDensity) {
   RestResult r = fluid_at_rest(4, 8);
   std::printf("fluid at rest, 4 iterations: interior %d, mean |rho/rho0 - 1| %.4f, max %.4f\n", r.interior, r.mean_err,
@@ -84,7 +84,7 @@ const double kMartinMoyce[][2] = {{0.41, 1.11}, {0.84, 1.22}, {1.19, 1.44}, {1.4
 
 // Column a = 25 diameters (1 m) wide and 2a high in a 2-particle slab between smooth walls (a
 // container SDF: a particle floor's bumps would act as friction the experiment did not have).
-// The front is the leading particle's edge. Tolerance 15 % from the issue, for 1 <= T <= 3.
+// The front is the leading particle's edge. Acceptance tolerance 15 %, for 1 <= T <= 3.
 TEST(PhysicsFluid, DamBreakFollowsMartinMoyce) {
   SolverParams p;
   p.max_speed = 10.f;  // the surge reaches ~6 m/s

@@ -118,9 +118,9 @@ void expect_block_parity(bool with_solids) {
   std::vector<vec3> solid, fluid_top;
   float top = -1e30f;
   for (std::size_t i = 0; i < b.x.size(); ++i)
-    if (kernels::phase::is(b.phase[i], kernels::phase::kFluid)) top = std::max(top, b.x[i].y);
+    if (phase::is(b.phase[i], phase::kFluid)) top = std::max(top, b.x[i].y);
   for (std::size_t i = 0; i < b.x.size(); ++i) {
-    if (!kernels::phase::is(b.phase[i], kernels::phase::kFluid)) solid.push_back(b.x[i]);
+    if (!phase::is(b.phase[i], phase::kFluid)) solid.push_back(b.x[i]);
     else if (b.x[i].y > top - h) fluid_top.push_back(b.x[i]);
   }
   float closest = 1e30f;

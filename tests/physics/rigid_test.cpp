@@ -177,7 +177,7 @@ InclineRun incline(float mu) {
 // it must not drift by more than 0.1 mm, less than the g sin 20 dt_sub^2 = 0.084 mm that one
 // substep of sliding would add (it crept 15 mm/s before the body-level static friction of
 // kernels::body_static_friction). Below the threshold it must slide: mu = 0.3 and 0.1 give
-// g (sin 20 - mu cos 20) = 0.589 and 2.43 m/s^2 (10 % tolerance from the issue).
+// g (sin 20 - mu cos 20) = 0.589 and 2.43 m/s^2 (10 % acceptance tolerance).
 TEST(PhysicsFriction, CubeOnIncline) {
   const double th = 20.0 * 3.14159265358979 / 180.0, g = 9.81;
   InclineRun stick = incline(0.5f);
@@ -194,8 +194,8 @@ TEST(PhysicsFriction, CubeOnIncline) {
   }
 }
 
-// The OBJ reader of rigid mesh bodies (issue 20: fuzzing found std::stoi's exception escape and
-// face indices past the vertices read out of bounds; issue 19: tinyobjloader reads the file). A
+// The OBJ reader of rigid mesh bodies (fuzzing found std::stoi's exception escape and
+// face indices past the vertices read out of bounds; tinyobjloader reads the file now). A
 // valid file with every kind of face reference gives a solid; each bad file is an InputError
 // naming the file and the problem (and the line, where tinyobjloader tells it).
 std::string write_obj(const std::string& name, const std::string& text) {

@@ -1,8 +1,8 @@
-// Issue 22: configs/dynamic_person.yaml's scene (a person walking through the synthetic room at
+// Configs/dynamic_person.yaml's scene (a person walking through the synthetic room at
 // 0.8 m/s from 1 s to 4.9 s, a ball rolling behind them, then 3 s of empty room) with exact ground
 // truth: the dynamic mask against the rendered mover masks, the ghost the person leaves in the
 // mesh, and the tracking error, each with dynamic.enabled off and on. With a CUDA device the runs
-// use it at the Kinect's 640x480, the resolution the issue's bounds are for; on the CPU they are
+// use it at the Kinect's 640x480, the resolution the mask and ghost bounds are for; on the CPU they are
 // made small (320x240), and take tens of minutes: label slow. At 320x240 ICP itself tracks this
 // orbit to ~1.8 cm without the person, so there the 1 cm bound cannot hold whatever the mask does.
 // (At 160x120 or with 2 cm voxels ICP loses the orbit.)
@@ -154,7 +154,7 @@ Outcome run(const InputParams& in, bool dynamic, const std::string& tracker = "i
     if (!dynamic || in.synthetic.movers.empty() || f.index == 0) continue;
     fraction_sum += r.dynamic_fraction;
     dynamic_ms.push_back(r.dynamic_ms);
-    // Mask quality (issue 22's condition, recon/mask_score.hpp): scored by the session itself.
+    // Mask quality (the condition of recon/mask_score.hpp): scored by the session itself.
     if (r.mask_score) scores.push_back({f.index, *r.mask_score});
   }
   o.allocate_ms = stages.median_ms("allocate"), o.visible_ms = stages.median_ms("visible");
@@ -209,7 +209,7 @@ TEST(Dynamic, SlowPersonWalkingThroughTheRoom) {
   std::printf("icp, no person:   ATE %.2f cm\n", 100 * empty.ate_m);
   print_below("ground-truth poses", on);
   print_below("icp", tracked_on);
-  // Mask quality (issue 22): IoU at least 0.8 on every frame with the person 0.5 m or more away.
+  // Mask quality: IoU at least 0.8 on every frame with the person 0.5 m or more away.
   EXPECT_GT(on.iou_frames, 10);
   EXPECT_GE(on.min_iou, 0.8);
   // Ghost: with dynamic handling off the person is fused into the model where they walked.

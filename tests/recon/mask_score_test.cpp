@@ -1,4 +1,4 @@
-// recon/mask_score: the dynamic mask against the movers' ground truth (issue 22's mask test), on
+// recon/mask_score: the dynamic mask against the movers' ground truth (the mask test of docs/DYNAMIC.md), on
 // hand-made masks whose counts are known.
 #include "recon/mask_score.hpp"
 

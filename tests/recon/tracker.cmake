@@ -1,10 +1,10 @@
-# Camera tracking tests (issue 5). *Parity* cases compare CPU and CUDA (ctest label gpu).
+# Camera tracking tests. *Parity* cases compare CPU and CUDA (ctest label gpu).
 seamless_test(test_tracker_icp SOURCES tracker_icp_test.cpp LIBS seamless_tracker seamless_eval)
 seamless_test(test_tracker_sequence SOURCES tracker_sequence_test.cpp LIBS seamless_tracker seamless_refine seamless_eval)
 seamless_test(test_tracker_parity SOURCES tracker_parity_test.cpp LIBS seamless_tracker seamless_eval)
 # External trackers (src/recon/external/): OpenCV / PCL cases skip when the module is off.
 seamless_test(test_tracker_external SOURCES external_tracker_test.cpp LIBS seamless_tracker seamless_eval)
-# Issue 22: dynamic pixels, ghosts and tracking with a person walking through (Parity: label gpu).
+# Dynamic pixels, ghosts and tracking with a person walking through (Parity: label gpu).
 seamless_test(test_dynamic SOURCES dynamic_test.cpp LIBS seamless_tracker seamless_eval)
 seamless_test(test_dynamic_kernels SOURCES dynamic_kernels_test.cpp LIBS seamless_tracker seamless_eval)
 # The dynamic mask against the movers' ground truth (recon/mask_score; summary.json dynamic.mask).

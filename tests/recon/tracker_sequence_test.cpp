@@ -65,7 +65,7 @@ class CutSource : public FrameSource {
 }  // namespace
 
 TEST(TrackSequence, SyntheticRoomFrameToModelWithinOneCentimetre) {
-  // Issue 5: the synthetic room with Kinect v1 noise, our ICP, ATE RMSE at most 1 cm and no lost
+  // The synthetic room with Kinect v1 noise, our ICP, ATE RMSE at most 1 cm and no lost
   // frame. 60 frames = 2 s of hand-held orbit (30 deg around the desk).
   InputParams in = test::synthetic_input(60);
   auto src = make_source(in);
@@ -151,8 +151,8 @@ TEST(TrackSequence, UnavailableTrackerSaysSo) {
   }
 }
 
-// The tracker section of configs/tum_fr1.yaml before issue 24 (it is frame to frame now: see
-// docs/TRACKING.md, "Issue 24", and ctest compare_trackers_fr1_rpy): RGB-D frame-to-model with robust self-balancing
+// The tracker section of configs/tum_fr1.yaml before online refinement (it is frame to frame now: see
+// docs/TRACKING.md and ctest compare_trackers_fr1_rpy): RGB-D frame-to-model with robust self-balancing
 // weights, the Kinect's depth-squared noise, a colour row for every visible pixel and the last frame's image as the
 // photometric reference, a constant-velocity prediction, photometric weight 1. Volume at 1 cm (see default_params).
 TrackSequenceParams best_tum_params() {
@@ -168,10 +168,10 @@ TrackSequenceParams best_tum_params() {
   return p;
 }
 
-// Issue 5: real Kinect v1 frames with fast roll/pitch/yaw (up to 6 deg a frame); every one of the
+// Real Kinect v1 frames with fast roll/pitch/yaw (up to 6 deg a frame); every one of the
 // 150 frames must be tracked (none reported lost). One tracking run serves both checks (it takes
 // minutes on the CPU, so CI runs it once): every frame tracked, then, where Ceres is built, the
-// refined trajectory within 3 cm (issue 5's ATE RMSE goal). The tracker alone measures 2.5 cm at 5 mm (session 4:
+// refined trajectory within 3 cm (the tracker's ATE RMSE goal). The tracker alone measures 2.5 cm at 5 mm (with
 // robust weights, depth-squared noise, colour on every visible pixel; 3.3 cm before them; frame-to-frame RGB-D 3.1 cm,
 // geometric ICP much worse: on these frames the Kinect depth shows about 25 % less rotation between frames than the
 // ground truth and the colour do, see docs/TRACKING.md). Our best tracker is therefore the tracker followed by the

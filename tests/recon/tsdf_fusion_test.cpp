@@ -239,7 +239,7 @@ TEST(TsdfFusion, FullPoolGrowsAndRetriesOrReports) {
   EXPECT_GT(c.failed_insertions, 0);  // counted and reported, not silent
 }
 
-// Issue 20: growth used to stop after 4 doublings a frame, dropping the rest of the frame. A pool
+// Growth used to stop after 4 doublings a frame, dropping the rest of the frame. A pool
 // of 2 blocks and 1024 hash slots must grow as often as the first frame needs (here 2 -> 1024
 // blocks and more: 9 doublings or more) and hold exactly the blocks a roomy volume allocates.
 TEST(TsdfFusion, GrowthKeepsUpWithAFrameThatNeedsManyDoublings) {
@@ -260,7 +260,7 @@ TEST(TsdfFusion, GrowthKeepsUpWithAFrameThatNeedsManyDoublings) {
   EXPECT_EQ(grown.allocated_block_coords(), ref.allocated_block_coords());
 }
 
-// Issue 20: a 10,000-frame run doubled its hash table 11 times while holding at most 65,536 blocks,
+// A 10,000-frame run doubled its hash table 11 times while holding at most 65,536 blocks,
 // then overflowed 32-bit slot indices. Insertion never reuses tombstones, and a block that the
 // truncation band only grazes (every voxel in it ends at +truncation) is allocated and freed again
 // in every frame, one more tombstone before its key each time: after max_probe (128) frames its

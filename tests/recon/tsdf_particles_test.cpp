@@ -215,7 +215,7 @@ TEST(TsdfSamplerParity, GridOnCpuAndCudaAgree) {
   for (std::size_t i = 0; i < ga.size(); ++i) ASSERT_NEAR(ga[i], gb[i], 1e-5f) << i;
 }
 
-// ---- the synthetic room (issue #4 / #8: surfaces between lattice planes) -------------------------
+// ---- the synthetic room (surfaces between lattice planes) ---------------------------------------
 
 namespace R = kernels::room;
 
@@ -297,7 +297,7 @@ bool seen_by_all(const RoomScan& r, vec3 q) {
 //   half a spacing: a particle is a zero of the trilinear TSDF, in a cell whose corners have both
 //     signs; exact depth and poses give each fused voxel the sign of its side, so the patch crosses
 //     that cell, and the particle is within a cell diagonal (sqrt(3) cm = 0.017 m) of it: < s/2.
-//   one spacing: the hole the issue is about is a column without any particle; a particle of
+//   one spacing: the hole this guards against is a column without any particle; a particle of
 //     diameter s passes a hole only when the hole's circumradius reaches s.
 // `side` (+1 or -1) is the direction of free space along the axis.
 int holes(const RoomScan& r, int axis, float side, float level, vec2 lo, vec2 hi, int* columns) {

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "core/buffer.hpp"
-#include "core/camera.hpp"
+#include "core/intrinsics.hpp"
 #include "core/math.hpp"
 #include "recon/volume_params.hpp"
 #include "recon/voxel_hash_volume.hpp"

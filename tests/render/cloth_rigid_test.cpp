@@ -3,7 +3,7 @@
 #include <cmath>
 #include <memory>
 
-#include "kernels/physics/particle_math.hpp"
+#include "core/phase.hpp"
 #include "physics/particle_solver.hpp"
 #include "render_test_util.hpp"
 
@@ -20,7 +20,7 @@ struct Sheet {
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i)
         x.push_back(vec3{-0.5f + static_cast<float>(i) / (n - 1), -0.5f + static_cast<float>(j) / (n - 1), 2.f});
-    ph.assign(x.size(), kernels::phase::kCloth);
+    ph.assign(x.size(), phase::kCloth);
     for (int j = 0; j + 1 < n; ++j)
       for (int i = 0; i + 1 < n; ++i) {
         const int a = j * n + i, b = a + 1, c = a + n + 1, d = a + n;
@@ -150,10 +150,10 @@ TEST(RenderRigid, DrawListFromTheSolversObjects) {
   RigidBody box{0, 3, 2, {}, nullptr};
   for (vec3 q : {vec3{-0.3f, -0.1f, -0.05f}, vec3{0.3f, 0.1f, 0.05f}, vec3{0.3f, -0.1f, 0.f}}) {
     st.x.push_back(R * q + c);
-    st.phase.push_back(kernels::phase::kRigid);
+    st.phase.push_back(phase::kRigid);
     box.rest.push_back(q);
   }
-  st.x.push_back({0.f, 0.f, 0.f}), st.phase.push_back(kernels::phase::kCloth);
+  st.x.push_back({0.f, 0.f, 0.f}), st.phase.push_back(phase::kCloth);
   auto mesh = std::make_shared<BodyMesh>();
   objects.bodies = {{10, 1, 0, {vec3{0.f, 0.f, 0.f}}, mesh}, box};      // the first is not in the frames
   objects.cloths.push_back({0, 0, 1, {int3{0, 1, 3}, int3{0, 1, 4}}});  // id 4: not spawned yet
@@ -175,7 +175,7 @@ TEST(RenderRigid, DrawListFromTheSolversObjects) {
   ASSERT_EQ(d.cloths[0].triangles.size(), 1u);
   EXPECT_EQ(d.cloths[0].triangles[0].z, 3);
   // The mesh body, once its frame is there, is drawn with its mesh.
-  st.x.resize(11, vec3{0.f, 0.f, 0.f}), st.phase.resize(11, kernels::phase::kRigid);
+  st.x.resize(11, vec3{0.f, 0.f, 0.f}), st.phase.resize(11, phase::kRigid);
   RigidFrame g{vec3{0.f, 1.f, 0.f}, vec4{0.f, 0.f, 0.f, 1.f}, 10, 1};
   const DrawList e = make_draw_list(st, objects, {f, g}, 0.02f);
   ASSERT_EQ(e.rigids.size(), 2u);

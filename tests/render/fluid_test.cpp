@@ -4,8 +4,8 @@
 #include <cmath>
 #include <filesystem>
 
+#include "core/phase.hpp"
 #include "io/png_io.hpp"
-#include "kernels/physics/particle_math.hpp"
 #include "render/headless_output.hpp"
 #include "render_test_util.hpp"
 
@@ -21,7 +21,7 @@ struct FluidBlock {
     for (int k = 0; k < 8; ++k)
       for (int j = 0; j < 8; ++j)
         for (int i = 0; i < 8; ++i) x.push_back(vec3{(i - 3.5f) * 2 * r, (j - 3.5f) * 2 * r, 2.f + (k - 3.5f) * 2 * r});
-    ph.assign(x.size(), kernels::phase::kFluid);
+    ph.assign(x.size(), phase::kFluid);
   }
   DrawList list() const {
     DrawList d;

@@ -2,7 +2,7 @@
 // surface, and the virtual camera is the sensor's exact pinhole model and tracked pose.
 #include <cmath>
 
-#include "kernels/physics/particle_math.hpp"
+#include "core/phase.hpp"
 #include "render_test_util.hpp"
 
 namespace seamless::test {
@@ -37,7 +37,7 @@ Pixels render_sphere(const KinectScene& s, vec3 c, float radius, int W, int H) {
   Renderer r(p, W, H);
   r.set_kinect_view(s.rgb, s.depth, s.K, s.world_T_camera);
   const std::vector<vec3> x = {s.world_T_camera * c};
-  const std::vector<std::uint32_t> ph = {kernels::phase::kFluid};
+  const std::vector<std::uint32_t> ph = {phase::kFluid};
   DrawList list;
   list.positions = x, list.phases = ph, list.particle_radius = radius;
   return Pixels(r.render(list, RenderCamera{}));

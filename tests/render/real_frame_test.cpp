@@ -1,4 +1,4 @@
-// Issue #18 ("Looks real") on a real Kinect frame: frame 130 of tum_fr1_rpy_000-149 (a desk with
+// The realistic look on a real Kinect frame: frame 130 of tum_fr1_rpy_000-149 (a desk with
 // papers and a keyboard at about 1 m), read with the TUM reader (undistorted, freiburg1
 // intrinsics), pose identity (world = camera frame). The desk's plane is fitted to the frame's
 // depth; a cube and a puddle of fluid rest on it.
@@ -14,12 +14,13 @@
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
+#include <numbers>
 
 #include "core/error.hpp"
+#include "core/phase.hpp"
 #include "io/input_params.hpp"
 #include "io/png_io.hpp"
 #include "io/tum_source.hpp"
-#include "kernels/physics/particle_math.hpp"
 #include "render_test_util.hpp"
 
 namespace seamless::test {
@@ -233,7 +234,7 @@ TEST(RenderLooks, CubeShadowOnTheRealDesk) {
     const vec3 c{(k & 1) ? half : -half, (k & 2) ? half : -half, (k & 4) ? half : -half};
     z0 = std::min(z0, dot(L, fr.cube.world_T_body * c));
   }
-  const float tan_a = std::tan(0.5f * fr.p.light_angle * kernels::kPi / 180.f);
+  const float tan_a = std::tan(0.5f * fr.p.light_angle * std::numbers::pi_v<float> / 180.f);
   const float texel = 2.f * std::sqrt(3.f) * half / (fr.p.shadow_map_size - 4);
   const float k = fr.p.shadow_strength;
   int umbra = 0, contact = 0, lit = 0, lit_faces = 0;
@@ -284,8 +285,8 @@ TEST(RenderLooks, CubeShadowOnTheRealDesk) {
 
 // A resting body of water on the desk below pixel (u, v): particles on a lattice of one diameter
 // (PBF's rest spacing) inside half an ellipsoid (semi-axes A along t1, B along t2, height H along
-// n), the shape surface tension gives a puddle with a rounded rim. 2 cm particles (issue #18:
-// 2-3 cm at 1-2 m): a few hundred of them.
+// n), the shape surface tension gives a puddle with a rounded rim. 2 cm particles (the
+// realistic look's 2-3 cm at 1-2 m): a few hundred of them.
 struct Puddle {
   std::vector<vec3> x;
   std::vector<std::uint32_t> ph;
@@ -302,7 +303,7 @@ struct Puddle {
           if ((xx * xx) / (ea * ea) + (y * y) / (eb * eb) + (h * h) / (eh * eh) > 1.f) continue;
           x.push_back(centre + a * xx + b * y + n * h);
         }
-    ph.assign(x.size(), kernels::phase::kFluid);
+    ph.assign(x.size(), phase::kFluid);
   }
   // Length of the ray t dir (from the camera) inside the half-ellipsoid: the unit sphere after
   // scaling each axis, cut by the desk plane (h >= 0).

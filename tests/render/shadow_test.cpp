@@ -1,8 +1,9 @@
 // Shadows in the mesh view, against analytic footprints: a floor mesh (the scan, unlit: its
 // colours hold the room's light) under a cube and under a slab of water, the light straight down.
 #include <cmath>
+#include <numbers>
 
-#include "kernels/physics/particle_math.hpp"
+#include "core/phase.hpp"
 #include "render_test_util.hpp"
 
 namespace seamless::test {
@@ -63,7 +64,7 @@ TEST(RenderShadow, MeshViewFloorUnderACube) {
   const Pixels off(r.render(list, cam));
   r.params().shadows = true;
   const Pixels on(r.render(list, cam));
-  const float margin = std::tan(0.5f * p.light_angle * kernels::kPi / 180.f) * (0.15f + 2 * half) +
+  const float margin = std::tan(0.5f * p.light_angle * std::numbers::pi_v<float> / 180.f) * (0.15f + 2 * half) +
                        3.f * 2.f * std::sqrt(3.f) * half / (p.shadow_map_size - 4);
   const float k = p.shadow_strength;
   int umbra = 0, lit = 0;
@@ -114,13 +115,13 @@ TEST(RenderShadow, WaterShadowIsTintedByBeerLambert) {
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i)
         x.push_back({(i - 0.5f * (n - 1)) * 2 * rad, 0.15f + 2 * rad * k, (j - 0.5f * (n - 1)) * 2 * rad});
-  const std::vector<std::uint32_t> ph(x.size(), kernels::phase::kFluid);
+  const std::vector<std::uint32_t> ph(x.size(), phase::kFluid);
   DrawList list;
   list.positions = x, list.phases = ph, list.particle_radius = rad;
   const RenderCamera cam = above();
   const Pixels on(r.render(list, cam));
   const Renderer::FluidImages fluid = r.read_fluid_images();  // rows bottom to top
-  const float s = p.fluid_radius_scale, R = s * rad, scale = 6.f / (kernels::kPi * s * s * s);
+  const float s = p.fluid_radius_scale, R = s * rad, scale = 6.f / (std::numbers::pi_v<float> * s * s * s);
   const float half = n * rad - R;  // interior: the column centres' extent
   vec3 sum_got{0, 0, 0}, sum_want{0, 0, 0};
   int count = 0;

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <random>
 
-#include "kernels/physics/particle_math.hpp"
+#include "core/phase.hpp"
 #include "render_test_util.hpp"
 
 namespace seamless::test {
@@ -27,7 +27,7 @@ struct Block {
         for (int i = 0; i < 6; ++i)
           x.push_back(
               vec3{(i - 2.5f) * 2 * r + j(rng), (jj - 2.5f) * 2 * r + j(rng), kWallZ + (k - 2.5f) * 2 * r + j(rng)});
-    ph.assign(x.size(), kernels::phase::kFluid);
+    ph.assign(x.size(), phase::kFluid);
   }
   DrawList list() const {
     DrawList d;

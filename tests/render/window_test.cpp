@@ -17,7 +17,7 @@
 #include <filesystem>
 #include <thread>
 
-#include "kernels/physics/particle_math.hpp"
+#include "core/phase.hpp"
 #include "render/renderer.hpp"
 #include "render/window.hpp"
 
@@ -93,7 +93,7 @@ TEST(RenderWindow, ScriptedKeysPauseStepToggleSpawnAndCloseCleanly) {
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j)
       for (int k = 0; k < 4; ++k) x.push_back({0.04f * i - 0.06f, 0.04f * j - 0.06f, 0.04f * k - 0.06f});
-  std::vector<std::uint32_t> ph(x.size(), kernels::phase::kFluid);
+  std::vector<std::uint32_t> ph(x.size(), phase::kFluid);
   int steps = 0, spawns = 0;
   std::vector<bool> fluid_shown;
   std::vector<std::size_t> passes;

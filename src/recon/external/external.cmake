@@ -1,4 +1,4 @@
-# External trackers (issue 5, the tracker comparison): OpenCV contrib's rgbd odometries and PCL's
+# External trackers (the tracker comparison): OpenCV contrib's rgbd odometries and PCL's
 # GICP behind recon/external/odometry.hpp. Each implementation is compiled only when its library
 # was found (SEAMLESS_HAS_OPENCV / SEAMLESS_HAS_PCL); odometry.cpp always is and returns an empty
 # factory for a missing one, so the registry can say what to install.

@@ -1,4 +1,4 @@
-// External frame-to-frame odometry (issue 5, the tracker comparison): trackers of other libraries
+// External frame-to-frame odometry (the tracker comparison): trackers of other libraries
 // (OpenCV contrib's rgbd module, PCL's generalized ICP) behind one small interface, so that
 // TrackingSession can chain their relative poses exactly as it chains ours and `seamless eval`
 // compares like with like. Host images only: these libraries run on the CPU.
@@ -13,7 +13,7 @@
 #include <optional>
 #include <string>
 
-#include "core/camera.hpp"
+#include "core/intrinsics.hpp"
 #include "core/math.hpp"
 #include "io/frame_source.hpp"
 #include "recon/tracker_params.hpp"

@@ -1,4 +1,4 @@
-// Online refinement (refine.online, issue 24): the keyframe pose graph of the offline refinement
+// Online refinement (refine.online): the keyframe pose graph of the offline refinement
 // (refine.hpp), grown and re-solved in a background thread while tracking runs. The tracking thread
 // hands each new keyframe over a queue (a host copy of its images and its odometry pose) and, after
 // each frame, picks up the newest solution if one is ready; it never waits for a solve. The

@@ -1,5 +1,5 @@
 // Pinhole camera helpers shared by the screen-space passes (x right, y down, z forward; see
-// render/camera.hpp for the projection these invert).
+// render/render_camera.hpp for the projection these invert).
 uniform vec4 u_K;         // fx, fy, cx, cy in framebuffer pixels
 uniform vec2 u_size;      // framebuffer width, height
 uniform vec2 u_near_far;  // znear, zfar

@@ -1,11 +1,11 @@
-// The renderer's camera: the pinhole model of the Kinect (core/camera.hpp; x right, y down,
+// The renderer's camera: the pinhole model of the Kinect (core/intrinsics.hpp; x right, y down,
 // z forward) with a pose, so that the Kinect view projects with the sensor's exact intrinsics
 // and any free camera is the same model with intrinsics made from a field of view.
 #pragma once
 #include <array>
 #include <vector>
 
-#include "core/camera.hpp"
+#include "core/intrinsics.hpp"
 #include "core/math.hpp"
 
 namespace seamless {

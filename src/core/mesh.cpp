@@ -1,4 +1,4 @@
-#include "core/geometry.hpp"
+#include "core/mesh.hpp"
 
 namespace seamless {
 

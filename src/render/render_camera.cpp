@@ -1,6 +1,8 @@
-#include "render/camera.hpp"
+#include "render/render_camera.hpp"
 
 #include <cmath>
+
+#include "core/basis.hpp"
 
 namespace seamless {
 namespace {
@@ -101,10 +103,10 @@ float window_to_depth(float w, float n, float f) {
 }
 
 vec3 OrbitState::eye(vec3 up) const {
-  // An orthonormal basis with `up` as the pole; yaw about it, pitch above the horizon.
-  vec3 u = normalize(up);
-  vec3 a = std::fabs(u.x) < 0.9f ? vec3{1.f, 0.f, 0.f} : vec3{0.f, 0.f, 1.f};
-  vec3 e1 = normalize(cross(u, a)), e2 = cross(e1, u);
+  // An orthonormal basis with `up` as the pole (e1 x e2 = -u); yaw about it, pitch above the horizon.
+  vec3 u = normalize(up), e1, e2;
+  orthonormal_basis(u, e1, e2);
+  e2 = -e2;
   vec3 dir = (e1 * std::cos(yaw) + e2 * std::sin(yaw)) * std::cos(pitch) + u * std::sin(pitch);
   return target + dir * distance;
 }

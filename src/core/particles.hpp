@@ -1,28 +1,21 @@
-// Geometry that several layers hand each other: the reconstructed mesh (recon makes it, render and
-// physics read it) and the particle state, the objects and the rigid-body frames (physics makes
-// them, render and the app read them). Kept in core so that render depends on core and kernels only.
+// The particle solver's state and objects as the layers hand them to each other: physics makes
+// them (ParticleSolver, or read_objects for a finished run), render and the app read them. In core
+// so that render depends on core and kernels only; the solver itself is in physics.
 #pragma once
 #include <cstdint>
 #include <memory>
 #include <vector>
 
 #include "core/math.hpp"
+#include "core/mesh.hpp"
 
 namespace seamless {
-
-// A triangle mesh; normals and colors are per vertex and may be empty.
-struct Mesh {
-  std::vector<vec3> positions;
-  std::vector<vec3> normals;
-  std::vector<uchar3> colors;
-  std::vector<int3> triangles;
-};
 
 // Particle state in id order (ids are given in spawn order and never change).
 struct ParticleState {
   std::vector<vec3> x, v;
   std::vector<float> inv_mass;
-  std::vector<std::uint32_t> phase;  // kernels::phase flags and group
+  std::vector<std::uint32_t> phase;  // phase flags and group (core/phase.hpp)
 };
 
 // One rigid body's frame: x = R q + c for its rest offsets q.
@@ -30,13 +23,6 @@ struct RigidFrame {
   vec3 centre;
   vec4 rotation;                      // quaternion (x, y, z, w)
   std::int64_t first = 0, count = 0;  // particle ids
-};
-
-// A rigid body's surface in its body frame (the frame of its rest offsets q), shaded smooth or
-// flat as its normals say. The renderer uploads each one once (keyed by the object).
-struct BodyMesh {
-  std::vector<vec3> positions, normals;
-  std::vector<int3> triangles;
 };
 
 // The objects the particle solver has created (physics makes them: ParticleSolver::objects(), or
@@ -56,9 +42,5 @@ struct SceneObjects {
   std::vector<RigidBody> bodies;   // in the order the solver created them (its body index)
   std::vector<ClothSheet> cloths;  // likewise
 };
-
-// Area-weighted vertex normals of a triangle mesh (smooth shading; zero-area or unused vertices
-// get (0, 0, 0)).
-std::vector<vec3> vertex_normals(const std::vector<vec3>& positions, const std::vector<int3>& triangles);
 
 }  // namespace seamless
