@@ -100,7 +100,7 @@ ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
     progress.update(++n, to_string(f.result.status));
   };
   TrackSequenceParams tp = tracking_params(e, volume_stages);
-  tp.keep_model_mesh = !with_volume;  // tracking only: the tracker's own model, for the ghost measure
+  tp.keep_model_mesh = !with_volume;        // tracking only: the tracker's own model, for the ghost measure
   std::unique_ptr<OnlineCorrector> online;  // refine.online: the keyframe graph solved while tracking runs
   if (e.refine.online) {
     online =

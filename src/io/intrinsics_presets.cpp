@@ -54,7 +54,8 @@ Intrinsics intrinsics_preset(const std::string& name) {
   // The Asus Xtion of the Bonn RGB-D Dynamic dataset (Palazzolo et al., IROS 2019), as the dataset
   // publishes it (k1 k2 p1 p2 k3, OpenCV order); its images are stored as recorded, not undistorted.
   if (name == "bonn")
-    return make(542.822841f, 542.576870f, 315.593520f, 237.756098f, {0.039903f, -0.099343f, -0.000730f, -0.000144f, 0.f});
+    return make(542.822841f, 542.576870f, 315.593520f, 237.756098f,
+                {0.039903f, -0.099343f, -0.000730f, -0.000144f, 0.f});
   throw ConfigError("unknown intrinsics preset '" + name +
                     "': use freiburg1, freiburg2, freiburg3, kinect_v1, bonn, custom or auto");
 }

@@ -99,13 +99,13 @@ TEST(Ghost, SeenThroughCountsWhatTheViewsSawThrough) {
   views.add(wall, K, b);
   ASSERT_EQ(views.size(), 2u);
   Mesh m;
-  m.positions = {{0.f, 0.f, 3.f},     // on the wall: seen at
-                 {0.f, 0.f, 2.f},     // a metre in front of it, in the middle of the view: seen through
-                 {0.f, 0.f, 2.97f},   // 3 cm in front: within the noise and slack margin
-                 {0.f, 0.f, 3.5f},    // behind the wall: hidden
-                 {0.f, 0.f, -1.f},    // behind the camera
-                 {10.f, 0.f, 2.f},    // out of view
-                 {0.3f, 0.f, 2.f}};   // projects to x = 398: its 3x3 neighbours reach into the hole
+  m.positions = {{0.f, 0.f, 3.f},    // on the wall: seen at
+                 {0.f, 0.f, 2.f},    // a metre in front of it, in the middle of the view: seen through
+                 {0.f, 0.f, 2.97f},  // 3 cm in front: within the noise and slack margin
+                 {0.f, 0.f, 3.5f},   // behind the wall: hidden
+                 {0.f, 0.f, -1.f},   // behind the camera
+                 {10.f, 0.f, 2.f},   // out of view
+                 {0.3f, 0.f, 2.f}};  // projects to x = 398: its 3x3 neighbours reach into the hole
   // The margin at 2 m: 3 sigma = 3 * 1.5e-3 * 4 = 1.8 cm, plus the slack.
   EXPECT_NEAR(seen_through_margin(2.f, 0.05f), 0.068f, 1e-6f);
   const SeenThroughGhost g = seen_through_vertices(m, views, 0.05f);
