@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "core/buffer.hpp"
-#include "core/camera.hpp"
+#include "core/intrinsics.hpp"
 #include "core/mesh.hpp"
 #include "io/input_params.hpp"
 #include "io/trajectory.hpp"
