@@ -17,6 +17,7 @@ ScanResult reconstruct_experiment(RunContext& ctx) {
   ScanResult s = scan(ctx, true);
   add_tracking(ctx.summary(), s.tracking, s.unreadable, groundtruth_path(ctx));
   ctx.summary().intrinsics = s.intrinsics;
+  ctx.summary().seen_through = s.seen_through;
   return s;
 }
 
@@ -25,6 +26,8 @@ ScanResult track_experiment(RunContext& ctx) {
   // summary.json as `run` writes it, for the trajectory.txt written (refined, when refine is on).
   add_tracking(ctx.summary(), r.tracking, r.unreadable, groundtruth_path(ctx));
   ctx.summary().intrinsics = r.intrinsics;
+  ctx.summary().seen_through = r.seen_through;
+  ctx.summary().online_refine = r.online_refine;
   return r;
 }
 

@@ -109,6 +109,7 @@ RunOutputs run_experiment(RunContext& ctx, const std::string& config) {
     summary.ghost_vertices =
         ghost_vertices(scan_result.mesh, e.input, traj, read_tum_trajectory(gt), 2 * e.volume.voxel_size);
   summary.online_refine = scan_result.online_refine;
+  summary.seen_through = scan_result.seen_through;
   std::optional<SdfGrid> grid;
   if (e.solver.scene_collision == SceneCollision::sdf) grid = scene_sdf_grid(*scan_result.volume, scan_result.mesh, e);
   SceneParticleParams sp;

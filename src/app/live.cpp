@@ -71,6 +71,7 @@ class LiveLoop : public FrameLoop {
     const auto k = static_cast<std::int64_t>(records_.size());
     if (traj_) traj_->write(frame_.timestamp, rec.result.world_T_camera);
     poses_.push_back(TumPose::from_se3(frame_.timestamp, rec.result.world_T_camera));
+    if (rec.result.ok()) seen_.add(frame_.depth, source_->intrinsics(), rec.result.world_T_camera);
     if (frame_.ground_truth) groundtruth_.push_back(TumPose::from_se3(frame_.timestamp, *frame_.ground_truth));
     const bool reextract = rec.fused && (fused_++ % e_.reextract_every) == 0;
     if (reextract) extract_scene();
@@ -200,6 +201,7 @@ class LiveLoop : public FrameLoop {
     sum.mask_quality = mask_quality(records_, mover_ids(e_.input.synthetic.movers, MoverKind::person));
     if (!groundtruth_.empty())  // the source's own poses (the synthetic room's)
       sum.ghost_vertices = ghost_vertices(mesh, e_.input, poses_, groundtruth_, 2 * e_.volume.voxel_size);
+    if (seen_.size() > 0) sum.seen_through = seen_through_vertices(mesh, seen_, seen_through_slack(e_.volume));
     if (online_) sum.online_refine = online_->stats();
     sum.escaped = count_escaped(state, b, e_.solver.particle_diameter);
     add_stage_medians(sum, ctx_.timer());
@@ -262,6 +264,7 @@ class LiveLoop : public FrameLoop {
   bool points_stale_ = false;                   // points_ is not scene_'s copy yet
   Trajectory poses_;                            // tracked so far (pixel placements)
   Trajectory groundtruth_;                      // the source's ground-truth poses of the same frames, where it has them
+  SeenViews seen_;                              // what the tracked frames saw (the seen-through ghost)
   std::vector<SpawnParams> spawns_ = e_.spawn;  // with the live placements resolved
   std::vector<ResolvedPlacement> placements_;
   bool finished_ = false;

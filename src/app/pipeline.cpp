@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <memory>
 #include <optional>
 
@@ -76,6 +77,8 @@ void record_intrinsics(RunContext& ctx, const FrameSource& source) {
 }  // namespace detail
 
 using namespace detail;
+
+float seen_through_slack(const VolumeParams& v) { return v.truncation + 0.03f; }
 
 namespace {
 
@@ -149,7 +152,9 @@ ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
   Progress progress("scan", total);
   std::int64_t n = 0;
   r.intrinsics = source->intrinsics();
+  SeenViews seen;  // what the tracked frames saw, for the seen-through ghost
   auto on_frame = [&](const RgbdFrame& frame, const FrameRecord& f) {
+    if (f.result.ok()) seen.add(frame.depth, r.intrinsics, f.result.world_T_camera);
     ctx.timer().add(f.frame, "preprocess", f.preprocess_ms);  // as it goes: a run that fails keeps them
     ctx.timer().add(f.frame, "track", f.track_ms);
     ctx.timer().add(f.frame, "fuse", f.fuse_ms);
@@ -158,6 +163,7 @@ ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
     progress.update(++n, "tracking " + std::string(to_string(f.result.status)));
   };
   TrackSequenceParams tp = tracking_params(e, volume_stages);
+  tp.keep_model_mesh = !with_volume;        // tracking only: the tracker's own model, for the ghost measure
   std::unique_ptr<OnlineCorrector> online;  // refine.online: the keyframe graph solved while tracking runs
   if (e.refine.online) {
     online =
@@ -187,6 +193,13 @@ ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
       write_mesh_ply(ctx.out_path("mesh.ply"), r.mesh);
       spdlog::info("mesh.ply: {} vertices, {} triangles", r.mesh.positions.size(), r.mesh.triangles.size());
     }
+  }
+  const Mesh* model = r.volume ? &r.mesh : (r.tracking.model_mesh ? &*r.tracking.model_mesh : nullptr);
+  if (model && seen.size() > 0) {
+    r.seen_through = seen_through_vertices(*model, seen, seen_through_slack(e.volume));
+    spdlog::info("ghost: {} of the {} mesh's {} vertices lie where at least two of {} frames saw through them",
+                 r.seen_through->vertices, r.volume ? "volume" : "tracker's model", r.seen_through->mesh_vertices,
+                 r.seen_through->views);
   }
   return r;
 }

@@ -3,6 +3,7 @@
 #include <memory>
 #include <optional>
 
+#include "app/ghost.hpp"
 #include "app/run_context.hpp"
 #include "io/frame_source.hpp"
 #include "kernels/physics/scene_sdf.hpp"
@@ -22,7 +23,15 @@ struct ScanResult {
   RgbdFrame first_frame;                           // host copy of the first frame (the Kinect view's fixed camera)
   std::int64_t unreadable = 0;                     // frames the source skipped as unreadable
   std::optional<OnlineRefineStats> online_refine;  // refine.online; tracking.trajectory is then the final graph's
+  // The mesh's vertices the frames saw through (app/ghost.hpp; summary.json `ghost`): of the volume's
+  // mesh, or when tracking only, of the tracker's own model (frame-to-model tracking or dynamic
+  // handling build one); none without either.
+  std::optional<SeenThroughGhost> seen_through;
 };
+
+// The seen-through ghost's slack for an experiment's volume: a truncation width (how far the
+// mesh's zero crossing can lie from the surface) and 3 cm of pose error (app/ghost.hpp).
+float seen_through_slack(const VolumeParams& v);
 
 class RunRenderer;
 

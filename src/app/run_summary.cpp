@@ -149,6 +149,11 @@ void write_summary(const std::string& path, const RunSummary& s) {
     }
     if (s.mask_quality) d["mask"] = mask_json(*s.mask_quality);
   }
+  if (s.seen_through)
+    j["ghost"] = {{"seen_through_vertices", s.seen_through->vertices},
+                  {"mesh_vertices", s.seen_through->mesh_vertices},
+                  {"fraction", s.seen_through->fraction()},
+                  {"views", s.seen_through->views}};
   if (s.floor_height) j["floor_height"] = *s.floor_height;
   Json& surfaces = j["surfaces"] = Json::array();
   for (std::size_t i = 0; i < s.surfaces.size() && i < 10; ++i) {

@@ -47,6 +47,7 @@ struct RunSummary {
   std::int64_t ate_pairs = 0;
   std::optional<double> dynamic_masked_fraction;  // dynamic.enabled: mean over the tracked frames
   std::optional<GhostCount> ghost_vertices;       // synthetic movers: what they left in the map (app/ghost.hpp)
+  std::optional<SeenThroughGhost> seen_through;   // any source: mesh vertices the frames saw through (app/ghost.hpp)
   std::optional<MaskQuality> mask_quality;        // synthetic movers: the dynamic mask against their masks
   std::vector<ResolvedPlacement> placements;
   std::vector<SpawnParams> spawns;  // as resolved

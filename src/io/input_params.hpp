@@ -56,9 +56,10 @@ struct IntrinsicsParams {
     // generic 525/319.5/239.5 set the TUM page gives for the default OpenNI calibration.
     // auto: a folder's calibration.txt (written by `seamless record`), else its 3x3 K file
     // (camera-intrinsics.txt or intrinsics.K.txt, frame folders), else the freiburg preset its name
-    // contains, else kinect_v1 (also for the synthetic room and a live Kinect).
+    // contains (or bonn: the Bonn RGB-D Dynamic dataset's Asus Xtion), else kinect_v1 (also for the
+    // synthetic room and a live Kinect).
     v("preset", preset, "intrinsics preset (fx fy cx cy below are used only for custom)",
-      Choices{"auto", "freiburg1", "freiburg2", "freiburg3", "kinect_v1", "custom"});
+      Choices{"auto", "freiburg1", "freiburg2", "freiburg3", "kinect_v1", "bonn", "custom"});
     v("file", file,
       "camera file: ORB-SLAM/OpenCV YAML, ROS camera_info YAML or Open3D JSON (told by content); with preset auto");
     // Negative focal lengths (ICL-NUIM's fy = -480) are taken as a flipped image axis.

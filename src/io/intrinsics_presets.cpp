@@ -51,8 +51,13 @@ Intrinsics intrinsics_preset(const std::string& name) {
     return make(520.9f, 521.0f, 325.1f, 249.7f, {0.2312f, -0.7849f, -0.0033f, -0.0001f, 0.9172f});
   if (name == "freiburg3") return make(535.4f, 539.2f, 320.1f, 247.6f);
   if (name == "kinect_v1") return make(525.f, 525.f, 319.5f, 239.5f);
+  // The Asus Xtion of the Bonn RGB-D Dynamic dataset (Palazzolo et al., IROS 2019), as the dataset
+  // publishes it (k1 k2 p1 p2 k3, OpenCV order); its images are stored as recorded, not undistorted.
+  if (name == "bonn")
+    return make(542.822841f, 542.576870f, 315.593520f, 237.756098f,
+                {0.039903f, -0.099343f, -0.000730f, -0.000144f, 0.f});
   throw ConfigError("unknown intrinsics preset '" + name +
-                    "': use freiburg1, freiburg2, freiburg3, kinect_v1, custom or auto");
+                    "': use freiburg1, freiburg2, freiburg3, kinect_v1, bonn, custom or auto");
 }
 
 std::string camera_in_folder_name(const std::string& name) {
@@ -71,6 +76,11 @@ std::string camera_in_folder_name(const std::string& name) {
       std::string camera = std::string("freiburg") + s[j];
       if (!found.empty() && found != camera) return "";  // names two cameras: cannot tell
       found = camera;
+    }
+    // The Bonn RGB-D Dynamic dataset's folders are rgbd_bonn_<scene>.
+    if (s.compare(i, 4, "bonn") == 0 && (i + 4 == s.size() || !alpha(s[i + 4]))) {
+      if (!found.empty() && found != "bonn") return "";
+      found = "bonn";
     }
   }
   return found;
@@ -144,7 +154,7 @@ IntrinsicsChoice choose_intrinsics(const IntrinsicsParams& p, const std::string&
       c.chosen = "kinect_v1";
       c.generic = true;
       c.reason = "preset auto: the folder name '" + name +
-                 "' names no TUM camera (fr1/fr2/fr3, freiburg1/2/3) and the folder has no calibration.txt, "
+                 "' names no known camera (fr1/fr2/fr3, freiburg1/2/3, bonn) and the folder has no calibration.txt, "
                  "camera-intrinsics.txt or intrinsics.K.txt";
     }
   }
@@ -164,7 +174,7 @@ IntrinsicsChoice resolve_intrinsics(const IntrinsicsParams& p, const std::string
   if (c.generic)
     spdlog::warn(
         "intrinsics: {}: USING THE GENERIC KINECT v1 SET ({}), which can be off by several pixels for "
-        "this camera; set input.intrinsics.preset (freiburg1, freiburg2, freiburg3, kinect_v1 or custom "
+        "this camera; set input.intrinsics.preset (freiburg1, freiburg2, freiburg3, kinect_v1, bonn or custom "
         "with fx fy cx cy) or put a calibration.txt in the folder",
         c.reason, describe_intrinsics(c.K));
   else if (!folder.empty() || p.preset != "auto" || !p.file.empty())

@@ -68,8 +68,9 @@ Intrinsics read_intrinsics_matrix(const std::string& path);
 
 // The TUM camera a folder name names: "freiburg1" for "rgbd_dataset_freiburg1_desk" or
 // "tum_fr1_rpy" (freiburg or fr, an optional _ or -, then 1, 2 or 3 and no further digit, at the
-// start of a word); "" when it names none or two different ones. scripts/compare_trackers applies
-// the same rule.
+// start of a word), or "bonn" for the Bonn RGB-D Dynamic dataset's "rgbd_bonn_crowd" (bonn at the
+// start of a word, no letter after it); "" when it names none or two different ones.
+// scripts/compare_trackers applies the same rule to the TUM names.
 std::string camera_in_folder_name(const std::string& name);
 
 // "fx 517.3 fy 516.5 cx 318.6 cy 255.3, 640x480, distortion 0.2624 ..." for logs.

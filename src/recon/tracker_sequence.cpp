@@ -186,6 +186,7 @@ TrackSequenceResult track_sequence(FrameSource& source, const TrackSequenceParam
   out.gravity = session.gravity();
   out.median_track_ms = median(track_ms);
   out.median_frame_ms = median(frame_ms);
+  if (params.keep_model_mesh && !volume && session.volume()) out.model_mesh = session.volume()->extract_mesh();
   if (writer) writer->close();
   if (gt_writer) gt_writer->close();
   if (params.write_files) write_tracking_stats(out_dir + "/tracking_stats.csv", out.frames);

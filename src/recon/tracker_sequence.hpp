@@ -58,6 +58,10 @@ struct TrackSequenceParams {
   // >= 0: this pyramid level's vertex and normal maps are also kept as they were before the
   // dynamic mask zeroed them (TrackingSession::unmasked_level; the live colliders of solver.dynamic_colliders).
   int keep_unmasked_level = -1;
+  // The session's own model (frame-to-model tracking, or dynamic handling with another mode, and no
+  // volume given) marched into TrackSequenceResult::model_mesh at the end (`seamless track`'s ghost
+  // measure).
+  bool keep_model_mesh = false;
 };
 
 // One frame's outcome, one row of tracking_stats.csv.
@@ -196,6 +200,7 @@ struct TrackSequenceResult {
   GravityEstimate gravity;
   double median_track_ms = 0;
   double median_frame_ms = 0;
+  std::optional<Mesh> model_mesh;  // params.keep_model_mesh and the session built a model
 };
 
 // Tracks every frame of `source` (up to params.max_frames), writes out_dir/trajectory.txt and

@@ -82,5 +82,42 @@ TEST(Ghost, CountsVerticesInsideTheMoversButNotTheRoomsOwnSurfaces) {
   EXPECT_FALSE(ghost_vertices(m, in, shifted, gt, 0.02f).has_value());
 }
 
+// The seen-through ghost (app/ghost.hpp) against a wall 3 m in front of two cameras: a vertex on
+// the wall is seen at, one 1 m in front of it is seen through by both views, one behind the wall or
+// out of view is not, and a vertex in front of a hole (no readings) is no evidence.
+TEST(Ghost, SeenThroughCountsWhatTheViewsSawThrough) {
+  const Intrinsics K;  // 525 / 319.5 / 239.5, 640x480
+  Image<float> wall(640, 480, Device::CPU);
+  std::vector<float> d(640 * 480, 3.f);
+  for (int y = 200; y < 280; ++y)
+    for (int x = 400; x < 480; ++x) d[static_cast<std::size_t>(y) * 640 + x] = 0.f;  // a hole: no readings
+  wall.buffer().copy_from_host(d.data(), static_cast<std::int64_t>(d.size()));
+  SeenViews views;
+  SE3 a = SE3::identity(), b = SE3::identity();
+  b.t = {0.01f, 0.f, 0.f};  // 1 cm to the side: the same wall at 3 m to within a pixel
+  views.add(wall, K, a);
+  views.add(wall, K, b);
+  ASSERT_EQ(views.size(), 2u);
+  Mesh m;
+  m.positions = {{0.f, 0.f, 3.f},    // on the wall: seen at
+                 {0.f, 0.f, 2.f},    // a metre in front of it, in the middle of the view: seen through
+                 {0.f, 0.f, 2.97f},  // 3 cm in front: within the noise and slack margin
+                 {0.f, 0.f, 3.5f},   // behind the wall: hidden
+                 {0.f, 0.f, -1.f},   // behind the camera
+                 {10.f, 0.f, 2.f},   // out of view
+                 {0.3f, 0.f, 2.f}};  // projects to x = 398: its 3x3 neighbours reach into the hole
+  // The margin at 2 m: 3 sigma = 3 * 1.5e-3 * 4 = 1.8 cm, plus the slack.
+  EXPECT_NEAR(seen_through_margin(2.f, 0.05f), 0.068f, 1e-6f);
+  const SeenThroughGhost g = seen_through_vertices(m, views, 0.05f);
+  EXPECT_EQ(g.mesh_vertices, 7);
+  EXPECT_EQ(g.views, 2);
+  EXPECT_EQ(g.vertices, 1);
+  EXPECT_NEAR(g.fraction(), 1.0 / 7.0, 1e-12);
+  // min_views 3: two views cannot count a vertex.
+  EXPECT_EQ(seen_through_vertices(m, views, 0.05f, 3).vertices, 0);
+  // max_views 1: the first view alone, then min_views 1 finds the vertex.
+  EXPECT_EQ(seen_through_vertices(m, views, 0.05f, 1, 1).vertices, 1);
+}
+
 }  // namespace
 }  // namespace seamless

@@ -46,6 +46,25 @@ TEST(Intrinsics, FolderNamesTellTheTumCamera) {
   EXPECT_EQ(camera_in_folder_name("fr1_vs_fr2"), "");
   EXPECT_EQ(camera_in_folder_name("frames_box_50"), "");
   EXPECT_EQ(camera_in_folder_name("fr4"), "");
+  // The Bonn RGB-D Dynamic dataset's Asus Xtion: its own folder names and ours.
+  EXPECT_EQ(camera_in_folder_name("rgbd_bonn_crowd"), "bonn");
+  EXPECT_EQ(camera_in_folder_name("bonn_crowd_220-279"), "bonn");
+  EXPECT_EQ(camera_in_folder_name("bonnet"), "");
+  EXPECT_EQ(camera_in_folder_name("fr1_vs_bonn"), "");
+}
+
+TEST(Intrinsics, BonnPresetIsTheDatasetsPublishedXtion) {
+  // The values the dataset publishes (SOURCE.txt of ../shared/data/bonn_crowd_220-279), with distortion.
+  IntrinsicsChoice c = choose_intrinsics(preset("bonn"), "");
+  EXPECT_FLOAT_EQ(c.K.fx, 542.822841f);
+  EXPECT_FLOAT_EQ(c.K.fy, 542.576870f);
+  EXPECT_FLOAT_EQ(c.K.cx, 315.593520f);
+  EXPECT_FLOAT_EQ(c.K.cy, 237.756098f);
+  EXPECT_FLOAT_EQ(c.K.dist[0], 0.039903f);
+  EXPECT_FLOAT_EQ(c.K.dist[1], -0.099343f);
+  EXPECT_FLOAT_EQ(c.K.dist[2], -0.000730f);
+  EXPECT_FLOAT_EQ(c.K.dist[3], -0.000144f);
+  EXPECT_FLOAT_EQ(c.K.dist[4], 0.f);
 }
 
 TEST(Intrinsics, AutoTakesTheNamedCameraAndSaysSo) {
