@@ -74,11 +74,8 @@ class RunDrawState {
 class GlRunRenderer : public RunRenderer {
  public:
   explicit GlRunRenderer(RunContext& ctx)
-      : ctx_(ctx),
-        p_(ctx.experiment().render),
-        region_(input_colour_region(ctx.experiment().input)),
-        renderer_(p_, p_.width, p_.height),
-        out_(ctx.out_dir(), p_) {
+      : ctx_(ctx), p_(ctx.experiment().render), region_(input_colour_region(ctx.experiment().input)),
+        renderer_(p_, p_.width, p_.height), out_(ctx.out_dir(), p_) {
     spdlog::info("rendering {}x{} {} view with {} ({})", p_.width, p_.height, enum_name(p_.view),
                  renderer_.gl_info().renderer, renderer_.gl_info().version);
 #if SEAMLESS_HAS_CUDA
