@@ -33,7 +33,7 @@ struct KinectCalibration {
 };
 
 // The factory calibration of one production unit, saved by fakenect-record with a public recording
-// (OpenISS, 2017, Apache-2.0; ../shared/data/kinect_v1_planes/device.json), the only complete one
+// (OpenISS, 2017, Apache-2.0: the device.json of its test-recording), the only complete one
 // published with its recording. Units differ: libfreenect 0.1's built-in unit, applied to that
 // recording, puts depth edges 18 px from their colour edges (docs/INPUT.md), so a unit's own values
 // are always preferred.
