@@ -61,9 +61,10 @@ Summary summarise(const std::vector<double>& v) { return {quantile(v, 0.5), quan
 struct RepResult {
   std::map<std::string, std::vector<double>> per_frame;  // stage -> one value a frame, in frame order
   std::int64_t frames = 0, lost = 0;
-  std::size_t peak_buffer_bytes = 0;  // the memory ledger's peak on the run's device (Buffer allocations)
-  std::int64_t peak_rss_bytes = -1;   // the process's high-water mark (VmHWM); -1 where unreadable
-  double wall_s = 0;                  // the whole replay, PNG decoding and output files included
+  std::size_t peak_buffer_bytes = 0;      // the memory ledger's peak on the run's device (Buffer allocations)
+  std::int64_t peak_rss_bytes = -1;       // the process's high-water mark (VmHWM); -1 where unreadable
+  double wall_s = 0;                      // the whole replay, PNG decoding and output files included
+  double load_start = -1, load_end = -1;  // the machine's 1-minute load average around the replay; -1 unreadable
   int exit_code = kExitOk;
 };
 
@@ -72,6 +73,13 @@ struct RepResult {
 bool reset_peak_rss() {
   std::ofstream f("/proc/self/clear_refs");
   return static_cast<bool>(f << "5" << std::flush);
+}
+// The 1-minute load average (the first field of /proc/loadavg, proc(5)), -1 where unreadable: on a
+// shared machine a replay's times mean little without it.
+double load_average() {
+  std::ifstream f("/proc/loadavg");
+  double v = -1;
+  return f >> v ? v : -1;
 }
 std::int64_t peak_rss_bytes() {
   std::ifstream f("/proc/self/status");
@@ -160,6 +168,7 @@ RepResult replay(const PipelineBenchOptions& o, const Experiment& e, const std::
   RepResult r;
   memory::reset_peak(o.device);
   const bool rss_reset = reset_peak_rss();
+  r.load_start = load_average();
   const auto t0 = std::chrono::steady_clock::now();
   {
     Experiment run_e = e;
@@ -192,6 +201,7 @@ RepResult replay(const PipelineBenchOptions& o, const Experiment& e, const std::
     r.exit_code = ctx.exit_code();
   }
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.load_end = load_average();
   r.peak_buffer_bytes = memory::peak_bytes(o.device);
   if (rss_reset) r.peak_rss_bytes = peak_rss_bytes();
   return r;
@@ -263,6 +273,7 @@ void write_json(const std::string& path, const PipelineBenchOptions& o, const Ex
     replays.push_back({{"frames", r.frames},
                        {"lost_frames", r.lost},
                        {"wall_s", r.wall_s},
+                       {"load_average", {r.load_start, r.load_end}},
                        {"peak_buffer_bytes", r.peak_buffer_bytes},
                        {"peak_rss_bytes", r.peak_rss_bytes},
                        {"exit_code", r.exit_code},
@@ -311,6 +322,7 @@ int run_pipeline_bench(const PipelineBenchOptions& o) {
       static_cast<long long>(last.frames), static_cast<long long>(last.lost), last.peak_buffer_bytes / 1048576.0,
       device_name(o.device),
       last.peak_rss_bytes < 0 ? "unknown" : (std::to_string(last.peak_rss_bytes >> 20) + " MiB").c_str());
+  std::printf("load average %.2f at the start of the last replay, %.2f at its end\n", last.load_start, last.load_end);
   if (o.mode == "live") std::printf("render: %s\n", render_note.empty() ? "measured" : render_note.c_str());
   if (!o.json.empty()) {
     write_json(o.json, o, e, stages, reps, render_note);

@@ -62,6 +62,9 @@ class BenchPipeline(unittest.TestCase):
             self.assertEqual(rep["frames"], frames)
             self.assertGreater(rep["peak_buffer_bytes"], 0)
             self.assertGreater(rep["peak_rss_bytes"], 0)
+            # Read from /proc/loadavg before and after the replay: -1 would mean it was not read.
+            self.assertEqual(len(rep["load_average"]), 2)
+            self.assertTrue(all(x >= 0 for x in rep["load_average"]), rep["load_average"])
             for name in doc["stages"]:
                 st = rep["stages"][name]
                 v = st["per_frame_ms"]
