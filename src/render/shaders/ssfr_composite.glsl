@@ -128,9 +128,12 @@ void composite_at(ivec2 p, out vec4 o_color, out vec4 o_reflect, out vec4 o_refr
   vec2 uv_t = clamp(project_uv(Q), 0.5 / u_size, 1.0 - 0.5 / u_size);
   vec3 behind = srgb_to_linear(texture(u_scene_color, uv_t).rgb);
   // Water resting on the surface behind it (its back within u_contact of the scene along the
-  // view ray) wets it; a drop in the air does not.
+  // view ray) wets it; a drop in the air does not. The measured depth is noisy and quantised
+  // (a Kinect v1's step is about 2.85e-3 z^2 m: 1.1 cm at 2 m), so the tolerance grows with z^2
+  // and the fade spans twice it: a sharp threshold drew the depth's quantisation bands as stripes.
   float gap = max(z_bg - P.z, 0.0) * length(P) / P.z - T;
-  if (u_wet) behind *= mix(vec3(1.0), wet_factor(behind), 1.0 - smoothstep(u_contact, 2.0 * u_contact, gap));
+  float tol = u_contact + 0.006 * z_bg * z_bg;
+  if (u_wet) behind *= mix(vec3(1.0), wet_factor(behind), 1.0 - smoothstep(tol, 3.0 * tol, gap));
   // Beer-Lambert: each metre of water keeps exp(-absorption) of the light, per channel.
   vec3 refr = behind * exp(-u_absorption * T);
 
