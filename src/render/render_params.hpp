@@ -111,8 +111,11 @@ struct RenderParams {
   // Filter half-width in particle radii (world), projected per pixel: three particle spacings
   // (a diameter each), so that the spheres' bumps average out into one surface.
   float filter_size = 6.f;
-  int filter_max_px = 24;            // ... but at most this many pixels
-  float filter_depth_sigma = 1.f;    // range sigma of the bilateral filter, in particle radii
+  int filter_max_px = 24;          // ... but at most this many pixels
+  float filter_depth_sigma = 1.f;  // range sigma of the bilateral filter, in particle radii
+  // Gap fill of the depth before smoothing: empty runs between fluid pixels up to this many
+  // particle radii wide (world, at their depth) and at one depth become fluid (0: off).
+  float fluid_gap_fill = 4.f;
   vec3 absorption{25.f, 8.f, 3.5f};  // Beer-Lambert coefficients per colour channel, 1/m (tinted water)
   float ior = 1.33f;                 // refractive index (water): Snell's law bends the view into the fluid
   float fresnel_f0 = 0.02f;          // reflectance at normal incidence (water: ((1-1.33)/(1+1.33))^2)
@@ -120,6 +123,12 @@ struct RenderParams {
   float light_intensity =
       0.6f;             // radiance light_dir alone gives a white diffuse surface facing it (0..1 = black..white)
   int cube_size = 256;  // cube map face size for reflections in the mesh view
+  // Screen-space reflection: the reflected ray is marched over ssr_distance metres in ssr_steps
+  // steps against the scene depth (0 steps: the environment alone).
+  int ssr_steps = 24;
+  float ssr_distance = 1.5f;
+  // Water resting on a surface darkens it, as a wet surface is (Lekner & Dorf 1988).
+  bool fluid_wet = true;
   // Cost of the fluid passes (docs/RENDERING.md, section Speed).
   // compute: sphere depth and thickness as compute splats (GL 4.3; atomics into integer images)
   // and the full-screen passes as compute shaders; raster: point sprites and full-screen
@@ -216,6 +225,10 @@ struct RenderParams {
     v("filter_size", filter_size, "depth filter half-width, particle radii", Range{0.0, 50.0});
     v("filter_max_px", filter_max_px, "depth filter half-width limit, pixels", Range{1, 128});
     v("filter_depth_sigma", filter_depth_sigma, "bilateral range sigma, particle radii", Range{0.01, 100.0});
+    v("fluid_gap_fill", fluid_gap_fill,
+      "fluid depth gap fill: empty runs between fluid pixels up to this many particle radii wide become "
+      "fluid at their neighbours' depth, if both agree (0 = off)",
+      Range{0.0, 50.0});
     v("absorption", absorption, "fluid absorption per channel (Beer-Lambert), 1/m");
     v("ior", ior, "fluid refractive index (Snell's law at the surface)", Range{1.0, 3.0});
     v("fresnel_f0", fresnel_f0, "fluid reflectance at normal incidence", Range{0.0, 1.0});
@@ -224,6 +237,10 @@ struct RenderParams {
     v("light_intensity", light_intensity,
       "light_dir's radiance on a white diffuse surface facing it (1 = white): strength of highlights",
       Range{0.0, 100.0});
+    v("ssr_steps", ssr_steps, "fluid reflections traced in screen space: steps along the ray (0 = off)", Range{0, 256});
+    v("ssr_distance", ssr_distance, "fluid screen-space reflection: length of the traced ray, metres",
+      Range{0.01, 100.0});
+    v("fluid_wet", fluid_wet, "the surface under resting fluid is darkened as when wet (Lekner & Dorf 1988)");
     v("cube_size", cube_size, "reflection cube map face size, pixels", Range{16, 4096});
     v("fluid_splat", fluid_splat, "fluid passes: compute shaders (GL 4.3: splats, screen passes) or raster sprites");
     v("thickness_downsample", thickness_downsample, "fluid thickness at 1/this resolution (1, 2 or 4)", Range{1, 4});

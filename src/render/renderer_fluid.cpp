@@ -144,13 +144,13 @@ void Renderer::Impl::fluid_depth_pass(std::int64_t n, float sphere_r, const Rend
 
 // SSFR 2: every sphere's chord, added up, at 1 / thickness_downsample resolution; sprites wholly
 // behind the scene fail the depth test (no depth writes), the rest are cut at the scene.
-void Renderer::Impl::fluid_thickness_pass(std::int64_t n, float sphere_r, const RenderCamera& cam) {
+void Renderer::Impl::fluid_thickness_pass(std::int64_t n, float sphere_r, float radius, const RenderCamera& cam) {
   RenderCamera low = cam;
   low.K = scale_intrinsics(cam.K, tw, th);
   glViewport(0, 0, tw, th);
   if (use_compute_splat()) {
     fluid_thickness_splat(n, sphere_r, low);
-    return thickness_blur(low);
+    return thickness_blur(low, radius);
   }
   glBindFramebuffer(GL_FRAMEBUFFER, thick_fbo[0]);
   glClear(GL_COLOR_BUFFER_BIT);
@@ -172,19 +172,26 @@ void Renderer::Impl::fluid_thickness_pass(std::int64_t n, float sphere_r, const 
   glDisable(GL_BLEND);
   glDisable(GL_DEPTH_TEST);
   glDepthMask(GL_TRUE);
-  thickness_blur(low);
+  thickness_blur(low, radius);
 }
 
-// Small Gaussian over the thickness, at its resolution (the viewport is tw x th on entry).
-void Renderer::Impl::thickness_blur(const RenderCamera& low) {
+// Smoothing of the thickness over the particle spacing, at its resolution (the viewport is tw x
+// th on entry): the depth filter's half-width (filter_size radii), projected at the filtered
+// depth, no range weight.
+void Renderer::Impl::thickness_blur(const RenderCamera& low, float radius) {
   glDisable(GL_DEPTH_TEST);  // thick_fbo[0] has the raster path's depth buffer attached
   const Program& fp = filter_program();
   set_camera_uniforms(fp, low);
   glBindVertexArray(empty_vao);
-  glUniform1i(fp.loc("u_max_px"), 3);
-  glUniform1i(fp.loc("u_max_taps"), 3);
+  const int down = std::max(1, p.thickness_downsample);
+  glUniform1f(fp.loc("u_world_radius"), p.filter_size * radius);
+  glUniform1i(fp.loc("u_max_px"), std::max(1, p.filter_max_px / down));
+  glUniform1i(fp.loc("u_max_taps"), std::max(1, p.filter_max_taps / down));
   glUniform1f(fp.loc("u_range_sigma"), 0.f);
   glUniform1i(fp.loc("u_skip_empty"), 0);
+  glUniform1f(fp.loc("u_fill_world"), 0.f);
+  bind_tex(1, GL_TEXTURE_2D, fluid_depth[0]);
+  glUniform1i(fp.loc("u_width_depth"), 1);
   filter_pass(thick[0], thick[1], thick_fbo[1], 1, 0, tw, th);
   filter_pass(thick[1], thick[0], thick_fbo[0], 0, 1, tw, th);
   glViewport(0, 0, w, h);
@@ -217,7 +224,11 @@ void Renderer::Impl::fluid_filter_passes(float radius, const RenderCamera& cam) 
   glUniform1f(fp.loc("u_range_sigma"), p.filter_depth_sigma * radius);
   glUniform1i(fp.loc("u_skip_empty"), 1);
   glUniform1i(fp.loc("u_narrow_range"), p.fluid_filter == FluidFilter::narrow_range);
+  bind_tex(1, GL_TEXTURE_2D, scene_depth);
+  glUniform1i(fp.loc("u_scene_depth_w"), 1);
   for (int it = 0; it < p.filter_iterations; ++it) {
+    // The gap fill closes the holes between the particles once; later iterations only smooth.
+    glUniform1f(fp.loc("u_fill_world"), it == 0 ? p.fluid_gap_fill * radius : 0.f);
     filter_pass(fluid_depth[0], fluid_depth[1], fluid_filter_fbo[1], 1, 0, w, h);
     filter_pass(fluid_depth[1], fluid_depth[0], fluid_filter_fbo[0], 0, 1, w, h);
   }
@@ -239,7 +250,8 @@ void Renderer::Impl::normals_pass(const RenderCamera& cam) {
 }
 
 // SSFR 5: shading over the scene, into final_fbo's colour, reflection and refraction targets.
-void Renderer::Impl::composite_pass(const RenderCamera& cam) {
+// `contact`: metres between the water's back and the scene within which the water wets it.
+void Renderer::Impl::composite_pass(const RenderCamera& cam, float contact) {
   const bool compute = use_compute_splat();
   const Program& cp = compute ? composite_cprog : composite_prog;
   set_camera_uniforms(cp, cam);
@@ -257,6 +269,7 @@ void Renderer::Impl::composite_pass(const RenderCamera& cam) {
   // the surface reflects.
   const vec3 env = p.view == RenderView::kinect && has_kinect ? kin_mean : srgb_to_linear(p.background);
   glUniform3f(cp.loc("u_env"), env.x, env.y, env.z);
+  glUniform1i(cp.loc("u_image_env"), p.view == RenderView::kinect && has_kinect && p.ssr_steps > 0);
   const std::vector<float> R = {
       cam.world_T_camera.R.m[0][0], cam.world_T_camera.R.m[1][0], cam.world_T_camera.R.m[2][0],
       cam.world_T_camera.R.m[0][1], cam.world_T_camera.R.m[1][1], cam.world_T_camera.R.m[2][1],
@@ -267,6 +280,10 @@ void Renderer::Impl::composite_pass(const RenderCamera& cam) {
   glUniform1f(cp.loc("u_f0"), p.fresnel_f0);
   glUniform1f(cp.loc("u_roughness"), p.fluid_roughness);
   glUniform1f(cp.loc("u_light_intensity"), p.light_intensity);
+  glUniform1i(cp.loc("u_ssr_steps"), p.ssr_steps);
+  glUniform1f(cp.loc("u_ssr_distance"), p.ssr_distance);
+  glUniform1f(cp.loc("u_contact"), contact);
+  glUniform1i(cp.loc("u_wet"), p.fluid_wet);
   if (compute) {
     const GLuint out[] = {final_color, reflect_color, refract_color};
     for (GLuint i = 0; i < 3; ++i) glBindImageTexture(i, out[i], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
@@ -284,13 +301,15 @@ bool Renderer::Impl::draw_fluid(std::int64_t n, float radius, const RenderCamera
   timer.mark("fluid_depth");
   if (p.stage_images)
     stages.push_back({"1_depth", float_to_grey(read_float(fluid_depth_fbo, 0, GL_RED, 1, w, h), w, h)});
-  fluid_thickness_pass(n, sphere_r, cam);
-  timer.mark("fluid_thickness");
+  // The filter before the thickness: the thickness is smoothed over widths projected at the
+  // filtered depth (which the gap fill has closed).
   fluid_filter_passes(radius, cam);
   timer.mark("fluid_filter");
+  fluid_thickness_pass(n, sphere_r, radius, cam);
+  timer.mark("fluid_thickness");
   normals_pass(cam);
   timer.mark("fluid_normals");
-  composite_pass(cam);
+  composite_pass(cam, sphere_r);
   glBindVertexArray(0);
   glEnable(GL_DEPTH_TEST);
   timer.mark("fluid_composite");

@@ -179,14 +179,14 @@ struct Renderer::Impl {
   bool draw_fluid(std::int64_t n, float radius, const RenderCamera& cam);
   void copy_scene_depth(GLuint dst, int dw, int dh);
   void fluid_depth_pass(std::int64_t n, float sphere_r, const RenderCamera& cam);
-  void fluid_thickness_pass(std::int64_t n, float sphere_r, const RenderCamera& cam);
+  void fluid_thickness_pass(std::int64_t n, float sphere_r, float radius, const RenderCamera& cam);
   void fluid_filter_passes(float radius, const RenderCamera& cam);
   // One axis of the filter from texture src into texture dst (iw x ih; dst_fbo renders to it).
   void filter_pass(GLuint src, GLuint dst, GLuint dst_fbo, int dx, int dy, int iw, int ih);
   const Program& filter_program() const { return use_compute_splat() ? filter_cprog : filter_prog; }
   void normals_pass(const RenderCamera& cam);
-  void composite_pass(const RenderCamera& cam);
-  void thickness_blur(const RenderCamera& low);
+  void composite_pass(const RenderCamera& cam, float contact);
+  void thickness_blur(const RenderCamera& low, float radius);
   // renderer_splat.cpp: the compute path of SSFR 1 and 2.
   bool use_compute_splat() const { return has_compute && p.fluid_splat == FluidSplat::compute; }
   void build_compute_programs();

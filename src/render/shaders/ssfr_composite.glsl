@@ -1,8 +1,9 @@
 // SSFR shading (van der Laan et al. 2009, section 4.4), in linear radiance (color.glsl): what is
 // behind the water seen through it (refraction by Snell's law, attenuated by Beer-Lambert over the
-// path in water), the surroundings reflected by it, mixed by Schlick's Fresnel approximation,
-// plus the reflection of the light itself (a GGX microfacet highlight). Also writes reflection
-// and refraction alone for the stage images (the dissertation's Figure 4.5).
+// path in water, darkened where the water wets the surface it rests on), the surroundings
+// reflected by it (traced in screen space, else the environment), mixed by Schlick's Fresnel
+// approximation, plus the reflection of the light itself (a GGX microfacet highlight). Also writes
+// reflection and refraction alone for the stage images (the dissertation's Figure 4.5).
 uniform sampler2D u_scene_color;
 uniform sampler2D u_scene_depth;  // window depth of the scene and objects behind the fluid
 uniform sampler2D u_fluid_depth;
@@ -11,6 +12,7 @@ uniform sampler2D u_thickness;
 uniform samplerCube u_cube;
 uniform bool u_use_cube;       // mesh view: cube map of the scene; Kinect view: u_env
 uniform vec3 u_env;            // Kinect view: the image's mean colour, linear
+uniform bool u_image_env;      // Kinect view: the image as the environment (else u_env)
 uniform mat3 u_world_R_eye;
 uniform vec3 u_absorption;     // 1/m per channel
 uniform float u_ior;           // refractive index of the fluid (water 1.33)
@@ -18,6 +20,10 @@ uniform float u_f0;            // reflectance at normal incidence
 uniform float u_roughness;     // GGX alpha of the surface (after the depth filter)
 uniform float u_light_intensity;  // a white diffuse surface facing the light alone: this radiance
 uniform vec3 u_light;          // towards the light, eye space
+uniform int u_ssr_steps;       // screen-space reflection: steps along the reflected ray; 0 = off
+uniform float u_ssr_distance;  // ... over this many metres
+uniform float u_contact;       // metres: water whose back is this close to the scene wets it
+uniform bool u_wet;            // darken the surface under the water (Lekner & Dorf 1988)
 
 float schlick(float f0, float cos_theta) { return f0 + (1.0 - f0) * pow(1.0 - clamp(cos_theta, 0.0, 1.0), 5.0); }
 
@@ -25,6 +31,71 @@ float schlick(float f0, float cos_theta) { return f0 + (1.0 - f0) * pow(1.0 - cl
 vec2 project_uv(vec3 q) {
   vec2 px = vec2(u_K.x * q.x / q.z + u_K.z, u_K.y * q.y / q.z + u_K.w);
   return vec2(px.x + 0.5, u_size.y - (px.y + 0.5)) / u_size;  // window rows run up
+}
+
+float scene_eye_depth(vec2 uv) { return eye_depth(texelFetch(u_scene_depth, ivec2(uv * u_size), 0).r); }
+
+// Screen-space reflection (the linear ray march of McGuire & Mara 2014, "Efficient GPU Screen-Space
+// Ray Tracing", in eye space): the reflected ray from P is followed in u_ssr_steps equal steps over
+// u_ssr_distance; the first step whose point lies behind the scene depth at its pixel, by less than
+// the step's own depth change plus 5 cm (the scene is a height field: further behind is hidden
+// space, not a hit), is refined by bisection. Returns the hit's weight (0: no hit), faded towards
+// the image border and the ray's end so that the fallback takes over smoothly, and its uv.
+float trace_reflection(vec3 P, vec3 R, out vec2 uv) {
+  uv = vec2(0.0);
+  if (u_ssr_steps <= 0) return 0.0;
+  float ds = u_ssr_distance / float(u_ssr_steps);
+  float tol = abs(R.z) * ds + 0.05;
+  float s0 = 0.0;
+  for (int i = 1; i <= u_ssr_steps; ++i) {
+    float s = ds * float(i);
+    vec3 q = P + R * s;
+    if (q.z <= u_near_far.x) return 0.0;
+    vec2 u = project_uv(q);
+    if (any(lessThan(u, vec2(0.0))) || any(greaterThanEqual(u, vec2(1.0)))) return 0.0;
+    float dz = q.z - scene_eye_depth(u);
+    if (dz > 0.0 && dz < tol) {
+      float lo = s0, hi = s;  // the surface is crossed between lo and hi
+      for (int k = 0; k < 5; ++k) {
+        float m = 0.5 * (lo + hi);
+        vec3 qm = P + R * m;
+        if (qm.z - scene_eye_depth(project_uv(qm)) > 0.0) hi = m;
+        else lo = m;
+      }
+      uv = project_uv(P + R * hi);
+      vec2 border = min(uv, 1.0 - uv) * u_size;  // pixels to the nearest image edge
+      return clamp(min(border.x, border.y) / 16.0, 0.0, 1.0) * (1.0 - smoothstep(0.7, 1.0, hi / u_ssr_distance));
+    }
+    s0 = s;
+  }
+  return 0.0;
+}
+
+// The Kinect view's environment where the traced ray finds nothing: the room at infinity as the
+// camera itself saw it, i.e. the image pixel that direction R points to from the camera (a
+// direction behind the camera is mirrored into the image plane, R.z -> |R.z|; one beyond the image
+// reads its nearest edge). A puddle on a desk then reflects what stands beyond it, with the room's
+// own colours and contrast, where a constant (the image's mean colour) made a flat grey sheen.
+vec3 image_environment(vec3 R) {
+  vec2 uv = project_uv(vec3(R.xy, max(abs(R.z), 0.2)));
+  return srgb_to_linear(texture(u_scene_color, clamp(uv, 0.5 / u_size, 1.0 - 0.5 / u_size)).rgb);
+}
+
+// A diffuse surface under water is darker than dry (Lekner & Dorf 1988, "Why some things are darker
+// when wet", Appl. Opt. 27): of the light that enters the water (1 - R_e), the surface of albedo a
+// sends up a; the water-air interface sends R_i of that back down (total internal reflection), so
+// the surface's radiosity is a E (1 - R_e) / (1 - a R_i), and the radiance leaving the water is
+// (1 - F_view) / n^2 of the surface's (the n^2 law of radiance). R_e, the reflectance for diffuse
+// light from above, is Schlick's Fresnel averaged over the hemisphere (cosine-weighted):
+// f0 + (1 - f0) / 21; R_i = 1 - (1 - R_e) / n^2 by reciprocity. This returns the factor on the dry
+// radiance apart from (1 - F_view), which the Fresnel mix applies. The albedo is taken as the
+// surface's linear radiance (clamped to 1): the image holds no other measure of it; a darker
+// surface darkens more, relatively, as it does when wet.
+vec3 wet_factor(vec3 dry) {
+  float n2 = u_ior * u_ior;
+  float Re = u_f0 + (1.0 - u_f0) / 21.0;
+  float Ri = 1.0 - (1.0 - Re) / n2;
+  return vec3((1.0 - Re) / n2) / (1.0 - clamp(dry, 0.0, 1.0) * Ri);
 }
 
 // The shaded colour at texel p, and reflection and refraction alone (ssfr_composite.frag / .comp).
@@ -55,13 +126,26 @@ void composite_at(ivec2 p, out vec4 o_color, out vec4 o_reflect, out vec4 o_refr
   float path = min(T, max(z_bg - P.z, 0.0) / max(t.z, 0.2));
   vec3 Q = P + t * path;
   vec2 uv_t = clamp(project_uv(Q), 0.5 / u_size, 1.0 - 0.5 / u_size);
+  vec3 behind = srgb_to_linear(texture(u_scene_color, uv_t).rgb);
+  // Water resting on the surface behind it (its back within u_contact of the scene along the
+  // view ray) wets it; a drop in the air does not. The measured depth is noisy and quantised
+  // (a Kinect v1's step is about 2.85e-3 z^2 m: 1.1 cm at 2 m), so the tolerance grows with z^2
+  // and the fade spans twice it: a sharp threshold drew the depth's quantisation bands as stripes.
+  float gap = max(z_bg - P.z, 0.0) * length(P) / P.z - T;
+  float tol = u_contact + 0.006 * z_bg * z_bg;
+  if (u_wet) behind *= mix(vec3(1.0), wet_factor(behind), 1.0 - smoothstep(tol, 3.0 * tol, gap));
   // Beer-Lambert: each metre of water keeps exp(-absorption) of the light, per channel.
-  vec3 refr = srgb_to_linear(texture(u_scene_color, uv_t).rgb) * exp(-u_absorption * T);
+  vec3 refr = behind * exp(-u_absorption * T);
 
-  // Reflection of the surroundings: the scene's cube map; in the Kinect view only the camera's
-  // own picture exists, whose mean colour stands for the room's light reflected off the surface.
+  // Reflection of the surroundings: what the reflected ray meets on screen (the scene and the other
+  // objects), else the scene's cube map (mesh view) or, in the Kinect view, the image as an
+  // environment at infinity (image_environment); u_image_env false: the image's mean colour.
   vec3 R = reflect(-V, N);
-  vec3 refl = u_use_cube ? srgb_to_linear(texture(u_cube, u_world_R_eye * R).rgb) : u_env;
+  vec3 env = u_use_cube ? srgb_to_linear(texture(u_cube, u_world_R_eye * R).rgb)
+                        : (u_image_env ? image_environment(R) : u_env);
+  vec2 uv_r;
+  float hit = trace_reflection(P, R, uv_r);
+  vec3 refl = hit > 0.0 ? mix(env, srgb_to_linear(texture(u_scene_color, uv_r).rgb), hit) : env;
   float F = schlick(u_f0, NV);
 
   // The light's own reflection: GGX microfacets (Walter et al. 2007) with Schlick's Fresnel and

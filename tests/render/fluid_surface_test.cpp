@@ -1,0 +1,245 @@
+// The fluid's surface and its shading against analytic truth, on small frames (each test renders a
+// few 200 x 150 frames on llvmpipe):
+//   - gap fill: a layer of particles spread over a plane (the spacing a spill leaves) gives one
+//     surface with no holes, between the spheres' fronts and their centres; without the fill it
+//     has holes (what the fill is for);
+//   - no bridge and no bleeding across a depth step: two layers 0.3 m apart in depth keep the gap
+//     between them empty and each keeps its own depth;
+//   - the gap fill respects the scene: a real bar in front of the layer is not covered;
+//   - Beer-Lambert: the refracted background's linear colour is exp(-absorption T) of what is
+//     behind, T the slab's thickness;
+//   - wetting: the same slab resting on a surface darkens it by Lekner & Dorf's factor, not in the air.
+#include <algorithm>
+#include <cmath>
+
+#include "core/phase.hpp"
+#include "render_test_util.hpp"
+
+namespace seamless::test {
+namespace {
+
+constexpr int kW = 200, kH = 150;
+constexpr float kF = 300.f;
+
+Intrinsics small_K() { return intrinsics(kF, 99.5f, 74.5f, kW, kH); }
+
+// Particles of radius r on a square lattice of spacing s in the plane z = const facing the
+// camera, centred at (cx, cy): n x n of them.
+void layer(std::vector<vec3>& x, float cx, float cy, float z, int n, float s) {
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) x.push_back({cx + (i - 0.5f * (n - 1)) * s, cy + (j - 0.5f * (n - 1)) * s, z});
+}
+
+DrawList fluid_list(const std::vector<vec3>& x, std::vector<std::uint32_t>& ph, float r) {
+  ph.assign(x.size(), phase::kFluid);
+  DrawList d;
+  d.positions = x, d.phases = ph, d.particle_radius = r;
+  return d;
+}
+
+// sRGB-encoded 8-bit value to linear (IEC 61966-2-1), as color.glsl decodes.
+vec3 linear(uchar3 c) {
+  auto f = [](std::uint8_t b) {
+    const float v = b / 255.f;
+    return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+  };
+  return {f(c.x), f(c.y), f(c.z)};
+}
+
+// Filtered eye depth at image pixel (u, v) (the read-back rows run bottom to top).
+float depth_at(const Renderer::FluidImages& f, int u, int v) {
+  return f.depth[static_cast<std::size_t>(f.h - 1 - v) * f.w + u];
+}
+
+RenderParams surface_params() {
+  RenderParams p;
+  p.shadows = false;
+  p.background = {0.8f, 0.8f, 0.8f};
+  return p;
+}
+
+// A layer spread to spacing 3 r (spheres of the default 1.5 r just touch along the lattice; the
+// holes at the lattice's diagonals, 2.12 r from each centre, are open): inside the layer's
+// projection, shrunk by one spacing, every pixel has a depth after the filter, and that depth lies
+// between the spheres' fronts (z - 1.5 r, less one window-depth step) and the centre plane z: the
+// filter averages the spheres' caps and the fill's interpolations, both within that range.
+// Without the fill the same pixels have holes.
+TEST(RenderFluidSurface, GapFillClosesASpreadLayer) {
+  SEAMLESS_REQUIRE_EGL();
+  const Intrinsics K = small_K();
+  const float r = 0.01f, z = 1.f, s = 3.f * r;
+  std::vector<vec3> x;
+  layer(x, 0.f, 0.f, z, 9, s);
+  std::vector<std::uint32_t> ph;
+  const DrawList list = fluid_list(x, ph, r);
+  const float half = 4.f * s - s;  // the layer's half-width (centres), shrunk by one spacing
+  const int u0 = static_cast<int>(std::ceil(K.cx - kF * half / z)), u1 = static_cast<int>(K.cx + kF * half / z);
+  const int v0 = static_cast<int>(std::ceil(K.cy - kF * half / z)), v1 = static_cast<int>(K.cy + kF * half / z);
+  auto holes_and_range = [&](float gap_fill, float& lo, float& hi) {
+    RenderParams p = surface_params();
+    p.fluid_gap_fill = gap_fill;
+    Renderer rd(p, kW, kH);
+    rd.draw(list, camera(K));
+    const Renderer::FluidImages f = rd.read_fluid_images();
+    int holes = 0;
+    lo = 1e9f, hi = -1e9f;
+    for (int v = v0; v <= v1; ++v)
+      for (int u = u0; u <= u1; ++u) {
+        const float d = depth_at(f, u, v);
+        if (d <= 0.f) ++holes;
+        else lo = std::min(lo, d), hi = std::max(hi, d);
+      }
+    return holes;
+  };
+  float lo = 0.f, hi = 0.f;
+  const int holes_off = holes_and_range(0.f, lo, hi);
+  const int holes = holes_and_range(RenderParams{}.fluid_gap_fill, lo, hi);
+  std::printf("pixels %d; holes without the fill %d, with it %d; depth %.4f..%.4f m\n", (u1 - u0 + 1) * (v1 - v0 + 1),
+              holes_off, holes, lo, hi);
+  EXPECT_GT(holes_off, 20) << "the layer should have holes without the fill (the test's premise)";
+  EXPECT_EQ(holes, 0);
+  EXPECT_GE(lo, z - 1.5f * r - 1e-3f);
+  EXPECT_LE(hi, z + 1e-4f);
+}
+
+// Two spread layers side by side, the right one 0.3 m further: 2 cm of empty space between their
+// outermost spheres (about 5 pixels, within the fill's reach of 4 radii at these depths), but
+// their depths differ by far more than the range mu plus that span: the gap stays empty, and
+// neither layer's depth is pulled towards the other beyond what the narrow-range filter allows
+// (each within its own spheres' fronts and centre plane; the far one's edge up to mu nearer).
+TEST(RenderFluidSurface, NoBridgeOrBleedingAcrossADepthStep) {
+  SEAMLESS_REQUIRE_EGL();
+  const Intrinsics K = small_K();
+  const float r = 0.01f, s = 3.f * r, rs = 1.5f * r;
+  const float zn = 1.f, zf = 1.3f;
+  // Right edge of the near layer's spheres at x = -0.01; left edge of the far layer's at +0.01.
+  const float xn = -0.01f - rs - 2.f * s, xf = 0.01f + rs + 2.f * s;
+  std::vector<vec3> x;
+  layer(x, xn, 0.f, zn, 5, s);
+  layer(x, xf, 0.f, zf, 5, s);
+  std::vector<std::uint32_t> ph;
+  Renderer rd(surface_params(), kW, kH);
+  rd.draw(fluid_list(x, ph, r), camera(K));
+  const Renderer::FluidImages f = rd.read_fluid_images();
+  const int v = static_cast<int>(K.cy);
+  // Pixels whose rays pass strictly between the two layers' sphere bounds (one pixel margin).
+  const int g0 = static_cast<int>(std::ceil(K.cx + kF * -0.01f / zn)) + 1;
+  const int g1 = static_cast<int>(K.cx + kF * 0.01f / zf) - 1;
+  ASSERT_GT(g1, g0);
+  for (int u = g0; u <= g1; ++u) EXPECT_EQ(depth_at(f, u, v), 0.f) << "bridged at u = " << u;
+  int near = 0, far = 0;
+  for (int u = 0; u < kW; ++u) {
+    const float d = depth_at(f, u, v);
+    if (d <= 0.f) continue;
+    const bool is_near = u < g0;
+    (is_near ? near : far)++;
+    // The narrow-range filter leaves samples behind the centre by more than mu out and clamps
+    // those in front to z - mu: a far pixel next to the near layer moves forward by at most mu,
+    // a near pixel not at all (0.3 m would be bleeding).
+    const float z = is_near ? zn : zf, mu = is_near ? 0.f : 3.f * RenderParams{}.filter_depth_sigma * r;
+    EXPECT_GE(d, z - rs - mu - 1e-3f) << "bled at u = " << u;
+    EXPECT_LE(d, z + 1e-4f) << "bled at u = " << u;
+  }
+  EXPECT_GT(near, 20);
+  EXPECT_GT(far, 15);
+}
+
+// The Kinect view of a flat surface at 1.2 m with a bar 5 pixels wide at 0.8 m in front of it
+// (depth image), and a spread layer at 1 m behind the bar: the bar hides the spheres behind it,
+// and the fill, whose two sides agree, must not cover the bar either (the scene is in front).
+TEST(RenderFluidSurface, GapFillLeavesTheSceneInFront) {
+  SEAMLESS_REQUIRE_EGL();
+  const Intrinsics K = small_K();
+  std::vector<uchar3> rgb(static_cast<std::size_t>(kW) * kH, uchar3{200, 200, 200});
+  std::vector<float> depth(rgb.size(), 1.2f);
+  const int b0 = 98, b1 = 102;
+  for (int v = 0; v < kH; ++v)
+    for (int u = b0; u <= b1; ++u) depth[static_cast<std::size_t>(v) * kW + u] = 0.8f;
+  RenderParams p = surface_params();
+  p.view = RenderView::kinect;
+  Renderer rd(p, kW, kH);
+  rd.set_kinect_view(Image<uchar3>::from_host(rgb, kW, kH, Device::CPU),
+                     Image<float>::from_host(depth, kW, kH, Device::CPU), K, SE3::identity());
+  const float r = 0.01f;
+  std::vector<vec3> x;
+  layer(x, 0.f, 0.f, 1.f, 9, 3.f * r);
+  std::vector<std::uint32_t> ph;
+  rd.draw(fluid_list(x, ph, r), RenderCamera{});
+  const Renderer::FluidImages f = rd.read_fluid_images();
+  int fluid_beside = 0;
+  for (int v = 60; v <= 90; ++v) {
+    for (int u = b0; u <= b1; ++u) EXPECT_EQ(depth_at(f, u, v), 0.f) << "fluid over the bar at " << u << "," << v;
+    fluid_beside += depth_at(f, b0 - 3, v) > 0.f && depth_at(f, b1 + 3, v) > 0.f ? 1 : 0;
+  }
+  EXPECT_GT(fluid_beside, 25) << "the test needs fluid on both sides of the bar";
+}
+
+// A slab of fluid (a lattice of one diameter, the spheres' thickness scaled to a path in fluid)
+// in front of a uniform Kinect image, its back 0.2 m before the measured surface (in the air: not
+// wet), then resting on it (wet). Refraction stage in linear units, mean over the slab's centre:
+//   in the air: what is behind times exp(-absorption T), T the slab's depth (n layers of 2 r);
+//   resting:    the same times Lekner & Dorf's factor (1 - R_e) / (n^2 (1 - a R_i)), a the image's
+//               linear value (the albedo it stands for).
+// Tolerances: T is a sum of sphere chords over their volume fraction; across the slab's centre it
+// scatters about the true depth by a fraction of a radius, so exp(-a T) is checked within the
+// range T +- r gives; the wet/dry ratio cancels T and absorption and is checked within 2 %
+// (8-bit stage images: a level in 60-200).
+TEST(RenderFluidSurface, BeerLambertAndWetting) {
+  SEAMLESS_REQUIRE_EGL();
+  const Intrinsics K = small_K();
+  const uchar3 grey{150, 150, 150};
+  const float z_surface = 1.2f;
+  std::vector<uchar3> rgb(static_cast<std::size_t>(kW) * kH, grey);
+  std::vector<float> depth(rgb.size(), z_surface);
+  RenderParams p = surface_params();
+  p.view = RenderView::kinect;
+  p.stage_images = true;
+  p.light_intensity = 0.f;
+  p.absorption = {20.f, 8.f, 2.f};
+  const float r = 0.01f, d = 2.f * r;
+  const int layers = 4;
+  const float T = layers * d;
+  auto refraction = [&](float back) {  // mean linear refraction over the slab's centre
+    Renderer rd(p, kW, kH);
+    rd.set_kinect_view(Image<uchar3>::from_host(rgb, kW, kH, Device::CPU),
+                       Image<float>::from_host(depth, kW, kH, Device::CPU), K, SE3::identity());
+    std::vector<vec3> x;
+    // The back layer's spheres (1.5 r as drawn) touch `back`: none is cut by the surface, so the
+    // thickness is the same resting or in the air.
+    for (int k = 0; k < layers; ++k) layer(x, 0.f, 0.f, back - 1.5f * r - k * d, 12, d);
+    std::vector<std::uint32_t> ph;
+    rd.draw(fluid_list(x, ph, r), RenderCamera{});
+    const StageImage* st = nullptr;
+    for (const StageImage& s : rd.stage_images())
+      if (s.name == "6_refraction") st = &s;
+    EXPECT_NE(st, nullptr);
+    if (!st) return vec3{0, 0, 0};
+    const Pixels im(st->image);
+    vec3 sum{0, 0, 0};
+    int n = 0;
+    for (int v = 65; v < 85; ++v)
+      for (int u = 90; u < 110; ++u) {
+        sum = sum + linear(im.at(u, v));
+        ++n;
+      }
+    return sum * (1.f / static_cast<float>(n));
+  };
+  const vec3 behind = linear(grey);
+  const vec3 dry = refraction(z_surface - 0.2f);
+  const vec3 wet = refraction(z_surface);
+  const float a[3] = {p.absorption.x, p.absorption.y, p.absorption.z};
+  const float n2 = p.ior * p.ior, Re = p.fresnel_f0 + (1.f - p.fresnel_f0) / 21.f, Ri = 1.f - (1.f - Re) / n2;
+  const float wet_expected = (1.f - Re) / (n2 * (1.f - behind.x * Ri));
+  for (int c = 0; c < 3; ++c) {
+    const float got = (&dry.x)[c] / (&behind.x)[c];
+    std::printf("channel %d: dry transmittance %.3f (exp(-a T) %.3f, range %.3f..%.3f); wet/dry %.3f (expected %.3f)\n",
+                c, got, std::exp(-a[c] * T), std::exp(-a[c] * (T + r)), std::exp(-a[c] * (T - r)),
+                (&wet.x)[c] / (&dry.x)[c], wet_expected);
+    EXPECT_GE(got, std::exp(-a[c] * (T + r)) - 0.01f);
+    EXPECT_LE(got, std::exp(-a[c] * (T - r)) + 0.01f);
+    EXPECT_NEAR((&wet.x)[c] / (&dry.x)[c], wet_expected, 0.02f * wet_expected);
+  }
+}
+
+}  // namespace
+}  // namespace seamless::test
