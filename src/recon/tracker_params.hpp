@@ -69,11 +69,11 @@ struct TrackerParams {
   float stop_translation = 1e-4f;     // metres per step
   float stop_rotation_deg = 0.0034f;  // degrees per step (6e-5 rad)
   float dist_threshold = 0.1f;        // metres
-  // Depth beyond this takes no part in tracking (current and reference points alike); 0: no cut. The
-  // default is the range the structured-light sensors are specified for and the one OpenCV's RGB-D
-  // odometries cut at (4 m): beyond it the Kinect v1 / Xtion depth step exceeds 5 cm (Khoshelham &
-  // Elberink 2012: sigma_z ~ 1.4 mm z^2), worse than the geometry it would constrain.
-  float max_depth = 4.0f;
+  // Depth beyond this takes no part in tracking (current and reference points alike); 0: no cut.
+  // 4 m is the range the structured-light sensors are specified for and the one OpenCV's RGB-D
+  // odometries cut at: beyond it the Kinect v1 / Xtion depth noise exceeds 2 cm (Khoshelham &
+  // Elberink 2012: sigma_z ~ 1.4 mm z^2). Alone it did not win on every folder (docs/TRACKING.md).
+  float max_depth = 0.f;
   // Frame to frame only: the reference stays the last keyframe until a frame's inlier ratio against it
   // falls below this fraction of the ratio the first frame tracked against it had (its overlap with
   // the keyframe dropped); then that frame becomes the keyframe (as DVO SLAM tracks against keyframes,
@@ -163,7 +163,7 @@ struct TrackerParams {
     v("dist_threshold", dist_threshold, "reject correspondences farther apart, metres", Range{0.0, 10.0});
     v("max_depth", max_depth,
       "depth farther than this (metres) takes no part in tracking, current and reference points alike; 0: no "
-      "cut (default 4: the range of structured-light sensors, and OpenCV's odometries' cut)",
+      "cut (4: the range of structured-light sensors, and OpenCV's odometries' cut)",
       Range{0.0, 100.0});
     v("keyframe_min_overlap", keyframe_min_overlap,
       "frame to frame: track against the last keyframe until a frame's inlier ratio falls below this fraction "

@@ -32,12 +32,14 @@ import time
 SKIP = 77
 FOLDERS = ("tum_fr1_rpy_000-149", "tum_fr1_rpy_150-299", "bonn_crowd_220-279", "frames_box_50",
            "tum_fr1_desk_9frames")
-CI_FRAMES = 40
+CI_FRAMES = 60
 PEERS = ("opencv_rgbd_odometry", "opencv_rgbd_icp")
 METRICS = (("ate_rmse_m", "ATE RMSE"), ("rpe_second_trans_rmse_m", "RPE/1 s"))
-# (folder, mode) -> how many times the better peer's figure ours may reach, where ours is measured to
-# lose (docs/TRACKING.md says which and by how much); 1 everywhere else: at or below.
-BOUND = {}
+# (folder, mode, metric) -> how many times a peer's figure ours may reach, where ours is measured to
+# lose (docs/TRACKING.md says which and by how much): the measured ratio, rounded up to a percent; 1
+# everywhere else: at or below. On tum_fr1_rpy_000-149's first 60 frames OpenCV's RgbdOdometry has
+# ATE 2.52 cm and RPE/1 s 4.56 cm, ours 2.56 and 5.04 (x1.016 and x1.105).
+BOUND = {("tum_fr1_rpy_000-149", "ci", "ate_rmse_m"): 1.02, ("tum_fr1_rpy_000-149", "ci", "rpe_second_trans_rmse_m"): 1.11}
 
 
 def main():
@@ -52,7 +54,7 @@ def main():
         return SKIP
     cmd = [sys.executable, os.path.join(src, "scripts", "compare_trackers"), "--protocol", "--data", data,
            "--seamless", seamless, "--out", out, "--device", "cpu", "--no-plots", "--frames", str(frames),
-           "--cores", "2" if mode == "ci" else "1"]
+           "--cores", "2" if mode == "ci" else "1", "--protocol-set", "input.fill_gaps=true"]
     if mode == "ci":
         cmd += ["--opencv-cache", os.path.join(src, "tests", "app", "data", f"opencv_protocol_{frames}.json")]
     else:
@@ -81,7 +83,7 @@ def main():
                 if p.get(key) is None or ours.get(key) is None:  # shorter than 1 s: no RPE/1 s
                     assert p.get(key) is None and ours.get(key) is None, (folder, key, ours, p)
                     continue
-                bound = BOUND.get((folder, mode), 1.0)
+                bound = BOUND.get((folder, mode, key), 1.0)
                 line = (f"{folder}: {label} ours {100 * ours[key]:.3f} cm, {peer} {100 * p[key]:.3f} cm"
                         + (f" (bound x{bound})" if bound != 1.0 else ""))
                 print(line)
