@@ -81,6 +81,9 @@ struct IcpLevel {
   // subsample at full resolution, which keeps the finest level's sharp intensity gradients and
   // exact depths (unlike the next, averaged level) at 1/stride^2 of the cost. 1: every pixel.
   int stride = 1;
+  // Points farther than this (camera z, metres) on either side have no correspondence
+  // (tracker.max_depth); 0: no cut.
+  float max_depth = 0.f;
 };
 
 // The number of pixels a level's reduction visits, and the i-th of them (row by row).
@@ -108,6 +111,7 @@ SEAMLESS_HD inline bool find_correspondence(const IcpLevel& L, int x, int y, Cor
   vec3 p = L.cur_vertex(x, y);
   vec3 np = L.cur_normal(x, y);
   if (!valid_point(p) || !valid_normal(np)) return false;
+  if (L.max_depth > 0.f && p.z > L.max_depth) return false;
   c.q = L.ref_T_cur * p;
   if (c.q.z <= 0.f) return false;
   c.uv = L.K.project(c.q);
@@ -116,6 +120,7 @@ SEAMLESS_HD inline bool find_correspondence(const IcpLevel& L, int x, int y, Cor
   c.v = L.ref_vertex(u, v);
   c.n = L.ref_normal(u, v);
   if (!valid_point(c.v) || !valid_normal(c.n)) return false;
+  if (L.max_depth > 0.f && c.v.z > L.max_depth) return false;
   if (length2(c.q - c.v) > L.dist_threshold * L.dist_threshold) return false;
   return dot(L.ref_T_cur.rotate(np), c.n) >= L.cos_angle;
 }

@@ -185,6 +185,7 @@ void Tracker::reduce_into(const FramePyramid& frame, const ReferenceMaps& ref, i
                       static_cast<float>(params_.stop_rotation_deg * kPi / 180.0),
                       params_.stop_translation};
   if (level < static_cast<int>(params_.pixel_stride.size())) L.stride = params_.pixel_stride[level];
+  L.max_depth = params_.max_depth;
   kernels::IcpState* st = state();
   kernels::IcpSums* out = sums_slot(level);
   with_exec(device_, [&]<class E>(const E& ex) {

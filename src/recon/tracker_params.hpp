@@ -69,6 +69,16 @@ struct TrackerParams {
   float stop_translation = 1e-4f;     // metres per step
   float stop_rotation_deg = 0.0034f;  // degrees per step (6e-5 rad)
   float dist_threshold = 0.1f;        // metres
+  // Depth beyond this takes no part in tracking (current and reference points alike); 0: no cut.
+  // 4 m is the range the structured-light sensors are specified for and the one OpenCV's RGB-D
+  // odometries cut at: beyond it the Kinect v1 / Xtion depth noise exceeds 2 cm (Khoshelham &
+  // Elberink 2012: sigma_z ~ 1.4 mm z^2). Alone it did not win on every folder (docs/TRACKING.md).
+  float max_depth = 0.f;
+  // Frame to frame only: the reference stays the last keyframe until a frame's inlier ratio against it
+  // falls below this fraction of the ratio the first frame tracked against it had (its overlap with
+  // the keyframe dropped); then that frame becomes the keyframe (as DVO SLAM tracks against keyframes,
+  // Kerl et al. 2013). Fewer reference changes, less drift. 0: every tracked frame is the reference.
+  float keyframe_min_overlap = 0.f;
   float angle_threshold_deg = 20.f;
   float photometric_weight = 0.1f;        // rgbd only: weight of the colour term vs geometry
   float min_inlier_ratio = 0.15f;         // see docs/TRACKING.md, "Tracking loss"
@@ -151,6 +161,14 @@ struct TrackerParams {
       Range{0.0, 1.0});
     v("stop_rotation_deg", stop_rotation_deg, "see stop_translation (degrees)", Range{0.0, 180.0});
     v("dist_threshold", dist_threshold, "reject correspondences farther apart, metres", Range{0.0, 10.0});
+    v("max_depth", max_depth,
+      "depth farther than this (metres) takes no part in tracking, current and reference points alike; 0: no "
+      "cut (4: the range of structured-light sensors, and OpenCV's odometries' cut)",
+      Range{0.0, 100.0});
+    v("keyframe_min_overlap", keyframe_min_overlap,
+      "frame to frame: track against the last keyframe until a frame's inlier ratio falls below this fraction "
+      "of the first frame's against it, then make that frame the keyframe; 0: every frame is the next reference",
+      Range{0.0, 1.0});
     v("angle_threshold_deg", angle_threshold_deg, "reject correspondences whose normals differ more, degrees",
       Range{0.0, 180.0});
     v("photometric_weight", photometric_weight, "weight of the photometric term (rgbd)", Range{0.0, 1e6});

@@ -135,6 +135,9 @@ class TrackingSession {
   void accept(const RgbdFrame& frame, const SE3& pose, FrameRecord& rec);
   double volume_allocate_ms(std::size_t first_row) const;
   void update_reference(const SE3& pose);
+  // Frame to frame with tracker.keyframe_min_overlap: whether the frame just accepted keeps the
+  // keyframe as the reference (its overlap with it still holds).
+  bool keeps_keyframe(const FrameRecord& rec);
   // Dynamic pixels: the model to compare with (ref_ when tracking frame to model, else
   // a raycast of the volume from the last good pose; nullptr without a volume), and the mask of the
   // current frame at pose world_T_camera into dyn_mask_: the frame's (final, at the tracked pose)
@@ -189,6 +192,7 @@ class TrackingSession {
   std::int64_t lost_run_ = 0;           // consecutive lost frames just before this one: > 0 means relocalising
   double last_good_time_ = 0;           // timestamp of the last good frame
   double last_inlier_ratio_ = 0;        // of the last frame tracked (not the first), 0 before
+  double keyframe_inlier_ratio_ = 0;    // of the first frame tracked against the keyframe; 0: none yet
   std::vector<double> good_residuals_;  // residual_rms of the last good tracked frames (at most 10)
 };
 

@@ -271,6 +271,18 @@ void TrackingSession::update_reference(const SE3& pose) {
   }
 }
 
+bool TrackingSession::keeps_keyframe(const FrameRecord& rec) {
+  const float overlap = p_.tracker.keyframe_min_overlap;
+  if (overlap <= 0.f || p_.tracker.mode != TrackingMode::frame_to_frame || !started_) return false;
+  if (keyframe_inlier_ratio_ <= 0) {  // the keyframe's first frame: its ratio is the overlap's measure
+    keyframe_inlier_ratio_ = rec.result.inlier_ratio;
+    return true;
+  }
+  if (rec.result.inlier_ratio >= overlap * keyframe_inlier_ratio_) return true;
+  keyframe_inlier_ratio_ = 0;  // this frame is the next keyframe
+  return false;
+}
+
 void TrackingSession::accept(const RgbdFrame& frame, const SE3& pose, FrameRecord& rec) {
   if (volume_) {
     join_colour();
@@ -278,7 +290,7 @@ void TrackingSession::accept(const RgbdFrame& frame, const SE3& pose, FrameRecor
     rec.fused = true;
   }
   marks_.mark(kFused);
-  if (tracker_) update_reference(pose);
+  if (tracker_ && !keeps_keyframe(rec)) update_reference(pose);
   if (odometry_) last_good_frame_ = host_copy(frame);
   // After lost frames the motion since prev_good_ spans all of them: no velocity to extrapolate.
   prev_good_ = started_ && lost_run_ == 0 ? last_good_ : pose;
