@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """The held-out tracking protocol (docs/TRACKING.md, "The held-out protocol"): on every real folder
-with ground truth in ../shared/data, with ONE config (configs/tum_fr1.yaml, only the data differing
+with ground truth in ../shared/data, with ONE config (configs/tum_fr1_f2m.yaml, only the data differing
 per folder: layout and the camera's intrinsics preset), our odometry (the tracker alone, no
 refinement) tracks every frame and is at or below both OpenCV RgbdOdometry and RgbdICPOdometry in
 ATE RMSE and RPE over 1 s (translation; a folder shorter than 1 s has no RPE over 1 s).
@@ -54,7 +54,8 @@ def main():
         return SKIP
     cmd = [sys.executable, os.path.join(src, "scripts", "compare_trackers"), "--protocol", "--data", data,
            "--seamless", seamless, "--out", out, "--device", "cpu", "--no-plots", "--frames", str(frames),
-           "--cores", "2" if mode == "ci" else "1", "--protocol-set", "input.fill_gaps=true"]
+           "--cores", "2" if mode == "ci" else "1", "--protocol-set", "input.fill_gaps=true",
+           "--config", os.path.join(src, "configs", "tum_fr1_f2m.yaml")]
     if mode == "ci":
         cmd += ["--opencv-cache", os.path.join(src, "tests", "app", "data", f"opencv_protocol_{frames}.json")]
     else:
