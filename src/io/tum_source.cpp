@@ -191,13 +191,7 @@ TumSource::TumSource(const InputParams& params, bool pinned) : params_(params), 
                      enum_name(params.association) + ": no rgb/depth timestamps within input.association_max_dt " +
                      std::to_string(params.association_max_dt) +
                      " s, or empty lists); check rgb.txt and depth.txt, or input.association_offset");
-  std::size_t first = static_cast<std::size_t>(std::min<std::int64_t>(params.first_frame, pairs_.size()));
-  pairs_.erase(pairs_.begin(), pairs_.begin() + first);
-  if (params.max_frames > 0 && pairs_.size() > static_cast<std::size_t>(params.max_frames))
-    pairs_.resize(params.max_frames);
-  if (pairs_.empty())
-    throw InputError("input.first_frame " + std::to_string(params.first_frame) + " is past the end of '" + folder_ +
-                     "'");
+  select_frames(pairs_, params.first_frame, params.max_frames, folder_);
   if (fs::exists(dir / "groundtruth.txt")) groundtruth_ = read_tum_trajectory((dir / "groundtruth.txt").string());
   if (fs::exists(dir / "accelerometer.txt")) accel_ = read_accelerometer((dir / "accelerometer.txt").string());
   scale_check_ = std::make_unique<DepthScaleCheck>(effective_depth_scale(params), params.check_depth_scale);
