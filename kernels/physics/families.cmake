@@ -16,7 +16,8 @@ set(SEAMLESS_PHYSICS_CPU_SOURCES physics/cpu_tiles.cpp physics/grid_cpu.cpp phys
 list(TRANSFORM SEAMLESS_PHYSICS_CPU_SOURCES PREPEND ${CMAKE_CURRENT_SOURCE_DIR}/)
 set_source_files_properties(${SEAMLESS_PHYSICS_CPU_SOURCES}
   PROPERTIES COMPILE_OPTIONS "$<$<CXX_COMPILER_ID:GNU,Clang>:-fno-math-errno;-Wno-psabi;--param=inline-unit-growth=200>")
-# The sanitizer build (scripts/sanitize): GCC 12's instrumentation changes what the AVX2 tiles
+# A gcc sanitizer build (-DSEAMLESS_SANITIZE; scripts/sanitize builds with clang, whose ASan and
+# UBSan leave the tiles matching, see docs/USAGE.md): GCC 12's instrumentation changes what the AVX2 tiles
 # compute: use-after-scope on every physics CPU file, and UBSan's checks on cpu_tiles.cpp (a fluid
 # at rest then leaves its box, and the tiles no longer match the scalar loops bit for bit), while
 # no check reports anything and the uninstrumented -O2 build, ASan alone and valgrind's memcheck of

@@ -44,43 +44,40 @@ SimulationResult simulate_experiment(RunContext& ctx) {
   return result;
 }
 
+namespace {
+
+// A subcommand that runs `run` on the experiment its options name (with --frames where `frames`):
+// it sets the action of the command line to that run, which returns the run's exit code.
+template <class Run>
+void add_experiment_command(CLI::App& app, std::function<int()>& action, const char* name, const char* help,
+                            bool frames, Run run) {
+  auto opts = std::make_shared<CommonOptions>();
+  auto* c = app.add_subcommand(name, help);
+  add_common_options(*c, *opts);
+  if (frames) add_frames_option(*c, *opts);
+  c->callback([&action, opts, run] {
+    action = [opts, run] {
+      RunContext ctx(*opts);
+      run(ctx);
+      return ctx.exit_code();
+    };
+  });
+}
+
+}  // namespace
+
 void add_pipeline_commands(CLI::App& app, std::function<int()>& action) {
-  auto rec = std::make_shared<CommonOptions>();
-  auto* r = app.add_subcommand("reconstruct",
-                               "track and fuse the input into the TSDF volume; write mesh.ply, "
-                               "trajectory.txt and tracking_stats.csv");
-  add_common_options(*r, *rec);
-  add_frames_option(*r, *rec);
-  r->callback([&action, rec] {
-    action = [rec] {
-      RunContext ctx(*rec);
-      reconstruct_experiment(ctx);
-      return ctx.exit_code();
-    };
-  });
-  auto trk = std::make_shared<CommonOptions>();
-  auto* t = app.add_subcommand("track", "track the camera over the input; write trajectory.txt and tracking_stats.csv");
-  add_common_options(*t, *trk);
-  add_frames_option(*t, *trk);
-  t->callback([&action, trk] {
-    action = [trk] {
-      RunContext ctx(*trk);
-      track_experiment(ctx);
-      return ctx.exit_code();
-    };
-  });
-  auto sim = std::make_shared<CommonOptions>();
-  auto* m = app.add_subcommand("simulate",
-                               "run the particle solver on the synthetic room's exact SDF (no scan); "
-                               "write particle states");
-  add_common_options(*m, *sim);
-  m->callback([&action, sim] {
-    action = [sim] {
-      RunContext ctx(*sim);
-      simulate_experiment(ctx);
-      return ctx.exit_code();
-    };
-  });
+  add_experiment_command(app, action, "reconstruct",
+                         "track and fuse the input into the TSDF volume; write mesh.ply, "
+                         "trajectory.txt and tracking_stats.csv",
+                         true, reconstruct_experiment);
+  add_experiment_command(app, action, "track",
+                         "track the camera over the input; write trajectory.txt and tracking_stats.csv", true,
+                         track_experiment);
+  add_experiment_command(app, action, "simulate",
+                         "run the particle solver on the synthetic room's exact SDF (no scan); "
+                         "write particle states",
+                         false, simulate_experiment);
 }
 
 }  // namespace seamless::app

@@ -157,13 +157,7 @@ FrameFolderSource::FrameFolderSource(const InputParams& params, bool pinned)
   if (frames_.empty())
     throw InputError("frame folder '" + folder_ +
                      "' has no frames (no frame-NNNNNN.color.png/.jpg with a frame-NNNNNN.depth.png)");
-  const std::size_t first = static_cast<std::size_t>(std::min<std::int64_t>(params.first_frame, frames_.size()));
-  frames_.erase(frames_.begin(), frames_.begin() + first);
-  if (params.max_frames > 0 && frames_.size() > static_cast<std::size_t>(params.max_frames))
-    frames_.resize(params.max_frames);
-  if (frames_.empty())
-    throw InputError("input.first_frame " + std::to_string(params.first_frame) + " is past the end of '" + folder_ +
-                     "'");
+  select_frames(frames_, params.first_frame, params.max_frames, folder_);
 
   std::int64_t with_pose = 0, lost_pose = 0;
   for (const FrameFolderEntry& f : frames_) {

@@ -1,5 +1,5 @@
 // libjpeg's classic API with setjmp error handling (its default error handler calls exit()).
-// Everything that must survive a longjmp lives on the heap (State), never in a non-volatile local
+// Everything that must survive a longjmp lives on the heap (JpegState), never in a non-volatile local
 // changed after setjmp.
 #include "io/jpeg_io.hpp"
 
@@ -23,15 +23,15 @@
 namespace seamless {
 namespace {
 
-struct State {
+struct JpegState {
   jpeg_error_mgr mgr;  // first member: libjpeg hands our handlers a pointer to it
   jmp_buf jb;
   std::string message;
   bool truncated = false;
 };
 
-void on_error(j_common_ptr c) {
-  auto* s = reinterpret_cast<State*>(c->err);
+void on_jpeg_error(j_common_ptr c) {
+  auto* s = reinterpret_cast<JpegState*>(c->err);
   char buf[JMSG_LENGTH_MAX];
   c->err->format_message(c, buf);
   s->message = buf;
@@ -40,30 +40,30 @@ void on_error(j_common_ptr c) {
 
 // Warnings (level -1) are corrupt-data notices; libjpeg goes on decoding. A premature end of the
 // file is one of them: libjpeg pads the missing rows with grey, which we must not pass on as data.
-void on_message(j_common_ptr c, int level) {
-  auto* s = reinterpret_cast<State*>(c->err);
+void on_jpeg_message(j_common_ptr c, int level) {
+  auto* s = reinterpret_cast<JpegState*>(c->err);
   if (level < 0 && c->err->msg_code == JWRN_JPEG_EOF) s->truncated = true;
 }
 
 using File = std::unique_ptr<FILE, int (*)(FILE*)>;
 
-File open_file(const std::string& path, const char* mode, const char* what) {
+File open_jpeg_file(const std::string& path, const char* mode, const char* what) {
   FILE* f = std::fopen(path.c_str(), mode);
   if (!f) throw InputError(std::string("cannot ") + what + " image file '" + path + "': " + std::strerror(errno));
   return File(f, std::fclose);
 }
 
-void install_handlers(State& s) {
+void install_handlers(JpegState& s) {
   jpeg_std_error(&s.mgr);
-  s.mgr.error_exit = on_error;
-  s.mgr.emit_message = on_message;
+  s.mgr.error_exit = on_jpeg_error;
+  s.mgr.emit_message = on_jpeg_message;
 }
 
 }  // namespace
 
 Image<uchar3> read_jpeg_rgb(const std::string& path) {
-  File f = open_file(path, "rb", "open");
-  auto s = std::make_unique<State>();
+  File f = open_jpeg_file(path, "rb", "open");
+  auto s = std::make_unique<JpegState>();
   auto d = std::make_unique<jpeg_decompress_struct>();
   install_handlers(*s);
   d->err = &s->mgr;
@@ -104,8 +104,8 @@ void write_jpeg_rgb(const std::string& path, const Image<uchar3>& im, int qualit
   if (im.width() <= 0 || im.height() <= 0) throw Error("write_jpeg_rgb: image for '" + path + "' is empty");
   if (quality < 1 || quality > 100)
     throw Error("write_jpeg_rgb: quality " + std::to_string(quality) + " for '" + path + "' is outside 1..100");
-  File f = open_file(path, "wb", "create");
-  auto s = std::make_unique<State>();
+  File f = open_jpeg_file(path, "wb", "create");
+  auto s = std::make_unique<JpegState>();
   auto c = std::make_unique<jpeg_compress_struct>();
   install_handlers(*s);
   c->err = &s->mgr;
@@ -133,7 +133,7 @@ void write_jpeg_rgb(const std::string& path, const Image<uchar3>& im, int qualit
 }
 
 ImageFormat image_format(const std::string& path) {
-  File f = open_file(path, "rb", "open");
+  File f = open_jpeg_file(path, "rb", "open");
   unsigned char b[8] = {};
   std::size_t n = std::fread(b, 1, sizeof b, f.get());
   static const unsigned char png_sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};

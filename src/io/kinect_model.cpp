@@ -116,6 +116,33 @@ std::int64_t signed_field(std::int32_t v, int bits) {
   return static_cast<std::int64_t>(static_cast<std::int32_t>(u) >> (32 - bits));
 }
 
+// One coordinate's cubic (x or y) as the forward differences described below: the row-start
+// value, its first difference along the row (dcol) and down the rows (drow), the second differences
+// (dcol2, dcol_drow, drow2), and the constant third differences a (along the row), b, c, d.
+struct CubicAxis {
+  std::int64_t start, dcol, drow, dcol2, dcol_drow, drow2;
+  std::int32_t a, b, c, d;
+  // Advances the row-start terms to the next row.
+  void next_row() {
+    dcol2 += c;
+    dcol += dcol_drow >> 8;
+    dcol_drow += d;
+    start += drow >> 6;
+    drow += drow2 >> 8;
+    drow2 += b;
+  }
+};
+
+// Along one row: the value, its first and second differences, advanced one column by step().
+struct RowWalk {
+  std::int64_t value, d1, d2;
+  void step(std::int32_t third) {
+    value += d1 >> 6;
+    d1 += d2 >> 8;
+    d2 += third;
+  }
+};
+
 }  // namespace
 
 // The unit stores its rectification as a bivariate cubic per coordinate, evaluated by forward
@@ -127,41 +154,28 @@ std::int64_t signed_field(std::int32_t v, int bits) {
 std::vector<vec2> kinect_registration_table(const KinectCalibration& c) {
   const int W = kKinectWidth, H = kKinectHeight;
   // Row-start state: offsets, their column differences, and those differences' row differences.
-  std::int64_t x0 = signed_field(c.dx_start, 19) << 9, y0 = signed_field(c.dy_start, 19) << 9;
-  std::int64_t x_dcol = signed_field(c.dxdx_start, 21) << 8, y_dcol = signed_field(c.dxdy_start, 21) << 8;
-  std::int64_t x_drow = signed_field(c.dydx_start, 21) << 8, y_drow = signed_field(c.dydy_start, 21) << 8;
-  std::int64_t x_dcol2 = signed_field(c.dxdxdx_start, 24) << 8, y_dcol2 = signed_field(c.dxdxdy_start, 24) << 8;
-  std::int64_t x_dcol_drow = signed_field(c.dydxdx_start, 24) << 8, y_dcol_drow = signed_field(c.dydxdy_start, 24) << 8;
-  std::int64_t x_drow2 = signed_field(c.dydydx_start, 24) << 8, y_drow2 = signed_field(c.dydydy_start, 24) << 8;
+  const std::int64_t x0 = signed_field(c.dx_start, 19) << 9, y0 = signed_field(c.dy_start, 19) << 9;
+  const std::int64_t x_dcol = signed_field(c.dxdx_start, 21) << 8, y_dcol = signed_field(c.dxdy_start, 21) << 8;
+  const std::int64_t x_drow = signed_field(c.dydx_start, 21) << 8, y_drow = signed_field(c.dydy_start, 21) << 8;
+  const std::int64_t x_dcol2 = signed_field(c.dxdxdx_start, 24) << 8, y_dcol2 = signed_field(c.dxdxdy_start, 24) << 8;
+  const std::int64_t x_dr_dc = signed_field(c.dydxdx_start, 24) << 8, y_dr_dc = signed_field(c.dydxdy_start, 24) << 8;
+  const std::int64_t x_drow2 = signed_field(c.dydydx_start, 24) << 8, y_drow2 = signed_field(c.dydydy_start, 24) << 8;
+  CubicAxis x{x0, x_dcol, x_drow, x_dcol2, x_dr_dc, x_drow2, c.ax, c.bx, c.cx, c.dx};
+  CubicAxis y{y0, y_dcol, y_drow, y_dcol2, y_dr_dc, y_drow2, c.ay, c.by, c.cy, c.dy};
   std::vector<vec2> table(static_cast<std::size_t>(W) * H);
   const double unit = 1.0 / (1 << 17);
   for (int row = 0; row < H; ++row) {
-    // Advance the row-start terms to this row (the device steps before its first row as well).
-    x_dcol2 += c.cx;
-    x_dcol += x_dcol_drow >> 8;
-    x_dcol_drow += c.dx;
-    x0 += x_drow >> 6;
-    x_drow += x_drow2 >> 8;
-    x_drow2 += c.bx;
-    y_dcol2 += c.cy;
-    y_dcol += y_dcol_drow >> 8;
-    y_dcol_drow += c.dy;
-    y0 += y_drow >> 6;
-    y_drow += y_drow2 >> 8;
-    y_drow2 += c.by;
-    std::int64_t x = x0, xd = x_dcol, xd2 = x_dcol2, y = y0, yd = y_dcol, yd2 = y_dcol2;
+    x.next_row();  // the device steps before its first row as well
+    y.next_row();
+    RowWalk xr{x.start, x.dcol, x.dcol2}, yr{y.start, y.dcol, y.dcol2};
     for (int col = 0; col < W; ++col) {
       // The device's pixel centres are one pixel down and right of ours.
-      const double u = col + x * unit + 1, v = row + y * unit + 1;
+      const double u = col + xr.value * unit + 1, v = row + yr.value * unit + 1;
       const bool inside = u >= 0 && v >= 0 && u < W && v < H;
       table[static_cast<std::size_t>(row) * W + col] = {inside ? static_cast<float>(u) : -1.f,
                                                         static_cast<float>(std::floor(v))};
-      x += xd >> 6;
-      xd += xd2 >> 8;
-      xd2 += c.ax;
-      y += yd >> 6;
-      yd += yd2 >> 8;
-      yd2 += c.ay;
+      xr.step(x.a);
+      yr.step(y.a);
     }
   }
   return table;

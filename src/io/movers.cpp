@@ -2,14 +2,13 @@
 
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 
 #include "core/error.hpp"
 
 namespace seamless {
 
 namespace {
-
-constexpr float kPi = 3.14159265358979f;
 
 // Where along the polyline (x, y on the floor) the mover is after travelling s metres, and the
 // unit direction it faces; false once s passes the path's end.
@@ -41,7 +40,7 @@ void push(kernels::movers::Scene& s, const kernels::movers::Capsule& c) {
 
 void add_person(kernels::movers::Scene& s, int id, vec3 at, vec3 facing, float travelled, float H) {
   const vec3 up{0.f, 0.f, 1.f}, side = cross(facing, up);  // side: the person's right
-  const float phase = 2.f * kPi * travelled / (0.8f * H);
+  const float phase = 2.f * std::numbers::pi_v<float> * travelled / (0.8f * H);
   const float leg_swing = 0.45f * std::sin(phase), arm_swing = -0.35f * std::sin(phase);
   const vec3 shirt{0.2f, 0.35f, 0.65f}, trousers{0.15f, 0.15f, 0.22f}, skin{0.85f, 0.62f, 0.5f};
   const float leg_r = 0.035f * H, arm_r = 0.026f * H, hip_z = 0.53f * H, shoulder_z = 0.81f * H;

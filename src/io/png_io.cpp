@@ -1,5 +1,5 @@
 // libpng's classic API with setjmp error handling. Everything that must survive a longjmp lives on
-// the heap (State), never in a non-volatile local changed after setjmp.
+// the heap (PngState), never in a non-volatile local changed after setjmp.
 #include "io/png_io.hpp"
 
 #include <png.h>
@@ -20,7 +20,7 @@ namespace {
 
 enum class Want { Info, U16, U8, RGB };
 
-struct State {
+struct PngState {
   jmp_buf jb;
   std::string libpng_message;
   std::string format_problem;  // set when the image is fine but not what was asked for
@@ -29,16 +29,16 @@ struct State {
   std::vector<png_bytep> rows;
 };
 
-void on_error(png_structp png, png_const_charp msg) {
-  auto* s = static_cast<State*>(png_get_error_ptr(png));
+void on_png_error(png_structp png, png_const_charp msg) {
+  auto* s = static_cast<PngState*>(png_get_error_ptr(png));
   s->libpng_message = msg;
   std::longjmp(s->jb, 1);
 }
-void on_warning(png_structp, png_const_charp) {}
+void on_png_warning(png_structp, png_const_charp) {}
 
 using File = std::unique_ptr<FILE, int (*)(FILE*)>;
 
-File open_file(const std::string& path, const char* mode, const char* what) {
+File open_png_file(const std::string& path, const char* mode, const char* what) {
   FILE* f = std::fopen(path.c_str(), mode);
   if (!f) {
     std::string msg = std::string("cannot ") + what + " PNG file '" + path + "': " + std::strerror(errno);
@@ -85,12 +85,12 @@ std::string set_transforms(png_structp png, int color_type, int bit_depth, Want 
 }
 
 // Reads `path` into s->pixels (tightly packed rows). Throws Error naming the file.
-void read_png(const std::string& path, Want want, State* s) {
-  File f = open_file(path, "rb", "open");
+void read_png(const std::string& path, Want want, PngState* s) {
+  File f = open_png_file(path, "rb", "open");
   png_byte sig[8];
   if (std::fread(sig, 1, 8, f.get()) != 8 || png_sig_cmp(sig, 0, 8))
     throw InputError("'" + path + "' is not a PNG file (bad signature; empty or truncated?)");
-  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, s, on_error, on_warning);
+  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, s, on_png_error, on_png_warning);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (!info) throw InputError("libpng could not allocate its read structures for '" + path + "'");
   if (setjmp(s->jb)) {
@@ -123,7 +123,7 @@ void read_png(const std::string& path, Want want, State* s) {
   if (!s->format_problem.empty()) throw InputError("PNG file '" + path + "' " + s->format_problem);
 }
 
-template <class T> Image<T> to_image(const State& s, const std::string& path) {
+template <class T> Image<T> to_image(const PngState& s, const std::string& path) {
   std::size_t n = static_cast<std::size_t>(s.info.width) * s.info.height;
   if (s.pixels.size() != n * sizeof(T))
     throw InputError("PNG file '" + path + "': unexpected decoded size (internal error)");
@@ -134,9 +134,9 @@ template <class T> Image<T> to_image(const State& s, const std::string& path) {
 
 void write_png(const std::string& path, int w, int h, int bit_depth, int color_type, const void* data,
                std::size_t row_bytes) {
-  File f = open_file(path, "wb", "create");
-  auto s = std::make_unique<State>();
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, s.get(), on_error, on_warning);
+  File f = open_png_file(path, "wb", "create");
+  auto s = std::make_unique<PngState>();
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, s.get(), on_png_error, on_png_warning);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (!info) throw Error("libpng could not allocate its write structures for '" + path + "'");
   if (setjmp(s->jb)) {
@@ -166,25 +166,25 @@ template <class T> void check_host(const Image<T>& im, const std::string& path) 
 }  // namespace
 
 PngInfo png_info(const std::string& path) {
-  auto s = std::make_unique<State>();
+  auto s = std::make_unique<PngState>();
   read_png(path, Want::Info, s.get());
   return s->info;
 }
 
 Image<std::uint16_t> read_png_u16(const std::string& path) {
-  auto s = std::make_unique<State>();
+  auto s = std::make_unique<PngState>();
   read_png(path, Want::U16, s.get());
   return to_image<std::uint16_t>(*s, path);
 }
 
 Image<std::uint8_t> read_png_u8(const std::string& path) {
-  auto s = std::make_unique<State>();
+  auto s = std::make_unique<PngState>();
   read_png(path, Want::U8, s.get());
   return to_image<std::uint8_t>(*s, path);
 }
 
 Image<uchar3> read_png_rgb(const std::string& path) {
-  auto s = std::make_unique<State>();
+  auto s = std::make_unique<PngState>();
   read_png(path, Want::RGB, s.get());
   return to_image<uchar3>(*s, path);
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "core/error.hpp"
 #include "core/exec.hpp"
@@ -12,21 +13,19 @@
 namespace seamless {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 // Deterministic phase in [0, 2 pi) for wobble component k.
 double phase(std::uint64_t seed, int k) {
   std::uint32_t h =
       kernels::hash32(static_cast<std::uint32_t>(seed) ^
                       kernels::hash32(static_cast<std::uint32_t>(k + 1) ^ static_cast<std::uint32_t>(seed >> 32)));
-  return 2 * kPi * (h / 4294967296.0);
+  return 2 * std::numbers::pi * (h / 4294967296.0);
 }
 
 // A smooth wobble: three sinusoids at incommensurate frequencies (Hz), like a hand that drifts.
 double wobble(std::uint64_t seed, int axis, double t) {
   const double f[3] = {0.23, 0.61, 1.37}, a[3] = {1.0, 0.45, 0.15};
   double s = 0;
-  for (int k = 0; k < 3; ++k) s += a[k] * std::sin(2 * kPi * f[k] * t + phase(seed, 3 * axis + k));
+  for (int k = 0; k < 3; ++k) s += a[k] * std::sin(2 * std::numbers::pi * f[k] * t + phase(seed, 3 * axis + k));
   return s / 1.6;  // |s| <= 1
 }
 
@@ -57,7 +56,7 @@ struct PathPoint {
 PathPoint path_point(const SyntheticParams& p, double t) {
   const vec3 c = kernels::room::desk_centre();
   double shake = p.shake;
-  double ang = (p.start_deg + (p.trajectory == CameraPath::orbit ? p.speed_deg * t : 0.0)) * kPi / 180.0;
+  double ang = (p.start_deg + (p.trajectory == CameraPath::orbit ? p.speed_deg * t : 0.0)) * std::numbers::pi / 180.0;
   double r = p.radius + 0.05 * shake * wobble(p.seed, 0, t);
   // Amplitudes: a few centimetres and a degree or two, what a steady hand-held camera does.
   return {{c.x + r * std::cos(ang), c.y + r * std::sin(ang), p.height + 0.04 * shake * wobble(p.seed, 1, t)},
@@ -89,7 +88,7 @@ kernels::DepthNoise synthetic_noise_model(const SyntheticParams& p) {
   n.sigma_disparity = p.sensor.sigma_disparity;
   n.min_depth = p.sensor.min_depth;
   n.max_depth = p.sensor.max_depth;
-  n.min_incidence_cos = static_cast<float>(std::cos(p.sensor.max_incidence_deg * kPi / 180.0));
+  n.min_incidence_cos = static_cast<float>(std::cos(p.sensor.max_incidence_deg * std::numbers::pi / 180.0));
   n.edge_jump = p.sensor.edge_jump;
   n.projector_shadow = p.sensor.projector_shadow;
   return n;

@@ -37,6 +37,16 @@ bool repeated(double prev, double t, const std::string& path, int n, const std::
   return true;
 }
 
+// Calls fn(line, n) for each line of a TUM text file that is neither blank nor a comment (n: its
+// number from 1); `what` names the kind of file in the error when it cannot be opened.
+template <class F> void for_each_data_line(const std::string& path, const char* what, F fn) {
+  std::ifstream in(path);
+  if (!in) throw InputError("cannot open " + std::string(what) + " file '" + path + "': " + std::strerror(errno));
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n)
+    if (!is_comment(line)) fn(line, n);
+}
+
 void check_order(double prev, double t, const std::string& path, int n) {
   if (t < prev)
     throw InputError("timestamps out of order at " + where(path, n) + " (" + std::to_string(t) + " after " +
@@ -46,12 +56,8 @@ void check_order(double prev, double t, const std::string& path, int n) {
 // associations.txt: `t_rgb rgb_file t_depth depth_file` (TUM's associate.py rgb.txt depth.txt);
 // a file written the other way round (depth first) is recognised by its file names.
 std::vector<TumPair> read_associations(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError("cannot open association file '" + path + "': " + std::strerror(errno));
   std::vector<TumPair> out;
-  std::string line;
-  for (int n = 1; std::getline(in, line); ++n) {
-    if (is_comment(line)) continue;
+  for_each_data_line(path, "association", [&](const std::string& line, int n) {
     std::istringstream ss(line);
     TumPair p;
     if (!(ss >> p.rgb.timestamp >> p.rgb.file >> p.depth.timestamp >> p.depth.file))
@@ -59,20 +65,16 @@ std::vector<TumPair> read_associations(const std::string& path) {
                        ": expected 't_rgb rgb/x.png t_depth depth/y.png', got '" + line + "'");
     if (p.rgb.file.find("depth") != std::string::npos && p.depth.file.find("rgb") != std::string::npos)
       std::swap(p.rgb, p.depth);
-    if (!out.empty() && repeated(out.back().rgb.timestamp, p.rgb.timestamp, path, n, line)) continue;
+    if (!out.empty() && repeated(out.back().rgb.timestamp, p.rgb.timestamp, path, n, line)) return;
     if (!out.empty()) check_order(out.back().rgb.timestamp, p.rgb.timestamp, path, n);
     out.push_back(p);
-  }
+  });
   return out;
 }
 
 std::vector<std::pair<double, vec3>> read_accelerometer(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError("cannot open accelerometer file '" + path + "': " + std::strerror(errno));
   std::vector<std::pair<double, vec3>> out;
-  std::string line;
-  for (int n = 1; std::getline(in, line); ++n) {
-    if (is_comment(line)) continue;
+  for_each_data_line(path, "accelerometer", [&](const std::string& line, int n) {
     std::istringstream ss(line);
     double t, ax, ay, az;
     if (!(ss >> t >> ax >> ay >> az))
@@ -81,27 +83,23 @@ std::vector<std::pair<double, vec3>> read_accelerometer(const std::string& path)
     // The Kinect's accelerometer axes are the camera's turned half a turn about z (x left, y up):
     // checked against the motion-capture ground truth of freiburg1 (tests/io/test_tum.cpp).
     out.push_back({t, vec3{static_cast<float>(-ax), static_cast<float>(-ay), static_cast<float>(az)}});
-  }
+  });
   return out;
 }
 
 }  // namespace
 
 std::vector<TumListEntry> read_tum_list(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError("cannot open TUM list file '" + path + "': " + std::strerror(errno));
   std::vector<TumListEntry> out;
-  std::string line;
-  for (int n = 1; std::getline(in, line); ++n) {
-    if (is_comment(line)) continue;
+  for_each_data_line(path, "TUM list", [&](const std::string& line, int n) {
     std::istringstream ss(line);
     TumListEntry e;
     if (!(ss >> e.timestamp >> e.file))
       throw InputError("malformed line at " + where(path, n) + ": expected 'timestamp filename', got '" + line + "'");
-    if (!out.empty() && repeated(out.back().timestamp, e.timestamp, path, n, line)) continue;
+    if (!out.empty() && repeated(out.back().timestamp, e.timestamp, path, n, line)) return;
     if (!out.empty()) check_order(out.back().timestamp, e.timestamp, path, n);
     out.push_back(e);
-  }
+  });
   return out;
 }
 
@@ -193,13 +191,7 @@ TumSource::TumSource(const InputParams& params, bool pinned) : params_(params), 
                      enum_name(params.association) + ": no rgb/depth timestamps within input.association_max_dt " +
                      std::to_string(params.association_max_dt) +
                      " s, or empty lists); check rgb.txt and depth.txt, or input.association_offset");
-  std::size_t first = static_cast<std::size_t>(std::min<std::int64_t>(params.first_frame, pairs_.size()));
-  pairs_.erase(pairs_.begin(), pairs_.begin() + first);
-  if (params.max_frames > 0 && pairs_.size() > static_cast<std::size_t>(params.max_frames))
-    pairs_.resize(params.max_frames);
-  if (pairs_.empty())
-    throw InputError("input.first_frame " + std::to_string(params.first_frame) + " is past the end of '" + folder_ +
-                     "'");
+  select_frames(pairs_, params.first_frame, params.max_frames, folder_);
   if (fs::exists(dir / "groundtruth.txt")) groundtruth_ = read_tum_trajectory((dir / "groundtruth.txt").string());
   if (fs::exists(dir / "accelerometer.txt")) accel_ = read_accelerometer((dir / "accelerometer.txt").string());
   scale_check_ = std::make_unique<DepthScaleCheck>(effective_depth_scale(params), params.check_depth_scale);

@@ -51,11 +51,6 @@ int grid_bits(std::int64_t n) {
   return bits;
 }
 
-struct Emitter {
-  SpawnParams s;
-  double start = 0.0, distance = 0.0, budget = 0.0;
-};
-
 }  // namespace
 
 // The solver's state by concern; ParticleSolver::Impl derives from them, so the code names each
@@ -152,6 +147,12 @@ struct ClothState {
   int cloth_groups = 0;
 };
 
+// An emitter of the spawn list and how far it has got (run_emitters).
+struct Emitter {
+  SpawnParams s;
+  double start = 0.0, distance = 0.0, budget = 0.0;
+};
+
 }  // namespace solver_state
 
 struct ParticleSolver::Impl : solver_state::ParticleState,
@@ -169,7 +170,7 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
   SpawnSchedule schedule;
   SpawnSchedule::Gate gate;
   SceneObjects objects;  // what add_batch created, as the app and the renderer see it
-  std::vector<Emitter> emitters;
+  std::vector<solver_state::Emitter> emitters;
   double time = 0.0;
   std::int64_t steps = 0;
   // Anything a captured step points to or depends on (particle count, buffers, constraints, scene)
@@ -543,7 +544,7 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
   }
 
   void run_emitters(float dt) {
-    for (Emitter& e : emitters) {
+    for (solver_state::Emitter& e : emitters) {
       if (e.s.duration > 0.f && time >= e.start + e.s.duration) continue;
       // A layer leaves the nozzle each time the jet has advanced one diameter, as far as the
       // rate allows.

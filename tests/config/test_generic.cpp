@@ -37,7 +37,7 @@ Outer load(const std::string& text) {
   return config::load_params<Outer>(YAML::Load(text), ctx);
 }
 
-std::string error_of(const std::string& text) {
+std::string load_error(const std::string& text) {
   try {
     load(text);
   } catch (const Error& e) {
@@ -48,8 +48,8 @@ std::string error_of(const std::string& text) {
 
 TEST(ConfigGeneric, FloatBoundsAreInclusiveAtFloatPrecision) {
   EXPECT_EQ(load("f: 0.1").f, 0.1f);  // float(0.1) > 0.1 as doubles; must still be accepted
-  EXPECT_THAT(error_of("f: 0.1000001"), HasSubstr("generic.yaml:1:4: f: out of range"));
-  EXPECT_THAT(error_of("f: -0.0000001"), HasSubstr("out of range"));
+  EXPECT_THAT(load_error("f: 0.1000001"), HasSubstr("generic.yaml:1:4: f: out of range"));
+  EXPECT_THAT(load_error("f: -0.0000001"), HasSubstr("out of range"));
 }
 
 TEST(ConfigGeneric, VectorsOfVec3AndStringsWithChoices) {
@@ -60,8 +60,8 @@ TEST(ConfigGeneric, VectorsOfVec3AndStringsWithChoices) {
   ASSERT_EQ(o.items.size(), 2u);
   EXPECT_EQ(o.items[0].d, 2.0);
   EXPECT_EQ(o.items[1].tags, Inner{}.tags);  // `{}` entry: all defaults
-  EXPECT_THAT(error_of("points: [[0, 0]]"), HasSubstr("points.0: expected a list of 3 numbers"));
-  EXPECT_THAT(error_of("inner: {tags: [x]}"), HasSubstr("inner.tags.0: got 'x', expected one of a b, c, d,e"));
+  EXPECT_THAT(load_error("points: [[0, 0]]"), HasSubstr("points.0: expected a list of 3 numbers"));
+  EXPECT_THAT(load_error("inner: {tags: [x]}"), HasSubstr("inner.tags.0: got 'x', expected one of a b, c, d,e"));
 }
 
 TEST(ConfigGeneric, WriteLoadRoundTripAndKeyList) {

@@ -18,7 +18,7 @@ spawn:
     rate: 10
 )";
 
-std::string error_of(const std::string& yaml, const std::vector<std::string>& overrides) {
+std::string override_error(const std::string& yaml, const std::vector<std::string>& overrides) {
   try {
     parse_experiment(yaml, overrides, "base.yaml");
   } catch (const Error& e) {
@@ -64,36 +64,36 @@ TEST(ConfigOverride, ListElementsByIndex) {
   EXPECT_EQ(e.spawn[1].kind, SpawnKind::cloth);
   EXPECT_EQ(e.spawn[1].nx, 9);
   EXPECT_EQ(parse_experiment("", {"spawn.0.kind=rigid"}, "empty.yaml").spawn.at(0).kind, SpawnKind::rigid);
-  EXPECT_THAT(error_of(kBase, {"spawn.5.rate=3"}), HasSubstr("'spawn' has 1 entries"));
-  EXPECT_THAT(error_of(kBase, {"spawn.first.rate=3"}), HasSubstr("'spawn' is a list"));
+  EXPECT_THAT(override_error(kBase, {"spawn.5.rate=3"}), HasSubstr("'spawn' has 1 entries"));
+  EXPECT_THAT(override_error(kBase, {"spawn.first.rate=3"}), HasSubstr("'spawn' is a list"));
 }
 
 TEST(ConfigOverride, UnknownKeyNamesTheOptionAndSuggests) {
-  std::string msg = error_of(kBase, {"volume.voxel_sise=0.01"});
+  std::string msg = override_error(kBase, {"volume.voxel_sise=0.01"});
   EXPECT_THAT(msg, HasSubstr("(from --set volume.voxel_sise=0.01): volume.voxel_sise: unknown key"));
   EXPECT_THAT(msg, HasSubstr("did you mean 'voxel_size'?"));
   EXPECT_THAT(msg, ::testing::Not(HasSubstr("base.yaml:")));
 }
 
 TEST(ConfigOverride, BadValuesNameTheOption) {
-  EXPECT_THAT(error_of(kBase, {"volume.voxel_size=big"}),
+  EXPECT_THAT(override_error(kBase, {"volume.voxel_size=big"}),
               HasSubstr("(from --set volume.voxel_size=big): volume.voxel_size: expected a number (float)"));
-  EXPECT_THAT(error_of(kBase, {"volume.layout=dens"}), HasSubstr("(from --set volume.layout=dens)"));
-  EXPECT_THAT(error_of(kBase, {"spawn.0.kind=goo"}), HasSubstr("(from --set spawn.0.kind=goo): spawn.0.kind"));
+  EXPECT_THAT(override_error(kBase, {"volume.layout=dens"}), HasSubstr("(from --set volume.layout=dens)"));
+  EXPECT_THAT(override_error(kBase, {"spawn.0.kind=goo"}), HasSubstr("(from --set spawn.0.kind=goo): spawn.0.kind"));
   // Whole-list override: errors inside it are still the option's.
-  EXPECT_THAT(error_of(kBase, {"spawn=[{kind: rigid, sise: [1,1,1]}]"}),
+  EXPECT_THAT(override_error(kBase, {"spawn=[{kind: rigid, sise: [1,1,1]}]"}),
               HasSubstr("(from --set spawn=[{kind: rigid, sise: [1,1,1]}]): spawn.0.sise: unknown key"));
   // A problem in the file is still reported at its position when overrides are present.
-  EXPECT_THAT(error_of("volume: {layot: hash}\n", {"volume.voxel_size=0.01"}),
+  EXPECT_THAT(override_error("volume: {layot: hash}\n", {"volume.voxel_size=0.01"}),
               HasSubstr("base.yaml:1:10: volume.layot"));
 }
 
 TEST(ConfigOverride, MalformedOptions) {
-  EXPECT_THAT(error_of(kBase, {"volume.voxel_size"}), HasSubstr("--set expects key.path=value"));
-  EXPECT_THAT(error_of(kBase, {"=3"}), HasSubstr("--set expects key.path=value"));
-  EXPECT_THAT(error_of(kBase, {"volume..voxel_size=1"}), HasSubstr("empty key segment"));
-  EXPECT_THAT(error_of(kBase, {"name.first=x"}), HasSubstr("'name' is a value"));
-  EXPECT_THAT(error_of(kBase, {"solver.gravity=[0,1"}), HasSubstr("cannot parse"));
+  EXPECT_THAT(override_error(kBase, {"volume.voxel_size"}), HasSubstr("--set expects key.path=value"));
+  EXPECT_THAT(override_error(kBase, {"=3"}), HasSubstr("--set expects key.path=value"));
+  EXPECT_THAT(override_error(kBase, {"volume..voxel_size=1"}), HasSubstr("empty key segment"));
+  EXPECT_THAT(override_error(kBase, {"name.first=x"}), HasSubstr("'name' is a value"));
+  EXPECT_THAT(override_error(kBase, {"solver.gravity=[0,1"}), HasSubstr("cannot parse"));
 }
 
 // An option that cannot be applied at all (malformed, or a path through a value) was

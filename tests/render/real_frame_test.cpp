@@ -160,12 +160,6 @@ float ray_box(const RigidDraw& box, vec3 o, vec3 dir, float grow) {
   return t0 <= t1 ? t0 : -1.f;
 }
 
-// sRGB level -> linear (IEC 61966-2-1), as the renderer's color.glsl.
-float linear(std::uint8_t c) {
-  const float x = c / 255.f;
-  return x <= 0.04045f ? x / 12.92f : std::pow((x + 0.055f) / 1.055f, 2.4f);
-}
-
 // CIE 1976 L*a*b* of an sRGB colour (D65 white).
 vec3 lab(uchar3 c) {
   const float r = linear(c.x), g = linear(c.y), b = linear(c.z);

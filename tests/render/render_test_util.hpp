@@ -2,6 +2,8 @@
 #pragma once
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -30,6 +32,11 @@ struct Pixels {
 inline bool same(uchar3 a, uchar3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
 inline int max_diff(uchar3 a, uchar3 b) {
   return std::max({std::abs(a.x - b.x), std::abs(a.y - b.y), std::abs(a.z - b.z)});
+}
+// sRGB level -> linear (IEC 61966-2-1), as the renderer's color.glsl.
+inline float linear(std::uint8_t c) {
+  const float x = c / 255.f;
+  return x <= 0.04045f ? x / 12.92f : std::pow((x + 0.055f) / 1.055f, 2.4f);
 }
 inline uchar3 to_rgb8(vec3 c) {
   auto q = [](float f) { return static_cast<std::uint8_t>(std::lround(std::clamp(f, 0.f, 1.f) * 255.f)); };

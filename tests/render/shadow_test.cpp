@@ -28,11 +28,6 @@ vec3 floor_point(const RenderCamera& c, int u, int v) {
   return o + d * (-o.y / d.y);
 }
 
-float linear(std::uint8_t c) {
-  const float x = c / 255.f;
-  return x <= 0.04045f ? x / 12.92f : std::pow((x + 0.055f) / 1.055f, 2.4f);
-}
-
 RenderParams down_light() {
   RenderParams p;
   p.light_dir = {0.f, -1.f, 0.f};
