@@ -11,6 +11,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/output_file.hpp"
+#include "io/tum_text.hpp"
 
 namespace seamless {
 namespace {
@@ -24,7 +25,7 @@ void set_quat(TumPose& p, const Eigen::Quaterniond& q) {
   p.q[3] = q.w();
 }
 
-std::string where(const std::string& path, int line) { return "'" + path + "' line " + std::to_string(line); }
+using tum_text::where;
 
 }  // namespace
 
@@ -56,13 +57,8 @@ TumPose TumPose::from_se3(double timestamp, const SE3& T) {
 }
 
 Trajectory read_tum_trajectory(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError("cannot open trajectory file '" + path + "': " + std::strerror(errno));
   Trajectory out;
-  std::string line;
-  for (int n = 1; std::getline(in, line); ++n) {
-    auto first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#') continue;
+  tum_text::for_each_data_line(path, "trajectory", [&](const std::string& line, int n) {
     std::istringstream ss(line);
     TumPose p;
     if (!(ss >> p.timestamp >> p.t[0] >> p.t[1] >> p.t[2] >> p.q[0] >> p.q[1] >> p.q[2] >> p.q[3]))
@@ -77,7 +73,7 @@ Trajectory read_tum_trajectory(const std::string& path) {
       throw InputError("timestamps go backwards at " + where(path, n) + " (" + std::to_string(p.timestamp) + " after " +
                        std::to_string(out.back().timestamp) + "): sort the file by time");
     out.push_back(p);
-  }
+  });
   return out;
 }
 

@@ -16,18 +16,15 @@
 #include "io/jpeg_io.hpp"
 #include "io/png_io.hpp"
 #include "io/rgbd_pair.hpp"
+#include "io/tum_text.hpp"
 #include "kernels/io/undistort.hpp"
 
 namespace seamless {
 namespace fs = std::filesystem;
 namespace {
 
-std::string where(const std::string& path, int line) { return "'" + path + "' line " + std::to_string(line); }
-
-bool is_comment(const std::string& line) {
-  auto first = line.find_first_not_of(" \t\r");
-  return first == std::string::npos || line[first] == '#';
-}
+using tum_text::for_each_data_line;
+using tum_text::where;
 
 // A line whose timestamp repeats the one before it (a list concatenated or edited twice) would make
 // one frame two, fused twice with two poses at one time: it is dropped, with a warning naming it.
@@ -35,16 +32,6 @@ bool repeated(double prev, double t, const std::string& path, int n, const std::
   if (t != prev) return false;
   spdlog::warn("{}: timestamp {:.6f} repeats the line before it; line dropped ('{}')", where(path, n), t, line);
   return true;
-}
-
-// Calls fn(line, n) for each line of a TUM text file that is neither blank nor a comment (n: its
-// number from 1); `what` names the kind of file in the error when it cannot be opened.
-template <class F> void for_each_data_line(const std::string& path, const char* what, F fn) {
-  std::ifstream in(path);
-  if (!in) throw InputError("cannot open " + std::string(what) + " file '" + path + "': " + std::strerror(errno));
-  std::string line;
-  for (int n = 1; std::getline(in, line); ++n)
-    if (!is_comment(line)) fn(line, n);
 }
 
 void check_order(double prev, double t, const std::string& path, int n) {
