@@ -1,6 +1,6 @@
 """The Python module against the `seamless` command of the same build: the same poses, the same
 evaluation figures, the same error messages, and frames fed from NumPy giving the poses the TUM
-folder source gives (docs/PYTHON.md). A few seconds per test on 2 cores: 30 frames or fewer."""
+folder source gives (docs/PYTHON.md). A few seconds per test on 2 cores: 15 frames or fewer."""
 import os
 
 import numpy as np
@@ -28,7 +28,7 @@ def quaternion_matrices(rows):
     return out
 
 
-def fr1_overrides(path, frames=30, refine=True):
+def fr1_overrides(path, frames=15, refine=True):
     # Refinement needs Ceres; a build without it (the lean pip build) tracks without.
     return {"input.path": path, "frames": frames, "device": "cpu",
             "refine.enabled": refine and seamless.features["ceres"]}
@@ -45,7 +45,7 @@ def fr1_config(source_dir):
 
 @pytest.fixture(scope="module")
 def cli_track(seamless_cli, fr1_rpy, fr1_config, tmp_path_factory):
-    """`seamless track configs/tum_fr1.yaml` on 30 frames of fr1_rpy 150-299 (with its refinement)."""
+    """`seamless track configs/tum_fr1.yaml` on 15 frames of fr1_rpy 150-299 (with its refinement)."""
     out = tmp_path_factory.mktemp("cli") / "track"
     seamless_cli("track", fr1_config, *as_sets(fr1_overrides(fr1_rpy)), "--out", out)
     return out
@@ -60,8 +60,8 @@ def test_track_poses_equal_the_cli(cli_track, py_track):
     cli = read_tum(cli_track / "trajectory.txt")
     r = py_track
     assert r.exit_code == 0
-    assert r.poses.shape == (30, 4, 4) and r.poses.dtype == np.float64
-    assert r.timestamps.shape == (30,)
+    assert r.poses.shape == (15, 4, 4) and r.poses.dtype == np.float64
+    assert r.timestamps.shape == (15,)
     # trajectory.txt prints seconds to 6 decimals, metres to 7 and the quaternion to 9.
     np.testing.assert_allclose(r.timestamps, cli[:, 0], rtol=0, atol=1e-6)
     np.testing.assert_allclose(r.poses, quaternion_matrices(cli), rtol=0, atol=2e-7)
@@ -73,7 +73,7 @@ def test_track_poses_equal_the_cli(cli_track, py_track):
     # Camera to world: rotations, and the motion of fr1_rpy (rolling, pitching, yawing in place).
     R = r.poses[:, :3, :3]
     np.testing.assert_allclose(R @ R.transpose(0, 2, 1), np.broadcast_to(np.eye(3), R.shape), atol=1e-6)
-    np.testing.assert_array_equal(r.poses[:, 3], np.broadcast_to([0, 0, 0, 1], (30, 4)))
+    np.testing.assert_array_equal(r.poses[:, 3], np.broadcast_to([0, 0, 0, 1], (15, 4)))
 
 
 def py_track_dir(r):
@@ -90,7 +90,7 @@ def test_eval_equals_the_cli(seamless_cli, cli_track, py_track, fr1_rpy, tmp_pat
     assert figures.pop("estimate") == py_track.trajectory_path
     cli.pop("estimate")
     assert figures == cli
-    assert 0 < figures["ate_rmse_m"] < 0.05 and figures["pairs"] == 30  # a few centimetres on fr1_rpy
+    assert 0 < figures["ate_rmse_m"] < 0.05 and figures["pairs"] == 15  # a few centimetres on fr1_rpy
 
 
 def tum_frames(folder, n):

@@ -22,31 +22,30 @@ namespace {
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 constexpr int kFrames = 60;  // 2 s of the hand-held orbit: 30 degrees around the desk
 
-// The synthetic sequence, rendered once per test binary (rendering is the slow part on a CPU) and
-// replayed: the refinement reads its source from the start, like `seamless track` does.
-const std::vector<RgbdFrame>& rendered() {
-  static const std::vector<RgbdFrame> frames = [] {
-    auto src = make_source(test::synthetic_input(kFrames));
-    std::vector<RgbdFrame> v;
-    RgbdFrame f;
-    while (src->next(f)) {
-      RgbdFrame c;
-      c.index = f.index, c.timestamp = f.timestamp, c.intrinsics = f.intrinsics;
-      c.depth = f.depth.clone(Device::CPU), c.rgb = f.rgb.clone(Device::CPU);
-      c.accelerometer = f.accelerometer, c.ground_truth = f.ground_truth;
-      v.push_back(std::move(c));
-    }
-    return v;
-  }();
-  return frames;
+// The synthetic sequence's first `frames` frames, rendered once per test process (rendering is the
+// slow part on a CPU: ctest runs each case in a process of its own, so a case that needs 30 frames
+// renders 30, not the whole sequence) and replayed: the refinement reads its source from the start,
+// like `seamless track` does.
+const std::vector<RgbdFrame>& rendered(int frames = kFrames) {
+  static const std::unique_ptr<FrameSource> src = make_source(test::synthetic_input(kFrames));
+  static std::vector<RgbdFrame> v;
+  RgbdFrame f;
+  while (std::ssize(v) < frames && src->next(f)) {
+    RgbdFrame c;
+    c.index = f.index, c.timestamp = f.timestamp, c.intrinsics = f.intrinsics;
+    c.depth = f.depth.clone(Device::CPU), c.rgb = f.rgb.clone(Device::CPU);
+    c.accelerometer = f.accelerometer, c.ground_truth = f.ground_truth;
+    v.push_back(std::move(c));
+  }
+  return v;
 }
 
 class ReplaySource : public FrameSource {
  public:
-  explicit ReplaySource(int frames) : n_(frames) {}
+  explicit ReplaySource(int frames) : n_(frames) { rendered(frames); }
   bool next(RgbdFrame& f) override {
     if (i_ >= n_) return false;
-    const RgbdFrame& s = rendered().at(i_++);
+    const RgbdFrame& s = rendered(n_).at(i_++);
     f.index = s.index, f.timestamp = s.timestamp, f.intrinsics = s.intrinsics;
     f.depth = s.depth.clone(Device::CPU), f.rgb = s.rgb.clone(Device::CPU);
     f.accelerometer = s.accelerometer, f.ground_truth = s.ground_truth;
@@ -63,8 +62,8 @@ class ReplaySource : public FrameSource {
 // The ground-truth poses of the synthetic sequence (what the frames were rendered from).
 Trajectory ground_truth(int frames) {
   Trajectory gt;
-  for (int i = 0; i < frames; ++i)
-    gt.push_back(TumPose::from_se3(rendered()[i].timestamp, *rendered()[i].ground_truth));
+  const std::vector<RgbdFrame>& r = rendered(frames);
+  for (int i = 0; i < frames; ++i) gt.push_back(TumPose::from_se3(r[i].timestamp, *r[i].ground_truth));
   return gt;
 }
 
