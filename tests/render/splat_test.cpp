@@ -40,7 +40,7 @@ RenderParams splat_params(int thickness_downsample) {
   RenderParams p;
   p.znear = kNear;
   p.fluid_anisotropy = false;  // the raster sprites are spheres (docs/RENDERING.md)
-  p.filter_iterations = 0;  // the depth image is then the spheres' own
+  p.filter_iterations = 0;     // the depth image is then the spheres' own
   p.thickness_downsample = thickness_downsample;
   return p;
 }
