@@ -116,6 +116,9 @@ struct RenderParams {
   // Gap fill of the depth before smoothing: empty runs between fluid pixels up to this many
   // particle radii wide (world, at their depth) and at one depth become fluid (0: off).
   float fluid_gap_fill = 4.f;
+  // Anisotropic kernels (Yu & Turk 2013): each fluid particle splatted as an ellipsoid shaped by
+  // its neighbours within filter_size radii (compute splats only; the raster path draws spheres).
+  bool fluid_anisotropy = true;
   vec3 absorption{25.f, 8.f, 3.5f};  // Beer-Lambert coefficients per colour channel, 1/m (tinted water)
   float ior = 1.33f;                 // refractive index (water): Snell's law bends the view into the fluid
   float fresnel_f0 = 0.02f;          // reflectance at normal incidence (water: ((1-1.33)/(1+1.33))^2)
@@ -229,6 +232,9 @@ struct RenderParams {
       "fluid depth gap fill: empty runs between fluid pixels up to this many particle radii wide become "
       "fluid at their neighbours' depth, if both agree (0 = off)",
       Range{0.0, 50.0});
+    v("fluid_anisotropy", fluid_anisotropy,
+      "fluid particles drawn as ellipsoids shaped by their neighbours (Yu & Turk 2013): a spread layer "
+      "becomes one flat sheet (compute splats only)");
     v("absorption", absorption, "fluid absorption per channel (Beer-Lambert), 1/m");
     v("ior", ior, "fluid refractive index (Snell's law at the surface)", Range{1.0, 3.0});
     v("fresnel_f0", fresnel_f0, "fluid reflectance at normal incidence", Range{0.0, 1.0});

@@ -94,6 +94,13 @@ struct Renderer::Impl {
   // Compute splats (render.fluid_splat: compute), built only with GL >= 4.3 (has_compute).
   bool has_compute = false;
   Program depth_splat_prog, thick_splat_prog, resolve_prog;
+  // Anisotropic kernels (fluid_aniso.comp): hashed grid buckets and the ellipsoids, 3 vec4 per
+  // particle; sized on demand.
+  Program aniso_prog;
+  GlBuffer aniso_count, aniso_slots, aniso_ell;
+  std::int64_t aniso_particles = 0;
+  GLuint aniso_buckets = 0;
+  bool aniso_live = false;                              // this frame's splats read aniso_ell
   Program filter_cprog, normal_cprog, composite_cprog;  // the full-screen passes as compute
   VertexArray empty_vao;
 
@@ -195,6 +202,7 @@ struct Renderer::Impl {
   void resolve_splat(GLuint acc, GLuint out, int iw, int ih, bool depth_bits);
   void dispatch_screen(int iw, int ih);  // 8 x 8 tiles over iw x ih, then the barriers
   void fluid_depth_splat(std::int64_t n, float sphere_r, const RenderCamera& cam);
+  void fluid_anisotropy_pass(std::int64_t n, float sphere_r, float radius);
   void fluid_thickness_splat(std::int64_t n, float sphere_r, const RenderCamera& low);
   void capture_stages();
   // renderer_shadow.cpp

@@ -8,7 +8,10 @@
 //   - the gap fill respects the scene: a real bar in front of the layer is not covered;
 //   - Beer-Lambert: the refracted background's linear colour is exp(-absorption T) of what is
 //     behind, T the slab's thickness;
-//   - wetting: the same slab resting on a surface darkens it by Lekner & Dorf's factor, not in the air.
+//   - wetting: the same slab resting on a surface darkens it by Lekner & Dorf's factor, not in the air;
+//   - anisotropic kernels: a tilted spread layer is one sheet without any gap fill, within the slab
+//     its flattened ellipsoids span, and its normals are the plane's within a bound derived from
+//     the ellipsoids' shape.
 #include <algorithm>
 #include <cmath>
 
@@ -51,8 +54,11 @@ float depth_at(const Renderer::FluidImages& f, int u, int v) {
   return f.depth[static_cast<std::size_t>(f.h - 1 - v) * f.w + u];
 }
 
+// Sphere splats: the gap fill and the shading are checked on their own (anisotropic kernels, which
+// flatten a spread layer before the fill sees it, have their own tests below).
 RenderParams surface_params() {
   RenderParams p;
+  p.fluid_anisotropy = false;
   p.shadows = false;
   p.background = {0.8f, 0.8f, 0.8f};
   return p;
@@ -239,6 +245,153 @@ TEST(RenderFluidSurface, BeerLambertAndWetting) {
     EXPECT_LE(got, std::exp(-a[c] * (T - r)) + 0.01f);
     EXPECT_NEAR((&wet.x)[c] / (&dry.x)[c], wet_expected, 0.02f * wet_expected);
   }
+}
+
+// A square n x n layer of spacing s in the plane through c spanned by ex and ey (unit, orthogonal).
+struct Plane {
+  vec3 c, ex, ey, n;  // n: ex x ey, towards the camera
+  float s;
+  int count;
+  std::vector<vec3> particles() const {
+    std::vector<vec3> x;
+    for (int j = 0; j < count; ++j)
+      for (int i = 0; i < count; ++i)
+        x.push_back(c + ex * ((i - 0.5f * (count - 1)) * s) + ey * ((j - 0.5f * (count - 1)) * s));
+    return x;
+  }
+  // Where pixel (u, v)'s ray meets the plane, in the plane's coordinates (a along ex, b along ey),
+  // and the ray's depth there.
+  void hit(const Intrinsics& K, int u, int v, float& a, float& b, float& z) const {
+    const vec3 d{(u - K.cx) / K.fx, (v - K.cy) / K.fy, 1.f};
+    z = dot(n, c) / dot(n, d);
+    const vec3 q = d * z - c;
+    a = dot(q, ex), b = dot(q, ey);
+  }
+};
+
+// A desk-like layer: 13 x 13 particles of radius r = 1 cm spread to spacing 3 r, 1 m away, its
+// normal tilted 20 degrees from the view axis (about x).
+Plane tilted_layer() {
+  const float t = 20.f * 3.14159265f / 180.f, r = 0.01f;
+  Plane p;
+  p.c = {0.f, 0.f, 1.f};
+  p.ex = {1.f, 0.f, 0.f};
+  p.ey = {0.f, std::cos(t), std::sin(t)};
+  p.n = {0.f, std::sin(t), -std::cos(t)};
+  p.s = 3.f * r;
+  p.count = 13;
+  return p;
+}
+
+// Anisotropic kernels (Yu & Turk 2013) on a spread layer, the splats' depth as drawn (no gap fill,
+// no filter): every neighbourhood
+// is planar, so each ellipsoid has its shortest axis along the plane's normal, at 1/4 of its
+// longest (the clamp), and the volume of the 1.5 r sphere. An interior particle's neighbourhood is
+// isotropic in the plane: axes (A, A, A/4) with A^3 / 4 = (1.5 r)^3, A = 4^(1/3) 1.5 r = 2.38 r,
+// which covers the lattice's holes (s / sqrt(2) = 2.12 r from the centres) where the spheres
+// (1.5 r) leave them open. So inside the layer's projection shrunk by one spacing there is no
+// hole, and every depth lies in the slab the ellipsoids span: the shortest axis is at most
+// 4^(-1/3) 1.5 r = 0.94 r for any planar neighbourhood (rim particles, less isotropic in the
+// plane, are thicker than the interior's A / 4 = 0.6 r), so within [plane - 0.94 r, plane] along
+// the normal.
+TEST(RenderFluidSurface, AnisotropicKernelsMakeASpreadLayerOneSheet) {
+  SEAMLESS_REQUIRE_EGL();
+  const Intrinsics K = small_K();
+  const Plane pl = tilted_layer();
+  const float r = 0.01f;
+  const std::vector<vec3> x = pl.particles();
+  std::vector<std::uint32_t> ph;
+  const DrawList list = fluid_list(x, ph, r);
+  const float half = 0.5f * (pl.count - 1) * pl.s - pl.s;
+  const float slab = std::pow(4.f, -1.f / 3.f) * 1.5f * r;
+  auto holes = [&](bool aniso, float& worst) {
+    RenderParams p = surface_params();
+    p.fluid_gap_fill = 0.f;
+    p.filter_iterations = 0;  // the splats' own depth
+    p.fluid_anisotropy = aniso;
+    Renderer rd(p, kW, kH);
+    rd.draw(list, camera(K));
+    EXPECT_TRUE(rd.uses_compute_splat());
+    const Renderer::FluidImages f = rd.read_fluid_images();
+    int n = 0, inside = 0;
+    worst = 0.f;
+    for (int v = 0; v < kH; ++v)
+      for (int u = 0; u < kW; ++u) {
+        float a, b, z;
+        pl.hit(K, u, v, a, b, z);
+        if (std::abs(a) > half || std::abs(b) > half) continue;
+        ++inside;
+        const float d = depth_at(f, u, v);
+        if (d <= 0.f) {
+          ++n;
+          continue;
+        }
+        // Distance of the depth's point in front of the plane, along the normal: (z - d) times
+        // the ray's component along n per unit depth.
+        const vec3 ray{(u - K.cx) / K.fx, (v - K.cy) / K.fy, 1.f};
+        const float front = (z - d) * -dot(pl.n, ray);
+        worst = std::max(worst, std::max(front - slab, -front));
+      }
+    EXPECT_GT(inside, 1000);
+    return n;
+  };
+  float worst_spheres = 0.f, worst = 0.f;
+  const int holes_spheres = holes(false, worst_spheres);
+  const int holes_aniso = holes(true, worst);
+  std::printf("holes with spheres %d, with anisotropic kernels %d; depth outside the slab by %.2f mm at most\n",
+              holes_spheres, holes_aniso, worst * 1e3f);
+  EXPECT_GT(holes_spheres, 50) << "spheres should leave holes in this layer (the test's premise)";
+  EXPECT_EQ(holes_aniso, 0);
+  EXPECT_LE(worst, 2e-4f);  // R32F depths at 1 m: well under 0.2 mm
+}
+
+// The same layer with the default surface (anisotropic kernels, gap fill, narrow-range filter):
+// its normals are the plane's within the slope of the ellipsoids' upper envelope. Interior
+// particles are discs (A, A, c) = (2.38 r, 2.38 r, 0.6 r); the envelope is, at each point, the cap
+// of the nearest centre, at most s / sqrt(2) = 2.12 r from it, where the cap's slope is
+// (c / A) (rho / A) / sqrt(1 - (rho / A)^2) = 0.25 * 0.891 / 0.454 = 0.49: 26 degrees at most.
+// Away from the layer's rim by the filter's half-width (6 r) the filter is a normalised
+// non-negative average (the layer's depth span over the filter, 6 r tan 20 deg + 0.6 r, is under
+// the narrow range mu = 3 r: no sample is left out or clamped), which cannot steepen a surface.
+// The 8-bit normal image adds at most 0.5 degree.
+TEST(RenderFluidSurface, AnisotropicSheetHasThePlanesNormal) {
+  SEAMLESS_REQUIRE_EGL();
+  const Intrinsics K = small_K();
+  const Plane pl = tilted_layer();
+  const float r = 0.01f;
+  const std::vector<vec3> x = pl.particles();
+  std::vector<std::uint32_t> ph;
+  RenderParams p = surface_params();
+  p.fluid_anisotropy = true;
+  p.stage_images = true;
+  Renderer rd(p, kW, kH);
+  rd.draw(fluid_list(x, ph, r), camera(K));
+  const StageImage* st = nullptr;
+  for (const StageImage& s : rd.stage_images())
+    if (s.name == "3_normals") st = &s;
+  ASSERT_NE(st, nullptr);
+  const Pixels im(st->image);
+  const float inner = 0.5f * (pl.count - 1) * pl.s - pl.s - 6.f * r;
+  const float A = std::cbrt(4.f) * 1.5f * r, c = A / 4.f, rho = pl.s / std::sqrt(2.f);
+  const float slope = (c / A) * (rho / A) / std::sqrt(1.f - (rho / A) * (rho / A));
+  const float bound = std::atan(slope) * 180.f / 3.14159265f + 0.5f;
+  float worst = 0.f, sum = 0.f;
+  int n = 0;
+  for (int v = 0; v < kH; ++v)
+    for (int u = 0; u < kW; ++u) {
+      float a, b, z;
+      pl.hit(K, u, v, a, b, z);
+      if (std::abs(a) > inner || std::abs(b) > inner) continue;
+      const uchar3 q = im.at(u, v);
+      vec3 nn{q.x / 127.5f - 1.f, q.y / 127.5f - 1.f, q.z / 127.5f - 1.f};
+      nn = nn * (1.f / std::sqrt(dot(nn, nn)));
+      const float deg = std::acos(std::clamp(dot(nn, pl.n), -1.f, 1.f)) * 180.f / 3.14159265f;
+      worst = std::max(worst, deg), sum += deg, ++n;
+    }
+  std::printf("%d pixels: normal off the plane's by %.2f degrees on average, %.2f at most (bound %.1f)\n", n,
+              sum / std::max(n, 1), worst, bound);
+  EXPECT_GT(n, 500);
+  EXPECT_LE(worst, bound);
 }
 
 }  // namespace

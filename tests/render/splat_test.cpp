@@ -39,7 +39,8 @@ struct Block {
 RenderParams splat_params(int thickness_downsample) {
   RenderParams p;
   p.znear = kNear;
-  p.filter_iterations = 0;  // the depth image is then the spheres' own
+  p.fluid_anisotropy = false;  // the raster sprites are spheres (docs/RENDERING.md)
+  p.filter_iterations = 0;     // the depth image is then the spheres' own
   p.thickness_downsample = thickness_downsample;
   return p;
 }
@@ -210,6 +211,7 @@ TEST(RenderSplat, ComputeScreenPassesGiveTheRasterFrame) {
   const Block b;
   RenderParams p;
   p.znear = kNear;
+  p.fluid_anisotropy = false;  // the raster sprites are spheres
   const Drawn a = draw_with(p, b, K, 2.5f, FluidSplat::raster),
               c = draw_with(p, b, K, 2.5f, FluidSplat::compute);  // wall behind
   if (!c.compute) GTEST_SKIP() << "no GL 4.3 compute here";

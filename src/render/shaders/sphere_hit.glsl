@@ -14,6 +14,19 @@ bool ray_sphere(vec3 d, vec3 c, out float z_in, out float z_out) {
   return z_in > u_near_far.x;
 }
 
+// The same for the ellipsoid (x - c)^T M (x - c) <= 1 (eye space; anisotropic kernels): the
+// quadratic (d^T M d) z^2 - 2 (d^T M c) z + c^T M c - 1 = 0.
+bool ray_quadric(vec3 d, vec3 c, mat3 M, out float z_in, out float z_out) {
+  vec3 Md = M * d;
+  float a = dot(d, Md), b = dot(c, Md), cc = dot(c, M * c) - 1.0;
+  float disc = b * b - a * cc;
+  if (disc < 0.0) return false;
+  float s = sqrt(disc);
+  z_in = (b - s) / a;
+  z_out = (b + s) / a;
+  return z_in > u_near_far.x;
+}
+
 #ifndef SEAMLESS_COMPUTE
 flat in vec3 v_centre;
 

@@ -5,13 +5,13 @@
 layout(r32ui, binding = 0) uniform uimage2D u_depth_bits;  // 0xffffffff = no fluid (resolve: 0)
 
 void main() {
-  vec3 c;
+  Splat s;
   ivec2 lo, hi;
-  if (!splat_centre(particle_index(), c) || !splat_rect(c, lo, hi)) return;
+  if (!splat_shape(particle_index(), s) || !splat_rect(s.c, s.r, lo, hi)) return;
   for (int v = lo.y; v <= hi.y; ++v)
     for (int u = lo.x; u <= hi.x; ++u) {
       float z_in, z_out;
-      if (!ray_sphere(pixel_ray(vec2(u, v)), c, z_in, z_out)) continue;
+      if (!ray_splat(pixel_ray(vec2(u, v)), s, z_in, z_out)) continue;
       ivec2 t = window_texel(ivec2(u, v));
       // Hidden by the scene: the raster path's depth test against the copied scene depth (window
       // depth, GL_LESS), done on the same values.

@@ -8,14 +8,14 @@ uniform float u_thickness_scale;  // inverse volume fraction (ssfr_thickness.fra
 uniform float u_fixed_per_metre;  // fixed-point units per metre of path (renderer_fluid.cpp)
 
 void main() {
-  vec3 c;
+  Splat s;
   ivec2 lo, hi;
-  if (!splat_centre(particle_index(), c) || !splat_rect(c, lo, hi)) return;
+  if (!splat_shape(particle_index(), s) || !splat_rect(s.c, s.r, lo, hi)) return;
   for (int v = lo.y; v <= hi.y; ++v)
     for (int u = lo.x; u <= hi.x; ++u) {
       float z_in, z_out;
       vec3 d = pixel_ray(vec2(u, v));
-      if (!ray_sphere(d, c, z_in, z_out)) continue;
+      if (!ray_splat(d, s, z_in, z_out)) continue;
       ivec2 t = window_texel(ivec2(u, v));
       // Same sample of the full-size scene depth as the fragment shader's gl_FragCoord / u_size.
       float z_scene = eye_depth(texture(u_scene_depth, (vec2(t) + 0.5) / u_size).r);
