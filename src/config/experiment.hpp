@@ -35,8 +35,8 @@ struct OutputParams {
   int particles_every = 25;        // write particles_<step>.ply every this many solver steps; 0 = only the last
   double max_lost_fraction = 0.2;  // a run whose tracking loses more of its frames exits with code 6
   // summary.json's seen-through ghost (app/ghost.hpp): with tracking alone (`seamless track`) it
-  // extracts the tracker's whole model mesh, a sixth of a short CPU run; trajectory-only
-  // evaluations (scripts/compare_trackers) turn it off.
+  // extracts the tracker's whole model mesh; trajectory-only evaluations (scripts/compare_trackers)
+  // turn it off.
   bool seen_through = true;
 
   template <class V> void visit(V& v) {
