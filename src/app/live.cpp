@@ -71,7 +71,8 @@ class LiveLoop : public FrameLoop {
     const auto k = static_cast<std::int64_t>(records_.size());
     if (traj_) traj_->write(frame_.timestamp, rec.result.world_T_camera);
     poses_.push_back(TumPose::from_se3(frame_.timestamp, rec.result.world_T_camera));
-    if (rec.result.ok()) seen_.add(frame_.depth, source_->intrinsics(), rec.result.world_T_camera);
+    if (rec.result.ok() && e_.output.seen_through)
+      seen_.add(frame_.depth, source_->intrinsics(), rec.result.world_T_camera);
     if (frame_.ground_truth) groundtruth_.push_back(TumPose::from_se3(frame_.timestamp, *frame_.ground_truth));
     const bool reextract = rec.fused && (fused_++ % e_.reextract_every) == 0;
     if (reextract) extract_scene();

@@ -154,7 +154,7 @@ ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
   r.intrinsics = source->intrinsics();
   SeenViews seen;  // what the tracked frames saw, for the seen-through ghost
   auto on_frame = [&](const RgbdFrame& frame, const FrameRecord& f) {
-    if (f.result.ok()) seen.add(frame.depth, r.intrinsics, f.result.world_T_camera);
+    if (f.result.ok() && e.output.seen_through) seen.add(frame.depth, r.intrinsics, f.result.world_T_camera);
     ctx.timer().add(f.frame, "preprocess", f.preprocess_ms);  // as it goes: a run that fails keeps them
     ctx.timer().add(f.frame, "track", f.track_ms);
     ctx.timer().add(f.frame, "fuse", f.fuse_ms);
@@ -163,7 +163,7 @@ ScanResult scan(RunContext& ctx, bool with_volume, StageTimer* volume_stages) {
     progress.update(++n, "tracking " + std::string(to_string(f.result.status)));
   };
   TrackSequenceParams tp = tracking_params(e, volume_stages);
-  tp.keep_model_mesh = !with_volume;        // tracking only: the tracker's own model, for the ghost measure
+  tp.keep_model_mesh = !with_volume && e.output.seen_through;  // tracking only: the tracker's model, for the ghost
   std::unique_ptr<OnlineCorrector> online;  // refine.online: the keyframe graph solved while tracking runs
   if (e.refine.online) {
     online =

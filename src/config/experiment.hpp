@@ -34,6 +34,10 @@ struct OutputParams {
   bool write_stats = true;         // tracking_stats.csv: per-frame residual, inliers, timings
   int particles_every = 25;        // write particles_<step>.ply every this many solver steps; 0 = only the last
   double max_lost_fraction = 0.2;  // a run whose tracking loses more of its frames exits with code 6
+  // summary.json's seen-through ghost (app/ghost.hpp): with tracking alone (`seamless track`) it
+  // extracts the tracker's whole model mesh; trajectory-only evaluations (scripts/compare_trackers)
+  // turn it off.
+  bool seen_through = true;
 
   template <class V> void visit(V& v) {
     v("dir", dir, "output folder (created if missing)");
@@ -48,6 +52,9 @@ struct OutputParams {
       "a run whose tracking loses more than this fraction of its frames exits with code 6 (README, exit codes); "
       "1 = never",
       Range{0, 1});
+    v("seen_through", seen_through,
+      "count the mesh vertices that at least two tracked frames saw through (summary.json ghost); with "
+      "`seamless track` this extracts the tracker's model mesh");
   }
 };
 

@@ -24,6 +24,7 @@ OpenCV odometry is in the build. Debian python3 + python3-numpy.
 """
 import json
 import os
+import resource
 import shutil
 import subprocess
 import sys
@@ -32,14 +33,19 @@ import time
 SKIP = 77
 FOLDERS = ("tum_fr1_rpy_000-149", "tum_fr1_rpy_150-299", "bonn_crowd_220-279", "frames_box_50",
            "tum_fr1_desk_9frames")
-CI_FRAMES = 60
+CI_FRAMES = 40
 PEERS = ("opencv_rgbd_odometry", "opencv_rgbd_icp")
 METRICS = (("ate_rmse_m", "ATE RMSE"), ("rpe_second_trans_rmse_m", "RPE/1 s"))
-# (folder, mode, metric) -> how many times a peer's figure ours may reach, where ours is measured to
-# lose (docs/TRACKING.md says which and by how much): the measured ratio, rounded up to a percent; 1
-# everywhere else: at or below. On tum_fr1_rpy_000-149's first 60 frames OpenCV's RgbdOdometry has
-# ATE 2.52 cm and RPE/1 s 4.56 cm, ours 2.56 and 5.04 (x1.016 and x1.105).
-BOUND = {("tum_fr1_rpy_000-149", "ci", "ate_rmse_m"): 1.02, ("tum_fr1_rpy_000-149", "ci", "rpe_second_trans_rmse_m"): 1.11}
+# (folder, mode, peer, metric) -> how many times a peer's figure ours may reach, where ours is measured
+# to lose (docs/TRACKING.md says which and by how much): the measured ratio, rounded up to a
+# percent; 1 everywhere else: at or below. On tum_fr1_rpy_000-149's first 40 frames OpenCV's
+# RgbdOdometry has ATE 0.70 cm and RPE/1 s 1.46 cm, RgbdICPOdometry 1.08 and 3.30, ours 1.90 and 4.87
+# (x2.709 and x3.329; x1.752 and x1.476). Over its first 60 frames the same config was within x1.02 /
+# x1.11 of RgbdOdometry: over its first 35 to 55 frames it is x1.2 to x3.9 above it (docs/TRACKING.md).
+BOUND = {("tum_fr1_rpy_000-149", "ci", "opencv_rgbd_odometry", "ate_rmse_m"): 2.71,
+         ("tum_fr1_rpy_000-149", "ci", "opencv_rgbd_odometry", "rpe_second_trans_rmse_m"): 3.33,
+         ("tum_fr1_rpy_000-149", "ci", "opencv_rgbd_icp", "ate_rmse_m"): 1.76,
+         ("tum_fr1_rpy_000-149", "ci", "opencv_rgbd_icp", "rpe_second_trans_rmse_m"): 1.48}
 
 
 def main():
@@ -67,7 +73,8 @@ def main():
     t0 = time.monotonic()
     print(" ".join(cmd), flush=True)
     subprocess.run(cmd, check=True)
-    print(f"protocol took {time.monotonic() - t0:.0f} s", flush=True)
+    cpu = resource.getrusage(resource.RUSAGE_CHILDREN)
+    print(f"protocol took {time.monotonic() - t0:.0f} s, {cpu.ru_utime + cpu.ru_stime:.0f} CPU s", flush=True)
     with open(os.path.join(out, "protocol.json")) as f:
         res = json.load(f)
     print(f"OpenCV figures: {res['opencv']}")
@@ -84,7 +91,7 @@ def main():
                 if p.get(key) is None or ours.get(key) is None:  # shorter than 1 s: no RPE/1 s
                     assert p.get(key) is None and ours.get(key) is None, (folder, key, ours, p)
                     continue
-                bound = BOUND.get((folder, mode, key), 1.0)
+                bound = BOUND.get((folder, mode, peer, key), 1.0)
                 line = (f"{folder}: {label} ours {100 * ours[key]:.3f} cm, {peer} {100 * p[key]:.3f} cm"
                         + (f" (bound x{bound})" if bound != 1.0 else ""))
                 print(line)
