@@ -8,10 +8,17 @@
 #include <cstdint>
 
 #include "core/exec.hpp"
+#include "core/intrinsics.hpp"
 #include "core/math.hpp"
 #include "core/view.hpp"
 
 namespace seamless::kernels {
+
+// What DepthColliders::inside counts in one frame.
+struct InsideCount {
+  std::int64_t inside = 0;   // particles inside a seen person now
+  std::int64_t resting = 0;  // of them, those inside for more than rest_frames frames in a row
+};
 
 template <Executor Exec> struct DepthColliders {
   // level(x, y) = 1 when any full-resolution pixel that the pyramid level's pixel averages is
@@ -38,6 +45,15 @@ template <Executor Exec> struct DepthColliders {
   // layers + 1 particles along its ray every `spacing` metres (point i's at i * (layers + 1) + k).
   static void thickened(const Exec& ex, const vec3* points, const vec3* rays, const vec3* velocity, std::int64_t n,
                         float back, float spacing, int layers, vec3* out);
+  // The colliders' check: particle i (world position p[i]) is inside a seen person when, in the
+  // camera camera_T_world with the full-resolution intrinsics K of `mask`, its nearest pixel is
+  // nonzero in the mask, the level pixel holding it (mask pixel / scale per axis) has a reading v,
+  // and along the particle's ray it lies more than `margin` and less than `thickness` behind v's
+  // depth. run[i]: the frames in a row it has been inside, this one included (0 when outside);
+  // updated from the previous frame's value.
+  static InsideCount inside(const Exec& ex, const vec3* p, std::int64_t n, SE3 camera_T_world, Intrinsics K,
+                            View2D<const std::uint8_t> mask, View2D<const vec3> level_vertices, int scale, float margin,
+                            float thickness, int rest_frames, int* run);
 };
 
 }  // namespace seamless::kernels

@@ -105,4 +105,33 @@ void DepthColliders<Exec>::thickened(const Exec& ex, const vec3* points, const v
   });
 }
 
+// The measured surface on the particle's ray is taken at the level pixel's depth v.z (flat across
+// the pixel), so the distance behind it along the ray is (z - v.z) * |q| / z.
+template <Executor Exec>
+InsideCount DepthColliders<Exec>::inside(const Exec& ex, const vec3* p, std::int64_t n, SE3 camera_T_world,
+                                         Intrinsics K, View2D<const std::uint8_t> mask,
+                                         View2D<const vec3> level_vertices, int scale, float margin, float thickness,
+                                         int rest_frames, int* run) {
+  ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) {
+    const vec3 q = camera_T_world * p[i];
+    bool in = false;
+    if (q.z > 0.f) {
+      const vec2 uv = K.project(q);
+      const int X = floor_int(uv.x + 0.5f), Y = floor_int(uv.y + 0.5f);
+      if (mask.inside(X, Y) && mask(X, Y) != 0 && level_vertices.inside(X / scale, Y / scale)) {
+        const vec3 v = level_vertices(X / scale, Y / scale);
+        const float behind = (q.z - v.z) * length(q) / q.z;
+        in = v.z > 0.f && behind > margin && behind < thickness;
+      }
+    }
+    run[i] = in ? run[i] + 1 : 0;
+  });
+  InsideCount c;
+  c.inside =
+      ex.transform_reduce(n, std::int64_t{0}, [=] SEAMLESS_HD(std::int64_t i) { return std::int64_t{run[i] > 0}; });
+  c.resting = ex.transform_reduce(n, std::int64_t{0},
+                                  [=] SEAMLESS_HD(std::int64_t i) { return std::int64_t{run[i] > rest_frames}; });
+  return c;
+}
+
 }  // namespace seamless::kernels

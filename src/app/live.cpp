@@ -33,13 +33,29 @@ using namespace detail;
 
 namespace {
 
+// A particle inside a seen person for more than this many frames in a row rests inside
+// (dynamic.inside_people): the colliders push a particle they reach out within the steps of one
+// frame, so two frames in a row already mean they did not; one more absorbs a frame whose mask or
+// depth flickers. A leg swinging at 2-3 m/s passes a particle in 2-3 frames at 30 Hz (a leg and a
+// particle, ~0.15 m), so a body passing through particles without colliders counts only where it
+// slows down or stands: a planted foot, a person standing.
+constexpr int kInsideRestFrames = 3;
+
+// The tracker's parameters, keeping the collider level's maps before the mask whenever there is a
+// mask: the inside-people check reads them with the colliders off as well.
+TrackSequenceParams live_tracking_params(const Experiment& e, StageTimer* volume_stages) {
+  TrackSequenceParams p = tracking_params(e, volume_stages);
+  if (e.dynamic.enabled) p.keep_unmasked_level = e.solver.collider_level;
+  return p;
+}
+
 // live()'s loop: one input frame per displayed frame (track, fuse, re-extract, one solver step).
 class LiveLoop : public FrameLoop {
  public:
   LiveLoop(RunContext& ctx, RunRenderer* renderer, StageTimer* volume_stages)
       : ctx_(ctx), e_(ctx.experiment()), renderer_(renderer), source_(ctx.open_source()),
         volume_(make_volume(e_.volume, ctx.device())),
-        session_(tracking_params(e_, volume_stages), ctx.device(), source_->intrinsics(), volume_.get()),
+        session_(live_tracking_params(e_, volume_stages), ctx.device(), source_->intrinsics(), volume_.get()),
         solver_(e_.solver, ctx.device()), total_(e_.frames > 0 ? e_.frames : source_->size().value_or(0)),
         progress_("live", total_) {
     solver_.schedule(e_.spawn);
@@ -58,6 +74,14 @@ class LiveLoop : public FrameLoop {
           "from the camera collides");
     if (e_.solver.dynamic_colliders != DynamicColliders::none)
       colliders_.emplace(e_.solver.particle_diameter, e_.solver.collider_thickness, e_.solver.max_speed, ctx.device());
+    // The check's margin is one particle radius: a particle whose centre is more than a radius
+    // behind the seen surface lies wholly behind it, while one touching it from outside has its
+    // centre in front (a contact keeps it a diameter from the collider points on the surface). The
+    // radius also covers the depth on the particle's ray differing from its level pixel's (a
+    // 160x120 level pixel is ~1.5 cm wide at 2 m) and the sensor's noise there (about 1 cm).
+    const float radius = 0.5f * e_.solver.particle_diameter;
+    if (e_.dynamic.enabled && e_.solver.collider_thickness > radius)
+      inside_.emplace(radius, e_.solver.collider_thickness, kInsideRestFrames, ctx.device());
   }
 
   bool advance() override {
@@ -92,6 +116,7 @@ class LiveLoop : public FrameLoop {
         solver_.step();  // spawns what is due first
         time_ += e_.solver.dt;
       }
+      if (inside_ && rec.result.ok() && session_.has_unmasked_level()) check_inside(rec.result.world_T_camera, k);
     }
     if (renderer_) {
       renderer_->set_kinect_frame(frame_, rec.result.world_T_camera);
@@ -151,6 +176,13 @@ class LiveLoop : public FrameLoop {
     spdlog::info("live: {} frames ({} lost), median track {:.3f} ms, physics {:.3f} ms, extraction {:.3f} ms",
                  records_.size(), session_.lost_frames(), ctx_.timer().median_ms("track"),
                  ctx_.timer().median_ms("physics"), ctx_.timer().median_ms("extract"));
+    if (inside_) {
+      const InsidePeopleStats& in = inside_->stats();
+      spdlog::info(
+          "live: particles inside people: at most {} in a frame; resting (inside > {} frames in a row) in {} of {} "
+          "frames checked, at most {}",
+          in.max_inside, in.rest_frames, in.frames_resting, in.frames_checked, in.max_resting);
+    }
     log_volume(volume_->stats(), volume_->device());
     const Mesh mesh = volume_->extract_mesh();
     if (e_.output.write_mesh) write_mesh_ply(ctx_.out_path("mesh.ply"), mesh);
@@ -180,6 +212,18 @@ class LiveLoop : public FrameLoop {
     colliders_->update(*vertices, *normals, world_T_camera, masked ? &session_.dynamic_mask() : nullptr, frame_time);
   }
 
+  // dynamic.inside_people: after this frame's physics, the particles inside the people it sees
+  // (physics/depth_colliders.hpp, InsidePeopleCheck), on the run's device from the solver's and
+  // the tracker's buffers: positions in id order (the ids a particle keeps from frame to frame), the
+  // full-resolution dynamic mask and the collider level's vertices before masking.
+  void check_inside(const SE3& world_T_camera, std::int64_t k) {
+    StageScope s(ctx_.timer(), "inside_check");
+    const kernels::InsideCount c =
+        inside_->check(solver_.device_positions(), solver_.size(), world_T_camera, source_->intrinsics(),
+                       session_.dynamic_mask(), *session_.unmasked_level().first, k);
+    if (c.resting > 0) spdlog::debug("live: frame {}: {} particles inside people, {} resting", k, c.inside, c.resting);
+  }
+
   // summary.json of a live run: as scan_then_simulate's, with the scene as it was at the end.
   void write_live_summary(const Mesh& mesh, const ParticleState& state) {
     RunSummary sum;
@@ -199,6 +243,7 @@ class LiveLoop : public FrameLoop {
     sum.spawns = spawns_;
     sum.physics = solver_.stats();
     sum.dynamic_masked_fraction = mean_dynamic_fraction(records_);
+    if (inside_) sum.inside_people = inside_->stats();
     sum.mask_quality = mask_quality(records_, mover_ids(e_.input.synthetic.movers, MoverKind::person));
     if (!groundtruth_.empty())  // the source's own poses (the synthetic room's)
       sum.ghost_vertices = ghost_vertices(mesh, e_.input, poses_, groundtruth_, 2 * e_.volume.voxel_size);
@@ -260,6 +305,7 @@ class LiveLoop : public FrameLoop {
   SE3 pose_ = SE3::identity();                  // this frame's tracked pose (placements made while it steps)
   std::optional<double> t0_;                    // timestamp of the first fused frame
   std::optional<DeviceColliders> colliders_;    // solver.dynamic_colliders
+  std::optional<InsidePeopleCheck> inside_;     // dynamic.enabled: dynamic.inside_people of summary.json
   SceneParticles scene_;                        // the scene particles of the last extraction (device)
   std::vector<vec3> points_;                    // their host copy, for placement
   bool points_stale_ = false;                   // points_ is not scene_'s copy yet

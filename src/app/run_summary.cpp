@@ -140,7 +140,7 @@ void write_summary(const std::string& path, const RunSummary& s) {
   j["frames"] = {
       {"read", s.frames_read}, {"lost", s.frames_lost}, {"fused", s.frames_fused}, {"unreadable", s.frames_unreadable}};
   if (s.ate_rmse_m) j["ate"] = {{"rmse_m", *s.ate_rmse_m}, {"pairs", s.ate_pairs}};
-  if (s.dynamic_masked_fraction || s.ghost_vertices || s.mask_quality) {
+  if (s.dynamic_masked_fraction || s.ghost_vertices || s.mask_quality || s.inside_people) {
     Json& d = j["dynamic"] = Json::object();
     if (s.dynamic_masked_fraction) d["mean_masked_fraction"] = *s.dynamic_masked_fraction;
     if (s.ghost_vertices) {
@@ -148,6 +148,17 @@ void write_summary(const std::string& path, const RunSummary& s) {
       d["ghost_vertices_by_mover"] = s.ghost_vertices->by_mover;
     }
     if (s.mask_quality) d["mask"] = mask_json(*s.mask_quality);
+    if (s.inside_people) {
+      const InsidePeopleStats& p = *s.inside_people;
+      d["inside_people"] = {{"frames_checked", p.frames_checked},
+                            {"max_inside", p.max_inside},
+                            {"max_inside_frame", p.max_inside_frame},
+                            {"frames_resting", p.frames_resting},
+                            {"max_resting", p.max_resting},
+                            {"rest_frames", p.rest_frames},
+                            {"margin_m", p.margin},
+                            {"thickness_m", p.thickness}};
+    }
   }
   if (s.seen_through)
     j["ghost"] = {{"seen_through_vertices", s.seen_through->vertices},

@@ -8,6 +8,7 @@
 #include "app/ghost.hpp"
 #include "app/placement.hpp"
 #include "core/intrinsics.hpp"
+#include "physics/depth_colliders.hpp"
 #include "physics/particle_solver.hpp"
 #include "recon/refine/online_refine.hpp"
 #include "recon/tracker_sequence.hpp"
@@ -49,6 +50,8 @@ struct RunSummary {
   std::optional<GhostCount> ghost_vertices;       // synthetic movers: what they left in the map (app/ghost.hpp)
   std::optional<SeenThroughGhost> seen_through;   // any source: mesh vertices the frames saw through (app/ghost.hpp)
   std::optional<MaskQuality> mask_quality;        // synthetic movers: the dynamic mask against their masks
+  // live mode with dynamic.enabled: the dynamic particles inside the people the frames saw
+  std::optional<InsidePeopleStats> inside_people;
   std::vector<ResolvedPlacement> placements;
   std::vector<SpawnParams> spawns;  // as resolved
   std::optional<SolverStats> physics;

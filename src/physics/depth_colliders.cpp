@@ -1,5 +1,6 @@
 #include "physics/depth_colliders.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -81,6 +82,44 @@ std::int64_t DeviceColliders::at(double t) {
                                           layers, out_.data());
   });
   return total;
+}
+
+InsidePeopleCheck::InsidePeopleCheck(float margin, float thickness, int rest_frames, Device d) : dev_(d) {
+  if (!(margin >= 0.f) || !(thickness > margin))
+    throw Error("inside-people check: the margin " + std::to_string(margin) + " m must be in [0, the thickness " +
+                std::to_string(thickness) + " m)");
+  stats_.margin = margin, stats_.thickness = thickness, stats_.rest_frames = rest_frames;
+}
+
+kernels::InsideCount InsidePeopleCheck::check(const vec3* p, std::int64_t n, const SE3& world_T_camera,
+                                              const Intrinsics& K, const Image<std::uint8_t>& mask,
+                                              const Image<vec3>& level_vertices, std::int64_t frame) {
+  if (n > run_.size()) {  // new particles spawned: they start outside
+    Buffer<int> grown(n, dev_);
+    grown.zero();
+    grown.copy_from(run_);
+    run_ = std::move(grown);
+  }
+  kernels::InsideCount c;
+  const int w = level_vertices.width();
+  if (n > 0 && mask.width() > 0 && w > 0) {
+    if (mask.width() % w != 0 || mask.width() / w * level_vertices.height() != mask.height())
+      throw Error("inside-people check: a " + std::to_string(mask.width()) + "x" + std::to_string(mask.height()) +
+                  " mask is not a whole number of " + std::to_string(w) + "x" +
+                  std::to_string(level_vertices.height()) + " level pixels");
+    with_exec(dev_, [&]<class E>(const E& ex) {
+      c = kernels::DepthColliders<E>::inside(ex, p, n, world_T_camera.inverse(), K, mask.cview(),
+                                             level_vertices.cview(), mask.width() / w, stats_.margin, stats_.thickness,
+                                             stats_.rest_frames, run_.data());
+    });
+  } else if (n > 0) {
+    run_.zero();  // no mask this frame: nobody seen, every run ends
+  }
+  ++stats_.frames_checked;
+  if (c.inside > stats_.max_inside) stats_.max_inside = c.inside, stats_.max_inside_frame = frame;
+  if (c.resting > 0) ++stats_.frames_resting;
+  stats_.max_resting = std::max(stats_.max_resting, c.resting);
+  return c;
 }
 
 }  // namespace seamless

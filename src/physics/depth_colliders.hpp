@@ -10,7 +10,9 @@
 
 #include "core/buffer.hpp"
 #include "core/device.hpp"
+#include "core/intrinsics.hpp"
 #include "core/math.hpp"
+#include "kernels/physics/depth_colliders.hpp"
 
 namespace seamless {
 
@@ -59,6 +61,38 @@ class DeviceColliders {
   std::int64_t count_ = 0, last_count_ = 0;
   double time_ = 0.0;
   bool have_ = false;
+};
+
+// The colliders' check (live mode, dynamic.inside_people of summary.json): after each frame's
+// physics, the dynamic particles that lie inside a person the frame sees, i.e. inside the shell the
+// depth colliders stand for: on a pixel of the dynamic mask, more than `margin` and less than
+// `thickness` behind the measured surface along the particle's ray (kernels::DepthColliders::inside).
+// A particle inside for more than rest_frames frames in a row rests inside: the colliders failed
+// to push it out.
+struct InsidePeopleStats {
+  std::int64_t frames_checked = 0;
+  std::int64_t max_inside = 0;         // the most particles inside in one frame
+  std::int64_t frames_resting = 0;     // frames where some particle had been inside for more than rest_frames frames
+  std::int64_t max_resting = 0;        // the most such particles in one frame
+  std::int64_t max_inside_frame = -1;  // the frame (index in the run) where max_inside first was
+  int rest_frames = 0;
+  float margin = 0.f, thickness = 0.f;
+};
+
+class InsidePeopleCheck {
+ public:
+  InsidePeopleCheck(float margin, float thickness, int rest_frames, Device d);
+  // One frame: n particles at world positions p (in id order, on d; the ids stay the particles'
+  // from frame to frame, new ones appended), the frame's pose, the full-resolution intrinsics of
+  // `mask` (the dynamic mask) and an unmasked pyramid level's vertex map (camera coordinates).
+  kernels::InsideCount check(const vec3* p, std::int64_t n, const SE3& world_T_camera, const Intrinsics& K,
+                             const Image<std::uint8_t>& mask, const Image<vec3>& level_vertices, std::int64_t frame);
+  const InsidePeopleStats& stats() const { return stats_; }
+
+ private:
+  Device dev_;
+  Buffer<int> run_;  // per particle: the frames in a row it has been inside
+  InsidePeopleStats stats_;
 };
 
 }  // namespace seamless

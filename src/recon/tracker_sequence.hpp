@@ -117,6 +117,8 @@ class TrackingSession {
   // The last frame's pyramid level params.keep_unmasked_level (vertices, then normals) with its
   // dynamic pixels still in it; the pyramid's own level when nothing was masked.
   std::pair<const Image<vec3>*, const Image<vec3>*> unmasked_level() const;
+  // Whether unmasked_level() holds this frame's level as it was before the mask zeroed the people.
+  bool has_unmasked_level() const { return kept_; }
 
  private:
   bool uses_volume() const;

@@ -171,5 +171,161 @@ TEST(DeviceCollidersParity, CudaGivesTheHostCodesColliders) {
   EXPECT_TRUE(device(MaskMode::no_mask_yet, Device::CUDA).colliders.empty());
 }
 
+// The colliders' check (InsidePeopleCheck, DepthColliders::inside) on a hand-made frame: a
+// 160x120 mask (f = 100 px) over a 40x30 level that sees a wall 2 m in front of the camera
+// everywhere; the mask marks a person on the block of full-resolution pixels [40, 80) x [40, 80),
+// one of whose level pixels, (12, 12), has no reading. The camera is turned and moved, the
+// particles are given in world coordinates. A particle is put on the ray of pixel (X, Y) at a
+// distance b behind the wall along that ray: its depth is z = 2 + b / s, s = |ray| / ray.z, so
+// (z - 2) * s = b exactly as the check measures it.
+namespace inside {
+
+constexpr int kW = 160, kH = 120, kScale = 4;
+constexpr float kWall = 2.f, kMargin = 0.015f, kThickness = 0.15f;
+constexpr int kRest = 3;
+const Intrinsics kK{100.f, 100.f, 79.5f, 59.5f, kW, kH};
+
+SE3 camera_pose() {
+  const float a = 0.3f, c = std::cos(a), s = std::sin(a);
+  SE3 T = SE3::identity();
+  T.R = {{{c, -s, 0.f}, {s, c, 0.f}, {0.f, 0.f, 1.f}}};
+  T.t = {0.5f, -0.2f, 1.f};
+  return T;
+}
+
+Image<std::uint8_t> mask(Device d) {
+  std::vector<std::uint8_t> m(kW * kH, 0);
+  for (int Y = 40; Y < 80; ++Y)
+    for (int X = 40; X < 80; ++X) m[static_cast<std::size_t>(Y) * kW + X] = 1;
+  return Image<std::uint8_t>::from_host(m, kW, kH, d);
+}
+
+Image<vec3> level(Device d) {
+  const Intrinsics k = kK.level(2);
+  std::vector<vec3> v(static_cast<std::size_t>(k.width) * k.height);
+  for (int y = 0; y < k.height; ++y)
+    for (int x = 0; x < k.width; ++x)
+      if (x != 12 || y != 12) v[static_cast<std::size_t>(y) * k.width + x] = k.unproject(x, y, kWall);
+  return Image<vec3>::from_host(v, k.width, k.height, d);
+}
+
+// In world coordinates: on pixel (X, Y)'s ray (plus a fraction of a pixel), b metres behind the wall.
+vec3 at(float X, float Y, float b) {
+  const vec3 ray = kK.unproject(X, Y, 1.f);
+  return camera_pose() * (ray * (kWall + b / length(ray)));
+}
+
+struct Case {
+  vec3 p;
+  bool inside;
+};
+
+std::vector<Case> cases() {
+  return {
+      {at(60.f, 60.f, 0.05f), true},                  // in the person, 5 cm behind the surface
+      {at(41.3f, 78.6f, 0.14f), true},                // near the mask's corner, near the shell's back
+      {at(60.f, 60.f, 0.01f), false},                 // less than the margin behind: touching, not inside
+      {at(60.f, 60.f, -0.05f), false},                // in front of the person
+      {at(60.f, 60.f, 0.2f), false},                  // behind the shell: behind the person
+      {at(20.f, 60.f, 0.05f), false},                 // behind the wall where nobody is (no mask)
+      {at(39.4f, 60.f, 0.05f), false},                // next to the mask's edge (nearest pixel 39)
+      {at(49.f, 50.f, 0.05f), false},                 // on the level pixel (12, 12) without a reading
+      {at(200.f, 60.f, 0.05f), false},                // outside the image
+      {camera_pose() * vec3{0.f, 0.f, -1.f}, false},  // behind the camera
+  };
+}
+
+std::vector<vec3> positions(const std::vector<Case>& c) {
+  std::vector<vec3> p;
+  for (const Case& e : c) p.push_back(e.p);
+  return p;
+}
+
+}  // namespace inside
+
+TEST(InsidePeopleCheck, CountsTheParticlesInsideTheShellAndThoseThatStay) {
+  using namespace inside;
+  const std::vector<Case> c = cases();
+  const std::int64_t expected = std::count_if(c.begin(), c.end(), [](const Case& e) { return e.inside; });
+  ASSERT_EQ(expected, 2);
+  const Image<std::uint8_t> m = mask(Device::CPU);
+  const Image<vec3> lv = level(Device::CPU);
+  // Each case alone: inside exactly where expected.
+  for (const Case& e : c) {
+    InsidePeopleCheck one(kMargin, kThickness, kRest, Device::CPU);
+    const Buffer<vec3> p = Buffer<vec3>::from_host({e.p}, Device::CPU);
+    EXPECT_EQ(one.check(p.data(), 1, camera_pose(), kK, m, lv, 0).inside, e.inside ? 1 : 0);
+  }
+  // Frame after frame: the two inside particles rest from the (kRest + 1)-th frame on; a particle
+  // spawned on frame 2 inside the person starts its own count; on frame 6 the first particle is
+  // pushed out (its run ends) and on frame 7 it is back (a new run).
+  InsidePeopleCheck check(kMargin, kThickness, kRest, Device::CPU);
+  std::vector<vec3> p = positions(c);
+  const std::vector<std::int64_t> inside_now = {2, 2, 3, 3, 3, 3, 2, 3};
+  const std::vector<std::int64_t> resting_now = {0, 0, 0, 2, 2, 3, 2, 2};
+  for (std::int64_t f = 0; f < 8; ++f) {
+    if (f == 2) p.push_back(at(70.f, 45.f, 0.1f));
+    p[0] = at(60.f, 60.f, f == 6 ? -0.05f : 0.05f);
+    const Buffer<vec3> b = Buffer<vec3>::from_host(p, Device::CPU);
+    const kernels::InsideCount k =
+        check.check(b.data(), static_cast<std::int64_t>(p.size()), camera_pose(), kK, m, lv, f);
+    EXPECT_EQ(k.inside, inside_now[f]) << "frame " << f;
+    EXPECT_EQ(k.resting, resting_now[f]) << "frame " << f;
+  }
+  const InsidePeopleStats& s = check.stats();
+  EXPECT_EQ(s.frames_checked, 8);
+  EXPECT_EQ(s.max_inside, 3);
+  EXPECT_EQ(s.max_inside_frame, 2);
+  EXPECT_EQ(s.frames_resting, 5);
+  EXPECT_EQ(s.max_resting, 3);
+  // A frame without a mask (none computed yet): nothing inside, every run ends.
+  const Buffer<vec3> b = Buffer<vec3>::from_host(p, Device::CPU);
+  EXPECT_EQ(check.check(b.data(), static_cast<std::int64_t>(p.size()), camera_pose(), kK, Image<std::uint8_t>(), lv, 8)
+                .inside,
+            0);
+  EXPECT_EQ(check.check(b.data(), static_cast<std::int64_t>(p.size()), camera_pose(), kK, m, lv, 9).resting, 0);
+}
+
+TEST(InsidePeopleCheck, BadSettingsAndMapsAreErrors) {
+  using namespace inside;
+  EXPECT_THROW(InsidePeopleCheck(0.2f, 0.1f, kRest, Device::CPU), Error);  // margin past the shell
+  InsidePeopleCheck check(kMargin, kThickness, kRest, Device::CPU);
+  const Buffer<vec3> p = Buffer<vec3>::from_host({at(60.f, 60.f, 0.05f)}, Device::CPU);
+  const Image<vec3> odd(kW / 3, kH / 3, Device::CPU);  // 53 does not divide 160
+  EXPECT_THROW(check.check(p.data(), 1, camera_pose(), kK, mask(Device::CPU), odd, 0), Error);
+}
+
+// CUDA against the CPU on a field of particles around the person, none within 2 mm of the margin
+// or the shell's back and none within a quarter pixel of a pixel's border (so that rounding, FMA
+// contraction on CUDA, cannot move one across): the same runs, frame after frame.
+TEST(InsidePeopleCheckParity, CudaCountsAsTheCpu) {
+  if (!cuda_available()) GTEST_SKIP() << "no CUDA device";
+  using namespace inside;
+  std::vector<vec3> p;
+  for (int Y = 30; Y < 90; Y += 3)
+    for (int X = 30; X < 90; X += 2)
+      for (float b : {-0.05f, 0.005f, 0.03f, 0.1f, 0.16f}) p.push_back(at(X + 0.2f, Y - 0.2f, b));
+  const auto n = static_cast<std::int64_t>(p.size());
+  std::vector<kernels::InsideCount> counts[2];
+  const Device devs[2] = {Device::CPU, Device::CUDA};
+  for (int d = 0; d < 2; ++d) {
+    InsidePeopleCheck check(kMargin, kThickness, kRest, devs[d]);
+    const Image<std::uint8_t> m = mask(devs[d]);
+    const Image<vec3> lv = level(devs[d]);
+    for (int f = 0; f < 5; ++f) {
+      const Buffer<vec3> b = Buffer<vec3>::from_host(p, devs[d]);
+      counts[d].push_back(check.check(b.data(), n, camera_pose(), kK, m, lv, f));
+    }
+  }
+  // On the mask ([40, 80)): 13 of the rows, 20 of the columns; 2 of the 5 depths inside; but the 4
+  // positions on the level pixel without a reading (X 48, 50; Y 48, 51).
+  EXPECT_EQ(counts[0][0].inside, 2 * 13 * 20 - 2 * 4);
+  for (int f = 0; f < 5; ++f) {
+    EXPECT_EQ(counts[0][f].inside, counts[1][f].inside) << "frame " << f;
+    EXPECT_EQ(counts[0][f].resting, counts[1][f].resting) << "frame " << f;
+  }
+  EXPECT_EQ(counts[1][4].resting, counts[1][4].inside);
+}
+
 }  // namespace
 }  // namespace seamless
