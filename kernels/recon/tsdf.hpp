@@ -119,17 +119,21 @@ struct SurfaceFlags {
 };
 // The bits of a block's flag word (SurfaceFlags::flag): the surface flag, and where the block holds
 // an observed voxel with sdf <= 0 (the raycast's kMarchCross, block_march_flags below, reads them):
-// anywhere, or in its layer x = 0 (y = 0, z = 0), the voxels that its lower neighbours' cells read.
+// anywhere, and for k = 1..7 among its voxels with local coordinate 0 along each axis of k (bit
+// 1 << (1 + k); axis x if k & 1, y if k & 2, z if k & 4): the voxels that the cells of its lower
+// neighbour b - k read (a face for one axis, an edge for two, the corner voxel for three).
 constexpr std::int32_t kFlagSurface = 1;
 constexpr std::int32_t kFlagNonPositive = 2;
-constexpr std::int32_t kFlagNonPositiveX0 = 4, kFlagNonPositiveY0 = 8, kFlagNonPositiveZ0 = 16;
+SEAMLESS_HD constexpr std::int32_t flag_non_positive_toward(int k) { return 1 << (1 + k); }
 
 // The flag bits a voxel adds to its block's word (local coordinates l).
 SEAMLESS_HD inline std::int32_t voxel_flag_bits(const Voxel& v, int3 l, float surface_below) {
   std::int32_t bits = voxel_keeps_block(v, surface_below) ? kFlagSurface : 0;
-  if (v.weight > 0.f && v.sdf <= 0.f)
-    bits |= kFlagNonPositive | (l.x == 0 ? kFlagNonPositiveX0 : 0) | (l.y == 0 ? kFlagNonPositiveY0 : 0) |
-            (l.z == 0 ? kFlagNonPositiveZ0 : 0);
+  if (!(v.weight > 0.f && v.sdf <= 0.f)) return bits;
+  bits |= kFlagNonPositive;
+  const int on_zero = (l.x == 0 ? 1 : 0) | (l.y == 0 ? 2 : 0) | (l.z == 0 ? 4 : 0);  // axes where l is 0
+  for (int k = 1; k < 8; ++k)
+    if ((k & on_zero) == k) bits |= flag_non_positive_toward(k);
   return bits;
 }
 
@@ -250,8 +254,8 @@ constexpr std::int32_t kEmptyFar = 0;            // +0: no block splatted
 // asks (near_test); the band-only volume has freed those blocks already.
 //
 // kMarchCross: whether a sample in b's cells may be <= 0: b holds an observed voxel with sdf <= 0,
-// or an upper neighbour does in the layer b's cells read (x = 0 for the neighbours across b's
-// x face, y = 0 or z = 0 for the others: their voxels b reads lie in that layer). Without it every
+// or an upper neighbour b + k does among the voxels b's cells read (its face, edge or corner at
+// local coordinate 0 along the axes of k: flag_non_positive_toward(k)). Without it every
 // value the trilinear field takes in b's cells is > 0, so no +/- crossing lies strictly inside b:
 // the march crosses it in one step instead of the ~3 samples a block of free space in front of a
 // surface costs, and brackets a crossing just behind it from a sample just before its exit (see
@@ -268,9 +272,8 @@ SEAMLESS_HD inline std::int32_t block_march_flags(const HashTableView& t, const 
     const std::int32_t i = s < 0 ? -1 : t.values[s];
     if (i < 0) continue;
     const std::int32_t f = flags[i];
-    const std::int32_t layer = k & 1 ? kFlagNonPositiveX0 : k & 2 ? kFlagNonPositiveY0 : kFlagNonPositiveZ0;
     near = near || (f & kFlagSurface);
-    cross = cross || (f & layer);
+    cross = cross || (f & flag_non_positive_toward(k));
   }
   return (near ? kMarchNear : 0) | (cross ? kMarchCross : 0);
 }

@@ -184,7 +184,7 @@ SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z
     const bool cross_block = !skip && !exact && !(m & kMarchCross);  // its samples are all > 0
     float f = 0.f;
     const bool sampled = !skip && !cross_block && sample_tsdf_in(a, q, g0, i0, c, &f);  // no second lookup
-    if (refine >= 0) {  // regula falsi between the bracket's ends
+    if (refine >= 0) {      // regula falsi between the bracket's ends
       if (!sampled) break;  // no value here: the last estimate, z, is the hit
       if (f > 0.f) ta = z, fa = f;
       else tb = z, fb = f;

@@ -252,7 +252,6 @@ TEST(TsdfRaycastSurfaceFlags, SameSurfacesAsTheMarchThroughTheFreeSpace) {
   }
 }
 
-
 // --- the coarse march: blocks whose samples are all > 0 crossed in one step ----------------------
 
 // Every stored block's flag word is its definition (voxel_flag_bits over its voxels), and the march
@@ -260,7 +259,7 @@ TEST(TsdfRaycastSurfaceFlags, SameSurfacesAsTheMarchThroughTheFreeSpace) {
 // whose samples can be <= 0: one with an observed voxel <= 0 among the voxels its cells read, the
 // 9^3 voxels 8b + {0..8}^3 (counted here from the downloaded voxels, by coordinate). The scene
 // (sphere, box, wall) has blocks of the band's free-space side only: those the march crosses whole.
-void expect_march_flags_cover_every_crossing(const VoxelHashVolume& vol) {
+void expect_march_flags_cover_every_crossing(VoxelHashVolume& vol) {
   const auto blocks = vol.download_blocks();
   const float below = 0.999f * vol.params().truncation;
   std::map<std::tuple<int, int, int>, const VoxelHashVolume::HostBlock*> by_coord;
@@ -362,8 +361,9 @@ TEST(TsdfRaycastCoarse, SameSurfacesAsTheFineMarch) {
 // The coarse march on CUDA against the CPU, band-only volume: the flag words agree (the voxels
 // agree to 1e-5 m, so a sign bit may differ only through a voxel within 1e-5 m of zero, and the
 // surface bit through one within 1e-5 m of its threshold: such blocks are left out), and the
-// raycasts, whose march flags each backend computes from its words, agree from the views above as in TsdfParity.SameBlocksAndValues: depths within 1e-4 m where both hit, a hit
-// on one backend only for at most 0.1 % of the pixels (a ray grazing a block edge).
+// raycasts, whose march flags each backend computes from its words, agree from the views above as in
+// TsdfParity.SameBlocksAndValues: depths within 1e-4 m where both hit, a hit on one backend only for at most 0.1 % of
+// the pixels (a ray grazing a block edge).
 TEST(TsdfRaycastParity, CoarseMarchOnCuda) {
   if (!cuda_available()) GTEST_SKIP() << "no CUDA device";
   const Intrinsics K = test::camera(200, 150, 170.f);
@@ -378,7 +378,8 @@ TEST(TsdfRaycastParity, CoarseMarchOnCuda) {
   for (std::size_t i = 0; i < a.size(); ++i) {
     bool borderline = false;
     for (const kernels::Voxel& v : a[i].voxels)
-      borderline = borderline || (v.weight > 0.f && (std::fabs(v.sdf) <= 1e-5f || std::fabs(std::fabs(v.sdf) - below) <= 1e-5f));
+      borderline =
+          borderline || (v.weight > 0.f && (std::fabs(v.sdf) <= 1e-5f || std::fabs(std::fabs(v.sdf) - below) <= 1e-5f));
     if (borderline) continue;
     ASSERT_EQ(a[i].flags, b[i].flags) << "block " << i;
     ++compared;
