@@ -180,10 +180,10 @@ TEST(DeviceCollidersParity, CudaGivesTheHostCodesColliders) {
 // (z - 2) * s = b exactly as the check measures it.
 namespace inside {
 
-constexpr int kW = 160, kH = 120, kScale = 4;
-constexpr float kWall = 2.f, kMargin = 0.015f, kThickness = 0.15f;
+constexpr int kMaskW = 160, kMaskH = 120, kMaskScale = 4;
+constexpr float kWall = 2.f, kMargin = 0.015f, kShell = 0.15f;
 constexpr int kRest = 3;
-const Intrinsics kK{100.f, 100.f, 79.5f, 59.5f, kW, kH};
+const Intrinsics kK{100.f, 100.f, 79.5f, 59.5f, kMaskW, kMaskH};
 
 SE3 camera_pose() {
   const float a = 0.3f, c = std::cos(a), s = std::sin(a);
@@ -194,10 +194,10 @@ SE3 camera_pose() {
 }
 
 Image<std::uint8_t> mask(Device d) {
-  std::vector<std::uint8_t> m(kW * kH, 0);
+  std::vector<std::uint8_t> m(kMaskW * kMaskH, 0);
   for (int Y = 40; Y < 80; ++Y)
-    for (int X = 40; X < 80; ++X) m[static_cast<std::size_t>(Y) * kW + X] = 1;
-  return Image<std::uint8_t>::from_host(m, kW, kH, d);
+    for (int X = 40; X < 80; ++X) m[static_cast<std::size_t>(Y) * kMaskW + X] = 1;
+  return Image<std::uint8_t>::from_host(m, kMaskW, kMaskH, d);
 }
 
 Image<vec3> level(Device d) {
@@ -252,14 +252,14 @@ TEST(InsidePeopleCheck, CountsTheParticlesInsideTheShellAndThoseThatStay) {
   const Image<vec3> lv = level(Device::CPU);
   // Each case alone: inside exactly where expected.
   for (const Case& e : c) {
-    InsidePeopleCheck one(kMargin, kThickness, kRest, Device::CPU);
+    InsidePeopleCheck one(kMargin, kShell, kRest, Device::CPU);
     const Buffer<vec3> p = Buffer<vec3>::from_host({e.p}, Device::CPU);
     EXPECT_EQ(one.check(p.data(), 1, camera_pose(), kK, m, lv, 0).inside, e.inside ? 1 : 0);
   }
   // Frame after frame: the two inside particles rest from the (kRest + 1)-th frame on; a particle
   // spawned on frame 2 inside the person starts its own count; on frame 6 the first particle is
   // pushed out (its run ends) and on frame 7 it is back (a new run).
-  InsidePeopleCheck check(kMargin, kThickness, kRest, Device::CPU);
+  InsidePeopleCheck check(kMargin, kShell, kRest, Device::CPU);
   std::vector<vec3> p = positions(c);
   const std::vector<std::int64_t> inside_now = {2, 2, 3, 3, 3, 3, 2, 3};
   const std::vector<std::int64_t> resting_now = {0, 0, 0, 2, 2, 3, 2, 2};
@@ -289,9 +289,9 @@ TEST(InsidePeopleCheck, CountsTheParticlesInsideTheShellAndThoseThatStay) {
 TEST(InsidePeopleCheck, BadSettingsAndMapsAreErrors) {
   using namespace inside;
   EXPECT_THROW(InsidePeopleCheck(0.2f, 0.1f, kRest, Device::CPU), Error);  // margin past the shell
-  InsidePeopleCheck check(kMargin, kThickness, kRest, Device::CPU);
+  InsidePeopleCheck check(kMargin, kShell, kRest, Device::CPU);
   const Buffer<vec3> p = Buffer<vec3>::from_host({at(60.f, 60.f, 0.05f)}, Device::CPU);
-  const Image<vec3> odd(kW / 3, kH / 3, Device::CPU);  // 53 does not divide 160
+  const Image<vec3> odd(kMaskW / 3, kMaskH / 3, Device::CPU);  // 53 does not divide 160
   EXPECT_THROW(check.check(p.data(), 1, camera_pose(), kK, mask(Device::CPU), odd, 0), Error);
 }
 
@@ -309,7 +309,7 @@ TEST(InsidePeopleCheckParity, CudaCountsAsTheCpu) {
   std::vector<kernels::InsideCount> counts[2];
   const Device devs[2] = {Device::CPU, Device::CUDA};
   for (int d = 0; d < 2; ++d) {
-    InsidePeopleCheck check(kMargin, kThickness, kRest, devs[d]);
+    InsidePeopleCheck check(kMargin, kShell, kRest, devs[d]);
     const Image<std::uint8_t> m = mask(devs[d]);
     const Image<vec3> lv = level(devs[d]);
     for (int f = 0; f < 5; ++f) {
