@@ -107,8 +107,8 @@ SEAMLESS_HD inline bool voxel_keeps_block(const Voxel& v, float keep_below) {
   return v.weight > 0.f && fabsf(v.sdf) < keep_below;
 }
 
-// The surface flag of each block of the pool (docs/DYNAMIC.md "The surface flag"): bit kFlagSurface
-// (below) of its flag word while one of its voxels is observed and near a surface (voxel_keeps_block with the band's
+// The surface flag of each block of the pool (docs/DYNAMIC.md "The surface flag"): 1
+// while one of its voxels is observed and near a surface (voxel_keeps_block with the band's
 // threshold below = 0.999 truncation, whatever the garbage collection keeps), else 0. It is the
 // band-only volume's garbage collection's decision (Niessner et al. 2013), kept for the blocks
 // that a volume storing free space keeps anyway (ReFusion, Palazzolo et al. 2019), so that the
@@ -117,25 +117,6 @@ struct SurfaceFlags {
   std::int32_t* flag = nullptr;  // one per pool block, by block index; nullptr: not kept
   float below = 0.f;             // metres
 };
-// The bits of a block's flag word (SurfaceFlags::flag): the surface flag, and where the block holds
-// an observed voxel with sdf <= 0 (the raycast's kMarchCross, block_march_flags below, reads them):
-// anywhere, and for k = 1..7 among its voxels with local coordinate 0 along each axis of k (bit
-// 1 << (1 + k); axis x if k & 1, y if k & 2, z if k & 4): the voxels that the cells of its lower
-// neighbour b - k read (a face for one axis, an edge for two, the corner voxel for three).
-constexpr std::int32_t kFlagSurface = 1;
-constexpr std::int32_t kFlagNonPositive = 2;
-SEAMLESS_HD constexpr std::int32_t flag_non_positive_toward(int k) { return 1 << (1 + k); }
-
-// The flag bits a voxel adds to its block's word (local coordinates l).
-SEAMLESS_HD inline std::int32_t voxel_flag_bits(const Voxel& v, int3 l, float surface_below) {
-  std::int32_t bits = voxel_keeps_block(v, surface_below) ? kFlagSurface : 0;
-  if (!(v.weight > 0.f && v.sdf <= 0.f)) return bits;
-  bits |= kFlagNonPositive;
-  const int on_zero = (l.x == 0 ? 1 : 0) | (l.y == 0 ? 2 : 0) | (l.z == 0 ? 4 : 0);  // axes where l is 0
-  for (int k = 1; k < 8; ++k)
-    if ((k & on_zero) == k) bits |= flag_non_positive_toward(k);
-  return bits;
-}
 
 // Free space in the voxel-hashed volume (docs/DYNAMIC.md "Evidence of free space"): as in
 // ReFusion (Palazzolo et al. 2019), the blocks along the whole ray in front of a reading are
@@ -167,7 +148,7 @@ template <Executor Exec> struct TsdfFusion {
                                   HashCounters* counters, FrameInput in, VoxelGeometry geom);
 
   // Appends to visible_slots every allocated block that the frame may change (counters->visible is
-  // the count) and zeroes its keep flag (keep may be empty) and its block's flag word (surface
+  // the count) and zeroes its keep flag (keep may be empty) and its block's surface flag (surface
   // may be nullptr; fuse_hash_blocks sets it again): blocks whose voxels may project into the
   // image, less those that tiles (when given) show to be occluded or unobserved. Also clamps
   // free_top after a failed allocation pass.
@@ -185,9 +166,8 @@ template <Executor Exec> struct TsdfFusion {
 
   // Fuses one frame into the listed blocks, one thread per column of 8 voxels. When keep is not empty, keep[j]
   // becomes 1 if block j still has a voxel near a surface afterwards (voxel_keeps_block), so that
-  // finding the empty blocks costs no second pass over the voxels. Likewise the flag word
-  // surface.flag (when set, and zeroed by find_visible_blocks; voxel_flag_bits) of each listed
-  // block's pool index, with surface.below.
+  // finding the empty blocks costs no second pass over the voxels. Likewise surface.flag (when
+  // set, and zeroed by find_visible_blocks) of each listed block's pool index, with surface.below.
   static void fuse_hash_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
                                Voxel* voxels, FrameInput in, VoxelGeometry geom, float max_weight, bool color,
                                View<std::int32_t> keep, float keep_below, SurfaceFlags surface = {});
@@ -200,8 +180,8 @@ template <Executor Exec> struct TsdfFusion {
   static void mark_kept_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
                                const Voxel* voxels, View<std::int32_t> keep, float keep_below);
 
-  // surface.flag[blocks[i]] = the flag word of block blocks[i] (skipped when < 0; voxel_flag_bits
-  // of its voxels), one thread per block: for blocks whose voxels were copied in (streaming).
+  // surface.flag[blocks[i]] = whether block blocks[i] (skipped when < 0) has a voxel near a
+  // surface, one thread per block: for blocks whose voxels were copied in (streaming).
   static void mark_surface_blocks(const Exec& ex, View<const std::int32_t> blocks, const Voxel* voxels,
                                   SurfaceFlags surface);
 
@@ -230,52 +210,35 @@ struct RayIntervals : TileGrid {
 constexpr std::int32_t kEmptyNear = 0x7f800000;  // +infinity
 constexpr std::int32_t kEmptyFar = 0;            // +0: no block splatted
 
-// The march's flags of a pool block (HashAccess::march_flags), set once a raycast from the flag
-// words above. The trilinear sample in the cell of voxel g0 reads the voxels g0 + {0,1}^3, which
-// lie in block b = g0 / 8 and in b + {0,1}^3 when g0 is on b's upper faces, so both flags look at b
-// and its 7 upper neighbours.
-//
-// kMarchNear: whether the block may hold a surface at all (docs/DYNAMIC.md "The surface flag").
-// A volume that stores free space keeps the blocks in front of the surfaces, whose voxels all hold
-// +truncation; the march would cross them in truncation-sized steps where it skips an unallocated
-// block whole. Block b is *near a surface* when it or one of its 7 upper neighbours has its surface
-// flag set; otherwise every voxel a sample in b's cells can read is unallocated, unobserved or at
-// least 0.999 truncation from a surface. A zero crossing there would have to jump from >= +0.999
-// to <= -0.999 truncation within one voxel, which fusion writes only across a depth discontinuity
-// and which the band-only volume's garbage collection frees with the block: the surfaces such a
-// block holds are none that the band-only volume keeps. The raycast treats a block not near a
-// surface as unallocated (skipped whole, and left out of the ray intervals), with one exception:
-// the first sample after one in a block near a surface is taken, so that a crossing between the two
-// (the march's step from just in front of a surface may land past it) is bracketed as before. The
+// Blocks without a surface (docs/DYNAMIC.md "The surface flag"). A volume that stores
+// free space keeps the blocks in front of the surfaces, whose voxels all hold +truncation; the
+// raycast would march through them in truncation-sized steps where it skips an unallocated block
+// whole. The trilinear sample in the cell of voxel g0 reads the voxels g0 + {0,1}^3, which lie in
+// block b = g0 / 8 and in b + {0,1}^3 when g0 is on b's upper faces. So block b is *near a
+// surface* when it or one of those 7 upper neighbours has its surface flag set (SurfaceFlags);
+// otherwise every voxel a sample in b's cells can read is unallocated, unobserved or at least
+// 0.999 truncation from a surface. A zero crossing there would have to jump from >= +0.999 to
+// <= -0.999 truncation within one voxel, which fusion writes only across a depth discontinuity and
+// which the band-only volume's garbage collection frees with the block: the surfaces such a block
+// holds are none that the band-only volume keeps. The raycast treats a block not near a surface
+// as unallocated (skipped whole, and left out of the ray intervals), with one exception: the first
+// sample after one in a block near a surface is taken, so that a crossing between the two (the
+// march's step from just in front of a surface may land past it) is bracketed as before. The
 // entry into the next block is then an entry from empty space, which the march already handles:
 // the sample just inside it cannot have crossed from a positive value at the border, since the
-// trilinear field changes by at most two truncations per voxel and the border's value interpolates
-// voxels at >= +0.999 truncation (or mixes signs: the jump above). Only a volume storing free space
-// asks (near_test); the band-only volume has freed those blocks already.
-//
-// kMarchCross: whether a sample in b's cells may be <= 0: b holds an observed voxel with sdf <= 0,
-// or an upper neighbour b + k does among the voxels b's cells read (its face, edge or corner at
-// local coordinate 0 along the axes of k: flag_non_positive_toward(k)). Without it every
-// value the trilinear field takes in b's cells is > 0, so no +/- crossing lies strictly inside b:
-// the march crosses it in one step instead of the ~3 samples a block of free space in front of a
-// surface costs, and brackets a crossing just behind it from a sample just before its exit (see
-// march_ray in tsdf_raycast.inl).
-constexpr std::int32_t kMarchNear = 1, kMarchCross = 2;
-SEAMLESS_HD inline std::int32_t block_march_flags(const HashTableView& t, const std::int32_t* flags, bool near_test,
-                                                  int3 b, std::int32_t block) {
-  const std::int32_t own = flags[block];
-  bool near = !near_test || (own & kFlagSurface), cross = (own & kFlagNonPositive) != 0;
-  for (int k = 1; k < 8 && !(near && cross); ++k) {
+// trilinear field changes by at most two truncations per voxel and the border's value
+// interpolates voxels at >= +0.999 truncation (or mixes signs: the jump above).
+SEAMLESS_HD inline bool block_near_surface(const HashTableView& t, const std::int32_t* surface, int3 b,
+                                           std::int32_t block) {
+  if (surface[block]) return true;
+  for (int k = 1; k < 8; ++k) {
     const int3 n{b.x + (k & 1), b.y + ((k >> 1) & 1), b.z + (k >> 2)};
     if (!block_in_range(n)) continue;
     const std::int32_t s = t.find_stable(pack_block(n));
     const std::int32_t i = s < 0 ? -1 : t.values[s];
-    if (i < 0) continue;
-    const std::int32_t f = flags[i];
-    near = near || (f & kFlagSurface);
-    cross = cross || (f & flag_non_positive_toward(k));
+    if (i >= 0 && surface[i]) return true;
   }
-  return (near ? kMarchNear : 0) | (cross ? kMarchCross : 0);
+  return false;
 }
 
 template <Executor Exec, class Acc = HashAccess> struct TsdfRaycast {
@@ -286,26 +249,23 @@ template <Executor Exec, class Acc = HashAccess> struct TsdfRaycast {
   // ray can take in the block lies in it), clipped to the depth slab [min_depth, max_depth], is
   // projected, and the tiles under its pixel bounding box take the min / max of its depth range.
   // With a window w (cleared by clear_ray_intervals) the same pass fills it, as fill_block_window
-  // does: one pass over the slots instead of two. With flag words (per pool block) the same pass
-  // also sets march[block] = block_march_flags(...) and splats only the blocks near a surface.
+  // does: one pass over the slots instead of two. With surface flags (per pool block) the same
+  // pass also sets near[block] = block_near_surface(...) and splats only the blocks near a surface.
   static void splat_ray_intervals(const Exec& ex, HashTableView t, VoxelGeometry geom, Intrinsics K, SE3 world_T_camera,
                                   float min_depth, float max_depth, RayIntervals iv, BlockWindow w = {},
-                                  const std::int32_t* flags = nullptr, bool near_test = false,
-                                  std::int32_t* march = nullptr);
+                                  const std::int32_t* surface = nullptr, std::int32_t* near = nullptr);
 
-  // march[block] = block_march_flags(...) for every live block (one thread per hash slot): the
-  // stand-alone version of what splat_ray_intervals does with flag words.
-  static void mark_march_flags(const Exec& ex, HashTableView t, const std::int32_t* flags, bool near_test,
-                               std::int32_t* march);
+  // near[block] = block_near_surface(...) for every live block (one thread per hash slot): the
+  // stand-alone version of what splat_ray_intervals does with surface flags.
+  static void mark_near_surface(const Exec& ex, HashTableView t, const std::int32_t* surface, std::int32_t* near);
 
   // Fills window w from the hash table: -1 everywhere, then the pool index of every live block
   // inside it. Run after the last change to the table and before the kernels that read through it.
   static void fill_block_window(const Exec& ex, HashTableView t, BlockWindow w);
 
   // One ray per pixel from min_depth to max_depth, or only over its tile's interval when iv.bits is
-  // set: skips unallocated blocks whole (and, when the accessor has march flags, blocks not near a
-  // surface, and crosses blocks whose samples are all > 0 in one step), steps by the TSDF inside
-  // the others, refines the +/- zero crossing by
+  // set: skips unallocated blocks whole (and blocks not near a surface, when the accessor has
+  // near_surface flags), steps by the TSDF inside the others, refines the +/- zero crossing by
   // regula falsi on the trilinear field (KinectFusion section 3.5; Niessner section 4.3); a second
   // pass takes each hit's normal from its neighbours' vertices (vertex_map_normal). A ray starting
   // before its tile's near depth is in skipped blocks up to there, where the full march skips

@@ -189,17 +189,6 @@ SEAMLESS_HD inline void set_keep(std::int32_t* flag) {
   if (atomic_load(flag) == 0) atomic_exch(flag, 1);
 }
 
-// *word |= bits, by compare-and-swap (the columns of a block set their bits concurrently); no
-// write when they are all set already.
-SEAMLESS_HD inline void set_bits(std::int32_t* word, std::int32_t bits) {
-  std::int32_t old = atomic_load(word);
-  while ((old & bits) != bits) {
-    const std::int32_t seen = atomic_cas(word, old, old | bits);
-    if (seen == old) return;
-    old = seen;
-  }
-}
-
 // Free-space carving (after ReFusion, Palazzolo et al. 2019, section III-D): the voxel
 // lies more than in.carve in front of the reading at its pixel and of the 3x3 readings around it,
 // so the ray saw through it: whatever surface it held (a person who stood there) is gone. The
@@ -272,18 +261,17 @@ void TsdfFusion<Exec>::fuse_hash_blocks(const Exec& ex, HashTableView t, View<co
     // transform (to_world's, and the x and y products of each row's dot product, summed first)
     // once a column instead of once a voxel. The same operations in the same order: same values.
     const int3 l = local_coords(column);
-    bool kept = false;
-    std::int32_t bits = 0;
+    bool kept = false, surface_near = false;
 #pragma unroll
     for (int z = 0; z < kBlockSide; ++z) {
       const vec3 g{float(b.x * 8 + l.x), float(b.y * 8 + l.y), float(b.z * 8 + z)};
       Voxel& vz = v[kColumns * z];
       fuse_voxel(vz, geom.to_world(g), in, camera_T_world, geom.truncation, max_weight, color);
       kept = kept || (keep.data && voxel_keeps_block(vz, keep_below));
-      if (surface.flag) bits |= voxel_flag_bits(vz, int3{l.x, l.y, z}, surface.below);
+      surface_near = surface_near || (surface.flag && voxel_keeps_block(vz, surface.below));
     }
     if (kept) set_keep(&keep[j]);
-    if (bits) set_bits(&surface.flag[block], bits);
+    if (surface_near) set_keep(&surface.flag[block]);
   });
 }
 
@@ -324,7 +312,7 @@ void TsdfFusion<Exec>::mark_surface_blocks(const Exec& ex, View<const std::int32
     if (block < 0) return;
     const Voxel* v = voxels + static_cast<std::int64_t>(block) * kBlockVoxels;
     std::int32_t flag = 0;
-    for (int k = 0; k < kBlockVoxels; ++k) flag |= voxel_flag_bits(v[k], local_coords(k), surface.below);
+    for (int k = 0; k < kBlockVoxels && !flag; ++k) flag = voxel_keeps_block(v[k], surface.below) ? 1 : 0;
     surface.flag[block] = flag;
   });
 }

@@ -71,8 +71,7 @@ void TsdfRaycast<Exec, Acc>::clear_ray_intervals(const Exec& ex, RayIntervals iv
 template <Executor Exec, class Acc>
 void TsdfRaycast<Exec, Acc>::splat_ray_intervals(const Exec& ex, HashTableView t, VoxelGeometry geom, Intrinsics K,
                                                  SE3 world_T_camera, float min_depth, float max_depth, RayIntervals iv,
-                                                 BlockWindow w, const std::int32_t* flags, bool near_test,
-                                                 std::int32_t* march) {
+                                                 BlockWindow w, const std::int32_t* surface, std::int32_t* near) {
   const SE3 camera_T_world = world_T_camera.inverse();
   const float zn = fmaxf(min_depth, 1e-3f);
   ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
@@ -83,10 +82,10 @@ void TsdfRaycast<Exec, Acc>::splat_ray_intervals(const Exec& ex, HashTableView t
       const std::int64_t e = w.entry(unpack_block(k));
       if (e >= 0) w.index[e] = block;  // keys are unique: one writer per entry
     }
-    if (flags) {  // a block the march skips needs no interval (see block_march_flags)
-      const std::int32_t m = block_march_flags(t, flags, near_test, unpack_block(k), block);
-      march[block] = m;
-      if (!(m & kMarchNear)) return;
+    if (surface) {  // a block the march skips needs no interval (see block_near_surface)
+      const bool n = block_near_surface(t, surface, unpack_block(k), block);
+      near[block] = n ? 1 : 0;
+      if (!n) return;
     }
     ScreenBounds s;
     if (!block_screen_bounds(unpack_block(k), geom, K, camera_T_world, zn, max_depth, &s)) return;
@@ -107,13 +106,13 @@ void TsdfRaycast<Exec, Acc>::splat_ray_intervals(const Exec& ex, HashTableView t
 }
 
 template <Executor Exec, class Acc>
-void TsdfRaycast<Exec, Acc>::mark_march_flags(const Exec& ex, HashTableView t, const std::int32_t* flags,
-                                              bool near_test, std::int32_t* march) {
+void TsdfRaycast<Exec, Acc>::mark_near_surface(const Exec& ex, HashTableView t, const std::int32_t* surface,
+                                               std::int32_t* near) {
   ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
     const HashKey k = t.keys[i];
     const std::int32_t block = t.values[i];
     if (!is_live_key(k) || block < 0) return;
-    march[block] = block_march_flags(t, flags, near_test, unpack_block(k), block);
+    near[block] = block_near_surface(t, surface, unpack_block(k), block) ? 1 : 0;
   });
 }
 
@@ -128,13 +127,14 @@ void TsdfRaycast<Exec, Acc>::fill_block_window(const Exec& ex, HashTableView t, 
   });
 }
 
-// The march flags of block i (>= 0; block_march_flags in tsdf.hpp): both set unless the accessor
-// has march flags (HashAccess::march_flags).
-template <class Acc> SEAMLESS_HD inline std::int32_t march_flags(const Acc& a, std::int32_t i) {
-  if constexpr (requires { a.march_flags; }) {
-    return a.march_flags ? a.march_flags[i] : kMarchNear | kMarchCross;
+// Whether block i (>= 0) may hold a surface for the march: false only where the accessor has
+// near-surface flags (a volume storing free space; block_near_surface in tsdf.hpp) and block i's
+// is 0, so that the march skips it like an unallocated block.
+template <class Acc> SEAMLESS_HD inline bool near_surface(const Acc& a, std::int32_t i) {
+  if constexpr (requires { a.near_surface; }) {
+    return !a.near_surface || a.near_surface[i];
   } else {
-    return kMarchNear | kMarchCross;
+    return true;
   }
 }
 
@@ -143,13 +143,6 @@ template <class Acc> SEAMLESS_HD inline std::int32_t march_flags(const Acc& a, s
 // refined by three steps of regula falsi on the trilinear field, taken by the same loop: its
 // samples then run through the one copy of the sample code (on the GPU the kernel's size, not its
 // arithmetic, held the march back: most warps waited on instruction fetch).
-//
-// Coarse, then fine: unallocated blocks and blocks whose samples are all > 0 (no kMarchCross) are
-// crossed in one step each, read from the flags alone; inside the other blocks the steps follow
-// the TSDF, down to half a voxel at the surface. Where a crossed block is followed by a first
-// sample <= 0, the crossing lies between the block's exit and that sample: the march then takes
-// one sample just before the exit (> 0 there) and brackets the crossing between the two, so the
-// same zero of the same trilinear field is refined as when the block's samples were taken.
 template <class Acc>
 SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z_end, BlockCache& c, float* hit) {
   const float dlen = length(d);        // voxels per metre of depth
@@ -166,25 +159,19 @@ SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z
   bool have_prev = false, prev_near = false;     // prev_near: the last sample's block is near a surface
   int refine = -1;                               // -1: marching; else regula falsi steps taken
   float ta = 0.f, fa = 0.f, tb = 0.f, fb = 0.f;  // the bracket: fa > 0 at ta, fb <= 0 at tb
-  float z_back = -1.f;                           // >= 0: just before the exit of the block crossed last
-  float z_neg = -1.f, f_neg = 0.f;               // >= 0: a sample <= 0 waiting for the one at z_back
   for (int it = 0; refine >= 0 || (it < 8192 && z < z_end); ++it) {
     vec3 q = o + d * z;
     const int3 g0 = floor_to_int(q), b = block_of_voxel(g0);
     const std::int32_t i0 = cached_block(a, b, c);
-    // Every sample is taken while refining a bracket or looking back from a sample <= 0.
-    const bool exact = refine >= 0 || z_neg >= 0.f;
-    const std::int32_t m = i0 >= 0 ? march_flags(a, i0) : 0;
-    // Skipped: unallocated, or not near a surface while marching, except for one sample right
-    // after a sample in a block near a surface: a crossing between the two (the step from the
-    // last sample in front of a surface may land past it) is then bracketed as without the flags
-    // (block_march_flags in tsdf.hpp).
-    const bool near = i0 >= 0 && (exact || (m & kMarchNear));
+    // Skipped: unallocated, or not near a surface while marching (not while refining a bracket),
+    // except for one sample right after a sample in a block near a surface: a crossing between
+    // the two (the step from the last sample in front of a surface may land past it) is then
+    // bracketed as without the flags (block_near_surface in tsdf.hpp).
+    const bool near = i0 >= 0 && (refine >= 0 || near_surface(a, i0));
     const bool skip = i0 < 0 || (!near && !(have_prev && prev_near));
-    const bool cross_block = !skip && !exact && !(m & kMarchCross);  // its samples are all > 0
     float f = 0.f;
-    const bool sampled = !skip && !cross_block && sample_tsdf_in(a, q, g0, i0, c, &f);  // no second lookup
-    if (refine >= 0) {      // regula falsi between the bracket's ends
+    const bool sampled = !skip && sample_tsdf_in(a, q, g0, i0, c, &f);  // the block just found: no second lookup
+    if (refine >= 0) {                                                  // regula falsi between the bracket's ends
       if (!sampled) break;  // no value here: the last estimate, z, is the hit
       if (f > 0.f) ta = z, fa = f;
       else tb = z, fb = f;
@@ -192,34 +179,16 @@ SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z
       if (++refine == kRefineSteps) break;
       continue;
     }
-    if (z_neg >= 0.f) {  // the sample just before the crossed block's exit
-      if (sampled && f > 0.f) {
-        ta = z, fa = f, tb = z_neg, fb = f_neg, refine = 0;
-        z = ta + (tb - ta) * fa / (fa - fb);
-      } else {  // no value > 0 there (rounding at the block's face): go on from the sample <= 0
-        z_prev = z_neg, f_prev = f_neg, have_prev = true, prev_near = true;
-        z = z_neg + max_of(fabsf(f_neg) * step_per_sdf, min_step);
-      }
-      z_neg = -1.f;
-      continue;
-    }
-    if (skip || cross_block) {  // empty space (Niessner section 4.3) or a block of free space: one step
-      const float exit = max_of(block_exit(o, d, inv_d, b), z);
-      z_back = skip ? -1.f : max_of(exit - min_step * 0.1f, z);
-      z = exit + min_step * 0.1f;
+    if (skip) {  // empty space: skip the whole block (Niessner section 4.3)
+      z = max_of(block_exit(o, d, inv_d, b), z) + min_step * 0.1f;
       have_prev = false;
       continue;
     }
     if (!sampled) {
       z += unobserved_step;
-      have_prev = false, z_back = -1.f;
+      have_prev = false;
       continue;
     }
-    if (!have_prev && z_back >= 0.f && f <= 0.f) {  // right behind a crossed block: look back
-      z_neg = z, f_neg = f, z = z_back, z_back = -1.f;
-      continue;
-    }
-    z_back = -1.f;
     if (have_prev && f_prev > 0.f && f <= 0.f) {
       ta = z_prev, fa = f_prev, tb = z, fb = f, refine = 0;
       z = ta + (tb - ta) * fa / (fa - fb);

@@ -159,10 +159,10 @@ struct HashAccess {
   HashTableView table;
   Voxel* voxels = nullptr;
   VoxelGeometry geom;
-  // Per pool block, for the raycast only: its march flags (block_march_flags in tsdf.hpp): a block
-  // without kMarchNear is skipped like an unallocated one, a block without kMarchCross is crossed
-  // in one step. nullptr (every other user): every block is marched through.
-  const std::int32_t* march_flags = nullptr;
+  // Per pool block, for the raycast only: 0 where the block is not near a surface
+  // (block_near_surface in tsdf.hpp), which the march then skips like an unallocated block.
+  // nullptr (every other user): no block is skipped.
+  const std::int32_t* near_surface = nullptr;
   SEAMLESS_HD std::int32_t find_block(int3 b) const {
     if (!block_in_range(b)) return -1;
     std::int32_t s = table.find_stable(pack_block(b));

@@ -363,8 +363,7 @@ std::vector<VoxelHashVolume::HostBlock> VoxelHashVolume::download_blocks() const
   for (std::int64_t i = 0; i < n; ++i) {
     out[i].coord = kernels::unpack_block(hk[i]);
     out[i].voxels.assign(hv.begin() + i * kBlockVoxels, hv.begin() + (i + 1) * kBlockVoxels);
-    out[i].flags = flags[hb[i]];
-    out[i].surface = (out[i].flags & kernels::kFlagSurface) != 0;
+    out[i].surface = flags[hb[i]] != 0;
   }
   std::sort(out.begin(), out.end(), [](const HostBlock& a, const HostBlock& b) {
     return std::tie(a.coord.x, a.coord.y, a.coord.z) < std::tie(b.coord.x, b.coord.y, b.coord.z);
@@ -401,13 +400,14 @@ void VoxelHashVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, Ra
     intervals_.reserve_discard(2 * grid.count(), device_);
     iv = {grid, intervals_.data()};
   }
-  // The march crosses the blocks whose samples are all > 0 in one step, and with free space stored
-  // skips the blocks not near a surface as it skips unallocated ones (kernels::block_march_flags;
-  // the band-only volume has freed those blocks already).
+  // With free space stored, the march skips the blocks not near a surface as it skips unallocated
+  // ones (kernels::block_near_surface); the band-only volume has freed those blocks already.
   kernels::HashAccess view = device_view();
-  near_.reserve_discard(static_cast<std::int64_t>(pool_size()), device_);
-  view.march_flags = near_.data();
-  const std::int32_t* flags = surface_.data();
+  const std::int32_t* surface = nullptr;
+  if (store_free_space_) {
+    near_.reserve_discard(static_cast<std::int64_t>(pool_size()), device_);
+    surface = surface_.data(), view.near_surface = near_.data();
+  }
   with_exec(device_, [&]<class E>(const E& ex) {
     staged(timer, "raycast", [&] {
       const kernels::BlockWindow w = raycast_window(world_T_camera);
@@ -415,10 +415,9 @@ void VoxelHashVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, Ra
         staged(timer, "raycast_splat", [&] {  // part of "raycast"
           kernels::TsdfRaycast<E>::clear_ray_intervals(ex, iv, w);
           kernels::TsdfRaycast<E>::splat_ray_intervals(ex, table(), geom_, K, world_T_camera, params_.min_depth,
-                                                       params_.max_depth, iv, w, flags, store_free_space_,
-                                                       near_.data());
+                                                       params_.max_depth, iv, w, surface, near_.data());
         });
-      else kernels::TsdfRaycast<E>::mark_march_flags(ex, table(), flags, store_free_space_, near_.data());
+      else if (surface) kernels::TsdfRaycast<E>::mark_near_surface(ex, table(), surface, near_.data());
       if (!w.index) {
         kernels::TsdfRaycast<E, kernels::HashAccess>::raycast(ex, view, K, world_T_camera, params_.min_depth,
                                                               params_.max_depth, out, iv);

@@ -45,7 +45,6 @@ class VoxelHashVolume final : public Volume {
     int3 coord;
     std::vector<kernels::Voxel> voxels;  // 512, x fastest
     bool surface = false;                // its surface flag (kernels::SurfaceFlags)
-    std::int32_t flags = 0;              // its whole flag word (kernels::kFlagSurface, ...)
   };
   std::vector<HostBlock> download_blocks() const;
   // Block coordinates of the allocated blocks, sorted like download_blocks().
@@ -109,8 +108,8 @@ class VoxelHashVolume final : public Volume {
   Buffer<kernels::HashCounters> counters_;
   Buffer<std::int32_t> visible_;
   Buffer<std::int32_t> keep_;             // per visible block: 1 = has a voxel near a surface
-  Buffer<std::int32_t> surface_;          // per pool block: its flag word (kernels::SurfaceFlags)
-  Buffer<std::int32_t> near_;             // per pool block, per raycast: kernels::block_march_flags
+  Buffer<std::int32_t> surface_;          // per pool block: its surface flag (kernels::SurfaceFlags)
+  Buffer<std::int32_t> near_;             // per pool block, per raycast: kernels::block_near_surface
   Buffer<std::int32_t> intervals_;        // ray-interval tiles (kernels::RayIntervals)
   Buffer<std::int32_t> depth_tiles_;      // the frame's farthest reading per tile (kernels::DepthTiles)
   Buffer<std::int32_t> window_;           // the raycast's block-index window (kernels::BlockWindow)

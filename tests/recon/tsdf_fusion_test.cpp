@@ -533,7 +533,7 @@ TEST(TsdfParity, StoredFreeSpace) {
 // voxels agree to 1e-5 m (expect_same_blocks), and each backend's flags are their definition on
 // its own voxels (the same float comparison), so the flags differ at most where a voxel lies
 // within 1e-5 m of the threshold. The raycast, with the ray intervals (whose pass also marks the
-// blocks near a surface) and without (mark_march_flags), as TsdfParity.SameBlocksAndValues
+// blocks near a surface) and without (mark_near_surface), as TsdfParity.SameBlocksAndValues
 // compares it: a ray grazing a block edge may go either way, depths within 1e-4 m.
 TEST(TsdfParity, SurfaceFlagsAndRaycastWithStoredFreeSpace) {
   if (!cuda_available()) GTEST_SKIP() << "no CUDA device";
