@@ -61,11 +61,14 @@ template <Executor Exec> struct VoxelHash {
   static void hash_gather(const Exec& ex, HashTableView t, View<const std::int32_t> slots, View<HashKey> keys_out,
                           View<std::int32_t> values_out);
 
-  // Copies whole blocks out of / into the pool: out[i*512 + k] = pool[blocks[i]*512 + k] and back
-  // (host download, streaming, dense <-> hash conversion); scatter skips blocks[i] < 0.
-  static void gather_blocks(const Exec& ex, const Voxel* pool, View<const std::int32_t> blocks, View<Voxel> out);
+  // Copies whole blocks out of / into the pools of voxels and colours: out[i*512 + k] =
+  // pool[blocks[i]*512 + k] and back, the same for colours (host download, streaming, dense <->
+  // hash conversion); scatter skips blocks[i] < 0.
+  static void gather_blocks(const Exec& ex, const Voxel* pool, const uchar3* colors, View<const std::int32_t> blocks,
+                            View<Voxel> out, View<uchar3> out_colors);
 
-  static void scatter_blocks(const Exec& ex, Voxel* pool, View<const std::int32_t> blocks, View<const Voxel> in);
+  static void scatter_blocks(const Exec& ex, Voxel* pool, uchar3* colors, View<const std::int32_t> blocks,
+                             View<const Voxel> in, View<const uchar3> in_colors);
 };
 
 // --- per-frame fusion (family recon/tsdf_fusion) -----------------------------------------------
@@ -169,8 +172,8 @@ template <Executor Exec> struct TsdfFusion {
   // finding the empty blocks costs no second pass over the voxels. Likewise surface.flag (when
   // set, and zeroed by find_visible_blocks) of each listed block's pool index, with surface.below.
   static void fuse_hash_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
-                               Voxel* voxels, FrameInput in, VoxelGeometry geom, float max_weight, bool color,
-                               View<std::int32_t> keep, float keep_below, SurfaceFlags surface = {});
+                               Voxel* voxels, uchar3* colors, FrameInput in, VoxelGeometry geom, float max_weight,
+                               bool color, View<std::int32_t> keep, float keep_below, SurfaceFlags surface = {});
 
   // Fuses one frame into every block of a dense grid.
   static void fuse_dense_blocks(const Exec& ex, DenseAccess grid, FrameInput in, float max_weight, bool color);
@@ -185,11 +188,11 @@ template <Executor Exec> struct TsdfFusion {
   static void mark_surface_blocks(const Exec& ex, View<const std::int32_t> blocks, const Voxel* voxels,
                                   SurfaceFlags surface);
 
-  // Frees the listed blocks whose keep flag is 0: zeroes their voxels, tombstones their keys and
-  // pushes them on the free list (counters->removed counts). A few threads per block.
+  // Frees the listed blocks whose keep flag is 0: zeroes their voxels and colours, tombstones their
+  // keys and pushes them on the free list (counters->removed counts). A few threads per block.
   static void remove_unkept_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
-                                   View<const std::int32_t> keep, Voxel* voxels, View<std::int32_t> free_list,
-                                   HashCounters* counters);
+                                   View<const std::int32_t> keep, Voxel* voxels, uchar3* colors,
+                                   View<std::int32_t> free_list, HashCounters* counters);
 };
 
 // --- raycasting (family recon/tsdf_raycast) ----------------------------------------------------

@@ -101,7 +101,7 @@ void TsdfExtract<Exec, Acc>::mesh_emit(const Exec& ex, Acc a, View<const int3> b
       vec3 n = normalize(tsdf_gradient(a, q, 0.f, c, &complete));
       if (!complete) n = normalize(cell_gradient(v, q - to_vec3(g)));
       normals[out] = n;
-      uchar3 k0 = v[c0]->color, k1 = v[c1]->color;
+      const uchar3 k0 = a.colors[v[c0] - a.voxels], k1 = a.colors[v[c1] - a.voxels];
       colors[out] = {static_cast<std::uint8_t>(k0.x * (1.f - t) + k1.x * t + 0.5f),
                      static_cast<std::uint8_t>(k0.y * (1.f - t) + k1.y * t + 0.5f),
                      static_cast<std::uint8_t>(k0.z * (1.f - t) + k1.z * t + 0.5f)};

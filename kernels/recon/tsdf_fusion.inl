@@ -208,8 +208,9 @@ SEAMLESS_HD inline bool carved(const FrameInput& in, int u, int v, float z) {
 // Weighted running average of the truncated signed distance (Curless & Levoy 1996; KinectFusion
 // eq. 11-13) with the weight capped at max_weight so the model can follow change. The distance is
 // projective (along z), as in KinectFusion and Niessner; colour is averaged only near the surface.
-SEAMLESS_HD inline void fuse_voxel(Voxel& v, vec3 p_world, const FrameInput& in, const SE3& camera_T_world, float mu,
-                                   float max_weight, bool color) {
+// v_color: the voxel's colour (nullptr: no colour fused).
+SEAMLESS_HD inline void fuse_voxel(Voxel& v, uchar3* v_color, vec3 p_world, const FrameInput& in,
+                                   const SE3& camera_T_world, float mu, float max_weight) {
   vec3 pc = camera_T_world * p_world;
   if (pc.z <= 0.f) return;
   vec2 uv = in.K.project(pc);
@@ -227,20 +228,21 @@ SEAMLESS_HD inline void fuse_voxel(Voxel& v, vec3 p_world, const FrameInput& in,
   float tsdf = min_of(sdf, mu);
   float wt = v.weight;
   v.sdf = (v.sdf * wt + tsdf) / (wt + 1.f);
-  if (color && in.rgb.data && sdf < mu) {
-    uchar3 c = in.rgb(u, w);
-    auto avg = [&](std::uint8_t old, std::uint8_t obs) {
-      return static_cast<std::uint8_t>(min_of((old * wt + obs) / (wt + 1.f) + 0.5f, 255.f));
+  if (v_color && in.rgb.data && sdf < mu) {
+    const uchar3 c = in.rgb(u, w), old = *v_color;
+    auto avg = [&](std::uint8_t o, std::uint8_t obs) {
+      return static_cast<std::uint8_t>(min_of((o * wt + obs) / (wt + 1.f) + 0.5f, 255.f));
     };
-    v.color = {avg(v.color.x, c.x), avg(v.color.y, c.y), avg(v.color.z, c.z)};
+    *v_color = {avg(old.x, c.x), avg(old.y, c.y), avg(old.z, c.z)};
   }
   v.weight = min_of(wt + 1.f, max_weight);
 }
 
 template <Executor Exec>
 void TsdfFusion<Exec>::fuse_hash_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots,
-                                        std::int64_t count, Voxel* voxels, FrameInput in, VoxelGeometry geom,
-                                        float max_weight, bool color, View<std::int32_t> keep, float keep_below,
+                                        std::int64_t count, Voxel* voxels, uchar3* colors, FrameInput in,
+                                        VoxelGeometry geom, float max_weight, bool color, View<std::int32_t> keep,
+                                        float keep_below,
                                         SurfaceFlags surface) {
   const SE3 camera_T_world = in.world_T_camera.inverse();
   // One thread per column of a block (its 8 voxels along z, 64 threads a block): the block's slot,
@@ -256,7 +258,9 @@ void TsdfFusion<Exec>::fuse_hash_blocks(const Exec& ex, HashTableView t, View<co
     if (block < 0) return;
     const int3 b = unpack_block(t.keys[slot]);
     const int column = static_cast<int>(i % kColumns);
-    Voxel* v = voxels + static_cast<std::int64_t>(block) * kBlockVoxels + column;
+    const std::int64_t first = static_cast<std::int64_t>(block) * kBlockVoxels + column;
+    Voxel* v = voxels + first;
+    uchar3* vc = color ? colors + first : nullptr;
     // The column's x and y are fixed: written so, the compiler computes their part of the
     // transform (to_world's, and the x and y products of each row's dot product, summed first)
     // once a column instead of once a voxel. The same operations in the same order: same values.
@@ -266,7 +270,8 @@ void TsdfFusion<Exec>::fuse_hash_blocks(const Exec& ex, HashTableView t, View<co
     for (int z = 0; z < kBlockSide; ++z) {
       const vec3 g{float(b.x * 8 + l.x), float(b.y * 8 + l.y), float(b.z * 8 + z)};
       Voxel& vz = v[kColumns * z];
-      fuse_voxel(vz, geom.to_world(g), in, camera_T_world, geom.truncation, max_weight, color);
+      fuse_voxel(vz, vc ? vc + kColumns * z : nullptr, geom.to_world(g), in, camera_T_world, geom.truncation,
+                 max_weight);
       kept = kept || (keep.data && voxel_keeps_block(vz, keep_below));
       surface_near = surface_near || (surface.flag && voxel_keeps_block(vz, surface.below));
     }
@@ -287,7 +292,8 @@ void TsdfFusion<Exec>::fuse_dense_blocks(const Exec& ex, DenseAccess grid, Frame
     int3 b{static_cast<int>(block % n), static_cast<int>((block / n) % n), static_cast<int>(block / n / n)};
     int3 l = local_coords(li);
     vec3 g{float(b.x * 8 + l.x), float(b.y * 8 + l.y), float(b.z * 8 + l.z)};
-    fuse_voxel(grid.voxels[i], grid.geom.to_world(g), in, camera_T_world, grid.geom.truncation, max_weight, color);
+    fuse_voxel(grid.voxels[i], color ? grid.colors + i : nullptr, grid.geom.to_world(g), in, camera_T_world,
+               grid.geom.truncation, max_weight);
   });
 }
 
@@ -320,9 +326,9 @@ void TsdfFusion<Exec>::mark_surface_blocks(const Exec& ex, View<const std::int32
 template <Executor Exec>
 void TsdfFusion<Exec>::remove_unkept_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots,
                                             std::int64_t count, View<const std::int32_t> keep, Voxel* voxels,
-                                            View<std::int32_t> free_list, HashCounters* counters) {
+                                            uchar3* colors, View<std::int32_t> free_list, HashCounters* counters) {
   // kParts threads per block, each zeroing 512 / kParts voxels: one thread clearing a whole block
-  // (6 KiB) would hold up the kernel. Part 0 also frees the slot and the block; the block is not
+  // (5.5 KiB with its colours) would hold up the kernel. Part 0 also frees the slot and the block; the block is not
   // handed out again before the next allocation kernel, after this one has finished. The slot's
   // value is left as it is (as hash_erase does): nobody reads the value of a tombstone.
   constexpr int kParts = 8, kPerPart = kBlockVoxels / kParts;
@@ -333,8 +339,8 @@ void TsdfFusion<Exec>::remove_unkept_blocks(const Exec& ex, HashTableView t, Vie
     std::int32_t slot = slots[j];
     std::int32_t block = t.values[slot];
     if (block < 0) return;
-    Voxel* v = voxels + static_cast<std::int64_t>(block) * kBlockVoxels + part * kPerPart;
-    for (int k = 0; k < kPerPart; ++k) v[k] = Voxel{0.f, 0.f, {0, 0, 0}, 0};
+    const std::int64_t first = static_cast<std::int64_t>(block) * kBlockVoxels + part * kPerPart;
+    for (int k = 0; k < kPerPart; ++k) voxels[first + k] = Voxel{0.f, 0.f}, colors[first + k] = uchar3{0, 0, 0};
     if (part != 0) return;
     atomic_exch(&t.keys[slot], kTombstone);
     pool_push(counters, free_list.data, block);

@@ -143,19 +143,24 @@ void VoxelHash<Exec>::hash_gather(const Exec& ex, HashTableView t, View<const st
 }
 
 template <Executor Exec>
-void VoxelHash<Exec>::gather_blocks(const Exec& ex, const Voxel* pool, View<const std::int32_t> blocks,
-                                    View<Voxel> out) {
+void VoxelHash<Exec>::gather_blocks(const Exec& ex, const Voxel* pool, const uchar3* colors,
+                                    View<const std::int32_t> blocks, View<Voxel> out, View<uchar3> out_colors) {
   ex.for_each(blocks.size * kBlockVoxels, [=] SEAMLESS_HD(std::int64_t i) {
-    out[i] = pool[static_cast<std::int64_t>(blocks[i / kBlockVoxels]) * kBlockVoxels + i % kBlockVoxels];
+    const std::int64_t k = static_cast<std::int64_t>(blocks[i / kBlockVoxels]) * kBlockVoxels + i % kBlockVoxels;
+    out[i] = pool[k];
+    out_colors[i] = colors[k];
   });
 }
 
 template <Executor Exec>
-void VoxelHash<Exec>::scatter_blocks(const Exec& ex, Voxel* pool, View<const std::int32_t> blocks,
-                                     View<const Voxel> in) {
+void VoxelHash<Exec>::scatter_blocks(const Exec& ex, Voxel* pool, uchar3* colors, View<const std::int32_t> blocks,
+                                     View<const Voxel> in, View<const uchar3> in_colors) {
   ex.for_each(blocks.size * kBlockVoxels, [=] SEAMLESS_HD(std::int64_t i) {
     const std::int32_t block = blocks[i / kBlockVoxels];
-    if (block >= 0) pool[static_cast<std::int64_t>(block) * kBlockVoxels + i % kBlockVoxels] = in[i];
+    if (block < 0) return;
+    const std::int64_t k = static_cast<std::int64_t>(block) * kBlockVoxels + i % kBlockVoxels;
+    pool[k] = in[i];
+    colors[k] = in_colors[i];
   });
 }
 

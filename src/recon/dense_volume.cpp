@@ -19,6 +19,8 @@ DenseVolume::DenseVolume(const VolumeParams& p, Device d) : params_(p), device_(
   const std::int64_t n = blocks_per_side_;
   voxels_ = Buffer<kernels::Voxel>(n * n * n * kernels::kBlockVoxels, d);
   voxels_.zero();
+  colors_ = Buffer<uchar3>(n * n * n * kernels::kBlockVoxels, d);
+  colors_.zero();
   std::vector<int3> coords;
   coords.reserve(static_cast<std::size_t>(n * n * n));
   for (int z = 0; z < n; ++z)
@@ -82,9 +84,9 @@ VolumeStats DenseVolume::stats() {
   s.frames = frames_;
   s.allocated_blocks = s.block_capacity = block_coords_.size();
   s.visible_blocks = s.allocated_blocks;
-  s.bytes_per_block = sizeof(kernels::Voxel) * kernels::kBlockVoxels;
-  s.voxel_bytes = voxels_.bytes();
-  s.device_bytes = voxels_.bytes() + block_coords_.bytes();
+  s.bytes_per_block = (sizeof(kernels::Voxel) + sizeof(uchar3)) * kernels::kBlockVoxels;
+  s.voxel_bytes = voxels_.bytes() + colors_.bytes();
+  s.device_bytes = voxels_.bytes() + colors_.bytes() + block_coords_.bytes();
   return s;
 }
 

@@ -29,7 +29,7 @@ class DenseVolume final : public Volume {
   Device device() const override { return device_; }
   const VolumeParams& params() const override { return params_; }
 
-  kernels::DenseAccess device_view() const { return {voxels_.data(), blocks_per_side_, geom_}; }
+  kernels::DenseAccess device_view() const { return {voxels_.data(), colors_.data(), blocks_per_side_, geom_}; }
 
  private:
   VolumeParams params_;
@@ -37,6 +37,7 @@ class DenseVolume final : public Volume {
   kernels::VoxelGeometry geom_;
   int blocks_per_side_;
   Buffer<kernels::Voxel> voxels_;
+  Buffer<uchar3> colors_;  // the colour of voxels_[i] at colors_[i]
   Buffer<int3> block_coords_;
   std::int64_t frames_ = 0;
 };

@@ -38,10 +38,10 @@ struct VolumeParams {
   float stream_step = 0.25f;   // camera travel (metres) between two streaming passes
 
   // The pool a voxel-hashed volume starts with. capacity 0 chooses by the device: on CUDA 2^18
-  // blocks (1.5 GiB of 12-byte voxels), reserved up front because growing there stops the frame
-  // and briefly holds the old and the new pool on the GPU; on the CPU 4096 blocks (24 MiB), grown
+  // blocks (1.4 GiB of 8-byte voxels and 3-byte colours), reserved up front because growing there stops the frame
+  // and briefly holds the old and the new pool on the GPU; on the CPU 4096 blocks (22 MiB), grown
   // by doubling as the scan needs them (grow_when_full), so a small scan does not reserve and zero
-  // 1.5 GiB of host memory. Without grow_when_full the CPU starts large as well.
+  // 1.4 GiB of host memory. Without grow_when_full the CPU starts large as well.
   static constexpr std::int64_t kDeviceCapacity = std::int64_t{1} << 18;
   static constexpr std::int64_t kHostStartCapacity = 4096;
   std::int64_t start_capacity(bool on_cuda) const {
@@ -72,7 +72,7 @@ struct VolumeParams {
     v("max_weight", max_weight, "maximum fusion weight per voxel", Range{1.0, 1e6});
     v("hash_buckets", hash_buckets, "hash table buckets (hash layout)", Range{1024, 1e9});
     v("capacity", capacity,
-      "voxel blocks the pool starts with (hash layout); 0: by the device, 262144 (1.5 GiB) on CUDA, 4096 (24 MiB) "
+      "voxel blocks the pool starts with (hash layout); 0: by the device, 262144 (1.4 GiB) on CUDA, 4096 (22 MiB) "
       "on the CPU growing as needed (grow_when_full)",
       Range{0, 1e9});
     v("dense_resolution", dense_resolution, "voxels per side (dense layout)", Range{8, 2048});

@@ -66,6 +66,8 @@ VoxelHashVolume::VoxelHashVolume(const VolumeParams& p, Device d)
   const std::int64_t capacity = params_.capacity;
   voxels_ = Buffer<kernels::Voxel>(capacity * kBlockVoxels, d);
   voxels_.zero();
+  colors_ = Buffer<uchar3>(capacity * kBlockVoxels, d);
+  colors_.zero();
   free_list_ = Buffer<std::int32_t>(capacity, d);
   visible_ = Buffer<std::int32_t>(capacity, d);
   keep_ = Buffer<std::int32_t>(capacity, d);
@@ -85,7 +87,7 @@ kernels::HashTableView VoxelHashVolume::table() const {
   return {keys_.data(), values_.data(), static_cast<std::uint32_t>(keys_.size() - 1), kMaxProbe};
 }
 
-kernels::HashAccess VoxelHashVolume::device_view() const { return {table(), voxels_.data(), geom_}; }
+kernels::HashAccess VoxelHashVolume::device_view() const { return {table(), voxels_.data(), colors_.data(), geom_}; }
 
 HashCounters VoxelHashVolume::read_counters() const { return counters_.to_host()[0]; }
 
@@ -118,14 +120,14 @@ void VoxelHashVolume::integrate(const Image<float>& depth, const Image<uchar3>& 
       if (device_ == Device::CPU)
         kernels::TsdfFusion<E>::sort_visible_by_block(ex, table(), visible_.view(), n, scratch_.view(),
                                                       static_cast<int>(std::bit_width(pool_size())));
-      kernels::TsdfFusion<E>::fuse_hash_blocks(ex, table(), visible_.cview(), n, voxels_.data(), in, geom_,
-                                               params_.max_weight, params_.integrate_color, keep, keep_below(),
-                                               surface_flags());
+      kernels::TsdfFusion<E>::fuse_hash_blocks(ex, table(), visible_.cview(), n, voxels_.data(), colors_.data(), in,
+                                               geom_, params_.max_weight, params_.integrate_color, keep,
+                                               keep_below(), surface_flags());
     });
     if (params_.remove_empty_blocks)
       staged(timer, "remove_empty", [&] {
         kernels::TsdfFusion<E>::remove_unkept_blocks(ex, table(), visible_.cview(), n, keep_.cview(), voxels_.data(),
-                                                     free_list_.view(), counters_.data());
+                                                     colors_.data(), free_list_.view(), counters_.data());
       });
   });
   ++frames_;
@@ -298,6 +300,10 @@ void VoxelHashVolume::grow_pool(std::int64_t blocks) {
   voxels.zero();
   voxels.copy_from(voxels_);
   voxels_ = std::move(voxels);
+  Buffer<uchar3> colors(blocks * kBlockVoxels, device_);
+  colors.zero();
+  colors.copy_from(colors_);
+  colors_ = std::move(colors);
   Buffer<std::int32_t> free_list(blocks, device_);
   free_list.copy_from(free_list_);
   free_list_ = std::move(free_list);
@@ -324,7 +330,7 @@ std::int64_t VoxelHashVolume::remove_empty_blocks() {
     kernels::VoxelHash<E>::reset_frame_counters(ex, counters_.data());
     kernels::TsdfFusion<E>::mark_kept_blocks(ex, table(), listed, n, voxels_.data(), keep.view(), keep_below());
     kernels::TsdfFusion<E>::remove_unkept_blocks(ex, table(), listed, n, keep.cview(), voxels_.data(),
-                                                 free_list_.view(), counters_.data());
+                                                 colors_.data(), free_list_.view(), counters_.data());
   });
   last_ = read_counters();
   return last_.removed;
@@ -351,18 +357,21 @@ std::vector<VoxelHashVolume::HostBlock> VoxelHashVolume::download_blocks() const
   Buffer<kernels::HashKey> keys(n, device_);
   Buffer<std::int32_t> values(n, device_);
   Buffer<kernels::Voxel> vox(n * kBlockVoxels, device_);
+  Buffer<uchar3> col(n * kBlockVoxels, device_);
   with_exec(device_, [&]<class E>(const E& ex) {
     kernels::VoxelHash<E>::hash_gather(ex, table(), View<const std::int32_t>{slots.data(), n}, keys.view(),
                                        values.view());
-    kernels::VoxelHash<E>::gather_blocks(ex, voxels_.data(), values.cview(), vox.view());
+    kernels::VoxelHash<E>::gather_blocks(ex, voxels_.data(), colors_.data(), values.cview(), vox.view(), col.view());
   });
   std::vector<kernels::HashKey> hk = keys.to_host();
   std::vector<kernels::Voxel> hv = vox.to_host();
+  std::vector<uchar3> hc = col.to_host();
   const std::vector<std::int32_t> hb = values.to_host(), flags = surface_.to_host();
   std::vector<HostBlock> out(static_cast<std::size_t>(n));
   for (std::int64_t i = 0; i < n; ++i) {
     out[i].coord = kernels::unpack_block(hk[i]);
     out[i].voxels.assign(hv.begin() + i * kBlockVoxels, hv.begin() + (i + 1) * kBlockVoxels);
+    out[i].colors.assign(hc.begin() + i * kBlockVoxels, hc.begin() + (i + 1) * kBlockVoxels);
     out[i].surface = flags[hb[i]] != 0;
   }
   std::sort(out.begin(), out.end(), [](const HostBlock& a, const HostBlock& b) {
@@ -481,9 +490,10 @@ VolumeStats VoxelHashVolume::stats() {
   s.retries = retries_;
   s.visible_blocks = last_.visible;
   s.removed_blocks = c.removed;
-  s.bytes_per_block = sizeof(kernels::Voxel) * kBlockVoxels;
+  s.bytes_per_block = (sizeof(kernels::Voxel) + sizeof(uchar3)) * kBlockVoxels;
   s.voxel_bytes = s.bytes_per_block * static_cast<std::size_t>(s.allocated_blocks);
-  s.device_bytes = keys_.bytes() + values_.bytes() + scratch_.bytes() + voxels_.bytes() + free_list_.bytes() +
+  s.device_bytes = keys_.bytes() + values_.bytes() + scratch_.bytes() + voxels_.bytes() + colors_.bytes() +
+                   free_list_.bytes() +
                    visible_.bytes() + keep_.bytes() + surface_.bytes() + near_.bytes() + intervals_.bytes() +
                    depth_tiles_.bytes() + counters_.bytes();
   s.host_blocks = host_count_;

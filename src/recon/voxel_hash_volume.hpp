@@ -44,6 +44,7 @@ class VoxelHashVolume final : public Volume {
   struct HostBlock {
     int3 coord;
     std::vector<kernels::Voxel> voxels;  // 512, x fastest
+    std::vector<uchar3> colors;          // 512, the colour of voxels[k] at colors[k]
     bool surface = false;                // its surface flag (kernels::SurfaceFlags)
   };
   std::vector<HostBlock> download_blocks() const;
@@ -88,14 +89,15 @@ class VoxelHashVolume final : public Volume {
   struct HostChunk {
     std::vector<kernels::HashKey> keys;
     std::vector<kernels::Voxel> voxels;  // 512 per key
+    std::vector<uchar3> colors;          // the colour of voxels[k] at colors[k]
   };
   static constexpr int kChunkShift = 3;  // chunks of 8^3 blocks (32 cm at 5 mm voxels)
   void maybe_stream(const Intrinsics& K, const vec3& camera_position);
   void stream_out(const vec3& camera_position);
   void take_from_host(const vec3& camera_position, bool all, std::vector<kernels::HashKey>& keys,
-                      std::vector<kernels::Voxel>& voxels);
-  void put_on_host(const kernels::HashKey* keys, const kernels::Voxel* voxels, std::int64_t n);
-  void upload(std::vector<kernels::HashKey>& keys, std::vector<kernels::Voxel>& voxels);
+                      std::vector<kernels::Voxel>& voxels, std::vector<uchar3>& colors);
+  void put_on_host(const kernels::HashKey* keys, const kernels::Voxel* voxels, const uchar3* colors, std::int64_t n);
+  void upload(std::vector<kernels::HashKey>& keys, std::vector<kernels::Voxel>& voxels, std::vector<uchar3>& colors);
   bool beyond_radius(kernels::HashKey key, const vec3& camera_position) const;
 
   VolumeParams params_;
@@ -104,6 +106,7 @@ class VoxelHashVolume final : public Volume {
   Buffer<kernels::HashKey> keys_;
   Buffer<std::int32_t> values_;
   Buffer<kernels::Voxel> voxels_;
+  Buffer<uchar3> colors_;  // the colour of voxels_[i] at colors_[i]
   Buffer<std::int32_t> free_list_;
   Buffer<kernels::HashCounters> counters_;
   Buffer<std::int32_t> visible_;

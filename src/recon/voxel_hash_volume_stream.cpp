@@ -55,8 +55,9 @@ void VoxelHashVolume::stream(const vec3& camera_position) {
   stream_out(camera_position);
   std::vector<HashKey> keys;
   std::vector<Voxel> voxels;
-  take_from_host(camera_position, false, keys, voxels);
-  upload(keys, voxels);
+  std::vector<uchar3> colors;
+  take_from_host(camera_position, false, keys, voxels, colors);
+  upload(keys, voxels, colors);
   stream_pos_ = camera_position;
   streamed_ = true;
   const kernels::HashCounters c = read_counters();
@@ -67,8 +68,9 @@ void VoxelHashVolume::stream(const vec3& camera_position) {
 void VoxelHashVolume::stream_in_all() {
   std::vector<HashKey> keys;
   std::vector<Voxel> voxels;
-  take_from_host({0.f, 0.f, 0.f}, true, keys, voxels);
-  upload(keys, voxels);
+  std::vector<uchar3> colors;
+  take_from_host({0.f, 0.f, 0.f}, true, keys, voxels, colors);
+  upload(keys, voxels, colors);
   const kernels::HashCounters c = read_counters();
   last_.free_top = c.free_top;
   last_.tombstones = c.tombstones;
@@ -97,34 +99,38 @@ void VoxelHashVolume::stream_out(const vec3& camera_position) {
   Buffer<HashKey> keys(n, device_);
   Buffer<std::int32_t> blocks(n, device_);
   Buffer<Voxel> staging(n * kBlockVoxels, device_);
+  Buffer<uchar3> staging_colors(n * kBlockVoxels, device_);
   memory::fill_zero(keep_.data(), device_, sizeof(std::int32_t) * static_cast<std::size_t>(n));
   with_exec(device_, [&]<class E>(const E& ex) {
     kernels::VoxelHash<E>::hash_gather(ex, table(), listed, keys.view(), blocks.view());
-    kernels::VoxelHash<E>::gather_blocks(ex, voxels_.data(), blocks.cview(), staging.view());
+    kernels::VoxelHash<E>::gather_blocks(ex, voxels_.data(), colors_.data(), blocks.cview(), staging.view(),
+                                         staging_colors.view());
     kernels::TsdfFusion<E>::remove_unkept_blocks(ex, table(), listed, n, View<const std::int32_t>{keep_.data(), n},
-                                                 voxels_.data(), free_list_.view(), counters_.data());
+                                                 voxels_.data(), colors_.data(), free_list_.view(), counters_.data());
   });
   const std::vector<HashKey> hk = keys.to_host();
   const std::vector<Voxel> hv = staging.to_host();
-  put_on_host(hk.data(), hv.data(), n);
+  const std::vector<uchar3> hc = staging_colors.to_host();
+  put_on_host(hk.data(), hv.data(), hc.data(), n);
   streamed_out_ += n;
 }
 
-void VoxelHashVolume::put_on_host(const HashKey* keys, const Voxel* voxels, std::int64_t n) {
+void VoxelHashVolume::put_on_host(const HashKey* keys, const Voxel* voxels, const uchar3* colors, std::int64_t n) {
   for (std::int64_t i = 0; i < n; ++i) {
     const int3 b = kernels::unpack_block(keys[i]);
     const HashKey chunk = kernels::pack_block({b.x >> kChunkShift, b.y >> kChunkShift, b.z >> kChunkShift});
     HostChunk& c = host_[chunk];
     c.keys.push_back(keys[i]);
     c.voxels.insert(c.voxels.end(), voxels + i * kBlockVoxels, voxels + (i + 1) * kBlockVoxels);
+    c.colors.insert(c.colors.end(), colors + i * kBlockVoxels, colors + (i + 1) * kBlockVoxels);
   }
   host_count_ += n;
 }
 
-// Moves the stored blocks within the radius (or all) out of the host store into keys / voxels.
+// Moves the stored blocks within the radius (or all) out of the host store into keys / voxels / colors.
 // Whole chunks farther than the radius are passed over without looking at their blocks.
 void VoxelHashVolume::take_from_host(const vec3& camera_position, bool all, std::vector<HashKey>& keys,
-                                     std::vector<Voxel>& voxels) {
+                                     std::vector<Voxel>& voxels, std::vector<uchar3>& colors) {
   const float chunk_m = static_cast<float>(kernels::kBlockSide << kChunkShift) * geom_.voxel_size;
   const float chunk_reach = params_.stream_radius + chunk_m * std::sqrt(3.f);  // radius + chunk diagonal
   for (auto it = host_.begin(); it != host_.end();) {
@@ -138,25 +144,30 @@ void VoxelHashVolume::take_from_host(const vec3& camera_position, bool all, std:
     }
     std::size_t kept = 0;
     for (std::size_t i = 0; i < c.keys.size(); ++i) {
-      const auto src = c.voxels.begin() + static_cast<std::ptrdiff_t>(i * kBlockVoxels);
+      const auto at = static_cast<std::ptrdiff_t>(i * kBlockVoxels), to = static_cast<std::ptrdiff_t>(kept * kBlockVoxels);
+      const auto src = c.voxels.begin() + at;
+      const auto src_colors = c.colors.begin() + at;
       if (!all && beyond_radius(c.keys[i], camera_position)) {  // stays: compact in place
-        std::copy(src, src + kBlockVoxels, c.voxels.begin() + static_cast<std::ptrdiff_t>(kept * kBlockVoxels));
+        std::copy(src, src + kBlockVoxels, c.voxels.begin() + to);
+        std::copy(src_colors, src_colors + kBlockVoxels, c.colors.begin() + to);
         c.keys[kept++] = c.keys[i];
         continue;
       }
       keys.push_back(c.keys[i]);
       voxels.insert(voxels.end(), src, src + kBlockVoxels);
+      colors.insert(colors.end(), src_colors, src_colors + kBlockVoxels);
     }
     host_count_ -= static_cast<std::int64_t>(c.keys.size() - kept);
     c.keys.resize(kept);
     c.voxels.resize(kept * kBlockVoxels);
+    c.colors.resize(kept * kBlockVoxels);
     it = kept == 0 ? host_.erase(it) : std::next(it);
   }
 }
 
 // Inserts the blocks with fresh pool blocks and copies their voxels in. The pool and table are
 // grown first when allowed; what still does not fit goes back to the host store, with a warning.
-void VoxelHashVolume::upload(std::vector<HashKey>& keys, std::vector<Voxel>& voxels) {
+void VoxelHashVolume::upload(std::vector<HashKey>& keys, std::vector<Voxel>& voxels, std::vector<uchar3>& colors) {
   std::int64_t n = static_cast<std::int64_t>(keys.size());
   if (n == 0) return;
   HashCounters c = read_counters();
@@ -175,29 +186,33 @@ void VoxelHashVolume::upload(std::vector<HashKey>& keys, std::vector<Voxel>& vox
   maybe_rehash(c, fit);
   Buffer<HashKey> dkeys = Buffer<HashKey>::from_host(keys, device_);
   Buffer<Voxel> dvox = Buffer<Voxel>::from_host(voxels, device_);
+  Buffer<uchar3> dcol = Buffer<uchar3>::from_host(colors, device_);
   Buffer<std::int32_t> blocks(fit, device_);
   with_exec(device_, [&]<class E>(const E& ex) {
     kernels::VoxelHash<E>::reset_frame_counters(ex, counters_.data());
     kernels::VoxelHash<E>::insert_with_blocks(ex, table(), free_list_.cview(), counters_.data(),
                                               View<const HashKey>{dkeys.data(), fit}, blocks.view());
-    kernels::VoxelHash<E>::scatter_blocks(ex, voxels_.data(), blocks.cview(), dvox.cview());
+    kernels::VoxelHash<E>::scatter_blocks(ex, voxels_.data(), colors_.data(), blocks.cview(), dvox.cview(),
+                                          dcol.cview());
     kernels::TsdfFusion<E>::mark_surface_blocks(ex, blocks.cview(), voxels_.data(), surface_flags());
   });
   const std::vector<std::int32_t> got = blocks.to_host();
   const HashCounters after = read_counters();
   std::vector<HashKey> back_keys;
   std::vector<Voxel> back_vox;
+  std::vector<uchar3> back_col;
   for (std::int64_t i = 0; i < n; ++i) {
     if (i < fit && got[i] >= 0) continue;
     back_keys.push_back(keys[i]);
     back_vox.insert(back_vox.end(), voxels.begin() + i * kBlockVoxels, voxels.begin() + (i + 1) * kBlockVoxels);
+    back_col.insert(back_col.end(), colors.begin() + i * kBlockVoxels, colors.begin() + (i + 1) * kBlockVoxels);
   }
   const std::int64_t failed_in = static_cast<std::int64_t>(back_keys.size()) - (n - fit);
   if (failed_in > after.probe_failures + after.pool_failures)
     throw Error("voxel hashing: a streamed-in block was also on the device (" +
                 std::to_string(failed_in - after.probe_failures - after.pool_failures) +
                 " blocks); the streaming invariant is broken: raise volume.stream_radius");
-  put_on_host(back_keys.data(), back_vox.data(), static_cast<std::int64_t>(back_keys.size()));
+  put_on_host(back_keys.data(), back_vox.data(), back_col.data(), static_cast<std::int64_t>(back_keys.size()));
   streamed_in_ += n - static_cast<std::int64_t>(back_keys.size());
   if (!back_keys.empty())
     spdlog::warn(

@@ -163,7 +163,7 @@ TEST(TsdfFusion, RemovingEmptyBlocksFreesThem) {
   VolumeStats s2 = vol.stats();
   EXPECT_EQ(s2.allocated_blocks, static_cast<std::int64_t>(blocks_far.size()));
   for (int3 b : blocks_far) EXPECT_GT(b.z * 0.08f, 2.0f) << "block " << b.x << " " << b.y << " " << b.z;
-  EXPECT_EQ(s2.voxel_bytes, s2.allocated_blocks * sizeof(kernels::Voxel) * 512);
+  EXPECT_EQ(s2.voxel_bytes, s2.allocated_blocks * (sizeof(kernels::Voxel) + sizeof(uchar3)) * 512);
   EXPECT_GT(s2.tombstones, 0);
   EXPECT_EQ(s2.failed_insertions, 0);
   // Freed blocks are reused: going back to the near wall needs no growth.

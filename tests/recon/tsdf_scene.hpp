@@ -139,7 +139,9 @@ inline void expect_same_blocks(const std::vector<VoxelHashVolume::HostBlock>& a,
       ASSERT_EQ(a[i].voxels[k].weight, b[i].voxels[k].weight);
       ASSERT_NEAR(a[i].voxels[k].sdf, b[i].voxels[k].sdf, 1e-5f);
       if (colour) {
-        ASSERT_NEAR(a[i].voxels[k].color.x, b[i].voxels[k].color.x, 1);
+        ASSERT_NEAR(a[i].colors[k].x, b[i].colors[k].x, 1);
+        ASSERT_NEAR(a[i].colors[k].y, b[i].colors[k].y, 1);
+        ASSERT_NEAR(a[i].colors[k].z, b[i].colors[k].z, 1);
       }
     }
   }

@@ -54,7 +54,9 @@ void expect_same_blocks(const std::vector<VoxelHashVolume::HostBlock>& a,
     for (int k = 0; k < kernels::kBlockVoxels; ++k) {  // copies: bit-identical
       ASSERT_EQ(a[i].voxels[k].sdf, b[i].voxels[k].sdf);
       ASSERT_EQ(a[i].voxels[k].weight, b[i].voxels[k].weight);
-      ASSERT_EQ(a[i].voxels[k].color.x, b[i].voxels[k].color.x);
+      ASSERT_EQ(a[i].colors[k].x, b[i].colors[k].x);
+      ASSERT_EQ(a[i].colors[k].y, b[i].colors[k].y);
+      ASSERT_EQ(a[i].colors[k].z, b[i].colors[k].z);
     }
   }
 }
@@ -81,7 +83,7 @@ TEST(VolumeStream, RoundTripKeepsEveryVoxelAndTheMesh) {
   VolumeStats out = vol.stats();
   EXPECT_EQ(out.allocated_blocks, 0);
   EXPECT_EQ(out.host_blocks, static_cast<std::int64_t>(before.size()));
-  EXPECT_EQ(out.host_bytes, before.size() * sizeof(kernels::Voxel) * kernels::kBlockVoxels);
+  EXPECT_EQ(out.host_bytes, before.size() * (sizeof(kernels::Voxel) + sizeof(uchar3)) * kernels::kBlockVoxels);
   EXPECT_TRUE(vol.download_blocks().empty());
 
   vol.stream({0.f, 0.f, 0.f});
