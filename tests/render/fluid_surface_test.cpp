@@ -182,14 +182,17 @@ TEST(RenderFluidSurface, GapFillLeavesTheSceneInFront) {
 
 // A slab of fluid (a lattice of one diameter, the spheres' thickness scaled to a path in fluid)
 // in front of a uniform Kinect image, its back 0.2 m before the measured surface (in the air: not
-// wet), then resting on it (wet). Refraction stage in linear units, mean over the slab's centre:
-//   in the air: what is behind times exp(-absorption T), T the slab's depth (n layers of 2 r);
-//   resting:    the same times Lekner & Dorf's factor (1 - R_e) / (n^2 (1 - a R_i)), a the image's
-//               linear value (the albedo it stands for).
+// wet), then resting on it (wet). Face-on, so the depth of water h is the thickness T (n layers of
+// 2 r) and the refracted view ray crosses it over T. Refraction stage in linear units, mean over
+// the slab's centre:
+//   in the air: what is behind times exp(-absorption T) (Beer-Lambert up the view ray);
+//   resting:    also the light's way down, exp(-absorption T / mu_d) (mu_d = 0.83, the downwelling
+//               mean cosine; shadows are off, so all of the light), and Lekner & Dorf's wet factor
+//               (1 - R_e) / (n^2 (1 - a R_i exp(-4 absorption T))) with its internal reflections
+//               absorbed on their round trip, a the image's linear value (the albedo it stands for).
 // Tolerances: T is a sum of sphere chords over their volume fraction; across the slab's centre it
-// scatters about the true depth by a fraction of a radius, so exp(-a T) is checked within the
-// range T +- r gives; the wet/dry ratio cancels T and absorption and is checked within 2 %
-// (8-bit stage images: a level in 60-200).
+// scatters about the true depth by a fraction of a radius, so both are checked within the range
+// T +- r gives, plus one 8-bit level (stage images: a level in 60-200).
 TEST(RenderFluidSurface, BeerLambertAndWetting) {
   SEAMLESS_REQUIRE_EGL();
   const Intrinsics K = small_K();
@@ -235,15 +238,24 @@ TEST(RenderFluidSurface, BeerLambertAndWetting) {
   const vec3 wet = refraction(z_surface);
   const float a[3] = {p.absorption.x, p.absorption.y, p.absorption.z};
   const float n2 = p.ior * p.ior, Re = p.fresnel_f0 + (1.f - p.fresnel_f0) / 21.f, Ri = 1.f - (1.f - Re) / n2;
-  const float wet_expected = (1.f - Re) / (n2 * (1.f - behind.x * Ri));
+  const float mu_d = 0.5f / n2 / (1.f - std::sqrt(1.f - 1.f / n2));
+  // wet / dry for a depth of water h, channel c.
+  auto wet_ratio = [&](int c, float h) {
+    return std::exp(-a[c] * h / mu_d) * (1.f - Re) / (n2 * (1.f - behind.x * Ri * std::exp(-4.f * a[c] * h)));
+  };
   for (int c = 0; c < 3; ++c) {
     const float got = (&dry.x)[c] / (&behind.x)[c];
-    std::printf("channel %d: dry transmittance %.3f (exp(-a T) %.3f, range %.3f..%.3f); wet/dry %.3f (expected %.3f)\n",
-                c, got, std::exp(-a[c] * T), std::exp(-a[c] * (T + r)), std::exp(-a[c] * (T - r)),
-                (&wet.x)[c] / (&dry.x)[c], wet_expected);
+    const float ratio = (&wet.x)[c] / (&dry.x)[c];
+    std::printf("channel %d: dry transmittance %.3f (exp(-a T) %.3f, range %.3f..%.3f); wet/dry %.3f (expected %.3f, "
+                "range %.3f..%.3f)\n",
+                c, got, std::exp(-a[c] * T), std::exp(-a[c] * (T + r)), std::exp(-a[c] * (T - r)), ratio,
+                wet_ratio(c, T), wet_ratio(c, T + r), wet_ratio(c, T - r));
     EXPECT_GE(got, std::exp(-a[c] * (T + r)) - 0.01f);
     EXPECT_LE(got, std::exp(-a[c] * (T - r)) + 0.01f);
-    EXPECT_NEAR((&wet.x)[c] / (&dry.x)[c], wet_expected, 0.02f * wet_expected);
+    // One 8-bit level of the wet stage (linear, at its value) over the dry value, as a ratio.
+    const float level = 1.f / (255.f * (&dry.x)[c]);
+    EXPECT_GE(ratio, wet_ratio(c, T + r) - level);
+    EXPECT_LE(ratio, wet_ratio(c, T - r) + level);
   }
 }
 
