@@ -259,6 +259,53 @@ TEST(RenderFluidSurface, BeerLambertAndWetting) {
   }
 }
 
+// Water resting on a measured surface, half of it over pixels without recorded depth (a Kinect
+// hole, depth 0): a hole is not an occluder, so the water is drawn there, and what the camera saw
+// there has the image's colour at an unmeasured depth, not infinitely far. The frame over the hole
+// must look like the frame over the measured half: the same uniform image, the same slab (the
+// lattice is symmetric about the image centre, so the two halves cover the same sphere pattern
+// mirrored). Taken as infinitely far, the hole's pixels counted the water as hanging in the air
+// (not wet: 1 / 0.62 times brighter, and the light's way down not absorbed) and ran the refracted
+// ray through the whole thickness. Tolerance: 2 % of each channel's linear value (a few 8-bit levels
+// at these values; the wet factor alone is a 38 % difference).
+TEST(RenderFluidSurface, WaterOverADepthHoleLooksLikeTheWaterAroundIt) {
+  SEAMLESS_REQUIRE_EGL();
+  const Intrinsics K = small_K();
+  const uchar3 grey{150, 150, 150};
+  const float z_surface = 1.2f;
+  std::vector<uchar3> rgb(static_cast<std::size_t>(kW) * kH, grey);
+  std::vector<float> depth(rgb.size(), z_surface);
+  const int hole_u0 = 100;  // the hole: every pixel right of the image centre
+  for (int v = 0; v < kH; ++v)
+    for (int u = hole_u0; u < kW; ++u) depth[static_cast<std::size_t>(v) * kW + u] = 0.f;
+  RenderParams p = surface_params();
+  p.view = RenderView::kinect;
+  p.light_intensity = 0.f;
+  p.absorption = {4.f, 2.f, 1.f};  // linear values 0.05-0.15 over 8 cm: 8-bit steps under 1 %
+  const float r = 0.01f, d = 2.f * r;
+  Renderer rd(p, kW, kH);
+  rd.set_kinect_view(Image<uchar3>::from_host(rgb, kW, kH, Device::CPU),
+                     Image<float>::from_host(depth, kW, kH, Device::CPU), K, SE3::identity());
+  std::vector<vec3> x;
+  for (int k = 0; k < 4; ++k) layer(x, 0.f, 0.f, z_surface - 1.5f * r - k * d, 12, d);
+  std::vector<std::uint32_t> ph;
+  const Pixels im(rd.render(fluid_list(x, ph, r), RenderCamera{}));
+  // Mean linear colour over columns [u0, u1] of rows 60-90 (inside the slab, which spans about
+  // u 68-131 and v 43-106, and 4 or more pixels from the hole's edge and the slab's rim).
+  auto mean = [&](int u0, int u1) {
+    vec3 sum{0, 0, 0};
+    int n = 0;
+    for (int v = 60; v <= 90; ++v)
+      for (int u = u0; u <= u1; ++u) sum = sum + linear(im.at(u, v)), ++n;
+    return sum * (1.f / static_cast<float>(n));
+  };
+  const vec3 measured = mean(80, 95), hole = mean(104, 119);
+  for (int c = 0; c < 3; ++c) {
+    std::printf("channel %d: over measured depth %.4f, over the hole %.4f\n", c, (&measured.x)[c], (&hole.x)[c]);
+    EXPECT_NEAR((&hole.x)[c], (&measured.x)[c], 0.02f * (&measured.x)[c]);
+  }
+}
+
 // A square n x n layer of spacing s in the plane through c spanned by ex and ey (unit, orthogonal).
 struct Plane {
   vec3 c, ex, ey, n;  // n: ex x ey, towards the camera

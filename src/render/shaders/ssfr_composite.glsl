@@ -24,6 +24,7 @@ uniform int u_ssr_steps;       // screen-space reflection: steps along the refle
 uniform float u_ssr_distance;  // ... over this many metres
 uniform float u_contact;       // metres: water whose back is this close to the scene wets it
 uniform bool u_wet;            // darken the surface under the water (Lekner & Dorf 1988)
+uniform bool u_depth_holes;    // Kinect view: scene window depth 1 is a pixel without recorded depth
 uniform float u_diffuse_share; // share of a real surface's light that the fluid's shadow does not already attenuate
 
 float schlick(float f0, float cos_theta) { return f0 + (1.0 - f0) * pow(1.0 - clamp(cos_theta, 0.0, 1.0), 5.0); }
@@ -146,7 +147,16 @@ void composite_at(ivec2 p, out vec4 o_color, out vec4 o_reflect, out vec4 o_refr
   // quantised (a Kinect v1's step is about 2.85e-3 z^2 m: 1.1 cm at 2 m), so the tolerance grows
   // with z^2 and the fade spans twice it: a sharp threshold drew the depth's quantisation bands as
   // stripes.
-  float z_bg = eye_depth(texelFetch(u_scene_depth, p, 0).r);
+  // A pixel without recorded depth (a Kinect hole: a glossy table at a grazing angle, a dark or
+  // too near surface) is not an occluder, so the water is drawn there, but nor is it a surface
+  // infinitely far away: the camera saw something there, in its colour, at a depth it did not
+  // measure. Taken as infinitely far, the water there counted as hanging in the air (not wet, its
+  // refracted ray run through the whole thickness and projected away from the pixel): blocks
+  // unlike the water around them, exactly where the depth has holes. The nearest surface
+  // consistent with seeing the water there is right behind it: the water's back along the view
+  // ray, so it rests on it, as on the measured pixels around.
+  float w_bg = texelFetch(u_scene_depth, p, 0).r;
+  float z_bg = u_depth_holes && w_bg >= 1.0 ? P.z * (1.0 + T / length(P)) : eye_depth(w_bg);
   float gap = max(z_bg - P.z, 0.0) * length(P) / P.z - T;
   float tol = u_contact + 0.006 * z_bg * z_bg;
   float resting = 1.0 - smoothstep(tol, 3.0 * tol, gap);
