@@ -39,14 +39,22 @@ int dry_run(const CommonOptions& o) {
 // never saw (under and in front of the desk, say) have no scene particles, and objects would fall
 // through them. Only where a floor was seen (find_horizontal_surfaces): a plane invented under a
 // scan without one would stand in the air where the room is empty.
-std::optional<kernels::SceneSdf> floor_plane(const HorizontalSurface* floor, vec3 up) {
-  if (!floor) return std::nullopt;
+// `support_plane` adds a plane the user states: a surface the camera does not measure at all (a
+// glossy table seen at a grazing angle returns no depth), which no scan can find.
+std::optional<kernels::SceneSdf> floor_plane(const HorizontalSurface* floor, const std::vector<float>& support,
+                                             vec3 up) {
+  std::vector<float> heights;
+  if (floor) heights.push_back(floor->height);
+  if (!support.empty()) heights.push_back(support.front());
+  if (heights.empty()) return std::nullopt;
   kernels::SceneSdf sdf{};
-  sdf.count = 1;
-  sdf.prims[0].kind = kernels::kSdfHalfSpace;
-  sdf.prims[0].a = up;
-  sdf.prims[0].b = {floor->height, 0.f, 0.f};
-  sdf.prims[0].R = mat3::identity();
+  for (float h : heights) {
+    kernels::SdfPrimitive& prim = sdf.prims[sdf.count++];
+    prim.kind = kernels::kSdfHalfSpace;
+    prim.a = up;
+    prim.b = {h, 0.f, 0.f};
+    prim.R = mat3::identity();
+  }
   return sdf;
 }
 
@@ -147,9 +155,11 @@ RunOutputs run_experiment(RunContext& ctx, const std::string& config) {
       renderer->set_kinect_frame(scan_result.first_frame, traj.front().se3());
   }
   const HorizontalSurface* floor_surface = e.floor_plane ? find_floor(ps.surfaces) : nullptr;
-  std::optional<kernels::SceneSdf> floor = floor_plane(floor_surface, ps.up);
-  if (floor) spdlog::info("floor plane at height {:.3f} m along -gravity", floor->prims[0].b.x);
+  std::optional<kernels::SceneSdf> floor = floor_plane(floor_surface, e.support_plane, ps.up);
+  if (floor_surface) spdlog::info("floor plane at height {:.3f} m along -gravity", floor_surface->height);
   else if (e.floor_plane) spdlog::info("no floor plane: the scan shows no floor");
+  if (!e.support_plane.empty())
+    spdlog::info("support plane (config) at height {:.3f} m along -gravity", e.support_plane.front());
   const SceneBounds bounds = scene_bounds(scan_result.mesh, ps.up, floor_surface);
   summary.floor_height = bounds.floor;
   summary.surfaces = ps.surfaces;

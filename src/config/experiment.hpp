@@ -65,6 +65,7 @@ struct Experiment {
   std::int64_t frames = 0;           // 0 = as many as the input gives
   double duration = 3.0;             // simulated seconds after the scan (scan_then_simulate)
   bool floor_plane = true;           // scan_then_simulate: an infinite floor under the scanned floor
+  std::vector<float> support_plane;  // [height]: an infinite horizontal plane there (world y, metres); empty: none
   float scene_interior_depth = 0.f;  // scene particles also fill the solid this deep below the surface
   int reextract_every = 10;          // live mode: scene particles re-extracted every this many fused frames
   InputParams input;
@@ -92,6 +93,11 @@ struct Experiment {
     v("floor_plane", floor_plane,
       "collide with an infinite plane at the scanned floor's height (unseen floor "
       "would otherwise let objects fall through)");
+    v("support_plane", support_plane,
+      "[height]: collide with an infinite horizontal plane at this height (world y, metres along -gravity from "
+      "the first camera): a surface the depth camera does not measure (a glossy table seen at a grazing angle); "
+      "empty: none",
+      Range{-100.0, 100.0});
     v("scene_interior_depth", scene_interior_depth,
       "scene particles also fill the scanned solid this deep below its surface (metres; 0: surface only). A "
       "second layer stops particles that squeeze between surface particles where the scan is thin or has seams",

@@ -284,6 +284,12 @@ void Renderer::Impl::composite_pass(const RenderCamera& cam, float contact) {
   glUniform1f(cp.loc("u_ssr_distance"), p.ssr_distance);
   glUniform1f(cp.loc("u_contact"), contact);
   glUniform1i(cp.loc("u_wet"), p.fluid_wet);
+  // A real surface under the water: the light's share of its light (shadow_strength) has crossed
+  // the water already where the fluid is in the shadow map; the composite attenuates the rest.
+  // In the Kinect view the scene's depth is the recorded one, and window depth 1 a pixel without a
+  // reading (kinect_bg.frag); in the mesh view it is the background, where nothing was scanned.
+  glUniform1i(cp.loc("u_depth_holes"), p.view == RenderView::kinect && has_kinect);
+  glUniform1f(cp.loc("u_diffuse_share"), shadow_live && fluid_shadow_live ? 1.f - p.shadow_strength : 1.f);
   if (compute) {
     const GLuint out[] = {final_color, reflect_color, refract_color};
     for (GLuint i = 0; i < 3; ++i) glBindImageTexture(i, out[i], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);

@@ -141,6 +141,11 @@ TEST(ConfigErrors, RulesAcrossKeysAreCheckedAtLoad) {
   // depth without dynamic.enabled is allowed (no pixel is dynamic, so nothing collides: the live
   // loop says so), so that `--set dynamic.enabled=false` compares a run with and without.
   EXPECT_EQ(error_of("mode: live\nsolver: {dynamic_colliders: depth}"), "");
+  // support_plane: one height, and only where the floor plane is set up (after the scan).
+  EXPECT_THAT(error_of("mode: scan_then_simulate\nsupport_plane: [-0.1, 0.2]"),
+              HasSubstr("support_plane: expected [height] (one number) or [], got 2 numbers"));
+  EXPECT_THAT(error_of("mode: live\nsupport_plane: [-0.1]"), HasSubstr("support_plane needs mode: scan_then_simulate"));
+  EXPECT_EQ(error_of("mode: scan_then_simulate\nsupport_plane: [-0.1]"), "");
 }
 
 // Key errors and the rules across keys in one list: one run shows every problem of a file. A

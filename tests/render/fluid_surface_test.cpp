@@ -182,14 +182,17 @@ TEST(RenderFluidSurface, GapFillLeavesTheSceneInFront) {
 
 // A slab of fluid (a lattice of one diameter, the spheres' thickness scaled to a path in fluid)
 // in front of a uniform Kinect image, its back 0.2 m before the measured surface (in the air: not
-// wet), then resting on it (wet). Refraction stage in linear units, mean over the slab's centre:
-//   in the air: what is behind times exp(-absorption T), T the slab's depth (n layers of 2 r);
-//   resting:    the same times Lekner & Dorf's factor (1 - R_e) / (n^2 (1 - a R_i)), a the image's
-//               linear value (the albedo it stands for).
+// wet), then resting on it (wet). Face-on, so the depth of water h is the thickness T (n layers of
+// 2 r) and the refracted view ray crosses it over T. Refraction stage in linear units, mean over
+// the slab's centre:
+//   in the air: what is behind times exp(-absorption T) (Beer-Lambert up the view ray);
+//   resting:    also the light's way down, exp(-absorption T / mu_d) (mu_d = 0.83, the downwelling
+//               mean cosine; shadows are off, so all of the light), and Lekner & Dorf's wet factor
+//               (1 - R_e) / (n^2 (1 - a R_i exp(-4 absorption T))) with its internal reflections
+//               absorbed on their round trip, a the image's linear value (the albedo it stands for).
 // Tolerances: T is a sum of sphere chords over their volume fraction; across the slab's centre it
-// scatters about the true depth by a fraction of a radius, so exp(-a T) is checked within the
-// range T +- r gives; the wet/dry ratio cancels T and absorption and is checked within 2 %
-// (8-bit stage images: a level in 60-200).
+// scatters about the true depth by a fraction of a radius, so both are checked within the range
+// T +- r gives, plus one 8-bit level (stage images: a level in 60-200).
 TEST(RenderFluidSurface, BeerLambertAndWetting) {
   SEAMLESS_REQUIRE_EGL();
   const Intrinsics K = small_K();
@@ -235,15 +238,71 @@ TEST(RenderFluidSurface, BeerLambertAndWetting) {
   const vec3 wet = refraction(z_surface);
   const float a[3] = {p.absorption.x, p.absorption.y, p.absorption.z};
   const float n2 = p.ior * p.ior, Re = p.fresnel_f0 + (1.f - p.fresnel_f0) / 21.f, Ri = 1.f - (1.f - Re) / n2;
-  const float wet_expected = (1.f - Re) / (n2 * (1.f - behind.x * Ri));
+  const float mu_d = 0.5f / n2 / (1.f - std::sqrt(1.f - 1.f / n2));
+  // wet / dry for a depth of water h, channel c.
+  auto wet_ratio = [&](int c, float h) {
+    return std::exp(-a[c] * h / mu_d) * (1.f - Re) / (n2 * (1.f - behind.x * Ri * std::exp(-4.f * a[c] * h)));
+  };
   for (int c = 0; c < 3; ++c) {
     const float got = (&dry.x)[c] / (&behind.x)[c];
-    std::printf("channel %d: dry transmittance %.3f (exp(-a T) %.3f, range %.3f..%.3f); wet/dry %.3f (expected %.3f)\n",
-                c, got, std::exp(-a[c] * T), std::exp(-a[c] * (T + r)), std::exp(-a[c] * (T - r)),
-                (&wet.x)[c] / (&dry.x)[c], wet_expected);
+    const float ratio = (&wet.x)[c] / (&dry.x)[c];
+    std::printf("channel %d: dry transmittance %.3f (exp(-a T) %.3f, range %.3f..%.3f); wet/dry %.3f (expected %.3f, "
+                "range %.3f..%.3f)\n",
+                c, got, std::exp(-a[c] * T), std::exp(-a[c] * (T + r)), std::exp(-a[c] * (T - r)), ratio,
+                wet_ratio(c, T), wet_ratio(c, T + r), wet_ratio(c, T - r));
     EXPECT_GE(got, std::exp(-a[c] * (T + r)) - 0.01f);
     EXPECT_LE(got, std::exp(-a[c] * (T - r)) + 0.01f);
-    EXPECT_NEAR((&wet.x)[c] / (&dry.x)[c], wet_expected, 0.02f * wet_expected);
+    // One 8-bit level of the wet stage (linear, at its value) over the dry value, as a ratio.
+    const float level = 1.f / (255.f * (&dry.x)[c]);
+    EXPECT_GE(ratio, wet_ratio(c, T + r) - level);
+    EXPECT_LE(ratio, wet_ratio(c, T - r) + level);
+  }
+}
+
+// Water resting on a measured surface, half of it over pixels without recorded depth (a Kinect
+// hole, depth 0): a hole is not an occluder, so the water is drawn there, and what the camera saw
+// there has the image's colour at an unmeasured depth, not infinitely far. The frame over the hole
+// must look like the frame over the measured half: the same uniform image, the same slab (the
+// lattice is symmetric about the image centre, so the two halves cover the same sphere pattern
+// mirrored). Taken as infinitely far, the hole's pixels counted the water as hanging in the air
+// (not wet: 1 / 0.62 times brighter, and the light's way down not absorbed) and ran the refracted
+// ray through the whole thickness. Tolerance: 2 % of each channel's linear value (a few 8-bit levels
+// at these values; the wet factor alone is a 38 % difference).
+TEST(RenderFluidSurface, WaterOverADepthHoleLooksLikeTheWaterAroundIt) {
+  SEAMLESS_REQUIRE_EGL();
+  const Intrinsics K = small_K();
+  const uchar3 grey{150, 150, 150};
+  const float z_surface = 1.2f;
+  std::vector<uchar3> rgb(static_cast<std::size_t>(kW) * kH, grey);
+  std::vector<float> depth(rgb.size(), z_surface);
+  const int hole_u0 = 100;  // the hole: every pixel right of the image centre
+  for (int v = 0; v < kH; ++v)
+    for (int u = hole_u0; u < kW; ++u) depth[static_cast<std::size_t>(v) * kW + u] = 0.f;
+  RenderParams p = surface_params();
+  p.view = RenderView::kinect;
+  p.light_intensity = 0.f;
+  p.absorption = {4.f, 2.f, 1.f};  // linear values 0.05-0.15 over 8 cm: 8-bit steps under 1 %
+  const float r = 0.01f, d = 2.f * r;
+  Renderer rd(p, kW, kH);
+  rd.set_kinect_view(Image<uchar3>::from_host(rgb, kW, kH, Device::CPU),
+                     Image<float>::from_host(depth, kW, kH, Device::CPU), K, SE3::identity());
+  std::vector<vec3> x;
+  for (int k = 0; k < 4; ++k) layer(x, 0.f, 0.f, z_surface - 1.5f * r - k * d, 12, d);
+  std::vector<std::uint32_t> ph;
+  const Pixels im(rd.render(fluid_list(x, ph, r), RenderCamera{}));
+  // Mean linear colour over columns [u0, u1] of rows 60-90 (inside the slab, which spans about
+  // u 68-131 and v 43-106, and 4 or more pixels from the hole's edge and the slab's rim).
+  auto mean = [&](int u0, int u1) {
+    vec3 sum{0, 0, 0};
+    int n = 0;
+    for (int v = 60; v <= 90; ++v)
+      for (int u = u0; u <= u1; ++u) sum = sum + linear(im.at(u, v)), ++n;
+    return sum * (1.f / static_cast<float>(n));
+  };
+  const vec3 measured = mean(80, 95), hole = mean(104, 119);
+  for (int c = 0; c < 3; ++c) {
+    std::printf("channel %d: over measured depth %.4f, over the hole %.4f\n", c, (&measured.x)[c], (&hole.x)[c]);
+    EXPECT_NEAR((&hole.x)[c], (&measured.x)[c], 0.02f * (&measured.x)[c]);
   }
 }
 

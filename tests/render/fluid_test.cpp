@@ -41,13 +41,15 @@ RenderParams fluid_params() {
 // silhouette lies within its bounding square in the image). Pixels two beyond that box must be untouched background:
 // the depth filter and the shading never write where no sphere was. Pixels inside the projection of the block's front
 // face shrunk by a radius are covered by spheres and must differ from the background: thickness > 0 there attenuates
-// the refracted background (Beer-Lambert, red coefficient 6/m over at least one diameter: at least 1 - exp(-0.24) = 21
-// % of 230).
+// the refracted background (Beer-Lambert with strongly tinted water, red coefficient 25/m, over at least one
+// diameter: at least 1 - exp(-0.5) = 39 % of 230; the default absorption is nearly clear at this size).
 TEST(RenderFluid, FluidPixelsExactlyWhereTheFluidProjects) {
   SEAMLESS_REQUIRE_EGL();
   const Intrinsics K = intrinsics(150.f, 79.5f, 59.5f, 160, 120);
   FluidBlock b;
-  Renderer r(fluid_params(), K.width, K.height);
+  RenderParams p = fluid_params();
+  p.absorption = {25.f, 8.f, 3.5f};
+  Renderer r(p, K.width, K.height);
   Pixels img(r.render(b.list(), camera(K)));
   Pixels empty(r.render(DrawList{}, camera(K)));
   float lo_u = 1e9f, hi_u = -1e9f, lo_v = 1e9f, hi_v = -1e9f, rad = 0.f;

@@ -24,6 +24,8 @@ uniform int u_ssr_steps;       // screen-space reflection: steps along the refle
 uniform float u_ssr_distance;  // ... over this many metres
 uniform float u_contact;       // metres: water whose back is this close to the scene wets it
 uniform bool u_wet;            // darken the surface under the water (Lekner & Dorf 1988)
+uniform bool u_depth_holes;    // Kinect view: scene window depth 1 is a pixel without recorded depth
+uniform float u_diffuse_share; // share of a real surface's light that the fluid's shadow does not already attenuate
 
 float schlick(float f0, float cos_theta) { return f0 + (1.0 - f0) * pow(1.0 - clamp(cos_theta, 0.0, 1.0), 5.0); }
 
@@ -91,11 +93,28 @@ vec3 image_environment(vec3 R) {
 // radiance apart from (1 - F_view), which the Fresnel mix applies. The albedo is taken as the
 // surface's linear radiance (clamped to 1): the image holds no other measure of it; a darker
 // surface darkens more, relatively, as it does when wet.
-vec3 wet_factor(vec3 dry) {
+// Absorbing water (Lekner & Dorf's water is clear): the light sent back down by the interface
+// crosses the layer of depth h twice before it meets the surface again; diffuse light in water
+// (cosine-weighted over the hemisphere) travels on average h / mu = 2 h to a plane h away (mean
+// cosine mu = 1/2), so each round trip keeps tau_r = exp(-absorption 4 h) and the series sums to
+// 1 / (1 - a R_i tau_r). (A first-order estimate: the share R_i is mostly totally reflected,
+// grazing light, whose paths are longer.)
+vec3 wet_factor(vec3 dry, vec3 tau_r) {
   float n2 = u_ior * u_ior;
   float Re = u_f0 + (1.0 - u_f0) / 21.0;
   float Ri = 1.0 - (1.0 - Re) / n2;
-  return vec3((1.0 - Re) / n2) / (1.0 - clamp(dry, 0.0, 1.0) * Ri);
+  return vec3((1.0 - Re) / n2) / (1.0 - clamp(dry, 0.0, 1.0) * Ri * tau_r);
+}
+
+// Mean cosine of the light just under a flat water surface lit by a uniform sky: the refracted
+// directions fill the cone of the critical angle theta_c (sin theta_c = 1 / n) with radiance
+// weighted by cos theta sin theta, so mu_d = E_d / E_0 = (sin^2 theta_c / 2) / (1 - cos theta_c)
+// = 0.83 for n = 1.33 (the downwelling average cosine of hydrologic optics: Kirk 1994, "Light and
+// Photosynthesis in Aquatic Ecosystems", 2nd ed., ch. 6; Mobley 1994, "Light and Water", ch. 1);
+// diffuse light reaching a depth h has come h / mu_d through the water on average.
+float downwelling_mean_cosine() {
+  float s2 = 1.0 / (u_ior * u_ior);
+  return 0.5 * s2 / (1.0 - sqrt(1.0 - s2));
 }
 
 // The shaded colour at texel p, and reflection and refraction alone (ssfr_composite.frag / .comp).
@@ -116,26 +135,54 @@ void composite_at(ivec2 p, out vec4 o_color, out vec4 o_reflect, out vec4 o_refr
   // chords), and only read where the full-resolution depth has fluid.
   float T = texture(u_thickness, frag / u_size).r;
 
-  // Refraction: the view ray bends at the surface (Snell) and meets what is behind the fluid
-  // after the path in water: where the scene behind this pixel is (fluid resting on a surface: the
-  // surface itself), or the fluid's thickness (fluid in the air: the ray leaves it there and goes
-  // on nearly parallel). That point, projected, is what this pixel shows, so the displacement
-  // grows with depth and with the tilt of the surface, as through real water.
+  // The water's depth along its normal: the thickness pass measures T, the path of the view ray
+  // through the water, and a locally plane-parallel layer of depth h is crossed over h / cos
+  // theta_v, so h = T cos theta_v (theta_v between the view ray and the normal).
+  float h = T * NV;
   vec3 t = refract(-V, N, 1.0 / u_ior);
-  float z_bg = eye_depth(texelFetch(u_scene_depth, p, 0).r);
-  float path = min(T, max(z_bg - P.z, 0.0) / max(t.z, 0.2));
+  float cos_t = max(-dot(t, N), 0.1);  // >= cos(critical angle) = 0.66 for water
+
+  // Does the water rest on the surface behind it (its back within u_contact of the scene along the
+  // view ray)? Then it wets it; a drop in the air does not. The measured depth is noisy and
+  // quantised (a Kinect v1's step is about 2.85e-3 z^2 m: 1.1 cm at 2 m), so the tolerance grows
+  // with z^2 and the fade spans twice it: a sharp threshold drew the depth's quantisation bands as
+  // stripes.
+  // A pixel without recorded depth (a Kinect hole: a glossy table at a grazing angle, a dark or
+  // too near surface) is not an occluder, so the water is drawn there, but nor is it a surface
+  // infinitely far away: the camera saw something there, in its colour, at a depth it did not
+  // measure. Taken as infinitely far, the water there counted as hanging in the air (not wet, its
+  // refracted ray run through the whole thickness and projected away from the pixel): blocks
+  // unlike the water around them, exactly where the depth has holes. The nearest surface
+  // consistent with seeing the water there is right behind it: the water's back along the view
+  // ray, so it rests on it, as on the measured pixels around.
+  float w_bg = texelFetch(u_scene_depth, p, 0).r;
+  float z_bg = u_depth_holes && w_bg >= 1.0 ? P.z * (1.0 + T / length(P)) : eye_depth(w_bg);
+  float gap = max(z_bg - P.z, 0.0) * length(P) / P.z - T;
+  float tol = u_contact + 0.006 * z_bg * z_bg;
+  float resting = 1.0 - smoothstep(tol, 3.0 * tol, gap);
+
+  // The refracted view ray's path in the water. Water resting on a surface is a layer: the ray
+  // bends (Snell, t = refract(-V, N, 1 / n)) and crosses it over h / cos theta_t (at most 1.51 h,
+  // however grazing the view, where the view ray's chord T grows without bound). Water in the air
+  // keeps the chord T: through a convex drop the refracted path is T cos theta_t / cos theta_v,
+  // through a slab T cos theta_v / cos theta_t, and T lies between the two.
+  float view_path = mix(T, h / cos_t, resting);
+  // Refraction: the ray meets what is behind the water after that path, or the scene where it is
+  // nearer (water resting on it). That point, projected, is what this pixel shows, so the
+  // displacement grows with depth and with the tilt of the surface, as through real water.
+  float path = min(view_path, max(z_bg - P.z, 0.0) / max(t.z, 0.2));
   vec3 Q = P + t * path;
   vec2 uv_t = clamp(project_uv(Q), 0.5 / u_size, 1.0 - 0.5 / u_size);
   vec3 behind = srgb_to_linear(texture(u_scene_color, uv_t).rgb);
-  // Water resting on the surface behind it (its back within u_contact of the scene along the
-  // view ray) wets it; a drop in the air does not. The measured depth is noisy and quantised
-  // (a Kinect v1's step is about 2.85e-3 z^2 m: 1.1 cm at 2 m), so the tolerance grows with z^2
-  // and the fade spans twice it: a sharp threshold drew the depth's quantisation bands as stripes.
-  float gap = max(z_bg - P.z, 0.0) * length(P) / P.z - T;
-  float tol = u_contact + 0.006 * z_bg * z_bg;
-  if (u_wet) behind *= mix(vec3(1.0), wet_factor(behind), 1.0 - smoothstep(tol, 3.0 * tol, gap));
-  // Beer-Lambert: each metre of water keeps exp(-absorption) of the light, per channel.
-  vec3 refr = behind * exp(-u_absorption * T);
+  // Beer-Lambert (each metre of water keeps exp(-absorption) of the light, per channel) along the
+  // paths the light takes. Every pixel: the refracted view ray, view_path. Under resting water,
+  // also the light's way down to the surface, which the camera image (the dry surface) does not
+  // hold: the room's diffuse light crosses h / mu_d on average (downwelling_mean_cosine); the
+  // light's own share is attenuated by the fluid's shadow already (shadow.glsl), so only
+  // u_diffuse_share of the light is attenuated here; and the internal reflections (wet_factor).
+  vec3 tau_down = vec3(1.0) - u_diffuse_share * (vec3(1.0) - exp(-u_absorption * (h / downwelling_mean_cosine())));
+  vec3 under = tau_down * (u_wet ? wet_factor(behind, exp(-u_absorption * (4.0 * h))) : vec3(1.0));
+  vec3 refr = behind * mix(vec3(1.0), under, resting) * exp(-u_absorption * view_path);
 
   // Reflection of the surroundings: what the reflected ray meets on screen (the scene and the other
   // objects), else the scene's cube map (mesh view) or, in the Kinect view, the image as an
