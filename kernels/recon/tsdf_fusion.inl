@@ -242,8 +242,7 @@ template <Executor Exec>
 void TsdfFusion<Exec>::fuse_hash_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots,
                                         std::int64_t count, Voxel* voxels, uchar3* colors, FrameInput in,
                                         VoxelGeometry geom, float max_weight, bool color, View<std::int32_t> keep,
-                                        float keep_below,
-                                        SurfaceFlags surface) {
+                                        float keep_below, SurfaceFlags surface) {
   const SE3 camera_T_world = in.world_T_camera.inverse();
   // One thread per column of a block (its 8 voxels along z, 64 threads a block): the block's slot,
   // index and key are read once per column instead of once per voxel, and the column's 8 voxels

@@ -84,7 +84,8 @@ void Experiment::check(std::vector<std::string>& problems) const {
     problems.push_back("support_plane: expected [height] (one number) or [], got " +
                        std::to_string(support_plane.size()) + " numbers");
   if (!support_plane.empty() && mode != ExperimentMode::scan_then_simulate)
-    problems.push_back("support_plane needs mode: scan_then_simulate (it joins the floor plane, which that mode sets up)");
+    problems.push_back(
+        "support_plane needs mode: scan_then_simulate (it joins the floor plane, which that mode sets up)");
   if (solver.dynamic_colliders != DynamicColliders::none && mode != ExperimentMode::live)
     problems.push_back("solver.dynamic_colliders: " + std::string(enum_name(solver.dynamic_colliders)) +
                        " needs mode: live (the colliders are each frame's depth points while the camera runs)");

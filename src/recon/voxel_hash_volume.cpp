@@ -121,8 +121,8 @@ void VoxelHashVolume::integrate(const Image<float>& depth, const Image<uchar3>& 
         kernels::TsdfFusion<E>::sort_visible_by_block(ex, table(), visible_.view(), n, scratch_.view(),
                                                       static_cast<int>(std::bit_width(pool_size())));
       kernels::TsdfFusion<E>::fuse_hash_blocks(ex, table(), visible_.cview(), n, voxels_.data(), colors_.data(), in,
-                                               geom_, params_.max_weight, params_.integrate_color, keep,
-                                               keep_below(), surface_flags());
+                                               geom_, params_.max_weight, params_.integrate_color, keep, keep_below(),
+                                               surface_flags());
     });
     if (params_.remove_empty_blocks)
       staged(timer, "remove_empty", [&] {
@@ -329,8 +329,8 @@ std::int64_t VoxelHashVolume::remove_empty_blocks() {
   with_exec(device_, [&]<class E>(const E& ex) {
     kernels::VoxelHash<E>::reset_frame_counters(ex, counters_.data());
     kernels::TsdfFusion<E>::mark_kept_blocks(ex, table(), listed, n, voxels_.data(), keep.view(), keep_below());
-    kernels::TsdfFusion<E>::remove_unkept_blocks(ex, table(), listed, n, keep.cview(), voxels_.data(),
-                                                 colors_.data(), free_list_.view(), counters_.data());
+    kernels::TsdfFusion<E>::remove_unkept_blocks(ex, table(), listed, n, keep.cview(), voxels_.data(), colors_.data(),
+                                                 free_list_.view(), counters_.data());
   });
   last_ = read_counters();
   return last_.removed;
@@ -493,9 +493,8 @@ VolumeStats VoxelHashVolume::stats() {
   s.bytes_per_block = (sizeof(kernels::Voxel) + sizeof(uchar3)) * kBlockVoxels;
   s.voxel_bytes = s.bytes_per_block * static_cast<std::size_t>(s.allocated_blocks);
   s.device_bytes = keys_.bytes() + values_.bytes() + scratch_.bytes() + voxels_.bytes() + colors_.bytes() +
-                   free_list_.bytes() +
-                   visible_.bytes() + keep_.bytes() + surface_.bytes() + near_.bytes() + intervals_.bytes() +
-                   depth_tiles_.bytes() + counters_.bytes();
+                   free_list_.bytes() + visible_.bytes() + keep_.bytes() + surface_.bytes() + near_.bytes() +
+                   intervals_.bytes() + depth_tiles_.bytes() + counters_.bytes();
   s.host_blocks = host_count_;
   s.host_bytes = s.bytes_per_block * static_cast<std::size_t>(host_count_);
   s.streamed_out = streamed_out_;

@@ -144,7 +144,8 @@ void VoxelHashVolume::take_from_host(const vec3& camera_position, bool all, std:
     }
     std::size_t kept = 0;
     for (std::size_t i = 0; i < c.keys.size(); ++i) {
-      const auto at = static_cast<std::ptrdiff_t>(i * kBlockVoxels), to = static_cast<std::ptrdiff_t>(kept * kBlockVoxels);
+      const auto at = static_cast<std::ptrdiff_t>(i * kBlockVoxels),
+                 to = static_cast<std::ptrdiff_t>(kept * kBlockVoxels);
       const auto src = c.voxels.begin() + at;
       const auto src_colors = c.colors.begin() + at;
       if (!all && beyond_radius(c.keys[i], camera_position)) {  // stays: compact in place

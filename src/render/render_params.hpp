@@ -120,9 +120,9 @@ struct RenderParams {
   // its neighbours within filter_size radii (compute splats only; the raster path draws spheres).
   bool fluid_anisotropy = true;
   vec3 absorption{2.f, 0.7f, 0.35f};  // Beer-Lambert coefficients per colour channel, 1/m (docs/RENDERING.md, Water)
-  float ior = 1.33f;                 // refractive index (water): Snell's law bends the view into the fluid
-  float fresnel_f0 = 0.02f;          // reflectance at normal incidence (water: ((1-1.33)/(1+1.33))^2)
-  float fluid_roughness = 0.05f;     // GGX alpha of the fluid surface: size of the light's highlight
+  float ior = 1.33f;                  // refractive index (water): Snell's law bends the view into the fluid
+  float fresnel_f0 = 0.02f;           // reflectance at normal incidence (water: ((1-1.33)/(1+1.33))^2)
+  float fluid_roughness = 0.05f;      // GGX alpha of the fluid surface: size of the light's highlight
   float light_intensity =
       0.6f;             // radiance light_dir alone gives a white diffuse surface facing it (0..1 = black..white)
   int cube_size = 256;  // cube map face size for reflections in the mesh view

@@ -246,10 +246,11 @@ TEST(RenderFluidSurface, BeerLambertAndWetting) {
   for (int c = 0; c < 3; ++c) {
     const float got = (&dry.x)[c] / (&behind.x)[c];
     const float ratio = (&wet.x)[c] / (&dry.x)[c];
-    std::printf("channel %d: dry transmittance %.3f (exp(-a T) %.3f, range %.3f..%.3f); wet/dry %.3f (expected %.3f, "
-                "range %.3f..%.3f)\n",
-                c, got, std::exp(-a[c] * T), std::exp(-a[c] * (T + r)), std::exp(-a[c] * (T - r)), ratio,
-                wet_ratio(c, T), wet_ratio(c, T + r), wet_ratio(c, T - r));
+    std::printf(
+        "channel %d: dry transmittance %.3f (exp(-a T) %.3f, range %.3f..%.3f); wet/dry %.3f (expected %.3f, "
+        "range %.3f..%.3f)\n",
+        c, got, std::exp(-a[c] * T), std::exp(-a[c] * (T + r)), std::exp(-a[c] * (T - r)), ratio, wet_ratio(c, T),
+        wet_ratio(c, T + r), wet_ratio(c, T - r));
     EXPECT_GE(got, std::exp(-a[c] * (T + r)) - 0.01f);
     EXPECT_LE(got, std::exp(-a[c] * (T - r)) + 0.01f);
     // One 8-bit level of the wet stage (linear, at its value) over the dry value, as a ratio.
