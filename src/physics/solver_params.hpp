@@ -209,7 +209,7 @@ struct PlaceParams {
     v("index", index, "which surface: 0 = largest, 1 = second largest, ...", Range{0, 1000});
     v("above", above, "height of the entry's centre above the surface, metres", Range{-10.0, 10.0});
     v("offset", offset,
-      "[x, z]: metres from the surface's centre along world x (right of the first camera) and z "
+      "[x, z]: metres from the surface's centre along world x (left of the first camera) and z "
       "(ahead of it); the point must lie on the surface",
       Range{-100.0, 100.0});
     v("pixel", pixel, "[u, v]: place on the surface seen at this pixel of input frame `frame`", Range{0, 1e5});
