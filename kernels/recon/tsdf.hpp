@@ -167,13 +167,14 @@ template <Executor Exec> struct TsdfFusion {
   static void sort_visible_by_block(const Exec& ex, HashTableView t, View<std::int32_t> slots, std::int64_t count,
                                     View<std::int32_t> block_keys, int key_bits);
 
-  // Fuses one frame into the listed blocks, one thread per column of 8 voxels. When keep is not empty, keep[j]
+  // Fuses one frame into the listed blocks, one thread per column of 8 voxels, and the frame's colour
+  // into colors (nullptr: no colour fused). When keep is not empty, keep[j]
   // becomes 1 if block j still has a voxel near a surface afterwards (voxel_keeps_block), so that
   // finding the empty blocks costs no second pass over the voxels. Likewise surface.flag (when
   // set, and zeroed by find_visible_blocks) of each listed block's pool index, with surface.below.
   static void fuse_hash_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
                                Voxel* voxels, uchar3* colors, FrameInput in, VoxelGeometry geom, float max_weight,
-                               bool color, View<std::int32_t> keep, float keep_below, SurfaceFlags surface = {});
+                               View<std::int32_t> keep, float keep_below, SurfaceFlags surface = {});
 
   // Fuses one frame into every block of a dense grid.
   static void fuse_dense_blocks(const Exec& ex, DenseAccess grid, FrameInput in, float max_weight, bool color);

@@ -241,8 +241,8 @@ SEAMLESS_HD inline void fuse_voxel(Voxel& v, uchar3* v_color, vec3 p_world, cons
 template <Executor Exec>
 void TsdfFusion<Exec>::fuse_hash_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots,
                                         std::int64_t count, Voxel* voxels, uchar3* colors, FrameInput in,
-                                        VoxelGeometry geom, float max_weight, bool color, View<std::int32_t> keep,
-                                        float keep_below, SurfaceFlags surface) {
+                                        VoxelGeometry geom, float max_weight, View<std::int32_t> keep, float keep_below,
+                                        SurfaceFlags surface) {
   const SE3 camera_T_world = in.world_T_camera.inverse();
   // One thread per column of a block (its 8 voxels along z, 64 threads a block): the block's slot,
   // index and key are read once per column instead of once per voxel, and the column's 8 voxels
@@ -259,7 +259,7 @@ void TsdfFusion<Exec>::fuse_hash_blocks(const Exec& ex, HashTableView t, View<co
     const int column = static_cast<int>(i % kColumns);
     const std::int64_t first = static_cast<std::int64_t>(block) * kBlockVoxels + column;
     Voxel* v = voxels + first;
-    uchar3* vc = color ? colors + first : nullptr;
+    uchar3* vc = colors ? colors + first : nullptr;
     // The column's x and y are fixed: written so, the compiler computes their part of the
     // transform (to_world's, and the x and y products of each row's dot product, summed first)
     // once a column instead of once a voxel. The same operations in the same order: same values.

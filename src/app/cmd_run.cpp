@@ -35,14 +35,15 @@ int dry_run(const CommonOptions& o) {
   return 0;
 }
 
-// The floor as an infinite plane at the scanned floor's height: parts of the floor the camera
+// The horizontal planes the solver collides with besides the scan. The floor as an infinite plane at
+// the scanned floor's height: parts of the floor the camera
 // never saw (under and in front of the desk, say) have no scene particles, and objects would fall
 // through them. Only where a floor was seen (find_horizontal_surfaces): a plane invented under a
 // scan without one would stand in the air where the room is empty.
 // `support_plane` adds a plane the user states: a surface the camera does not measure at all (a
 // glossy table seen at a grazing angle returns no depth), which no scan can find.
-std::optional<kernels::SceneSdf> floor_plane(const HorizontalSurface* floor, const std::vector<float>& support,
-                                             vec3 up) {
+std::optional<kernels::SceneSdf> scene_planes(const HorizontalSurface* floor, const std::vector<float>& support,
+                                              vec3 up) {
   std::vector<float> heights;
   if (floor) heights.push_back(floor->height);
   if (!support.empty()) heights.push_back(support.front());
@@ -155,7 +156,7 @@ RunOutputs run_experiment(RunContext& ctx, const std::string& config) {
       renderer->set_kinect_frame(scan_result.first_frame, traj.front().se3());
   }
   const HorizontalSurface* floor_surface = e.floor_plane ? find_floor(ps.surfaces) : nullptr;
-  std::optional<kernels::SceneSdf> floor = floor_plane(floor_surface, e.support_plane, ps.up);
+  std::optional<kernels::SceneSdf> floor = scene_planes(floor_surface, e.support_plane, ps.up);
   if (floor_surface) spdlog::info("floor plane at height {:.3f} m along -gravity", floor_surface->height);
   else if (e.floor_plane) spdlog::info("no floor plane: the scan shows no floor");
   if (!e.support_plane.empty())

@@ -120,9 +120,9 @@ void VoxelHashVolume::integrate(const Image<float>& depth, const Image<uchar3>& 
       if (device_ == Device::CPU)
         kernels::TsdfFusion<E>::sort_visible_by_block(ex, table(), visible_.view(), n, scratch_.view(),
                                                       static_cast<int>(std::bit_width(pool_size())));
-      kernels::TsdfFusion<E>::fuse_hash_blocks(ex, table(), visible_.cview(), n, voxels_.data(), colors_.data(), in,
-                                               geom_, params_.max_weight, params_.integrate_color, keep, keep_below(),
-                                               surface_flags());
+      kernels::TsdfFusion<E>::fuse_hash_blocks(ex, table(), visible_.cview(), n, voxels_.data(),
+                                               params_.integrate_color ? colors_.data() : nullptr, in, geom_,
+                                               params_.max_weight, keep, keep_below(), surface_flags());
     });
     if (params_.remove_empty_blocks)
       staged(timer, "remove_empty", [&] {

@@ -64,6 +64,13 @@ RenderParams surface_params() {
   return p;
 }
 
+// A uniform grey table facing the camera: the Kinect frame (colour and recorded depth) that the
+// shading tests put water on.
+const uchar3 kTableGrey{150, 150, 150};
+constexpr float kTableZ = 1.2f;
+std::vector<uchar3> table_rgb() { return std::vector<uchar3>(static_cast<std::size_t>(kW) * kH, kTableGrey); }
+std::vector<float> table_depth() { return std::vector<float>(static_cast<std::size_t>(kW) * kH, kTableZ); }
+
 // A layer spread to spacing 3 r (spheres of the default 1.5 r just touch along the lattice; the
 // holes at the lattice's diagonals, 2.12 r from each centre, are open): inside the layer's
 // projection, shrunk by one spacing, every pixel has a depth after the filter, and that depth lies
@@ -196,10 +203,10 @@ TEST(RenderFluidSurface, GapFillLeavesTheSceneInFront) {
 TEST(RenderFluidSurface, BeerLambertAndWetting) {
   SEAMLESS_REQUIRE_EGL();
   const Intrinsics K = small_K();
-  const uchar3 grey{150, 150, 150};
-  const float z_surface = 1.2f;
-  std::vector<uchar3> rgb(static_cast<std::size_t>(kW) * kH, grey);
-  std::vector<float> depth(rgb.size(), z_surface);
+  const uchar3 grey = kTableGrey;
+  const float z_surface = kTableZ;
+  std::vector<uchar3> rgb = table_rgb();
+  std::vector<float> depth = table_depth();
   RenderParams p = surface_params();
   p.view = RenderView::kinect;
   p.stage_images = true;
@@ -272,10 +279,10 @@ TEST(RenderFluidSurface, BeerLambertAndWetting) {
 TEST(RenderFluidSurface, WaterOverADepthHoleLooksLikeTheWaterAroundIt) {
   SEAMLESS_REQUIRE_EGL();
   const Intrinsics K = small_K();
-  const uchar3 grey{150, 150, 150};
-  const float z_surface = 1.2f;
-  std::vector<uchar3> rgb(static_cast<std::size_t>(kW) * kH, grey);
-  std::vector<float> depth(rgb.size(), z_surface);
+  const uchar3 grey = kTableGrey;
+  const float z_surface = kTableZ;
+  std::vector<uchar3> rgb = table_rgb();
+  std::vector<float> depth = table_depth();
   const int hole_u0 = 100;  // the hole: every pixel right of the image centre
   for (int v = 0; v < kH; ++v)
     for (int u = hole_u0; u < kW; ++u) depth[static_cast<std::size_t>(v) * kW + u] = 0.f;
