@@ -279,7 +279,6 @@ TEST(RenderFluidSurface, BeerLambertAndWetting) {
 TEST(RenderFluidSurface, WaterOverADepthHoleLooksLikeTheWaterAroundIt) {
   SEAMLESS_REQUIRE_EGL();
   const Intrinsics K = small_K();
-  const uchar3 grey = kTableGrey;
   const float z_surface = kTableZ;
   std::vector<uchar3> rgb = table_rgb();
   std::vector<float> depth = table_depth();
