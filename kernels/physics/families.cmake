@@ -1,6 +1,6 @@
 # kernels/physics: the unified particle solver (Macklin et al. 2014), see docs/PHYSICS.md and
 # kernels/physics/solver.hpp (the passes in order).
-foreach(family grid contacts fluid solids integration depth_colliders)
+foreach(family grid contacts fluid solids integration depth_colliders anisotropy)
   seamless_kernel_family(physics/${family})
 endforeach()
 # The CPU's SIMD tiles (never compiled by nvcc).
@@ -12,7 +12,7 @@ target_sources(seamless_kernels PRIVATE physics/cpu_tiles.cpp)
 # physics CPU file, as when they were one file (solver_cpu.cpp), so the scalar loops compile as
 # they did.
 set(SEAMLESS_PHYSICS_CPU_SOURCES physics/cpu_tiles.cpp physics/grid_cpu.cpp physics/contacts_cpu.cpp
-  physics/fluid_cpu.cpp physics/solids_cpu.cpp physics/integration_cpu.cpp)
+  physics/fluid_cpu.cpp physics/solids_cpu.cpp physics/integration_cpu.cpp physics/anisotropy_cpu.cpp)
 list(TRANSFORM SEAMLESS_PHYSICS_CPU_SOURCES PREPEND ${CMAKE_CURRENT_SOURCE_DIR}/)
 set_source_files_properties(${SEAMLESS_PHYSICS_CPU_SOURCES}
   PROPERTIES COMPILE_OPTIONS "$<$<CXX_COMPILER_ID:GNU,Clang>:-fno-math-errno;-Wno-psabi;--param=inline-unit-growth=200>")

@@ -113,6 +113,16 @@ struct GridSpec {
   SEAMLESS_HD std::int64_t cells() const { return std::int64_t{1} << (3 * bits); }
   // Grid of cells of half the search radius R.
   static GridSpec for_radius(float R, int bits) { return {2.f / R, bits, 0.5f * R}; }
+  // Cells per axis (as bits) for n points: about 16 cells a point, 8..128 per axis (at least 5 per
+  // axis keeps the cells searched around a point distinct). Cells are half the search radius, so a
+  // particle at the fluid rest spacing fills about one; the spare cells make the periodic grid wide
+  // enough that spread-out scenes (a sheet of cloth, bodies far apart) do not fold many far-away
+  // particles into the cells searched.
+  static int bits_for(std::int64_t n) {
+    int bits = 3;
+    while (bits < 7 && (std::int64_t{1} << (3 * bits)) < 16 * n) ++bits;
+    return bits;
+  }
 };
 
 // Distance along one axis from coordinate v to cell i's slab [i cs, (i + 1) cs), made smaller by

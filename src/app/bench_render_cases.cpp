@@ -19,6 +19,9 @@ RenderBenchResult run_one(const char* label, const RenderParams& settings, int r
               r.median_frame_ms, r.median_readback_ms);
   if (r.median_interop_ms >= 0) std::printf(", CUDA interop copy + draw %.3f ms", r.median_interop_ms);
   std::printf("\n");
+  if (r.median_ellipsoid_ms >= 0)
+    std::printf("  anisotropic kernels (%s, before the GL passes, in the interop figure) %.3f ms\n",
+                r.ellipsoid_device.c_str(), r.median_ellipsoid_ms);
   for (const RenderTiming& t : r.passes) std::printf("  pass %-20s %.3f ms\n", t.pass.c_str(), t.ms);
   return r;
 }
@@ -34,6 +37,7 @@ void write_json(const std::string& path, const RenderBenchResult& r) {
                          {"median_draw_ms", r.median_draw_ms},
                          {"median_readback_ms", r.median_readback_ms},
                          {"median_interop_ms", r.median_interop_ms},
+                         {"median_ellipsoid_ms", r.median_ellipsoid_ms},
                          {"passes_ms", std::move(passes)}});
 }
 }  // namespace

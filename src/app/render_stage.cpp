@@ -121,7 +121,8 @@ class GlRunRenderer : public RunRenderer {
       set_mesh_camera(static_cast<float>(solver.stats().time / duration));
 #if SEAMLESS_HAS_CUDA
     if (interop_ && solver.device() == Device::CUDA) {
-      interop_->copy_from_device(solver.device_positions(), solver.device_phases(), solver.size());
+      interop_->copy_from_device(solver.device_positions(), solver.device_phases(), solver.size(),
+                                 0.5f * solver.params().particle_diameter);
       renderer_.draw_device_particles(draw_state_.device_list(solver), solver.size(), camera_);
       out_.add(renderer_);
       return;

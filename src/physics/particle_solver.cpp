@@ -40,17 +40,6 @@ template <class T> void upload_at(Buffer<T>& b, std::int64_t offset, const std::
   memory::copy(b.data() + offset, b.device(), v.data(), Device::CPU, sizeof(T) * v.size());
 }
 
-// Cells per axis (as bits) so that the grid has about 16 cells per particle, 8..128 per axis (at
-// least 5 per axis keeps the cells searched around a particle distinct, GridSpec). Cells are half
-// the search radius, so a particle at the fluid rest spacing fills about one; the spare cells make
-// the periodic grid wide enough that spread-out scenes (a sheet of cloth, bodies far apart) do not
-// fold many far-away particles into the cells searched.
-int grid_bits(std::int64_t n) {
-  int bits = 3;
-  while (bits < 7 && (std::int64_t{1} << (3 * bits)) < 16 * n) ++bits;
-  return bits;
-}
-
 }  // namespace
 
 // The solver's state by concern; ParticleSolver::Impl derives from them, so the code names each
@@ -300,7 +289,7 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
 
   // Grid size and the buffers it needs for n particles; a reallocation bumps the generation.
   void prepare_grid() {
-    bits = grid_bits(n);
+    bits = K::GridSpec::bits_for(n);
     std::int64_t cells = std::int64_t{1} << (3 * bits);
     const void* before[2] = {cell_start.data(), snbr.data()};
     cell_start.reserve_discard(cells + 1, dev);
@@ -683,7 +672,7 @@ struct ParticleSolver::Impl : solver_state::ParticleState,
     ++generation;
     const std::int64_t ns = static_count();
     if (ns == 0) return;
-    int sb = grid_bits(ns);
+    int sb = K::GridSpec::bits_for(ns);
     sgrid = K::GridSpec::for_radius(std::max(P.fluid_smoothing * P.particle_diameter, 1.5f * P.particle_diameter), sb);
     std::int64_t cells = std::int64_t{1} << (3 * sb);
     // The scene's points, then the colliders' (device to device), in buffers kept between calls:

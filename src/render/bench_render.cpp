@@ -6,11 +6,14 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <optional>
 
 #include "core/buffer.hpp"
 #include "core/device.hpp"
+#include "core/exec.hpp"
 #include "core/mesh.hpp"
 #include "core/phase.hpp"
+#include "physics/fluid_ellipsoids.hpp"
 #include "seamless/build_config.hpp"
 #if SEAMLESS_HAS_CUDA
 #include "render/cuda_interop.hpp"
@@ -63,7 +66,7 @@ double interop_ms(Renderer& r, const std::vector<vec3>& x, const std::vector<std
     std::vector<double> ms;
     for (int f = 0; f < frames; ++f) {
       auto t0 = std::chrono::steady_clock::now();
-      interop.copy_from_device(dx.data(), dph.data(), static_cast<std::int64_t>(x.size()));
+      interop.copy_from_device(dx.data(), dph.data(), static_cast<std::int64_t>(x.size()), radius);
       r.draw_device_particles(device_list(radius), static_cast<std::int64_t>(x.size()), cam);
       glFinish();
       ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
@@ -76,6 +79,29 @@ double interop_ms(Renderer& r, const std::vector<vec3>& x, const std::vector<std
   (void)r, (void)x, (void)ph, (void)radius, (void)cam, (void)frames;
   return -1.0;
 #endif
+}
+
+// The anisotropic kernels' ellipsoids of the particles, computed where a run computes them (on
+// CUDA when there is a device, else on the CPU), their median time over a few calls into `res`:
+// the frames then time the GL passes alone. None when the renderer draws spheres.
+std::vector<vec4> bench_ellipsoids(const Renderer& r, const std::vector<vec3>& x, const std::vector<std::uint32_t>& ph,
+                                   float radius, RenderBenchResult& res) {
+  const std::optional<Renderer::EllipsoidSizes> sizes = r.fluid_ellipsoid_sizes(radius);
+  if (!sizes) return {};
+  const Device d = cuda_available() ? Device::CUDA : Device::CPU;
+  FluidEllipsoids shapes(d);
+  const Buffer<vec3> dx = Buffer<vec3>::from_host(x, d);
+  const Buffer<std::uint32_t> dph = Buffer<std::uint32_t>::from_host(ph, d);
+  std::vector<double> ms;
+  for (int i = 0; i < 5; ++i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    shapes.compute(dx.data(), dph.data(), static_cast<std::int64_t>(x.size()), sizes->radius, sizes->h);
+    with_exec(d, []<class E>(const E& ex) { ex.synchronize(); });
+    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  }
+  res.median_ellipsoid_ms = median_of(ms);
+  res.ellipsoid_device = device_name(d);
+  return shapes.compute_host(x, ph, sizes->radius, sizes->h);
 }
 
 }  // namespace
@@ -111,6 +137,9 @@ RenderBenchResult bench_render(int width, int height, std::int64_t particles, in
   std::vector<std::uint32_t> ph(x.size(), phase::kFluid);
   DrawList list;
   list.positions = x, list.phases = ph, list.particle_radius = radius;
+  RenderBenchResult res;
+  const std::vector<vec4> ellipsoids = bench_ellipsoids(r, x, ph, radius, res);
+  list.ellipsoids = ellipsoids;
   const float extent = side * 2 * radius;
   RenderCamera cam = RenderCamera::look_at({extent * 0.9f, extent * 1.1f, extent * 1.3f}, {0, extent * 0.4f, 0},
                                            {0, 1, 0}, 60.f, width, height);
@@ -135,7 +164,6 @@ RenderBenchResult bench_render(int width, int height, std::int64_t particles, in
     gpu_ms.push_back(gpu_total_ms(r.timings()));  // per pass and in total: the draw-only frame's
     for (const RenderTiming& t : r.timings()) pass_ms[t.pass].push_back(t.ms);
   }
-  RenderBenchResult res;
   res.median_interop_ms = interop_ms(r, x, ph, radius, cam, frames);
   res.median_gpu_ms = median_of(gpu_ms);
   res.width = width, res.height = height, res.particles = static_cast<std::int64_t>(x.size()), res.frames = frames;

@@ -19,10 +19,12 @@ struct RenderBenchResult {
   double median_draw_ms = 0.0;   // draw + glFinish with the particles already in GL buffers
                                  // (the CUDA-OpenGL interop path: no host upload)
   double median_readback_ms = 0.0;
-  double median_gpu_ms = 0.0;        // GPU time of the draw-only frame: first to last timestamp query
-  double median_interop_ms = -1.0;   // CUDA device copy into GL + draw + glFinish; -1: not measured
-                                     // (no CUDA, or the GL context is not on the CUDA device)
-  std::vector<RenderTiming> passes;  // GPU time per pass, median over the frames
+  double median_gpu_ms = 0.0;         // GPU time of the draw-only frame: first to last timestamp query
+  double median_interop_ms = -1.0;    // CUDA device copy into GL + draw + glFinish; -1: not measured
+                                      // (no CUDA, or the GL context is not on the CUDA device)
+  double median_ellipsoid_ms = -1.0;  // the anisotropic kernels (FluidEllipsoids) on ellipsoid_device,
+  std::string ellipsoid_device;       // wall time with synchronisation; -1: spheres drawn
+  std::vector<RenderTiming> passes;   // GPU time per pass, median over the frames
   std::string gl_renderer;
 };
 

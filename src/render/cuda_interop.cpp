@@ -4,18 +4,20 @@
 
 #include <cuda_gl_interop.h>
 
+#include <optional>
 #include <string>
 
 #include "core/cuda_check.hpp"
 #include "core/error.hpp"
+#include "kernels/physics/anisotropy.hpp"
 #include "render/renderer.hpp"
 
 namespace seamless {
 
-CudaGlParticles::CudaGlParticles(Renderer& r, std::int64_t capacity) : capacity_(capacity) {
+CudaGlParticles::CudaGlParticles(Renderer& r, std::int64_t capacity) : renderer_(r), capacity_(capacity) {
   r.reserve_particles(capacity);  // reallocation after registration would invalidate it
-  const unsigned bufs[2] = {r.particle_position_buffer(), r.particle_phase_buffer()};
-  for (int i = 0; i < 2; ++i) {
+  const unsigned bufs[3] = {r.particle_position_buffer(), r.particle_phase_buffer(), r.particle_ellipsoid_buffer()};
+  for (int i = 0; i < 3; ++i) {
     cudaGraphicsResource_t res = nullptr;
     SEAMLESS_CUDA_CHECK(cudaGraphicsGLRegisterBuffer(&res, bufs[i], cudaGraphicsRegisterFlagsWriteDiscard));
     res_[i] = res;
@@ -27,20 +29,28 @@ CudaGlParticles::~CudaGlParticles() {
     if (res) cudaGraphicsUnregisterResource(static_cast<cudaGraphicsResource_t>(res));
 }
 
-void CudaGlParticles::copy_from_device(const vec3* d_x, const std::uint32_t* d_phase, std::int64_t n, void* stream) {
+void CudaGlParticles::copy_from_device(const vec3* d_x, const std::uint32_t* d_phase, std::int64_t n,
+                                       float particle_radius) {
   if (n > capacity_)
     throw Error("render: " + std::to_string(n) + " particles exceed the interop capacity " + std::to_string(capacity_));
-  auto s = static_cast<cudaStream_t>(stream);
-  cudaGraphicsResource_t res[2] = {static_cast<cudaGraphicsResource_t>(res_[0]),
-                                   static_cast<cudaGraphicsResource_t>(res_[1])};
-  SEAMLESS_CUDA_CHECK(cudaGraphicsMapResources(2, res, s));
-  void* dst[2] = {nullptr, nullptr};
+  const std::optional<Renderer::EllipsoidSizes> sizes = renderer_.fluid_ellipsoid_sizes(particle_radius);
+  const vec4* d_ell = sizes && n > 0 ? shapes_.compute(d_x, d_phase, n, sizes->radius, sizes->h) : nullptr;
+  const int maps = d_ell ? 3 : 2;
+  cudaGraphicsResource_t res[3] = {static_cast<cudaGraphicsResource_t>(res_[0]),
+                                   static_cast<cudaGraphicsResource_t>(res_[1]),
+                                   static_cast<cudaGraphicsResource_t>(res_[2])};
+  SEAMLESS_CUDA_CHECK(cudaGraphicsMapResources(maps, res, nullptr));
+  void* dst[3] = {nullptr, nullptr, nullptr};
   std::size_t bytes = 0;
-  for (int i = 0; i < 2; ++i) SEAMLESS_CUDA_CHECK(cudaGraphicsResourceGetMappedPointer(&dst[i], &bytes, res[i]));
+  for (int i = 0; i < maps; ++i) SEAMLESS_CUDA_CHECK(cudaGraphicsResourceGetMappedPointer(&dst[i], &bytes, res[i]));
   const auto un = static_cast<std::size_t>(n);
-  SEAMLESS_CUDA_CHECK(cudaMemcpyAsync(dst[0], d_x, un * sizeof(vec3), cudaMemcpyDeviceToDevice, s));
-  SEAMLESS_CUDA_CHECK(cudaMemcpyAsync(dst[1], d_phase, un * sizeof(std::uint32_t), cudaMemcpyDeviceToDevice, s));
-  SEAMLESS_CUDA_CHECK(cudaGraphicsUnmapResources(2, res, s));
+  SEAMLESS_CUDA_CHECK(cudaMemcpyAsync(dst[0], d_x, un * sizeof(vec3), cudaMemcpyDeviceToDevice, nullptr));
+  SEAMLESS_CUDA_CHECK(cudaMemcpyAsync(dst[1], d_phase, un * sizeof(std::uint32_t), cudaMemcpyDeviceToDevice, nullptr));
+  if (d_ell)
+    SEAMLESS_CUDA_CHECK(cudaMemcpyAsync(dst[2], d_ell, un * kernels::kEllipsoidVec4s * sizeof(vec4),
+                                        cudaMemcpyDeviceToDevice, nullptr));
+  SEAMLESS_CUDA_CHECK(cudaGraphicsUnmapResources(maps, res, nullptr));
+  renderer_.use_device_ellipsoids(d_ell != nullptr);
 }
 
 }  // namespace seamless

@@ -7,6 +7,7 @@
 #include "core/log.hpp"
 #include "core/mesh.hpp"
 #include "core/phase.hpp"
+#include "kernels/physics/anisotropy.hpp"
 #include "render/renderer_impl.hpp"
 
 namespace seamless {
@@ -181,9 +182,13 @@ void Renderer::Impl::upload_particles(const DrawList& list) {
     glBindBuffer(GL_ARRAY_BUFFER, part_phase);
     glBufferData(GL_ARRAY_BUFFER, part_capacity * static_cast<GLsizeiptr>(sizeof(std::uint32_t)), nullptr,
                  GL_STREAM_DRAW);
+    glBindBuffer(GL_ARRAY_BUFFER, part_ell);
+    glBufferData(GL_ARRAY_BUFFER, part_capacity * kernels::kEllipsoidVec4s * static_cast<GLsizeiptr>(sizeof(vec4)),
+                 nullptr, GL_STREAM_DRAW);
   }
   fluid_count = list.phases.empty() ? n : 0;
   for (std::uint32_t ph : list.phases) fluid_count += phase::is(ph, phase::kFluid) ? 1 : 0;
+  aniso_live = ellipsoids_in_buffer = false;
   if (n == 0) return;
   glBindBuffer(GL_ARRAY_BUFFER, part_pos);
   glBufferSubData(GL_ARRAY_BUFFER, 0, n * static_cast<GLsizeiptr>(sizeof(vec3)), list.positions.data());
@@ -194,6 +199,35 @@ void Renderer::Impl::upload_particles(const DrawList& list) {
   } else {
     glBufferSubData(GL_ARRAY_BUFFER, 0, n * static_cast<GLsizeiptr>(sizeof(std::uint32_t)), list.phases.data());
   }
+  upload_ellipsoids(list, n);
+}
+
+std::optional<Renderer::EllipsoidSizes> Renderer::Impl::ellipsoid_sizes(float radius) const {
+  if (!p.fluid_anisotropy || !use_compute_splat() || !(radius > 0.f)) return std::nullopt;
+  return Renderer::EllipsoidSizes{radius * p.fluid_radius_scale, std::max(p.filter_size, 2.f) * radius};
+}
+
+// This frame's fluid ellipsoids for the splats: the list's own, or computed here on the CPU when
+// the anisotropic kernels are on and the list brings none (a host run, a test, `seamless render`).
+void Renderer::Impl::upload_ellipsoids(const DrawList& list, std::int64_t n) {
+  aniso_live = false;
+  const std::optional<Renderer::EllipsoidSizes> sizes = ellipsoid_sizes(list.particle_radius);
+  if (!sizes || fluid_count == 0 || n == 0) return;
+  const std::int64_t count = n * kernels::kEllipsoidVec4s;
+  const vec4* e = list.ellipsoids.data();
+  if (list.ellipsoids.empty()) {
+    std::vector<std::uint32_t> all_fluid;
+    if (list.phases.empty()) all_fluid.assign(static_cast<std::size_t>(n), phase::kFluid);
+    e = cpu_shapes.compute(list.positions.data(), list.phases.empty() ? all_fluid.data() : list.phases.data(), n,
+                           sizes->radius, sizes->h);
+  } else if (static_cast<std::int64_t>(list.ellipsoids.size()) != count) {
+    throw Error("render: DrawList has " + std::to_string(list.ellipsoids.size()) + " ellipsoid vec4s for " +
+                std::to_string(n) + " particles; give " + std::to_string(kernels::kEllipsoidVec4s) +
+                " per particle (FluidEllipsoids) or none");
+  }
+  glBindBuffer(GL_ARRAY_BUFFER, part_ell);
+  glBufferSubData(GL_ARRAY_BUFFER, 0, count * static_cast<GLsizeiptr>(sizeof(vec4)), e);
+  aniso_live = ellipsoids_in_buffer = true;
 }
 
 void Renderer::Impl::draw_spheres(const Program& prog, std::int64_t n, std::uint32_t mask, float radius,
@@ -413,6 +447,7 @@ void init(Renderer::Impl& m, const RenderParams& params, int width, int height) 
   m.part_vao = VertexArray(new_name(glGenVertexArrays));
   m.part_pos = GlBuffer(new_name(glGenBuffers));
   m.part_phase = GlBuffer(new_name(glGenBuffers));
+  m.part_ell = GlBuffer(new_name(glGenBuffers));
   glBindVertexArray(m.part_vao);
   glBindBuffer(GL_ARRAY_BUFFER, m.part_pos);
   glEnableVertexAttribArray(0);
@@ -460,6 +495,11 @@ Renderer::FluidImages Renderer::read_fluid_images() const {
 
 unsigned Renderer::particle_position_buffer() const { return impl_->part_pos; }
 unsigned Renderer::particle_phase_buffer() const { return impl_->part_phase; }
+unsigned Renderer::particle_ellipsoid_buffer() const { return impl_->part_ell; }
+std::optional<Renderer::EllipsoidSizes> Renderer::fluid_ellipsoid_sizes(float particle_radius) const {
+  return impl_->ellipsoid_sizes(particle_radius);
+}
+void Renderer::use_device_ellipsoids(bool on) { impl_->ellipsoids_in_buffer = on; }
 
 void Renderer::resize(int width, int height) {
   if (width == impl_->w && height == impl_->h) return;
@@ -547,6 +587,7 @@ void Renderer::draw_device_particles(const DrawList& list, std::int64_t n, const
     throw Error("render: " + std::to_string(n) + " device particles but the interop buffers hold " +
                 std::to_string(impl_->part_capacity) + " (call reserve_particles first)");
   impl_->fluid_count = -1;
+  impl_->aniso_live = impl_->ellipsoids_in_buffer && n > 0;
   impl_->draw_frame(list, n, effective_camera(*this, impl_->p, camera));
 }
 

@@ -10,6 +10,7 @@
 // then screen-space fluid rendering (van der Laan, Green, Sainz 2009) over the result.
 #pragma once
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -88,9 +89,22 @@ class Renderer {
   bool uses_compute_splat() const;
   // Copies the last frame to the bound draw framebuffer (0 = the window), scaled to w x h.
   void blit_to(unsigned framebuffer, int w, int h);
-  // The particle position/phase buffers for CUDA-OpenGL interop (render/cuda_interop.hpp).
+  // The particle position/phase buffers for CUDA-OpenGL interop (render/cuda_interop.hpp), and
+  // the fluid's ellipsoids (kernels::kEllipsoidVec4s vec4 per particle).
   unsigned particle_position_buffer() const;
   unsigned particle_phase_buffer() const;
+  unsigned particle_ellipsoid_buffer() const;
+  // The anisotropic kernels' sizes for particles of this radius (FluidEllipsoids::compute's radius
+  // and h): the sphere drawn and the neighbourhood, the depth filter's half-width (filter_size
+  // radii: the spacing the surface must span). None when the fluid is drawn as spheres
+  // (render.fluid_anisotropy off, or no compute splats).
+  struct EllipsoidSizes {
+    float radius = 0.f, h = 0.f;
+  };
+  std::optional<EllipsoidSizes> fluid_ellipsoid_sizes(float particle_radius) const;
+  // Whether the next draw_device_particles splats the ellipsoids in particle_ellipsoid_buffer()
+  // (the interop filled it) or spheres. A host draw sets it too: whether it uploaded ellipsoids.
+  void use_device_ellipsoids(bool on);
   // Makes the particle buffers hold at least n particles (before registering them for interop).
   void reserve_particles(std::int64_t n);
   // Draws with particles already in particle_*_buffer() (n of them) instead of list.positions.

@@ -303,8 +303,6 @@ void Renderer::Impl::composite_pass(const RenderCamera& cam, float contact) {
 bool Renderer::Impl::draw_fluid(std::int64_t n, float radius, const RenderCamera& cam) {
   if (fluid_count == 0) return false;
   const float sphere_r = radius * p.fluid_radius_scale;
-  fluid_anisotropy_pass(n, sphere_r, radius);
-  timer.mark("fluid_aniso");
   fluid_depth_pass(n, sphere_r, cam);
   timer.mark("fluid_depth");
   if (p.stage_images)

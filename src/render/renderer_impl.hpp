@@ -5,10 +5,12 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "physics/fluid_ellipsoids.hpp"
 #include "render/renderer.hpp"
 #include "render/shader.hpp"
 
@@ -94,13 +96,11 @@ struct Renderer::Impl {
   // Compute splats (render.fluid_splat: compute), built only with GL >= 4.3 (has_compute).
   bool has_compute = false;
   Program depth_splat_prog, thick_splat_prog, resolve_prog;
-  // Anisotropic kernels (fluid_aniso.comp): hashed grid buckets and the ellipsoids, 3 vec4 per
-  // particle; sized on demand.
-  Program aniso_prog;
-  GlBuffer aniso_count, aniso_slots, aniso_ell;
-  std::int64_t aniso_particles = 0;
-  GLuint aniso_buckets = 0;
-  bool aniso_live = false;                              // this frame's splats read aniso_ell
+  // Anisotropic kernels: the fluid's ellipsoids (physics/fluid_ellipsoids.hpp), computed on the
+  // CPU for a host DrawList that has none, or copied in by the CUDA interop.
+  FluidEllipsoids cpu_shapes{Device::CPU};
+  bool aniso_live = false;            // this frame's splats read part_ell
+  bool ellipsoids_in_buffer = false;  // part_ell holds the particles' ellipsoids (last upload, or the interop)
   Program filter_cprog, normal_cprog, composite_cprog;  // the full-screen passes as compute
   VertexArray empty_vao;
 
@@ -145,6 +145,7 @@ struct Renderer::Impl {
   std::map<const BodyMesh*, std::pair<std::weak_ptr<const BodyMesh>, GlMesh>> body_meshes;
   VertexArray part_vao;
   GlBuffer part_pos, part_phase;
+  GlBuffer part_ell;  // kernels::kEllipsoidVec4s vec4 per particle (the anisotropic kernels)
   std::int64_t part_capacity = 0;
   std::int64_t fluid_count = -1;  // fluid particles of the last upload; -1: unknown (device data)
 
@@ -202,7 +203,8 @@ struct Renderer::Impl {
   void resolve_splat(GLuint acc, GLuint out, int iw, int ih, bool depth_bits);
   void dispatch_screen(int iw, int ih);  // 8 x 8 tiles over iw x ih, then the barriers
   void fluid_depth_splat(std::int64_t n, float sphere_r, const RenderCamera& cam);
-  void fluid_anisotropy_pass(std::int64_t n, float sphere_r, float radius);
+  void upload_ellipsoids(const DrawList& list, std::int64_t n);
+  std::optional<Renderer::EllipsoidSizes> ellipsoid_sizes(float radius) const;
   void fluid_thickness_splat(std::int64_t n, float sphere_r, const RenderCamera& low);
   void capture_stages();
   // renderer_shadow.cpp

@@ -33,7 +33,6 @@ void Renderer::Impl::build_compute_programs() {
   };
   depth_splat_prog = Program("fluid depth splat", {cs("ssfr_depth_splat.comp")});
   thick_splat_prog = Program("fluid thickness splat", {cs("ssfr_thickness_splat.comp")});
-  aniso_prog = Program("fluid anisotropic kernels", {cs("fluid_aniso.comp")});
   resolve_prog = Program("fluid splat resolve", {ShaderStage{GL_COMPUTE_SHADER, {"ssfr_resolve.comp"}}});
   auto screen = [](const char* name, const char* body, const char* main) {
     return Program(name, {ShaderStage{GL_COMPUTE_SHADER, {"camera.glsl", "color.glsl", "screen.glsl", body, main}}});
@@ -89,7 +88,7 @@ void Renderer::Impl::splat_uniforms(const Program& prog, std::int64_t n, float s
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, part_pos);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, part_phase);
   glUniform1i(prog.loc("u_aniso"), aniso_live);
-  if (aniso_live) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, aniso_ell);
+  if (aniso_live) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, part_ell);
 }
 
 namespace {
@@ -102,66 +101,6 @@ void dispatch_particles(std::int64_t n) {
   glDispatchCompute(gx, gy, 1);
 }
 }  // namespace
-
-namespace {
-// (Re)allocates buffer b to `bytes` with no data.
-void alloc_buffer(GLuint b, std::int64_t bytes) {
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, b);
-  glBufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(bytes), nullptr, GL_DYNAMIC_DRAW);
-}
-
-// Particles one bucket of the neighbour grid holds. Cells are a neighbourhood radius wide (three
-// particle spacings at the default filter_size): fluid at rest puts 3^3 = 27 particles in one,
-// and compressed fluid and hash collisions a few more; particles beyond this are left out of the
-// neighbourhoods that read the bucket (the shapes coarsen, nothing else).
-constexpr GLuint kBucketCap = 48;
-}  // namespace
-
-// Anisotropic kernels (fluid_aniso.comp): every fluid particle's ellipsoid, from its neighbours
-// within the depth filter's half-width (filter_size particle radii: the spacing that the surface
-// must span), into aniso_ell; the splats then draw those instead of spheres (aniso_live).
-void Renderer::Impl::fluid_anisotropy_pass(std::int64_t n, float sphere_r, float radius) {
-  aniso_live = false;
-  if (!p.fluid_anisotropy || !use_compute_splat() || n == 0) return;
-  if (aniso_count == 0) {
-    aniso_count = GlBuffer(new_name(glGenBuffers));
-    aniso_slots = GlBuffer(new_name(glGenBuffers));
-    aniso_ell = GlBuffer(new_name(glGenBuffers));
-  }
-  if (n > aniso_particles) {
-    aniso_particles = std::max<std::int64_t>(n, 2 * aniso_particles);
-    // Twice as many buckets as particles (a power of two): few collisions at any density.
-    aniso_buckets = 1;
-    while (static_cast<std::int64_t>(aniso_buckets) < 2 * aniso_particles) aniso_buckets *= 2;
-    alloc_buffer(aniso_count, static_cast<std::int64_t>(aniso_buckets) * 4);
-    alloc_buffer(aniso_slots, static_cast<std::int64_t>(aniso_buckets) * kBucketCap * 4);
-    alloc_buffer(aniso_ell, aniso_particles * 3 * 16);
-  }
-  const GLuint zero = 0;
-  glBindBuffer(GL_SHADER_STORAGE_BUFFER, aniso_count);
-  glClearBufferData(GL_SHADER_STORAGE_BUFFER, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
-  aniso_prog.use();
-  glUniform1f(aniso_prog.loc("u_radius"), sphere_r);
-  glUniform1ui(aniso_prog.loc("u_phase_mask"), phase::kFluid);
-  glUniform1ui(aniso_prog.loc("u_count"), static_cast<GLuint>(n));
-  glUniform1ui(aniso_prog.loc("u_buckets"), aniso_buckets);
-  glUniform1ui(aniso_prog.loc("u_bucket_cap"), kBucketCap);
-  glUniform1f(aniso_prog.loc("u_h"), std::max(p.filter_size, 2.f) * radius);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, part_pos);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, part_phase);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, aniso_ell);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, aniso_count);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, aniso_slots);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, aniso_ell);
-  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);  // the clear
-  glUniform1i(aniso_prog.loc("u_stage"), 1);
-  dispatch_particles(n);
-  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-  glUniform1i(aniso_prog.loc("u_stage"), 2);
-  dispatch_particles(n);
-  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-  aniso_live = true;
-}
 
 // Integer splat image -> R32F image `out` (iw x ih), and the integer image cleared again.
 void Renderer::Impl::resolve_splat(GLuint acc, GLuint out, int iw, int ih, bool depth) {

@@ -24,9 +24,8 @@ TEST(RenderBench, SmallRunReportsEveryPass) {
   EXPECT_LE(r.median_gpu_ms, sum * (1 + 1e-12));
   std::vector<std::string> names;
   for (const RenderTiming& t : r.passes) names.push_back(t.pass);
-  const std::vector<std::string> want = {"shadow",          "scene",         "objects",
-                                         "fluid_aniso",     "fluid_depth",   "fluid_filter",
-                                         "fluid_thickness", "fluid_normals", "fluid_composite"};
+  const std::vector<std::string> want = {"shadow",       "scene",           "objects",       "fluid_depth",
+                                         "fluid_filter", "fluid_thickness", "fluid_normals", "fluid_composite"};
   EXPECT_EQ(names, want);
 }
 

@@ -6,7 +6,8 @@ layout(local_size_x = 64) in;
 
 layout(std430, binding = 0) readonly buffer Positions { float b_pos[]; };  // x y z, tightly packed
 layout(std430, binding = 1) readonly buffer Phases { uint b_phase[]; };
-// Anisotropic kernels (fluid_aniso.comp), 3 vec4 per particle: centre (world) and the radius of
+// Anisotropic kernels (kernels/physics/anisotropy.hpp, uploaded or copied in by the CUDA
+// interop), 3 vec4 per particle: centre (world) and the radius of
 // a sphere bounding the ellipsoid; the ellipsoid's matrix M (world, x inside iff
 // (x - c)^T M (x - c) <= 1) as M00 M01 M02 M11, M12 M22.
 layout(std430, binding = 2) readonly buffer Ellipsoids { vec4 b_ell[]; };

@@ -1,0 +1,3 @@
+#include "core/exec_cpu.hpp"
+#include "kernels/physics/anisotropy.inl"
+template struct seamless::kernels::Anisotropy<seamless::CpuExec>;
