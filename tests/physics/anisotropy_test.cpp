@@ -18,10 +18,12 @@
 
 namespace seamless {
 namespace {
+// Named: the unity build compiles this file with others whose helpers are in anonymous namespaces.
+namespace ellipsoids_test {
 
-constexpr float kR = 0.01f;       // sphere radius drawn
-constexpr float kD = 2.f * kR;    // lattice spacing: one particle diameter
-constexpr float kH = 3.f * kD;    // neighbourhood: the renderer's default (filter_size 6 radii)
+constexpr float kR = 0.01f;     // sphere radius drawn
+constexpr float kD = 2.f * kR;  // lattice spacing: one particle diameter
+constexpr float kH = 3.f * kD;  // neighbourhood: the renderer's default (filter_size 6 radii)
 constexpr int kV = kernels::kEllipsoidVec4s;
 
 struct Ellipsoid {
@@ -39,8 +41,7 @@ Ellipsoid ellipsoid(const std::vector<vec4>& e, std::size_t i) {
   return out;
 }
 
-std::vector<vec4> shapes(const std::vector<vec3>& x, const std::vector<std::uint32_t>& ph,
-                         Device d = Device::CPU) {
+std::vector<vec4> shapes(const std::vector<vec3>& x, const std::vector<std::uint32_t>& ph, Device d = Device::CPU) {
   return FluidEllipsoids(d).compute_host(x, ph, kR, kH);
 }
 
@@ -158,7 +159,9 @@ void random_cloud(int n, std::uint32_t seed, std::vector<vec3>& x, std::vector<s
   std::uniform_real_distribution<float> u(-0.15f, 0.15f), t(-0.006f, 0.006f), c(-0.04f, 0.04f), f(0.f, 1.f);
   for (int i = 0; i < n; ++i) {
     const float r = f(rng);
-    x.push_back(r < 0.6f ? vec3{u(rng), t(rng), u(rng)} : r < 0.9f ? vec3{c(rng), c(rng), c(rng)} : 3.f * vec3{u(rng), u(rng), u(rng)});
+    x.push_back(r < 0.6f   ? vec3{u(rng), t(rng), u(rng)}
+                : r < 0.9f ? vec3{c(rng), c(rng), c(rng)}
+                           : 3.f * vec3{u(rng), u(rng), u(rng)});
     ph.push_back(f(rng) < 0.1f ? phase::kRigid : phase::kFluid);
   }
 }
@@ -196,5 +199,6 @@ TEST(FluidEllipsoidsParity, CpuAndCudaAgree) {
   EXPECT_LT(worst, 1e-4);  // the same sums in the same order; FMA contraction only
 }
 
+}  // namespace ellipsoids_test
 }  // namespace
 }  // namespace seamless
