@@ -34,15 +34,15 @@ constexpr float kCentreSmoothing = 0.5f;
 constexpr int kEllipsoidVec4s = 3;
 
 struct EllipsoidViews {
-  std::int64_t n = 0;                // particles (all phases)
-  const Packed* sorted = nullptr;    // (position, phase bits) in cell order
-  const int* id = nullptr;           // cell order -> particle id
-  GridSpec grid{};                   // cells of h / 2 (GridSpec::for_radius(h, bits))
-  const int* cell_start = nullptr;   // NeighbourGrid::cell_starts of the sorted keys
-  std::uint32_t fluid_mask = 0;      // phase bits of the particles that are fluid
-  float radius = 0.f;                // the sphere drawn for an isotropic neighbourhood, metres
-  float h = 0.f;                     // neighbourhood radius, metres
-  vec4* ellipsoids = nullptr;        // out: kEllipsoidVec4s per particle id
+  std::int64_t n = 0;               // particles (all phases)
+  const Packed* sorted = nullptr;   // (position, phase bits) in cell order
+  const int* id = nullptr;          // cell order -> particle id
+  GridSpec grid{};                  // cells of h / 2 (GridSpec::for_radius(h, bits))
+  const int* cell_start = nullptr;  // NeighbourGrid::cell_starts of the sorted keys
+  std::uint32_t fluid_mask = 0;     // phase bits of the particles that are fluid
+  float radius = 0.f;               // the sphere drawn for an isotropic neighbourhood, metres
+  float h = 0.f;                    // neighbourhood radius, metres
+  vec4* ellipsoids = nullptr;       // out: kEllipsoidVec4s per particle id
 };
 
 template <Executor Exec> struct Anisotropy {

@@ -89,8 +89,8 @@ template <Executor Exec> void Anisotropy<Exec>::ellipsoids(const Exec& ex, const
           const vec3 inv2{1.f / (axes.x * axes.x), 1.f / (axes.y * axes.y), 1.f / (axes.z * axes.z)};
           for (int a = 0; a < 3; ++a)  // M = R diag(1 / axes^2) R^T
             for (int b = 0; b < 3; ++b)
-              M.m[a][b] = R.m[a][0] * R.m[b][0] * inv2.x + R.m[a][1] * R.m[b][1] * inv2.y +
-                          R.m[a][2] * R.m[b][2] * inv2.z;
+              M.m[a][b] =
+                  R.m[a][0] * R.m[b][0] * inv2.x + R.m[a][1] * R.m[b][1] * inv2.y + R.m[a][2] * R.m[b][2] * inv2.z;
           bound = fmaxf(axes.x, fmaxf(axes.y, axes.z));
           centre = xi + kCentreSmoothing * mean;
         }

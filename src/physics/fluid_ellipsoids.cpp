@@ -12,8 +12,7 @@ namespace K = kernels;
 
 FluidEllipsoids::FluidEllipsoids(Device d) : dev_(d) {}
 
-const vec4* FluidEllipsoids::compute(const vec3* x, const std::uint32_t* phase, std::int64_t n, float radius,
-                                     float h) {
+const vec4* FluidEllipsoids::compute(const vec3* x, const std::uint32_t* phase, std::int64_t n, float radius, float h) {
   if (!(radius > 0.f) || !(h > 0.f))
     throw Error("fluid ellipsoids: radius " + std::to_string(radius) + " and neighbourhood " + std::to_string(h) +
                 " must be positive");
