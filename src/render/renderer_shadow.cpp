@@ -4,7 +4,7 @@
 //      particles reduced on the GPU (shadow_bounds.comp), so the map fits the objects with no
 //      read-back, on the host-upload and the CUDA-interop path alike;
 //   2. rigid meshes and cloth rasterised into a depth texture, orthographic along the light;
-//   3. fluid particles splatted as spheres by a compute shader (shadow_splat.comp), into images
+//   3. fluid particles splatted as spheres or their ellipsoids by a compute shader (shadow_splat.comp), into images
 //      cleared by another (shadow_clear.comp);
 //   4. both merged into one R32F map of depths along the light (shadow_resolve.comp).
 // The scene pass (Kinect image or scan mesh) and the objects then look it up (shadow.glsl).
@@ -18,6 +18,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/phase.hpp"
+#include "kernels/physics/anisotropy.hpp"
 #include "render/renderer_impl.hpp"
 
 namespace seamless {
@@ -178,7 +179,10 @@ void Renderer::Impl::shadow_pass(const DrawList& list, std::int64_t n) {
     light_uniforms(shadow_bounds_prog, light_R, light_bounds, shadow_size);
     glUniform1ui(shadow_bounds_prog.loc("u_count"), static_cast<GLuint>(n));
     glUniform1ui(shadow_bounds_prog.loc("u_phase_mask"), mask);
-    glUniform1f(shadow_bounds_prog.loc("u_pad"), std::max(sphere_r, list.particle_radius));
+    // An ellipsoid's longest axis is at most cbrt(kMaxAxisRatio^2) sphere radii (two axes at the
+    // clamp, the volume kept: kernels/physics/anisotropy.hpp).
+    const float reach = aniso_live ? std::cbrt(kernels::kMaxAxisRatio * kernels::kMaxAxisRatio) : 1.f;
+    glUniform1f(shadow_bounds_prog.loc("u_pad"), std::max(reach * sphere_r, list.particle_radius));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, part_pos);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, part_phase);
     glBindImageTexture(0, light_bounds, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32I);
@@ -240,6 +244,8 @@ void Renderer::Impl::shadow_pass(const DrawList& list, std::int64_t n) {
     glUniform1ui(sp.loc("u_phase_mask"), phase::kFluid);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, part_pos);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, part_phase);
+    glUniform1i(sp.loc("u_aniso"), aniso_live);
+    if (aniso_live) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, part_ell);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
     glBindImageTexture(0, shadow_bits, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
     glBindImageTexture(1, shadow_thick, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);

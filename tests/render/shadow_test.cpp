@@ -145,5 +145,68 @@ TEST(RenderShadow, WaterShadowIsTintedByBeerLambert) {
   EXPECT_GT(want.z, 1.f - p.shadow_strength + 0.1f) << "the scene does not tell water from an opaque caster";
 }
 
+// A layer of water one particle thick, spread at 1.5 diameters (13 x 13 particles, 0.15 m above
+// the floor), casts one even shadow with anisotropic kernels: the discs of 2.4 radii overlap
+// where the 1.5-radius spheres leave a hole at every lattice diagonal (2.1 radii from the nearest
+// particle; docs/RENDERING.md, anisotropic kernels). The splats' path in fluid is the particles'
+// volume (a cube of one diameter each, 8 r^3, whatever their shape), so under the interior (one
+// spacing in from the outer columns) the mean path is 8 r^3 / spacing^2 = 8 r / 9 and the floor's
+// linear colour 1 - strength (1 - exp(-absorption 8 r / 9)) of the lit one: the mean must agree
+// within 0.03 (as in the test above). No pixel may be a quarter of the way from there to the lit
+// floor: where a hole lets the light through, the floor is lit. A nearly point-like light (0.5
+// degrees: a penumbra of 1.3 mm here, against holes of ~1 cm) keeps the spheres' holes visible,
+// which the same check must find (it can fail). Pixels: the floor the camera sees past the
+// layer's near edge.
+TEST(RenderShadow, ASpreadLayerCastsOneEvenShadow) {
+  SEAMLESS_REQUIRE_EGL();
+  const float rad = 0.02f, spacing = 3.f * rad;
+  const int n = 13;
+  std::vector<vec3> x;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) x.push_back({(i - 0.5f * (n - 1)) * spacing, 0.15f, (j - 0.5f * (n - 1)) * spacing});
+  const std::vector<std::uint32_t> ph(x.size(), phase::kFluid);
+  DrawList list;
+  list.positions = x, list.phases = ph, list.particle_radius = rad;
+  const uchar3 floor_colour{220, 220, 220};
+  const float half = (0.5f * (n - 1) - 1.f) * spacing, absorption = 40.f;  // well above 8-bit steps
+  RenderParams p = down_light();
+  p.light_angle = 0.5f;
+  p.absorption = {absorption, absorption, absorption};
+  const float want = 1.f - p.shadow_strength * (1.f - std::exp(-absorption * 8.f * rad / 9.f));
+  const float hole = want + 0.25f * (1.f - want);
+  const RenderCamera cam = above();
+  struct Seen {
+    int pixels = 0;
+    float mean = 0.f, brightest = 0.f;
+  };
+  auto floor_under = [&](bool aniso) {
+    p.fluid_anisotropy = aniso;
+    Renderer r(p, 240, 180);
+    r.set_scene_mesh(floor_scan(floor_colour));
+    const Pixels img(r.render(list, cam));
+    const Renderer::FluidImages fluid = r.read_fluid_images();  // rows bottom to top
+    Seen s;
+    for (int v = 0; v < img.h; ++v)
+      for (int u = 0; u < img.w; ++u) {
+        if (fluid.depth[static_cast<std::size_t>(img.h - 1 - v) * img.w + u] > 0.f) continue;  // the layer
+        const vec3 q = floor_point(cam, u, v);
+        if (std::abs(q.x) > half || std::abs(q.z) > half) continue;
+        const float ratio = linear(img.at(u, v).x) / linear(floor_colour.x);
+        ++s.pixels, s.mean += ratio, s.brightest = std::max(s.brightest, ratio);
+      }
+    s.mean /= std::max(s.pixels, 1);
+    return s;
+  };
+  const Seen spheres = floor_under(false), discs = floor_under(true);
+  std::printf(
+      "floor under the layer, linear ratio to lit (Beer-Lambert %.3f): spheres mean %.3f brightest %.3f, "
+      "ellipsoids mean %.3f brightest %.3f (%d pixels)\n",
+      want, spheres.mean, spheres.brightest, discs.mean, discs.brightest, discs.pixels);
+  ASSERT_GT(discs.pixels, 300);
+  EXPECT_NEAR(discs.mean, want, 0.03f);
+  EXPECT_LT(discs.brightest, hole);
+  EXPECT_GT(spheres.brightest, hole);
+}
+
 }  // namespace
 }  // namespace seamless::test
