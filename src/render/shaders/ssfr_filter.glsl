@@ -3,10 +3,25 @@
 // pixels neither change nor contribute. Two edge-preserving modes:
 //  - bilateral (the paper's cheaper alternative to curvature flow): Gaussian range weight.
 //  - narrow range (Truong & Yuksel 2018, "A Narrow-Range Filter for Screen-Space Fluid
-//    Rendering", section 3): samples further than the range mu behind the centre belong to
+//    Rendering", section 3): samples further than the range mu behind the reference belong to
 //    another surface and are left out; samples further than mu in front are clamped to
-//    z - mu, so that a nearer surface cannot pull this one forward, yet its edge still smooths.
-//    mu = 3 range sigmas (where the bilateral weight has fallen to 1%).
+//    reference - mu, so that a nearer surface cannot pull this one forward, yet its edge still
+//    smooths. mu = 3 range sigmas (where the bilateral weight has fallen to 1%).
+// The range reference is the centre's tangent, not its depth. Truong & Yuksel compare every
+// sample with the centre depth z: right for a surface facing the camera, wrong for one seen at a
+// grazing angle, whose depth changes from one pixel to the next by more than mu allows over the
+// kernel (a puddle on a table seen from 15 cm above, 0.6 m away: 5 mm per image row, so the
+// samples beyond 6 rows, on one side, are dropped and on the other clamped). The filter then
+// averages a one-sided, clamped set that changes abruptly from row to row: the surface breaks into
+// horizontal bands, which the normals and the reflection show. Here each sample is compared with
+// the depth the centre's tangent plane has at its pixel: a plane's inverse depth is affine in
+// the image coordinates (1/z = a u + b v + c), so along the axis the reference is
+// 1 / (1/z + k i), k the inverse depth's slope per texel at the centre (inverse_depth_slope), and
+// the result is z plus the weighted mean of the samples' differences from it (clamped or left out
+// as above). A plane at any angle then passes unchanged and no sample of it is lost, while a
+// depth discontinuity (a drop in front of the puddle, another layer behind it) is as far from the
+// tangent as it is from the centre depth, and stays apart. Where the slope is 0 this is exactly
+// Truong & Yuksel's filter.
 // Thickness (u_range_sigma <= 0, u_skip_empty false): no range weight; the half-width is the
 // world size projected at the filtered fluid depth of the texel (u_width_depth, full resolution),
 // so that the sum of chords is smoothed over the particle spacing at any distance: a spread layer
@@ -28,6 +43,9 @@
 // that spread over a surface leave holes of a particle's size between their spheres; filled, the
 // later passes smooth one surface over them instead of one bump per particle. Across a depth
 // discontinuity (a drop in front of the puddle) nothing is filled.
+// Lone drops (splat.glsl) are not part of the surface: a drop texel is kept as splatted (the
+// drop's sphere, which the composite shades as a bead), and other texels neither average it in nor
+// fill towards it.
 // filter_at() is the pass at one texel; ssfr_filter.frag and ssfr_filter.comp run it.
 uniform sampler2D u_src;
 uniform ivec2 u_dir;            // (1, 0) or (0, 1)
@@ -49,7 +67,7 @@ vec2 nearest_fluid(ivec2 p, int side, int n) {
     ivec2 q = p + side * i * u_dir;
     if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) break;
     float s = texelFetch(u_src, q, 0).r;
-    if (s > 0.0) return vec2(s, float(i));
+    if (s > 0.0 && !is_drop(s)) return vec2(s, float(i));
   }
   return vec2(0.0);
 }
@@ -64,12 +82,48 @@ float fill_at(ivec2 p, float mu) {
   float span = (a.y + b.y) * max(a.x, b.x) / f;  // metres between the two fluid texels
   if (span > u_fill_world || abs(a.x - b.x) > mu + span) return 0.0;
   float z = mix(a.x, b.x, a.y / (a.y + b.y));
-  return window_depth(z) < texelFetch(u_scene_depth_w, p, 0).r ? z : 0.0;
+  return window_depth(z) < texelFetch(u_scene_depth_w, p, 0).r ? with_drop_flag(z, false) : 0.0;
+}
+
+// Depth of the tangent reference i texels from the centre (depth c, inverse depth slope k); 0
+// where the tangent plane is behind the camera there (no depth of this surface can lie there).
+float tangent_depth(float c, float k, int i) {
+  float inv = 1.0 / c + k * float(i);
+  return inv > 0.0 ? 1.0 / inv : 0.0;
+}
+
+// The slope per texel along u_dir of the inverse depth of the surface at p (depth c), for the
+// range reference: measured to the farthest surface texel within b on each side (a baseline of
+// the kernel's scale, over which the splats' bumps average out more than between neighbours).
+// Both sides on one surface (each end within mu of the line through the other and the centre):
+// the central difference, exact for a plane. Otherwise one side crosses a discontinuity, and
+// the one with the smaller slope is taken, as the normals do (ssfr_normal.glsl).
+float inverse_depth_slope(ivec2 p, float c, int b, float mu) {
+  ivec2 size = textureSize(u_src, 0);
+  vec2 z = vec2(0.0), at = vec2(0.0);  // the two ends (-, +): depth and signed distance in texels
+  for (int side = 0; side < 2; ++side) {
+    int towards = 2 * side - 1;
+    for (int i = b; i >= 1; --i) {
+      ivec2 q = p + towards * i * u_dir;
+      if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
+      float s = texelFetch(u_src, q, 0).r;
+      if (s <= 0.0 || is_drop(s)) continue;
+      z[side] = s, at[side] = float(towards * i);
+      break;
+    }
+  }
+  vec2 k = vec2(at.x != 0.0 ? (1.0 / z.x - 1.0 / c) / at.x : 0.0, at.y != 0.0 ? (1.0 / z.y - 1.0 / c) / at.y : 0.0);
+  if (at.x == 0.0 || at.y == 0.0) return k.x + k.y;  // one side (or none) has surface
+  float kc = (1.0 / z.y - 1.0 / z.x) / (at.y - at.x);
+  if (abs(tangent_depth(c, k.x, int(at.y)) - z.y) <= mu && abs(tangent_depth(c, k.y, int(at.x)) - z.x) <= mu)
+    return kc;
+  return abs(k.x) < abs(k.y) ? k.x : k.y;
 }
 
 float filter_at(ivec2 p) {
   float c = texelFetch(u_src, p, 0).r;
   if (u_skip_empty && c <= 0.0) return u_fill_world > 0.0 ? fill_at(p, 3.0 * u_range_sigma) : 0.0;
+  if (u_skip_empty && is_drop(c)) return c;  // a lone drop keeps its sphere (and its flag)
   float f = u_dir.x != 0 ? u_K.x : u_K.y;
   float z_width = c;
   if (!u_skip_empty) {
@@ -82,6 +136,8 @@ float filter_at(ivec2 p) {
   int stride = (r + u_max_taps - 1) / u_max_taps;
   float rr = float(r + 1);  // the biweight is zero at +-(r + 1): the outermost taps still count
   float mu = 3.0 * u_range_sigma;
+  bool ranged = u_range_sigma > 0.0;
+  float k = ranged ? inverse_depth_slope(p, c, max(1, r / 2), mu) : 0.0;
   ivec2 hi = textureSize(u_src, 0) - 1;
   int at = u_dir.x != 0 ? p.x : p.y;
   int lo = at - r;  // the first lattice point at or after lo (integer division truncates toward 0)
@@ -89,20 +145,25 @@ float filter_at(ivec2 p) {
   float sum = 0.0, wsum = 0.0;
   for (int i = first; i <= r; i += stride) {
     float s = texelFetch(u_src, clamp(p + i * u_dir, ivec2(0), hi), 0).r;
-    if (u_skip_empty && s <= 0.0) continue;
+    if (u_skip_empty && (s <= 0.0 || is_drop(s))) continue;
     float x = float(i) / rr;
     float w = (1.0 - x * x) * (1.0 - x * x);
-    if (u_range_sigma > 0.0) {
+    if (ranged) {
+      float ref = tangent_depth(c, k, i);
+      if (ref <= 0.0) continue;
+      s -= ref;  // from here on, the sample's difference from the tangent reference
       if (u_narrow_range) {
-        if (s > c + mu) continue;
-        s = max(s, c - mu);
+        if (s > mu) continue;
+        s = max(s, -mu);
       } else {
-        float dz = (s - c) / u_range_sigma;
+        float dz = s / u_range_sigma;
         w *= exp(-0.5 * dz * dz);
       }
     }
     sum += s * w;
     wsum += w;
   }
-  return wsum > 0.0 ? sum / wsum : c;  // no tap on fluid (a sliver between lattice points): as it was
+  if (wsum <= 0.0) return c;  // no tap on fluid (a sliver between lattice points): as it was
+  float v = ranged ? c + sum / wsum : sum / wsum;
+  return u_skip_empty ? with_drop_flag(v, false) : v;
 }
