@@ -30,7 +30,7 @@
 // and no sample of it is lost, while a
 // depth discontinuity (a drop in front of the puddle, another layer behind it) is as far from the
 // tangent as it is from the centre depth, and stays apart. The range itself is a height above the
-// tangent plane, so in depth it grows as the surface turns away from the view (depth_range).
+// tangent plane, so in depth it grows as the surface turns away from the view (tangent_plane).
 // Where the surface faces the camera this is exactly Truong & Yuksel's filter.
 // Thickness (u_range_sigma <= 0, u_skip_empty false): no range weight; the half-width is the
 // world size projected at the filtered fluid depth of the texel (u_width_depth, full resolution),
