@@ -11,7 +11,11 @@
 //   - wetting: the same slab resting on a surface darkens it by Lekner & Dorf's factor, not in the air;
 //   - anisotropic kernels: a tilted spread layer is one sheet without any gap fill, within the slab
 //     its flattened ellipsoids span, and its normals are the plane's within a bound derived from
-//     the ellipsoids' shape.
+//     the ellipsoids' shape;
+//   - a puddle seen at a grazing angle (a table 15 cm below the camera) is as smooth as one seen
+//     face-on: its normals are the plane's within the same kind of bound (no bands from the depth
+//     filter's range), and a blob of water in front of it stays apart from it;
+//   - a lone particle is drawn as a drop of its own radius, with a sphere's normals.
 #include <algorithm>
 #include <cmath>
 
@@ -458,6 +462,237 @@ TEST(RenderFluidSurface, AnisotropicSheetHasThePlanesNormal) {
               sum / std::max(n, 1), worst, bound);
   EXPECT_GT(n, 500);
   EXPECT_LE(worst, bound);
+}
+
+// A puddle on a table seen from 15 cm above it, as the Kinect config sees its table: a Kinect
+// frame (640 x 480, f = 525), the table the plane y = 0.15 (camera y points down), one layer of
+// particles of radius r = 1 cm resting on it (centres r above it) at the spacing of water at rest
+// (2 r), 18 x 18 of them from 0.5 to 0.85 m ahead. At 0.6 m the depth of the surface changes by
+// z^2 / (f h) = 4.6 mm from one image row to the next: the narrow range mu (3 r) spans 6.5 rows
+// of the depth filter's window (6 r, 24 pixels at most each side).
+constexpr int kGW = 640, kGH = 480;
+constexpr float kGF = 525.f;
+Intrinsics grazing_K() { return intrinsics(kGF, 319.5f, 239.5f, kGW, kGH); }
+
+Plane grazing_puddle() {
+  const float r = 0.01f;
+  Plane p;
+  p.c = {0.f, 0.15f - r, 0.675f};
+  p.ex = {1.f, 0.f, 0.f};
+  p.ey = {0.f, 0.f, 1.f};
+  p.n = {0.f, -1.f, 0.f};  // up, towards the camera above the table
+  p.s = 2.f * r;
+  p.count = 18;
+  return p;
+}
+
+// Normal deviation from the plane's, degrees, of the 8-bit normal stage image at (u, v).
+float normal_off_plane(const Pixels& im, int u, int v, vec3 n) {
+  const uchar3 q = im.at(u, v);
+  vec3 nn{q.x / 127.5f - 1.f, q.y / 127.5f - 1.f, q.z / 127.5f - 1.f};
+  nn = nn * (1.f / std::sqrt(dot(nn, nn)));
+  return std::acos(std::clamp(dot(nn, n), -1.f, 1.f)) * 180.f / 3.14159265f;
+}
+
+// The grazing puddle with the default surface (anisotropic kernels, gap fill, narrow-range
+// filter): its normals must be the plane's within the slope of the ellipsoids' upper envelope,
+// as face-on (AnisotropicSheetHasThePlanesNormal). Interior particles at spacing s = 2 r are
+// discs (A, A, A / 4), A = 4^(1/3) 1.5 r; every point of the layer is within s / sqrt(2) of a
+// centre, where the nearest disc's cap (the highest of identical discs) has slope
+// (1/4) (rho / A) / sqrt(1 - (rho / A)^2) = 0.18: 10.5 degrees. The filter measures every sample
+// against the centre's tangent plane, so a plane passes unchanged whatever its angle, and over the
+// layer's interior (one spacing plus the filter's half-width from its rim) it averages the
+// envelope's differences from that plane, which cannot tilt it further. The 8-bit normal image
+// adds 0.5 degree. With the centre depth as the range reference, most of the window's samples
+// are a different depth (4.6 mm per row against mu = 3 cm): the vertical pass drops those behind
+// and clamps those in front, and the normals swing by tens of degrees from row to row (bands).
+TEST(RenderFluidSurface, GrazingPuddleHasThePlanesNormal) {
+  SEAMLESS_REQUIRE_EGL();
+  const Intrinsics K = grazing_K();
+  const Plane pl = grazing_puddle();
+  const float r = 0.01f;
+  const std::vector<vec3> x = pl.particles();
+  std::vector<std::uint32_t> ph;
+  RenderParams p = surface_params();
+  p.fluid_anisotropy = true;
+  p.stage_images = true;
+  Renderer rd(p, kGW, kGH);
+  rd.draw(fluid_list(x, ph, r), camera(K));
+  ASSERT_TRUE(rd.uses_compute_splat());
+  const StageImage* st = nullptr;
+  for (const StageImage& s : rd.stage_images())
+    if (s.name == "3_normals") st = &s;
+  ASSERT_NE(st, nullptr);
+  const Pixels im(st->image);
+  const float inner = 0.5f * (pl.count - 1) * pl.s - pl.s - 6.f * r;
+  const float A = std::cbrt(4.f) * 1.5f * r, rho = pl.s / std::sqrt(2.f);
+  const float slope = 0.25f * (rho / A) / std::sqrt(1.f - (rho / A) * (rho / A));
+  const float bound = std::atan(slope) * 180.f / 3.14159265f + 0.5f;
+  float worst = 0.f, sum = 0.f, row_jump = 0.f;
+  int n = 0;
+  for (int u = 0; u < kGW; ++u) {
+    float above = -1.f;  // the previous row's deviation in this column (-1: none)
+    for (int v = 0; v < kGH; ++v) {
+      float a, b, z;
+      pl.hit(K, u, v, a, b, z);
+      if (z <= 0.f || std::abs(a) > inner || std::abs(b) > inner) {
+        above = -1.f;
+        continue;
+      }
+      const float deg = normal_off_plane(im, u, v, pl.n);
+      if (above >= 0.f) row_jump = std::max(row_jump, std::abs(deg - above));
+      above = deg;
+      worst = std::max(worst, deg), sum += deg, ++n;
+    }
+  }
+  std::printf(
+      "%d pixels: normal off the plane's by %.2f degrees on average, %.2f at most (bound %.1f); largest "
+      "change from one row to the next %.2f\n",
+      n, sum / std::max(n, 1), worst, bound, row_jump);
+  EXPECT_GT(n, 1000);
+  EXPECT_LE(worst, bound);
+}
+
+// The grazing puddle with a blob of water in front of it: 3 x 3 x 3 particles at spacing 2 r,
+// centred 0.42 m ahead and 6 cm above the puddle's particles (more than the anisotropy's
+// neighbourhood of 6 r from any of them, so the puddle's kernels are the same as alone). The
+// blob hides the puddle from 0.59 m on, 17 cm behind it: a depth discontinuity far beyond mu.
+// The blob must keep its own depth: a pixel whose ray passes within r of its middle particle meets
+// that particle's sphere before its centre depth, and no pass may move it back by more than mu
+// (samples more than mu behind the reference are left out). Every other pixel over the puddle's
+// interior must hold either the puddle's depth or, where the blob can be (the ray within its
+// centres' box grown by the longest axis a kernel can have, 4^(2/3) 1.5 r, a needle at the
+// axis-ratio clamp), the blob's (its farthest centre plus that axis, plus mu). The puddle's: between
+// the plane (plus 1 mm for the filter's averaging of the envelope's perspective) and the
+// envelope's top, 0.94 r above the plane at most (the thickest planar disc), seen along the ray;
+// and nearer by what the narrow range lets the blob's samples pull: each pass clamps them at mu in
+// front of its reference, so it moves a depth forward by at most mu, and 2 filter_iterations
+// passes (x, y) run.
+TEST(RenderFluidSurface, GrazingPuddleAndABlobInFrontStayApart) {
+  SEAMLESS_REQUIRE_EGL();
+  const Intrinsics K = grazing_K();
+  const Plane pl = grazing_puddle();
+  const float r = 0.01f, mu = 3.f * RenderParams{}.filter_depth_sigma * r;
+  std::vector<vec3> x = pl.particles();
+  const vec3 blob{0.f, pl.c.y - 0.06f - 2.f * r, 0.42f};
+  for (int k = -1; k <= 1; ++k)
+    for (int j = -1; j <= 1; ++j)
+      for (int i = -1; i <= 1; ++i) x.push_back(blob + vec3{2.f * r * i, 2.f * r * j, 2.f * r * k});
+  std::vector<std::uint32_t> ph;
+  RenderParams p = surface_params();
+  p.fluid_anisotropy = true;
+  Renderer rd(p, kGW, kGH);
+  rd.draw(fluid_list(x, ph, r), camera(K));
+  const Renderer::FluidImages f = rd.read_fluid_images();
+  const float needle = std::cbrt(16.f) * 1.5f * r, pull = 2.f * RenderParams{}.filter_iterations * mu;
+  const float reach = 2.f * std::sqrt(3.f) * r + needle, blob_back = blob.z + 2.f * r + needle + mu;
+  const float inner = 0.5f * (pl.count - 1) * pl.s - pl.s - 6.f * r;
+  int blob_px = 0, puddle_px = 0, beside = 0, mixed = 0;
+  float worst_pull = 0.f, worst_push = -1.f;
+  for (int v = 0; v < kGH; ++v)
+    for (int u = 0; u < kGW; ++u) {
+      const vec3 ray{(u - K.cx) / K.fx, (v - K.cy) / K.fy, 1.f};
+      const vec3 dir = ray * (1.f / std::sqrt(dot(ray, ray)));
+      const vec3 off = blob - dir * dot(blob, dir);
+      const float miss = std::sqrt(dot(off, off));  // the ray's distance from the blob's middle
+      const float d = depth_at(f, u, v);
+      if (miss <= r) {
+        ++blob_px;
+        EXPECT_GT(d, 0.f) << "no depth on the blob at " << u << "," << v;
+        EXPECT_LE(d, blob.z + mu) << "the blob pulled back at " << u << "," << v;
+        worst_push = std::max(worst_push, d - blob.z);
+        continue;
+      }
+      float a, b, z;
+      pl.hit(K, u, v, a, b, z);
+      if (z <= 0.f || std::abs(a) > inner || std::abs(b) > inner) continue;
+      const float top = 0.94f * r / -dot(pl.n, ray);  // the envelope's top, in depth along this ray
+      if (d >= z - top - pull && d <= z + 1e-3f) {
+        worst_pull = std::max(worst_pull, z - top - d);
+        ++puddle_px;
+        beside += miss <= reach ? 1 : 0;
+      } else if (!(miss <= reach && d > 0.f && d <= blob_back)) {
+        ++mixed;
+        ADD_FAILURE() << "depth " << d << " at " << u << "," << v << ": neither the puddle's (" << z - top - pull
+                      << ".." << z + 1e-3f << ") nor the blob's";
+        if (mixed > 20) return;
+      }
+    }
+  std::printf(
+      "blob %d pixels, at most %.1f mm behind its middle's centre (allowed %.0f); puddle %d pixels, %d of "
+      "them where the blob could be, pulled forward %.1f mm at most (allowed %.0f); %d neither\n",
+      blob_px, worst_push * 1e3f, mu * 1e3f, puddle_px, beside, worst_pull * 1e3f, pull * 1e3f, mixed);
+  EXPECT_GT(blob_px, 50);
+  EXPECT_GT(puddle_px, 2000);
+  EXPECT_GT(beside, 500) << "the test needs the puddle beside the blob's image";
+}
+
+// A lone particle (no neighbour: the anisotropy leaves it a sphere) 0.3 m ahead is drawn as a
+// drop of the particle's own radius r, not the splat radius 1.5 r that closes a continuous
+// surface: every pixel with fluid depth has a ray within r of the centre (the depth is the exact
+// ray-sphere entry), and the disc is filled (the pixels whose ray passes within 0.9 r). Its
+// normals are the sphere's: the filter leaves the drop as splatted, and the normal pass's
+// one-sided differences over one pixel are secants, whose direction is the sphere's at some point
+// between the pixel and its neighbour: off by at most the normal's change over one pixel outwards,
+// asin(q + 1 / R) - asin(q) at q = rho / r on a sphere of R pixels radius; checked within
+// rho <= 0.8 r, plus 0.5 degree (8 bits).
+// Drawn at 1.5 r and flattened by the filter, it was a disc larger than the drop, facing the camera.
+TEST(RenderFluidSurface, LoneParticleIsADropOfItsOwnSize) {
+  SEAMLESS_REQUIRE_EGL();
+  const Intrinsics K = small_K();
+  const float r = 0.01f;
+  const vec3 c{0.02f, -0.01f, 0.3f};
+  std::vector<vec3> x = {c};
+  std::vector<std::uint32_t> ph;
+  RenderParams p = surface_params();
+  p.fluid_anisotropy = true;
+  p.stage_images = true;
+  Renderer rd(p, kW, kH);
+  rd.draw(fluid_list(x, ph, r), camera(K));
+  ASSERT_TRUE(rd.uses_compute_splat());
+  const Renderer::FluidImages f = rd.read_fluid_images();
+  const StageImage* st = nullptr;
+  for (const StageImage& s : rd.stage_images())
+    if (s.name == "3_normals") st = &s;
+  ASSERT_NE(st, nullptr);
+  const Pixels im(st->image);
+  const float R = kF * r / c.z;  // the drop's radius in pixels (about)
+  int drawn = 0, outside = 0, missing = 0, checked = 0;
+  float worst_excess = 0.f, worst_normal = -1e9f;
+  for (int v = 0; v < kH; ++v)
+    for (int u = 0; u < kW; ++u) {
+      const vec3 ray{(u - K.cx) / K.fx, (v - K.cy) / K.fy, 1.f};
+      const vec3 dir = ray * (1.f / std::sqrt(dot(ray, ray)));
+      const float along = dot(c, dir);
+      const vec3 off = c - dir * along;
+      const float rho = std::sqrt(dot(off, off));
+      const float d = depth_at(f, u, v);
+      if (d > 0.f) {
+        ++drawn;
+        if (rho > r * (1.f + 1e-4f)) ++outside, worst_excess = std::max(worst_excess, rho / r - 1.f);
+      } else if (rho < 0.9f * r) {
+        ++missing;
+      }
+      if (d <= 0.f || rho > 0.8f * r) continue;
+      // The sphere's normal where this ray enters it.
+      const float t = along - std::sqrt(r * r - rho * rho);
+      vec3 n = dir * t - c;
+      n = n * (1.f / std::sqrt(dot(n, n)));
+      const float q = rho / r;
+      const float bound = (std::asin(std::min(1.f, q + 1.f / R)) - std::asin(q)) * 180.f / 3.14159265f + 0.5f;
+      const float deg = normal_off_plane(im, u, v, n);
+      worst_normal = std::max(worst_normal, deg - bound);
+      EXPECT_LE(deg, bound) << "not the sphere's normal at " << u << "," << v;
+      ++checked;
+    }
+  std::printf(
+      "drop of %.1f pixels radius: %d pixels drawn, %d outside its radius (by %.0f %% at most), %d missing "
+      "inside; normals at worst %.2f degrees inside their bound over %d pixels\n",
+      R, drawn, outside, worst_excess * 100.f, missing, -worst_normal, checked);
+  EXPECT_GT(drawn, 50);
+  EXPECT_EQ(outside, 0);
+  EXPECT_EQ(missing, 0);
+  EXPECT_GT(checked, 50);
 }
 
 }  // namespace

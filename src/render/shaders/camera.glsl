@@ -26,3 +26,9 @@ float eye_depth(float w) {
   float n = u_near_far.x, f = u_near_far.y;
   return -2.0 * f * n / ((f - n) * ((2.0 * w - 1.0) - (f + n) / (f - n)));
 }
+
+// The fluid's depth images (eye z, 0 = no fluid) carry in each depth's least significant mantissa
+// bit whether the nearest splat there is a lone drop (splat.glsl, "Lone drops"); every pass that
+// writes a surface depth clears it.
+float with_drop_flag(float z, bool drop) { return uintBitsToFloat((floatBitsToUint(z) & ~1u) | (drop ? 1u : 0u)); }
+bool is_drop(float z) { return z > 0.0 && (floatBitsToUint(z) & 1u) != 0u; }

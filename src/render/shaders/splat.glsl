@@ -19,14 +19,33 @@ uniform float u_fmax;            // max(fx, fy), pixels
 uniform float u_max_point_size;  // pixels (render.max_point_size)
 uniform sampler2D u_scene_depth; // window depth of the scene, full resolution
 uniform bool u_aniso;            // splat b_ell's ellipsoids, not spheres of u_radius
+uniform float u_drop_radius;     // a lone drop's radius, metres: the particle's own (Lone drops below)
 
 // One particle's splat in eye space: centre c, bounding radius r; M the ellipsoid's matrix
-// (anisotropic kernels), unused for a sphere (ray_sphere with u_radius).
+// (anisotropic kernels), unused for a sphere (ray_sphere with u_radius); drop: a lone drop.
 struct Splat {
   vec3 c;
   float r;
   mat3 M;
+  bool drop;
 };
+
+// Lone drops. The splat radius u_radius (fluid_radius_scale particle radii) is larger than a
+// particle so that neighbouring spheres close into one surface; a particle with too few
+// neighbours for a shape has no surface to close, and drawn at u_radius it is a disc 1.5 times
+// the particle's size that the depth filter then flattens. The anisotropic kernels leave exactly
+// such a particle the isotropic sphere of u_radius (Yu & Turk 2013, section 4: fewer than N_eps
+// neighbours; kernels/physics/anisotropy.inl), and any shaped kernel has a longest axis above u_radius (its
+// axes keep the sphere's volume, so their geometric mean is u_radius): a bounding radius of
+// u_radius marks a lone particle. It is drawn as a drop of the particle's own radius
+// (u_drop_radius), the size at which the solver lets it rest on a surface, so the bead touches
+// the table it lies on instead of sinking half a radius into it. Whether the nearest splat at a
+// pixel is a drop travels with its depth, in the depth's least significant mantissa bit
+// (camera.glsl, with_drop_flag): one ulp of depth (1e-7 m at 1 m) is far below any depth the passes resolve, the
+// atomic minimum keeps flag and depth together, and no second image has to agree with the
+// first about which particle won the pixel. The later passes leave drops out of the surface
+// (ssfr_filter.glsl) and shade them as beads (ssfr_composite.glsl). With spheres (no
+// anisotropic kernels) there is no neighbourhood to tell, and no particle is a drop.
 
 // This invocation's particle: groups form a 2D grid because one dimension holds at most 65535.
 uint particle_index() {
@@ -43,12 +62,14 @@ bool splat_shape(uint i, out Splat s) {
   if (u_aniso) {
     vec4 a = b_ell[3u * i], m = b_ell[3u * i + 1u], n = b_ell[3u * i + 2u];
     s.c = (u_view * vec4(a.xyz, 1.0)).xyz;
-    s.r = a.w;
+    s.drop = a.w <= u_radius;
+    s.r = s.drop ? u_drop_radius : a.w;
     mat3 Rv = mat3(u_view);  // world -> eye rotation: M_eye = Rv M Rv^T
-    s.M = Rv * mat3(m.x, m.y, m.z, m.y, m.w, n.x, m.z, n.x, n.y) * transpose(Rv);
+    s.M = s.drop ? mat3(1.0 / (s.r * s.r)) : Rv * mat3(m.x, m.y, m.z, m.y, m.w, n.x, m.z, n.x, n.y) * transpose(Rv);
   } else {
     s.c = (u_view * vec4(b_pos[3u * i], b_pos[3u * i + 1u], b_pos[3u * i + 2u], 1.0)).xyz;
     s.r = u_radius;
+    s.drop = false;
   }
   return s.c.z > s.r && s.c.z - s.r > u_near_far.x && s.c.z - s.r < u_near_far.y;
 }

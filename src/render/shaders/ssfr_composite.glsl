@@ -26,6 +26,7 @@ uniform float u_contact;       // metres: water whose back is this close to the 
 uniform bool u_wet;            // darken the surface under the water (Lekner & Dorf 1988)
 uniform bool u_depth_holes;    // Kinect view: scene window depth 1 is a pixel without recorded depth
 uniform float u_diffuse_share; // share of a real surface's light that the fluid's shadow does not already attenuate
+uniform float u_drop_radius;   // metres: a lone drop's sphere (splat.glsl)
 
 float schlick(float f0, float cos_theta) { return f0 + (1.0 - f0) * pow(1.0 - clamp(cos_theta, 0.0, 1.0), 5.0); }
 
@@ -132,8 +133,12 @@ void composite_at(ivec2 p, out vec4 o_color, out vec4 o_reflect, out vec4 o_refr
   vec3 N = texelFetch(u_normal, p, 0).xyz;
   float NV = max(dot(N, V), 1e-3);
   // Thickness may be at reduced resolution: bilinear upsampling (it is smooth: a blurred sum of
-  // chords), and only read where the full-resolution depth has fluid.
-  float T = texture(u_thickness, frag / u_size).r;
+  // chords), and only read where the full-resolution depth has fluid. A lone drop (splat.glsl) is
+  // a sphere of u_drop_radius whose depth and normals are its own (the filter leaves it as
+  // splatted): the view ray, entering at theta_v to the normal, crosses it over the chord
+  // 2 r cos theta_v. (The blurred thickness would spread the drop's chords over the filter's width.)
+  bool drop = is_drop(z);
+  float T = drop ? 2.0 * u_drop_radius * NV : texture(u_thickness, frag / u_size).r;
 
   // The water's depth along its normal: the thickness pass measures T, the path of the view ray
   // through the water, and a locally plane-parallel layer of depth h is crossed over h / cos
@@ -159,7 +164,9 @@ void composite_at(ivec2 p, out vec4 o_color, out vec4 o_reflect, out vec4 o_refr
   float z_bg = u_depth_holes && w_bg >= 1.0 ? P.z * (1.0 + T / length(P)) : eye_depth(w_bg);
   float gap = max(z_bg - P.z, 0.0) * length(P) / P.z - T;
   float tol = u_contact + 0.006 * z_bg * z_bg;
-  float resting = 1.0 - smoothstep(tol, 3.0 * tol, gap);
+  // A drop is a bead, not a layer, wherever it lies: it is shaded as water in the air (a convex
+  // lens: refracted, reflecting at its rim, the light's highlight on it), not as a wet film.
+  float resting = drop ? 0.0 : 1.0 - smoothstep(tol, 3.0 * tol, gap);
 
   // The refracted view ray's path in the water. Water resting on a surface is a layer: the ray
   // bends (Snell, t = refract(-V, N, 1 / n)) and crosses it over h / cos theta_t (at most 1.51 h,

@@ -13,6 +13,6 @@ void main() {
   float z_in, z_out;
   if (!hit_sphere(z_in, z_out)) discard;
   if (u_test_scene && z_in >= eye_depth(texelFetch(u_scene_depth, ivec2(gl_FragCoord.xy), 0).r)) discard;
-  o_depth = z_in;
+  o_depth = with_drop_flag(z_in, false);  // sprites are spheres: no particle is a lone drop
   gl_FragDepth = window_depth(z_in);
 }
