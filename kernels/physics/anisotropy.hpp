@@ -30,7 +30,9 @@ constexpr float kCentreSmoothing = 0.5f;
 
 // One particle's ellipsoid as the splats read it, 3 vec4 per particle id:
 //   [0] centre (xyz) and the longest semi-axis (w, the splat's screen bound);
-//   [1] M00 M01 M02 M11, [2] M12 M22 0 0: the symmetric M of the ellipsoid (x - c)^T M (x - c) <= 1.
+//   [1] M00 M01 M02 M11, [2] M12 M22 lone 0: the symmetric M of the ellipsoid
+//   (x - c)^T M (x - c) <= 1, and 1 for a lone fluid particle (fewer than kMinNeighbours fluid
+//   neighbours: the renderer draws it as a drop of its own size), else 0.
 constexpr int kEllipsoidVec4s = 3;
 
 struct EllipsoidViews {

@@ -30,6 +30,7 @@ struct Ellipsoid {
   Eigen::Vector3d centre;
   double bound = 0.0;
   Eigen::Matrix3d M;
+  bool lone = false;  // a fluid particle with fewer than kMinNeighbours fluid neighbours
 };
 
 Ellipsoid ellipsoid(const std::vector<vec4>& e, std::size_t i) {
@@ -38,6 +39,8 @@ Ellipsoid ellipsoid(const std::vector<vec4>& e, std::size_t i) {
   out.centre = {a.x, a.y, a.z};
   out.bound = a.w;
   out.M << b.x, b.y, b.z, b.y, b.w, c.x, b.z, c.x, c.y;
+  out.lone = c.z == 1.f;
+  EXPECT_TRUE(c.z == 0.f || c.z == 1.f) << "the lone flag of particle " << i;
   return out;
 }
 
@@ -102,6 +105,8 @@ TEST(FluidEllipsoids, BulkFluidAndALoneDropStaySpheres) {
   EXPECT_NEAR(bulk.bound, kR, 1e-4 * kR);
   EXPECT_NEAR(bulk.centre.norm(), 0.0, 1e-6);
   EXPECT_EQ(lone.M, Eigen::Matrix3d::Identity() * double(1.f / (kR * kR)));
+  EXPECT_TRUE(lone.lone);
+  EXPECT_FALSE(bulk.lone);
   EXPECT_EQ(lone.bound, double(kR));
   EXPECT_EQ(lone.centre, Eigen::Vector3d(1.0, 1.0, 1.0));
 }
@@ -117,6 +122,7 @@ TEST(FluidEllipsoids, OnlyFluidNeighboursShapeAFluidParticle) {
     const Ellipsoid s = ellipsoid(e, i);
     expect_near_M(s.M, Eigen::Matrix3d::Identity() / (kR * kR));
     EXPECT_EQ(s.centre, Eigen::Vector3d(x[i].x, x[i].y, x[i].z));
+    EXPECT_EQ(s.lone, i == 0) << "only the fluid particle is a lone drop";
   }
 }
 
@@ -125,7 +131,7 @@ TEST(FluidEllipsoids, OnlyFluidNeighboursShapeAFluidParticle) {
 // smoothing) written out independently of the kernel.
 Ellipsoid reference(const std::vector<vec3>& x, const std::vector<std::uint32_t>& ph, std::size_t i) {
   const Eigen::Vector3d xi(x[i].x, x[i].y, x[i].z);
-  Ellipsoid out{xi, kR, Eigen::Matrix3d::Identity() / (double(kR) * kR)};
+  Ellipsoid out{xi, kR, Eigen::Matrix3d::Identity() / (double(kR) * kR), false};
   if (!phase::is(ph[i], phase::kFluid)) return out;
   double sw = 0.0;
   Eigen::Vector3d sy = Eigen::Vector3d::Zero();
@@ -140,7 +146,8 @@ Ellipsoid reference(const std::vector<vec3>& x, const std::vector<std::uint32_t>
     sw += w, sy += w * y, syy += w * y * y.transpose();
     neighbours += j != i;
   }
-  if (neighbours < kernels::kMinNeighbours) return out;
+  out.lone = neighbours < kernels::kMinNeighbours;
+  if (out.lone) return out;
   const Eigen::Vector3d mean = sy / sw;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(syy / sw - mean * mean.transpose());
   Eigen::Vector3d sd = es.eigenvalues().cwiseMax(0.0).cwiseSqrt();
@@ -178,6 +185,7 @@ TEST(FluidEllipsoids, ARandomCloudMatchesADoublePrecisionReference) {
     ASSERT_LT((got.M - want.M).norm(), 1e-3 * want.M.norm()) << "particle " << i;
     ASSERT_NEAR((got.centre - want.centre).norm(), 0.0, 1e-6) << "particle " << i;
     ASSERT_NEAR(got.bound, want.bound, 1e-3 * want.bound) << "particle " << i;
+    ASSERT_EQ(got.lone, want.lone) << "particle " << i;
   }
   EXPECT_GT(shaped, 500);  // the slab's particles are discs, so the comparison covers shapes
 }
@@ -193,6 +201,7 @@ TEST(FluidEllipsoidsParity, CpuAndCudaAgree) {
   for (std::size_t i = 0; i < x.size(); ++i) {
     const Ellipsoid p = ellipsoid(a, i), q = ellipsoid(b, i);
     worst = std::max(worst, (p.M - q.M).norm() / p.M.norm());
+    ASSERT_EQ(p.lone, q.lone) << "particle " << i;
     ASSERT_NEAR((p.centre - q.centre).norm(), 0.0, 1e-6) << "particle " << i;
   }
   std::printf("ellipsoid parity: largest relative CPU/CUDA difference of M %.3g\n", worst);

@@ -9,7 +9,7 @@ layout(std430, binding = 1) readonly buffer Phases { uint b_phase[]; };
 // Anisotropic kernels (kernels/physics/anisotropy.hpp, uploaded or copied in by the CUDA
 // interop), 3 vec4 per particle: centre (world) and the radius of
 // a sphere bounding the ellipsoid; the ellipsoid's matrix M (world, x inside iff
-// (x - c)^T M (x - c) <= 1) as M00 M01 M02 M11, M12 M22.
+// (x - c)^T M (x - c) <= 1) as M00 M01 M02 M11, M12 M22; then 1 for a lone drop, else 0.
 layout(std430, binding = 2) readonly buffer Ellipsoids { vec4 b_ell[]; };
 
 uniform mat4 u_view, u_proj;
@@ -33,11 +33,9 @@ struct Splat {
 // Lone drops. The splat radius u_radius (fluid_radius_scale particle radii) is larger than a
 // particle so that neighbouring spheres close into one surface; a particle with too few
 // neighbours for a shape has no surface to close, and drawn at u_radius it is a disc 1.5 times
-// the particle's size that the depth filter then flattens. The anisotropic kernels leave exactly
-// such a particle the isotropic sphere of u_radius (Yu & Turk 2013, section 4: fewer than N_eps
-// neighbours; kernels/physics/anisotropy.inl), and any shaped kernel has a longest axis above u_radius (its
-// axes keep the sphere's volume, so their geometric mean is u_radius): a bounding radius of
-// u_radius marks a lone particle. It is drawn as a drop of the particle's own radius
+// the particle's size that the depth filter then flattens. The anisotropic kernels mark such a
+// particle (fewer than N_eps fluid neighbours, Yu & Turk 2013, section 4: the third vec4's z,
+// kernels/physics/anisotropy.hpp). It is drawn as a drop of the particle's own radius
 // (u_drop_radius), the size at which the solver lets it rest on a surface, so the bead touches
 // the table it lies on instead of sinking half a radius into it. Whether the nearest splat at a
 // pixel is a drop travels with its depth, in the depth's least significant mantissa bit
@@ -62,7 +60,7 @@ bool splat_shape(uint i, out Splat s) {
   if (u_aniso) {
     vec4 a = b_ell[3u * i], m = b_ell[3u * i + 1u], n = b_ell[3u * i + 2u];
     s.c = (u_view * vec4(a.xyz, 1.0)).xyz;
-    s.drop = a.w <= u_radius;
+    s.drop = n.z > 0.5;
     s.r = s.drop ? u_drop_radius : a.w;
     mat3 Rv = mat3(u_view);  // world -> eye rotation: M_eye = Rv M Rv^T
     s.M = s.drop ? mat3(1.0 / (s.r * s.r)) : Rv * mat3(m.x, m.y, m.z, m.y, m.w, n.x, m.z, n.x, n.y) * transpose(Rv);
