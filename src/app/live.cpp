@@ -119,16 +119,17 @@ class LiveLoop : public FrameLoop {
       if (inside_ && rec.result.ok() && session_.has_unmasked_level()) check_inside(rec.result.world_T_camera, k);
     }
     if (renderer_) {
-      renderer_->set_kinect_frame(frame_, rec.result.world_T_camera);
+      {
+        StageScope s(ctx_.timer(), "render");  // the recorded frame's upload is the render's work
+        renderer_->set_kinect_frame(frame_, rec.result.world_T_camera);
+      }
       // The window switches between the views (key V): it needs the mesh whatever render.view says.
       if (reextract && (e_.render.view == RenderView::mesh || e_.render.mode == RenderMode::window))
         renderer_->set_scene(volume_->extract_mesh(), rec.result.world_T_camera);
       renderer_->draw(solver_);
-      // The draw's GPU time, pass by pass (GL timer queries): "render" is the host's side of it.
-      double gpu_ms = 0.0;
-      const auto passes = renderer_->gpu_passes();
-      for (const auto& [pass, ms] : passes) ctx_.timer().add(k, "gl_" + pass, ms), gpu_ms += ms;
-      if (!passes.empty()) ctx_.timer().add(k, "render_gpu", gpu_ms);
+      // The previous frame's GPU time, pass by pass (GL timer queries, read a frame late so that the
+      // host does not wait for the GPU: Renderer::timings): "render" is the host's side.
+      if (k > 0) add_gpu_passes(k - 1, renderer_->gpu_passes());
     }
     ctx_.timer().add(k, "preprocess", rec.preprocess_ms);  // as scan()'s rows: upload included
     ctx_.timer().add(k, "track", rec.track_ms);
@@ -163,6 +164,8 @@ class LiveLoop : public FrameLoop {
           "live: {} spawn entries were never spawned (their time or their placement's surface never "
           "came)",
           solver_.pending_spawns());
+    if (renderer_ && !records_.empty())
+      add_gpu_passes(static_cast<std::int64_t>(records_.size()) - 1, renderer_->last_gpu_passes());
     if (renderer_) finish_renderer(ctx_, *renderer_);
     if (online_) {
       traj_.reset();  // trajectory.txt complete under its name before it becomes trajectory_live.txt
@@ -190,6 +193,12 @@ class LiveLoop : public FrameLoop {
   }
 
  private:
+  void add_gpu_passes(std::int64_t k, const std::vector<std::pair<std::string, double>>& passes) {
+    double gpu_ms = 0.0;
+    for (const auto& [pass, ms] : passes) ctx_.timer().add(k, "gl_" + pass, ms), gpu_ms += ms;
+    if (!passes.empty()) ctx_.timer().add(k, "render_gpu", gpu_ms);
+  }
+
   void extract_scene() {
     StageScope s(ctx_.timer(), "extract");
     scene_ = volume_->extract_scene_particles(sp_);

@@ -132,11 +132,8 @@ class GlRunRenderer : public RunRenderer {
     out_.add(renderer_);
   }
 
-  std::vector<std::pair<std::string, double>> gpu_passes() const override {
-    std::vector<std::pair<std::string, double>> out;
-    for (const RenderTiming& t : renderer_.timings()) out.emplace_back(t.pass, t.ms);
-    return out;
-  }
+  std::vector<std::pair<std::string, double>> gpu_passes() const override { return named(renderer_.timings()); }
+  std::vector<std::pair<std::string, double>> last_gpu_passes() override { return named(renderer_.last_timings()); }
 
   void finish() override {
     out_.finish();
@@ -147,6 +144,11 @@ class GlRunRenderer : public RunRenderer {
   }
 
  private:
+  static std::vector<std::pair<std::string, double>> named(const std::vector<RenderTiming>& timings) {
+    std::vector<std::pair<std::string, double>> out;
+    for (const RenderTiming& t : timings) out.emplace_back(t.pass, t.ms);
+    return out;
+  }
   void set_mesh_camera(float progress) {
     const SceneCamera c = orbit_camera(mesh_camera_, p_, progress);
     camera_ = RenderCamera::look_at(c.eye, c.target, {0.f, 1.f, 0.f}, p_.fov_y, p_.width, p_.height, p_.znear, p_.zfar);

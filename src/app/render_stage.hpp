@@ -50,9 +50,12 @@ class RunRenderer {
   virtual void set_kinect_frame(const RgbdFrame& frame, const SE3& world_T_camera) = 0;
   virtual void draw(const ParticleSolver& solver) = 0;
   virtual void finish() = 0;
-  // The last draw's GPU time per pass (name, ms), from the renderer's GL timer queries; empty where
-  // there are none (the window draws on its own clock).
+  // The GPU time per pass (name, ms) of the draw before the last one, from the renderer's GL timer
+  // queries read a frame late (Renderer::timings); empty where there are none (the window draws on
+  // its own clock).
   virtual std::vector<std::pair<std::string, double>> gpu_passes() const { return {}; }
+  // The same for the last draw, waiting for the GPU to finish it (the end of a run).
+  virtual std::vector<std::pair<std::string, double>> last_gpu_passes() { return {}; }
 };
 
 // The camera of the mesh view: at render.eye looking at render.target where given, else looking

@@ -105,31 +105,38 @@ void GlMesh::draw() const {
 }
 
 void PassTimer::begin_frame() {
-  used_ = 0;
-  names_.clear();
+  current_ = 1 - current_;
+  frames_[current_].used = 0;
+  frames_[current_].names.clear();
   mark("");
 }
 
 void PassTimer::mark(const char* pass) {
-  if (used_ == queries_.size()) queries_.push_back(new_name([](GLsizei n, GLuint* q) { glGenQueries(n, q); }));
-  glQueryCounter(queries_[used_++], GL_TIMESTAMP);
-  names_.emplace_back(pass);
+  Frame& f = frames_[current_];
+  if (f.used == f.queries.size()) f.queries.push_back(new_name([](GLsizei n, GLuint* q) { glGenQueries(n, q); }));
+  glQueryCounter(f.queries[f.used++], GL_TIMESTAMP);
+  f.names.emplace_back(pass);
 }
 
-std::vector<RenderTiming> PassTimer::resolve() {
+std::vector<RenderTiming> PassTimer::read(const Frame& f) {
   std::vector<RenderTiming> out;
   GLuint64 prev = 0;
-  for (std::size_t i = 0; i < used_; ++i) {
+  for (std::size_t i = 0; i < f.used; ++i) {
     GLuint64 t = 0;
-    glGetQueryObjectui64v(queries_[i], GL_QUERY_RESULT, &t);
-    if (i > 0) out.push_back({names_[i], static_cast<double>(t - prev) * 1e-6});
+    glGetQueryObjectui64v(f.queries[i], GL_QUERY_RESULT, &t);
+    if (i > 0) out.push_back({f.names[i], static_cast<double>(t - prev) * 1e-6});
     prev = t;
   }
   return out;
 }
 
+std::vector<RenderTiming> PassTimer::resolve() { return read(frames_[current_]); }
+
+std::vector<RenderTiming> PassTimer::resolve_previous() { return read(frames_[1 - current_]); }
+
 PassTimer::~PassTimer() {
-  if (!queries_.empty()) glDeleteQueries(static_cast<GLsizei>(queries_.size()), queries_.data());
+  for (const Frame& f : frames_)
+    if (!f.queries.empty()) glDeleteQueries(static_cast<GLsizei>(f.queries.size()), f.queries.data());
 }
 
 }  // namespace seamless

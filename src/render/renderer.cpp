@@ -20,18 +20,37 @@ vec3 srgb_to_linear(vec3 c) {  // IEC 61966-2-1, as color.glsl
 namespace {
 
 // The mean of an sRGB image (width w) over the rectangle a, in linear radiance (what the fluid
-// reflects in the Kinect view).
-vec3 mean_linear_color(const std::vector<uchar3>& c, int w, const PixelRect& a) {
+// reflects in the Kinect view), from every 4th pixel of every 4th row: a tint, for which 19,200
+// samples of a 640 x 480 frame are plenty, where every pixel cost a share of each live frame.
+vec3 mean_linear_color(const uchar3* c, int w, const PixelRect& a) {
+  constexpr int kStride = 4;
   float lut[256];
   for (int i = 0; i < 256; ++i) lut[i] = srgb_to_linear(vec3{i / 255.f, 0.f, 0.f}).x;
-  double r = 0, g = 0, b = 0;
-  for (int y = a.y; y < a.y + a.height; ++y)
-    for (int x = a.x; x < a.x + a.width; ++x) {
+  double r = 0, g = 0, b = 0, n = 0;
+  for (int y = a.y; y < a.y + a.height; y += kStride)
+    for (int x = a.x; x < a.x + a.width; x += kStride) {
       const uchar3& q = c[static_cast<std::size_t>(y) * w + x];
-      r += lut[q.x], g += lut[q.y], b += lut[q.z];
+      r += lut[q.x], g += lut[q.y], b += lut[q.z], n += 1;
     }
-  const double n = std::max<double>(1.0, static_cast<double>(a.width) * a.height);
+  n = std::max(n, 1.0);
   return {static_cast<float>(r / n), static_cast<float>(g / n), static_cast<float>(b / n)};
+}
+
+// Texture tex (w x h) from host pixels through the pixel buffer pbo: the host's part is one copy
+// into a fresh buffer (the last frame's may still be in transfer: orphaned, not waited for), the
+// transfer and any conversion (3-byte RGB texels) run on the GPU. Straight from host memory the
+// driver converted and copied each frame's colour image before returning (docs/PERFORMANCE.md,
+// "The live loop's host side").
+void upload_texture(GLuint pbo, GLuint tex, int w, int h, GLenum format, GLenum type, const void* data,
+                    std::size_t texel_bytes) {
+  const auto bytes = static_cast<GLsizeiptr>(static_cast<std::size_t>(w) * h * texel_bytes);
+  glBindBuffer(GL_PIXEL_UNPACK_BUFFER, pbo);
+  glBufferData(GL_PIXEL_UNPACK_BUFFER, bytes, nullptr, GL_STREAM_DRAW);
+  glBufferSubData(GL_PIXEL_UNPACK_BUFFER, 0, bytes, data);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glBindTexture(GL_TEXTURE_2D, tex);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, format, type, nullptr);
+  glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
 }
 
 }  // namespace
@@ -420,7 +439,9 @@ void Renderer::Impl::draw_frame(const DrawList& list, std::int64_t n, const Rend
   timer.mark("objects");
   last_has_fluid = p.show_fluid && p.fluid == FluidDraw::ssfr && n > 0 && draw_fluid(n, list.particle_radius, cam);
   if (last_has_fluid && p.stage_images) capture_stages();
-  timings = timer.resolve();
+  // Submitted now, not waited for: the GPU renders while the host goes on to the next frame.
+  glFlush();
+  timings = timer.resolve_previous();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -482,6 +503,7 @@ RenderParams& Renderer::params() { return impl_->p; }
 const GlInfo& Renderer::gl_info() const { return impl_->info; }
 const std::vector<StageImage>& Renderer::stage_images() const { return impl_->stages; }
 const std::vector<RenderTiming>& Renderer::timings() const { return impl_->timings; }
+std::vector<RenderTiming> Renderer::last_timings() { return impl_->timer.resolve(); }
 bool Renderer::uses_compute_splat() const { return impl_->use_compute_splat(); }
 
 Renderer::FluidImages Renderer::read_fluid_images() const {
@@ -533,14 +555,11 @@ void Renderer::set_kinect_view(const Image<uchar3>& rgb, const Image<float>& dep
   if (!m.kin_rgb || m.kin_K.width != K.width || m.kin_K.height != K.height) {
     m.kin_rgb = make_texture_2d(GL_RGB8, K.width, K.height, GL_LINEAR);
     m.kin_depth = make_texture_2d(GL_R32F, K.width, K.height, GL_NEAREST);  // never blend depths
+    for (GlBuffer& b : m.kin_pbo) b = GlBuffer(new_name(glGenBuffers));
   }
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  const std::vector<uchar3> c = rgb.to_host();
-  const std::vector<float> d = depth.to_host();
-  glBindTexture(GL_TEXTURE_2D, m.kin_rgb);
-  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, K.width, K.height, GL_RGB, GL_UNSIGNED_BYTE, c.data());
-  glBindTexture(GL_TEXTURE_2D, m.kin_depth);
-  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, K.width, K.height, GL_RED, GL_FLOAT, d.data());
+  upload_texture(m.kin_pbo[0], m.kin_rgb, K.width, K.height, GL_RGB, GL_UNSIGNED_BYTE, rgb.buffer().data(),
+                 sizeof(uchar3));
+  upload_texture(m.kin_pbo[1], m.kin_depth, K.width, K.height, GL_RED, GL_FLOAT, depth.buffer().data(), sizeof(float));
   const PixelRect whole{0, 0, K.width, K.height};
   const PixelRect& r = colour_region.empty() ? whole : colour_region;
   if (r.x < 0 || r.y < 0 || r.x + r.width > K.width || r.y + r.height > K.height)
@@ -550,7 +569,7 @@ void Renderer::set_kinect_view(const Image<uchar3>& rgb, const Image<float>& dep
   m.kin_K = K;
   m.kin_region = r;
   m.kin_pose = world_T_camera;
-  m.kin_mean = mean_linear_color(c, K.width, r);
+  m.kin_mean = mean_linear_color(rgb.buffer().data(), K.width, r);
   m.has_kinect = true;
 }
 

@@ -75,8 +75,13 @@ class Renderer {
   Image<uchar3> render(const DrawList& list, const RenderCamera& camera);
   // Fluid stages of the last draw when params().stage_images is set (empty without fluid).
   const std::vector<StageImage>& stage_images() const;
-  // GPU time of each pass of the last draw.
+  // GPU time of each pass of the draw before the last one (empty after the first draw): a draw
+  // does not wait for its own passes, whose timer queries the GPU answers only when it has done
+  // them, and reads the previous draw's instead (by then done). Frames drawn alike (benchmarks)
+  // have the same passes; last_timings() has the last draw's.
   const std::vector<RenderTiming>& timings() const;
+  // GPU time of each pass of the last draw: waits for the GPU to finish it (the end of a run).
+  std::vector<RenderTiming> last_timings();
   // The fluid's float images of the last draw (rows bottom to top): eye depth after the filter
   // (0 = no fluid; with render.filter_iterations 0 the spheres' own depth) at the framebuffer
   // size, and the thickness in metres after its blur at 1/thickness_downsample. For tests.

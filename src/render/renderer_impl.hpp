@@ -76,13 +76,22 @@ class PassTimer {
  public:
   void begin_frame();
   void mark(const char* pass);  // the pass that just ended
+  // The passes of this frame: waits until the GPU has done them.
   std::vector<RenderTiming> resolve();
+  // The passes of the frame before this one ({} before the second frame): by now the GPU has
+  // almost always done them, so the host does not wait for this frame's.
+  std::vector<RenderTiming> resolve_previous();
   ~PassTimer();
 
  private:
-  std::vector<GLuint> queries_;
-  std::vector<std::string> names_;
-  std::size_t used_ = 0;
+  struct Frame {
+    std::vector<GLuint> queries;
+    std::vector<std::string> names;
+    std::size_t used = 0;
+  };
+  static std::vector<RenderTiming> read(const Frame& f);
+  Frame frames_[2];  // this frame's queries and the last frame's
+  int current_ = 0;
 };
 
 struct Renderer::Impl {
@@ -127,6 +136,7 @@ struct Renderer::Impl {
   Texture cube;
   bool has_cube = false;
   Texture kin_rgb, kin_depth;
+  GlBuffer kin_pbo[2];  // their uploads' pixel buffers (upload_texture)
   Intrinsics kin_K;
   PixelRect kin_region;             // where the image holds colour; the frame shows it cut to the framebuffer's aspect
   vec3 kin_mean{0.5f, 0.5f, 0.5f};  // the image's mean colour, linear

@@ -164,9 +164,9 @@ class BenchPipeline(unittest.TestCase):
             self.check_sum(st, frame_parts(doc), i)
             self.assertGreater(st["physics"][i], 0)  # one solver step a fused frame
         if rendered:
-            # render_gpu is the sum of the run's gl_<pass> rows of the frame (timings.csv), and lies
-            # inside render: the draw ends by reading its timer queries, so the host's interval
-            # holds the GPU's from the first pass to the last.
+            # render_gpu is the sum of the run's gl_<pass> rows of the frame (timings.csv), every frame
+            # has them (read a frame late, the last one's at the end of the run). It is not bounded
+            # by render: the draw does not wait for the GPU, whose passes run on into the next frame.
             gl, passes = {}, {}
             with open(os.path.join(out, "bench", "rep_0", "timings.csv")) as f:
                 for row in csv.DictReader(f):
@@ -177,7 +177,6 @@ class BenchPipeline(unittest.TestCase):
                 self.assertGreater(st["render_gpu"][i], 0)
                 # timings.csv prints 6 significant digits: each row within 5e-6 of its value, relative
                 self.assertAlmostEqual(st["render_gpu"][i], gl[i], delta=5e-6 * gl[i] + SUM_TOL * passes[i])
-                self.assertLessEqual(st["render_gpu"][i], st["render"][i] + CSV_TOL)
         self.assertGreater(st["extract"][0], 0)  # the first fused frame extracts the scene
         with open(os.path.join(out, "bench", "rep_0", "summary.json")) as f:
             summary = json.load(f)

@@ -107,7 +107,7 @@ TEST(RenderWindow, ScriptedKeysPauseStepToggleSpawnAndCloseCleanly) {
   };
   cb.before_draw = [&](Renderer& r) {
     fluid_shown.push_back(r.params().show_fluid);
-    passes.push_back(r.timings().size());  // of the previous frame
+    passes.push_back(r.timings().size());  // of the frame before the previous one (read a frame late)
   };
   cb.scripted_keys = [](int frame) -> std::vector<int> {
     switch (frame) {
@@ -132,7 +132,7 @@ TEST(RenderWindow, ScriptedKeysPauseStepToggleSpawnAndCloseCleanly) {
   EXPECT_TRUE(fluid_shown[2]);
   EXPECT_FALSE(fluid_shown[3]);
   EXPECT_FALSE(fluid_shown[8]);
-  // Frames 1 and 2 drew the fluid: the previous frame's pass timings include its five passes.
+  // Frames 0 and 1 drew the fluid: before frame 2 the timings (frame 0's) include its five passes.
   EXPECT_GE(passes[2], 7u);
   // GLFW was shut down cleanly: it starts again.
   EXPECT_TRUE(window_available());
