@@ -415,6 +415,30 @@ TEST(RenderFluidSurface, AnisotropicKernelsMakeASpreadLayerOneSheet) {
   EXPECT_LE(worst, 2e-4f);  // R32F depths at 1 m: well under 0.2 mm
 }
 
+// The angle in degrees between normal image im's normal at (u, v) and n.
+float normal_off_plane(const Pixels& im, int u, int v, vec3 n) {
+  const uchar3 q = im.at(u, v);
+  vec3 nn{q.x / 127.5f - 1.f, q.y / 127.5f - 1.f, q.z / 127.5f - 1.f};
+  nn = nn * (1.f / std::sqrt(dot(nn, nn)));
+  return std::acos(std::clamp(dot(nn, n), -1.f, 1.f)) * 180.f / 3.14159265f;
+}
+
+// The normals stage (3_normals) of particles x of radius r drawn with the anisotropic kernels
+// through camera K at w x h (compute splats).
+Pixels anisotropic_normals(const std::vector<vec3>& x, float r, const Intrinsics& K, int w, int h) {
+  std::vector<std::uint32_t> ph;
+  RenderParams p = surface_params();
+  p.fluid_anisotropy = true;
+  p.stage_images = true;
+  Renderer rd(p, w, h);
+  rd.draw(fluid_list(x, ph, r), camera(K));
+  EXPECT_TRUE(rd.uses_compute_splat());
+  for (const StageImage& s : rd.stage_images())
+    if (s.name == "3_normals") return Pixels(s.image);
+  ADD_FAILURE() << "no normals stage";
+  return Pixels(Image<uchar3>(w, h, Device::CPU));
+}
+
 // The same layer with the default surface (anisotropic kernels, gap fill, narrow-range filter):
 // its normals are the plane's within the slope of the ellipsoids' upper envelope. Interior
 // particles are discs (A, A, c) = (2.38 r, 2.38 r, 0.6 r); the envelope is, at each point, the cap
@@ -429,18 +453,7 @@ TEST(RenderFluidSurface, AnisotropicSheetHasThePlanesNormal) {
   const Intrinsics K = small_K();
   const Plane pl = tilted_layer();
   const float r = 0.01f;
-  const std::vector<vec3> x = pl.particles();
-  std::vector<std::uint32_t> ph;
-  RenderParams p = surface_params();
-  p.fluid_anisotropy = true;
-  p.stage_images = true;
-  Renderer rd(p, kW, kH);
-  rd.draw(fluid_list(x, ph, r), camera(K));
-  const StageImage* st = nullptr;
-  for (const StageImage& s : rd.stage_images())
-    if (s.name == "3_normals") st = &s;
-  ASSERT_NE(st, nullptr);
-  const Pixels im(st->image);
+  const Pixels im = anisotropic_normals(pl.particles(), r, K, kW, kH);
   const float inner = 0.5f * (pl.count - 1) * pl.s - pl.s - 6.f * r;
   const float A = std::cbrt(4.f) * 1.5f * r, c = A / 4.f, rho = pl.s / std::sqrt(2.f);
   const float slope = (c / A) * (rho / A) / std::sqrt(1.f - (rho / A) * (rho / A));
@@ -452,10 +465,7 @@ TEST(RenderFluidSurface, AnisotropicSheetHasThePlanesNormal) {
       float a, b, z;
       pl.hit(K, u, v, a, b, z);
       if (std::abs(a) > inner || std::abs(b) > inner) continue;
-      const uchar3 q = im.at(u, v);
-      vec3 nn{q.x / 127.5f - 1.f, q.y / 127.5f - 1.f, q.z / 127.5f - 1.f};
-      nn = nn * (1.f / std::sqrt(dot(nn, nn)));
-      const float deg = std::acos(std::clamp(dot(nn, pl.n), -1.f, 1.f)) * 180.f / 3.14159265f;
+      const float deg = normal_off_plane(im, u, v, pl.n);
       worst = std::max(worst, deg), sum += deg, ++n;
     }
   std::printf("%d pixels: normal off the plane's by %.2f degrees on average, %.2f at most (bound %.1f)\n", n,
@@ -487,13 +497,6 @@ Plane grazing_puddle() {
 }
 
 // Normal deviation from the plane's, degrees, of the 8-bit normal stage image at (u, v).
-float normal_off_plane(const Pixels& im, int u, int v, vec3 n) {
-  const uchar3 q = im.at(u, v);
-  vec3 nn{q.x / 127.5f - 1.f, q.y / 127.5f - 1.f, q.z / 127.5f - 1.f};
-  nn = nn * (1.f / std::sqrt(dot(nn, nn)));
-  return std::acos(std::clamp(dot(nn, n), -1.f, 1.f)) * 180.f / 3.14159265f;
-}
-
 // The grazing puddle with the default surface (anisotropic kernels, gap fill, narrow-range
 // filter): its normals must be the plane's within the slope of the ellipsoids' upper envelope,
 // as face-on (AnisotropicSheetHasThePlanesNormal). Interior particles at spacing s = 2 r are
@@ -511,19 +514,7 @@ TEST(RenderFluidSurface, GrazingPuddleHasThePlanesNormal) {
   const Intrinsics K = grazing_K();
   const Plane pl = grazing_puddle();
   const float r = 0.01f;
-  const std::vector<vec3> x = pl.particles();
-  std::vector<std::uint32_t> ph;
-  RenderParams p = surface_params();
-  p.fluid_anisotropy = true;
-  p.stage_images = true;
-  Renderer rd(p, kGW, kGH);
-  rd.draw(fluid_list(x, ph, r), camera(K));
-  ASSERT_TRUE(rd.uses_compute_splat());
-  const StageImage* st = nullptr;
-  for (const StageImage& s : rd.stage_images())
-    if (s.name == "3_normals") st = &s;
-  ASSERT_NE(st, nullptr);
-  const Pixels im(st->image);
+  const Pixels im = anisotropic_normals(pl.particles(), r, K, kGW, kGH);
   const float inner = 0.5f * (pl.count - 1) * pl.s - pl.s - 6.f * r;
   const float A = std::cbrt(4.f) * 1.5f * r, rho = pl.s / std::sqrt(2.f);
   const float slope = 0.25f * (rho / A) / std::sqrt(1.f - (rho / A) * (rho / A));
