@@ -5,18 +5,26 @@
 //   FluidEllipsoids shapes(Device::CUDA);
 //   const vec4* e = shapes.compute(d_x, d_phase, n, sphere_radius, h);  // 3 vec4 per particle
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
 #include "core/buffer.hpp"
 #include "core/device.hpp"
 #include "core/math.hpp"
+#include "kernels/physics/anisotropy.hpp"
 #include "kernels/physics/particle_math.hpp"
 
 namespace seamless {
 
 class FluidEllipsoids {
  public:
+  // vec4 per particle (the layout: kernels/physics/anisotropy.hpp).
+  static constexpr int kVec4s = kernels::kEllipsoidVec4s;
+  // The longest axis an ellipsoid can have, in sphere radii: two axes at the clamp
+  // (kernels::kMaxAxisRatio times shorter than the third) and the sphere's volume kept.
+  static float longest_axis() { return std::cbrt(kernels::kMaxAxisRatio * kernels::kMaxAxisRatio); }
+
   explicit FluidEllipsoids(Device d);
 
   // The ellipsoids of the n particles at x with phases `phase` (id order, both on device()): for

@@ -9,7 +9,6 @@
 
 #include "core/cuda_check.hpp"
 #include "core/error.hpp"
-#include "kernels/physics/anisotropy.hpp"
 #include "render/renderer.hpp"
 
 namespace seamless {
@@ -47,8 +46,8 @@ void CudaGlParticles::copy_from_device(const vec3* d_x, const std::uint32_t* d_p
   SEAMLESS_CUDA_CHECK(cudaMemcpyAsync(dst[0], d_x, un * sizeof(vec3), cudaMemcpyDeviceToDevice, nullptr));
   SEAMLESS_CUDA_CHECK(cudaMemcpyAsync(dst[1], d_phase, un * sizeof(std::uint32_t), cudaMemcpyDeviceToDevice, nullptr));
   if (d_ell)
-    SEAMLESS_CUDA_CHECK(cudaMemcpyAsync(dst[2], d_ell, un * kernels::kEllipsoidVec4s * sizeof(vec4),
-                                        cudaMemcpyDeviceToDevice, nullptr));
+    SEAMLESS_CUDA_CHECK(
+        cudaMemcpyAsync(dst[2], d_ell, un * FluidEllipsoids::kVec4s * sizeof(vec4), cudaMemcpyDeviceToDevice, nullptr));
   SEAMLESS_CUDA_CHECK(cudaGraphicsUnmapResources(maps, res, nullptr));
   renderer_.use_device_ellipsoids(d_ell != nullptr);
 }

@@ -27,7 +27,7 @@ struct ClothDraw {
 struct DrawList {
   std::span<const vec3> positions;        // dynamic particles, solver id order
   std::span<const std::uint32_t> phases;  // phase words (core/phase.hpp), same length
-  // The fluid's ellipsoids (kernels::kEllipsoidVec4s vec4 per particle, FluidEllipsoids), when the
+  // The fluid's ellipsoids (FluidEllipsoids::kVec4s vec4 per particle, FluidEllipsoids), when the
   // caller has them; empty: the renderer computes them on the CPU if render.fluid_anisotropy is on.
   std::span<const vec4> ellipsoids;
   float particle_radius = 0.02f;  // metres

@@ -7,7 +7,6 @@
 #include "core/log.hpp"
 #include "core/mesh.hpp"
 #include "core/phase.hpp"
-#include "kernels/physics/anisotropy.hpp"
 #include "render/renderer_impl.hpp"
 
 namespace seamless {
@@ -202,7 +201,7 @@ void Renderer::Impl::upload_particles(const DrawList& list) {
     glBufferData(GL_ARRAY_BUFFER, part_capacity * static_cast<GLsizeiptr>(sizeof(std::uint32_t)), nullptr,
                  GL_STREAM_DRAW);
     glBindBuffer(GL_ARRAY_BUFFER, part_ell);
-    glBufferData(GL_ARRAY_BUFFER, part_capacity * kernels::kEllipsoidVec4s * static_cast<GLsizeiptr>(sizeof(vec4)),
+    glBufferData(GL_ARRAY_BUFFER, part_capacity * FluidEllipsoids::kVec4s * static_cast<GLsizeiptr>(sizeof(vec4)),
                  nullptr, GL_STREAM_DRAW);
   }
   fluid_count = list.phases.empty() ? n : 0;
@@ -232,7 +231,7 @@ void Renderer::Impl::upload_ellipsoids(const DrawList& list, std::int64_t n) {
   aniso_live = false;
   const std::optional<Renderer::EllipsoidSizes> sizes = ellipsoid_sizes(list.particle_radius);
   if (!sizes || fluid_count == 0 || n == 0) return;
-  const std::int64_t count = n * kernels::kEllipsoidVec4s;
+  const std::int64_t count = n * FluidEllipsoids::kVec4s;
   const vec4* e = list.ellipsoids.data();
   if (list.ellipsoids.empty()) {
     std::vector<std::uint32_t> all_fluid;
@@ -241,7 +240,7 @@ void Renderer::Impl::upload_ellipsoids(const DrawList& list, std::int64_t n) {
                            sizes->radius, sizes->h);
   } else if (static_cast<std::int64_t>(list.ellipsoids.size()) != count) {
     throw Error("render: DrawList has " + std::to_string(list.ellipsoids.size()) + " ellipsoid vec4s for " +
-                std::to_string(n) + " particles; give " + std::to_string(kernels::kEllipsoidVec4s) +
+                std::to_string(n) + " particles; give " + std::to_string(FluidEllipsoids::kVec4s) +
                 " per particle (FluidEllipsoids) or none");
   }
   glBindBuffer(GL_ARRAY_BUFFER, part_ell);

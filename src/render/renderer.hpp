@@ -95,7 +95,7 @@ class Renderer {
   // Copies the last frame to the bound draw framebuffer (0 = the window), scaled to w x h.
   void blit_to(unsigned framebuffer, int w, int h);
   // The particle position/phase buffers for CUDA-OpenGL interop (render/cuda_interop.hpp), and
-  // the fluid's ellipsoids (kernels::kEllipsoidVec4s vec4 per particle).
+  // the fluid's ellipsoids (FluidEllipsoids::kVec4s vec4 per particle).
   unsigned particle_position_buffer() const;
   unsigned particle_phase_buffer() const;
   unsigned particle_ellipsoid_buffer() const;

@@ -155,7 +155,7 @@ struct Renderer::Impl {
   std::map<const BodyMesh*, std::pair<std::weak_ptr<const BodyMesh>, GlMesh>> body_meshes;
   VertexArray part_vao;
   GlBuffer part_pos, part_phase;
-  GlBuffer part_ell;  // kernels::kEllipsoidVec4s vec4 per particle (the anisotropic kernels)
+  GlBuffer part_ell;  // FluidEllipsoids::kVec4s vec4 per particle (the anisotropic kernels)
   std::int64_t part_capacity = 0;
   std::int64_t fluid_count = -1;  // fluid particles of the last upload; -1: unknown (device data)
 

@@ -18,7 +18,6 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/phase.hpp"
-#include "kernels/physics/anisotropy.hpp"
 #include "render/renderer_impl.hpp"
 
 namespace seamless {
@@ -179,9 +178,7 @@ void Renderer::Impl::shadow_pass(const DrawList& list, std::int64_t n) {
     light_uniforms(shadow_bounds_prog, light_R, light_bounds, shadow_size);
     glUniform1ui(shadow_bounds_prog.loc("u_count"), static_cast<GLuint>(n));
     glUniform1ui(shadow_bounds_prog.loc("u_phase_mask"), mask);
-    // An ellipsoid's longest axis is at most cbrt(kMaxAxisRatio^2) sphere radii (two axes at the
-    // clamp, the volume kept: kernels/physics/anisotropy.hpp).
-    const float reach = aniso_live ? std::cbrt(kernels::kMaxAxisRatio * kernels::kMaxAxisRatio) : 1.f;
+    const float reach = aniso_live ? FluidEllipsoids::longest_axis() : 1.f;  // in sphere radii
     glUniform1f(shadow_bounds_prog.loc("u_pad"), std::max(reach * sphere_r, list.particle_radius));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, part_pos);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, part_phase);
