@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/device.hpp"
+#include "core/error.hpp"
 #include "core/phase.hpp"
 #include "kernels/physics/anisotropy.hpp"
 #include "physics/fluid_ellipsoids.hpp"
@@ -124,6 +125,12 @@ TEST(FluidEllipsoids, OnlyFluidNeighboursShapeAFluidParticle) {
     EXPECT_EQ(s.centre, Eigen::Vector3d(x[i].x, x[i].y, x[i].z));
     EXPECT_EQ(s.lone, i == 0) << "only the fluid particle is a lone drop";
   }
+}
+
+TEST(FluidEllipsoids, PhasesOfTheWrongCountAreAnError) {
+  const std::vector<vec3> x(3, vec3{0.f, 0.f, 0.f});
+  EXPECT_THROW(FluidEllipsoids(Device::CPU).compute_host(x, fluid(2), kR, kH), Error);
+  EXPECT_THROW(FluidEllipsoids(Device::CPU).compute_host(x, fluid(3), 0.f, kH), Error);  // no size
 }
 
 // The reference: every pair by brute force in double precision, Eigen's eigensolver, the same

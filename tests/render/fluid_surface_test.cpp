@@ -20,6 +20,7 @@
 #include <cmath>
 
 #include "core/phase.hpp"
+#include "physics/fluid_ellipsoids.hpp"
 #include "render_test_util.hpp"
 
 namespace seamless::test {
@@ -616,6 +617,27 @@ TEST(RenderFluidSurface, GrazingPuddleAndABlobInFrontStayApart) {
   EXPECT_GT(blob_px, 50);
   EXPECT_GT(puddle_px, 2000);
   EXPECT_GT(beside, 500) << "the test needs the puddle beside the blob's image";
+}
+
+// A DrawList that brings its own ellipsoids must bring FluidEllipsoids::kVec4s of them per
+// particle: a wrong count is the caller's error, named, not a read past the end of its span.
+TEST(RenderFluidSurface, EllipsoidsOfTheWrongCountAreAnError) {
+  SEAMLESS_REQUIRE_EGL();
+  const std::vector<vec3> x = {{0.f, 0.f, 0.3f}, {0.02f, 0.f, 0.3f}};
+  std::vector<std::uint32_t> ph;
+  RenderParams p = surface_params();
+  p.fluid_anisotropy = true;
+  Renderer rd(p, kW, kH);
+  if (!rd.uses_compute_splat()) GTEST_SKIP() << "no compute splats: the renderer draws spheres";
+  DrawList list = fluid_list(x, ph, 0.01f);
+  const std::vector<vec4> one(FluidEllipsoids::kVec4s, vec4{0.f, 0.f, 0.3f, 0.01f});  // one particle's
+  list.ellipsoids = one;
+  try {
+    rd.draw(list, camera(small_K()));
+    FAIL() << "no error for " << one.size() << " ellipsoid vec4s for 2 particles";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("ellipsoid"), std::string::npos) << e.what();
+  }
 }
 
 // A lone particle (no neighbour: the anisotropy leaves it a sphere) 0.3 m ahead is drawn as a
