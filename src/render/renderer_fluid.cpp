@@ -290,7 +290,7 @@ void Renderer::Impl::composite_pass(const RenderCamera& cam, float contact) {
   // reading (kinect_bg.frag); in the mesh view it is the background, where nothing was scanned.
   glUniform1i(cp.loc("u_depth_holes"), p.view == RenderView::kinect && has_kinect);
   glUniform1f(cp.loc("u_diffuse_share"), shadow_live && fluid_shadow_live ? 1.f - p.shadow_strength : 1.f);
-  glUniform1f(cp.loc("u_drop_radius"), drop_r);
+  glUniform1f(cp.loc("u_drop_radius"), contact / p.fluid_radius_scale);  // the particle's own radius
   if (compute) {
     const GLuint out[] = {final_color, reflect_color, refract_color};
     for (GLuint i = 0; i < 3; ++i) glBindImageTexture(i, out[i], 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
@@ -304,7 +304,6 @@ void Renderer::Impl::composite_pass(const RenderCamera& cam, float contact) {
 bool Renderer::Impl::draw_fluid(std::int64_t n, float radius, const RenderCamera& cam) {
   if (fluid_count == 0) return false;
   const float sphere_r = radius * p.fluid_radius_scale;
-  drop_r = radius;  // a lone particle is drawn at its own size (splat.glsl, "Lone drops")
   fluid_depth_pass(n, sphere_r, cam);
   timer.mark("fluid_depth");
   if (p.stage_images)

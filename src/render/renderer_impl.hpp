@@ -170,7 +170,6 @@ struct Renderer::Impl {
   Texture shadow_fluid;               // RG32F: fluid front depth and path, in the splat's grid
   bool fluid_shadow_live = false;     // this frame's fluid transmits into the map
   float list_sphere_r = 0.f;          // this frame's fluid sphere radius (its splat level)
-  float drop_r = 0.f;                 // this frame's lone-drop radius: the particle radius (splat.glsl)
   Framebuffer shadow_fbo;
   int shadow_size = 0;
   mat3 light_R = mat3::identity();  // world -> light frame

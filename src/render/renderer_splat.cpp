@@ -78,7 +78,8 @@ void Renderer::Impl::make_splat_targets() {
 void Renderer::Impl::splat_uniforms(const Program& prog, std::int64_t n, float sphere_r, const RenderCamera& cam) {
   set_camera_uniforms(prog, cam);
   glUniform1f(prog.loc("u_radius"), sphere_r);
-  glUniform1f(prog.loc("u_drop_radius"), drop_r);
+  // A lone drop is drawn at the particle's own radius (splat.glsl, "Lone drops").
+  glUniform1f(prog.loc("u_drop_radius"), sphere_r / p.fluid_radius_scale);
   glUniform1f(prog.loc("u_fmax"), std::max(cam.K.fx, cam.K.fy));
   glUniform1ui(prog.loc("u_phase_mask"), phase::kFluid);
   glUniform1f(prog.loc("u_max_point_size"), p.max_point_size);

@@ -424,6 +424,16 @@ float normal_off_plane(const Pixels& im, int u, int v, vec3 n) {
   return std::acos(std::clamp(dot(nn, n), -1.f, 1.f)) * 180.f / 3.14159265f;
 }
 
+// The steepest slope, in degrees, of the upper envelope of a layer of interior discs (A, A, A / 4),
+// A = 4^(1/3) 1.5 r, at lattice spacing s: every point is within rho = s / sqrt(2) of a centre,
+// where the cap's slope is (1/4) (rho / A) / sqrt(1 - (rho / A)^2); plus 0.5 degree for the 8-bit
+// normal image.
+float disc_envelope_bound(float r, float s) {
+  const float A = std::cbrt(4.f) * 1.5f * r, rho = s / std::sqrt(2.f);
+  const float slope = 0.25f * (rho / A) / std::sqrt(1.f - (rho / A) * (rho / A));
+  return std::atan(slope) * 180.f / 3.14159265f + 0.5f;
+}
+
 // The normals stage (3_normals) of particles x of radius r drawn with the anisotropic kernels
 // through camera K at w x h (compute splats).
 Pixels anisotropic_normals(const std::vector<vec3>& x, float r, const Intrinsics& K, int w, int h) {
@@ -456,9 +466,7 @@ TEST(RenderFluidSurface, AnisotropicSheetHasThePlanesNormal) {
   const float r = 0.01f;
   const Pixels im = anisotropic_normals(pl.particles(), r, K, kW, kH);
   const float inner = 0.5f * (pl.count - 1) * pl.s - pl.s - 6.f * r;
-  const float A = std::cbrt(4.f) * 1.5f * r, c = A / 4.f, rho = pl.s / std::sqrt(2.f);
-  const float slope = (c / A) * (rho / A) / std::sqrt(1.f - (rho / A) * (rho / A));
-  const float bound = std::atan(slope) * 180.f / 3.14159265f + 0.5f;
+  const float bound = disc_envelope_bound(r, pl.s);
   float worst = 0.f, sum = 0.f;
   int n = 0;
   for (int v = 0; v < kH; ++v)
@@ -497,7 +505,6 @@ Plane grazing_puddle() {
   return p;
 }
 
-// Normal deviation from the plane's, degrees, of the 8-bit normal stage image at (u, v).
 // The grazing puddle with the default surface (anisotropic kernels, gap fill, narrow-range
 // filter): its normals must be the plane's within the slope of the ellipsoids' upper envelope,
 // as face-on (AnisotropicSheetHasThePlanesNormal). Interior particles at spacing s = 2 r are
@@ -517,9 +524,7 @@ TEST(RenderFluidSurface, GrazingPuddleHasThePlanesNormal) {
   const float r = 0.01f;
   const Pixels im = anisotropic_normals(pl.particles(), r, K, kGW, kGH);
   const float inner = 0.5f * (pl.count - 1) * pl.s - pl.s - 6.f * r;
-  const float A = std::cbrt(4.f) * 1.5f * r, rho = pl.s / std::sqrt(2.f);
-  const float slope = 0.25f * (rho / A) / std::sqrt(1.f - (rho / A) * (rho / A));
-  const float bound = std::atan(slope) * 180.f / 3.14159265f + 0.5f;
+  const float bound = disc_envelope_bound(r, pl.s);
   float worst = 0.f, sum = 0.f, row_jump = 0.f;
   int n = 0;
   for (int u = 0; u < kGW; ++u) {
