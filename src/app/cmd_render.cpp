@@ -2,10 +2,12 @@
 // or the input's frames at their tracked poses (Kinect view), particles_<step>.ply, objects.txt
 // (cloth triangles, rigid rest shapes) and the effective config.yaml (docs/RENDERING.md).
 #include <spdlog/spdlog.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <regex>
@@ -113,6 +115,24 @@ class KinectFrames {
   bool have_ = false;
 };
 
+// The planes the run's solver collided with besides the scan (the floor plane, as summary.json
+// records its height, and the config's support_plane), for the Kinect view's pixels without depth
+// as in the run (Renderer::set_unmeasured_planes).
+std::vector<vec4> run_planes(const Experiment& e, const std::string& run_dir) {
+  std::vector<float> heights;
+  std::ifstream f(run_dir + "/summary.json");
+  if (e.floor_plane && f) {
+    const nlohmann::json j = nlohmann::json::parse(f, nullptr, false);
+    if (!j.is_discarded() && j.contains("floor_height") && j["floor_height"].is_number())
+      heights.push_back(j["floor_height"].get<float>());
+  }
+  if (!e.support_plane.empty()) heights.push_back(e.support_plane.front());
+  const vec3 up = -normalize(e.solver.gravity);
+  std::vector<vec4> planes;
+  for (float h : heights) planes.push_back({up.x, up.y, up.z, h});
+  return planes;
+}
+
 SceneCamera mesh_camera(Renderer& r, const RenderOptions& o, const RenderParams& p) {
   const std::string mesh_path = o.run_dir + "/mesh.ply", traj_path = o.run_dir + "/trajectory.txt";
   Mesh mesh;
@@ -151,7 +171,10 @@ int render_run(const RenderOptions& o) {
                enum_name(p.view), r.gl_info().renderer);
   const SceneCamera scene_cam = p.view == RenderView::mesh ? mesh_camera(r, o, p) : SceneCamera{};
   std::unique_ptr<KinectFrames> kinect;
-  if (p.view == RenderView::kinect) kinect = std::make_unique<KinectFrames>(e, o.run_dir);
+  if (p.view == RenderView::kinect) {
+    kinect = std::make_unique<KinectFrames>(e, o.run_dir);
+    r.set_unmeasured_planes(run_planes(e, o.run_dir));
+  }
   HeadlessOutput out(out_dir, p);
   std::vector<vec4> warm;
   for (const auto& [step, path] : states) {

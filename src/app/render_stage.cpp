@@ -113,6 +113,10 @@ class GlRunRenderer : public RunRenderer {
     }
   }
 
+  void set_unmeasured_planes(const std::vector<vec4>& world_planes) override {
+    renderer_.set_unmeasured_planes(world_planes);
+  }
+
   void draw(const ParticleSolver& solver) override {
     StageScope s(ctx_.timer(), "render");
     // The orbit's progress: simulated time over the run's duration (0 at the first frame).
@@ -184,6 +188,9 @@ class WindowRunRenderer : public RunRenderer {
     rgb_ = frame.rgb.clone(Device::CPU), depth_ = frame.depth.clone(Device::CPU);
     K_ = frame.intrinsics, pose_ = world_T_camera, new_frame_ = true;
   }
+  void set_unmeasured_planes(const std::vector<vec4>& world_planes) override {
+    planes_ = world_planes, new_planes_ = true;
+  }
   void draw(const ParticleSolver&) override {}  // the window pulls its frames
   void finish() override {}
 
@@ -232,7 +239,8 @@ class WindowRunRenderer : public RunRenderer {
   void hand_over(Renderer& r) {
     if (new_mesh_) r.set_scene_mesh(mesh_);
     if (new_frame_) r.set_kinect_view(rgb_, depth_, K_, pose_, region_);
-    new_mesh_ = new_frame_ = false;
+    if (new_planes_) r.set_unmeasured_planes(planes_);
+    new_mesh_ = new_frame_ = new_planes_ = false;
   }
 
   RunContext& ctx_;
@@ -243,7 +251,8 @@ class WindowRunRenderer : public RunRenderer {
   Image<float> depth_;
   Intrinsics K_{};
   PixelRect region_{};
-  bool new_mesh_ = false, new_frame_ = false;
+  std::vector<vec4> planes_;
+  bool new_mesh_ = false, new_frame_ = false, new_planes_ = false;
 };
 
 // Why no window can be opened here, or "" when one can.

@@ -48,6 +48,8 @@ class RunRenderer {
   virtual void set_scene(const Mesh& mesh, const SE3& scan_camera) = 0;
   // Kinect view: this frame's colour and depth at its tracked pose.
   virtual void set_kinect_frame(const RgbdFrame& frame, const SE3& world_T_camera) = 0;
+  // Kinect view: the surfaces the camera did not measure (Renderer::set_unmeasured_planes).
+  virtual void set_unmeasured_planes(const std::vector<vec4>& world_planes) = 0;
   virtual void draw(const ParticleSolver& solver) = 0;
   virtual void finish() = 0;
   // The GPU time per pass (name, ms) of the draw before the last one, from the renderer's GL timer

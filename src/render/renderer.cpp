@@ -180,6 +180,9 @@ void Renderer::Impl::draw_scene(const RenderCamera& cam) {
     glUniform4f(kinect_prog.loc("u_crop"), static_cast<float>(v.x), static_cast<float>(v.y),
                 static_cast<float>(v.width), static_cast<float>(v.height));
     glUniform2f(kinect_prog.loc("u_image_size"), static_cast<float>(kin_K.width), static_cast<float>(kin_K.height));
+    glUniform1i(kinect_prog.loc("u_plane_count"), static_cast<GLint>(kin_planes.size()));
+    if (!kin_planes.empty())
+      glUniform4fv(kinect_prog.loc("u_planes"), static_cast<GLsizei>(kin_planes.size()), &kin_planes[0].x);
     glBindVertexArray(empty_vao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glDepthFunc(GL_LESS);
@@ -570,6 +573,16 @@ void Renderer::set_kinect_view(const Image<uchar3>& rgb, const Image<float>& dep
   m.kin_pose = world_T_camera;
   m.kin_mean = mean_linear_color(rgb.buffer().data(), K.width, r);
   m.has_kinect = true;
+}
+
+void Renderer::set_unmeasured_planes(const std::vector<vec4>& world_planes) {
+  if (world_planes.size() > static_cast<std::size_t>(kMaxUnmeasuredPlanes))
+    throw Error("render: " + std::to_string(world_planes.size()) + " unmeasured planes, at most " +
+                std::to_string(kMaxUnmeasuredPlanes));
+  for (const vec4& q : world_planes)
+    if (std::abs(length(vec3{q.x, q.y, q.z}) - 1.f) > 1e-3f)
+      throw Error("render: an unmeasured plane's normal must be a unit vector (plane n . x = w given as n, w)");
+  impl_->kin_planes = world_planes;
 }
 
 RenderCamera Renderer::kinect_camera() const {

@@ -62,6 +62,14 @@ class Renderer {
   // undistortion's black border), cut to the framebuffer's aspect ratio.
   void set_kinect_view(const Image<uchar3>& rgb, const Image<float>& depth, const Intrinsics& K,
                        const SE3& world_T_camera, const PixelRect& colour_region = {});
+  // Surfaces the camera did not measure, as planes n . x = w in the world (n a unit vector; at most
+  // kMaxUnmeasuredPlanes): in the Kinect view a pixel without recorded depth whose ray meets one
+  // in front of the camera takes the nearest such point as its real surface, which then hides what
+  // lies behind it and receives the virtual objects' shadows (a table top the Kinect returned no
+  // depth from, `support_plane`; the floor plane where its readings are missing). Empty (the
+  // default): such pixels stay empty, nothing there hides or receives anything.
+  static constexpr int kMaxUnmeasuredPlanes = 4;
+  void set_unmeasured_planes(const std::vector<vec4>& world_planes);
   // The camera the Kinect view draws with: K cropped to the part shown and scaled to the
   // framebuffer, the tracked pose.
   RenderCamera kinect_camera() const;

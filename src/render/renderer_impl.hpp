@@ -142,6 +142,7 @@ struct Renderer::Impl {
   vec3 kin_mean{0.5f, 0.5f, 0.5f};  // the image's mean colour, linear
   SE3 kin_pose = SE3::identity();
   bool has_kinect = false;
+  std::vector<vec4> kin_planes;  // set_unmeasured_planes
 
   // Objects.
   GlMesh box;

@@ -1,7 +1,9 @@
 // Kinect view: the RGB image is the background, its depth hides virtual objects behind the real
 // surface, and the virtual camera is the sensor's exact pinhole model and tracked pose.
 #include <cmath>
+#include <vector>
 
+#include "core/error.hpp"
 #include "core/phase.hpp"
 #include "render_test_util.hpp"
 
@@ -31,12 +33,15 @@ struct KinectScene {
 
 // Renders one sphere (a debug particle) at camera coordinates `c` and returns the frame, showing
 // the part `region` of the image (empty: all of it).
-Pixels render_sphere(const KinectScene& s, vec3 c, float radius, int W, int H, PixelRect region = {}) {
+// `planes`: surfaces the camera did not measure (world n . x = w).
+Pixels render_sphere(const KinectScene& s, vec3 c, float radius, int W, int H, PixelRect region = {},
+                     const std::vector<vec4>& planes = {}) {
   RenderParams p;
   p.view = RenderView::kinect;
   p.fluid = FluidDraw::particles;
   Renderer r(p, W, H);
   r.set_kinect_view(s.rgb, s.depth, s.K, s.world_T_camera, region);
+  r.set_unmeasured_planes(planes);
   const std::vector<vec3> x = {s.world_T_camera * c};
   const std::vector<std::uint32_t> ph = {phase::kFluid};
   DrawList list;
@@ -89,6 +94,47 @@ TEST(RenderKinectView, NoDepthReadingDoesNotOcclude) {
   Pixels img = render_sphere(s, c, 0.06f, s.K.width, s.K.height);
   const int u = static_cast<int>(std::lround(px.x)), v = static_cast<int>(std::lround(px.y));
   EXPECT_GT(max_diff(img.at(u, v), s.rgb_at(u, v)), 60);
+}
+
+// A surface the camera did not measure (a table top that returned no depth): the right half of
+// the image has no reading, and a plane 0.3 m below the optical axis (camera y runs down) is given
+// in world coordinates. A sphere of 0.1 m resting on it at 2 m, in that half, shows its upper part
+// and hides its lower part: at pixel row 70 the ray (y = 0.107 z) meets the plane at 2.8 m, behind
+// the sphere's front at ~1.95 m; at row 80 (y = 0.191 z) it meets the plane at 1.57 m, in front
+// of the sphere. Without the plane both rows show the sphere; with it, the left half (with
+// readings) is as before.
+TEST(RenderKinectView, UnmeasuredPlaneHidesWhatIsBelowIt) {
+  SEAMLESS_REQUIRE_EGL();
+  KinectScene s;
+  const vec3 n = s.world_T_camera.rotate(vec3{0.f, 1.f, 0.f});
+  const std::vector<vec4> plane = {{n.x, n.y, n.z, 0.3f + dot(n, s.world_T_camera.t)}};
+  const vec3 c{0.6f, 0.3f, 2.f};
+  const int u = static_cast<int>(std::lround(project(s, c).x));
+  ASSERT_GT(u - 120.f * 0.1f / 2.f, 81.f) << "the sphere must lie in the half without readings";
+  const Pixels with = render_sphere(s, c, 0.1f, s.K.width, s.K.height, {}, plane);
+  const Pixels without = render_sphere(s, c, 0.1f, s.K.width, s.K.height);
+  for (const Pixels* img : {&with, &without})
+    EXPECT_GT(max_diff(img->at(u, 70), s.rgb_at(u, 70)), 60) << "the sphere's upper part, above the plane";
+  EXPECT_GT(max_diff(without.at(u, 80), s.rgb_at(u, 80)), 60) << "no plane: nothing hides the lower part";
+  EXPECT_TRUE(same(with.at(u, 80), s.rgb_at(u, 80))) << "the plane hides the sphere's lower part";
+  // The same sphere behind the wall in the left half (readings at 1.5 m) stays hidden either way.
+  const vec3 behind{-0.35f * 2.f, 0.1f * 2.f, 2.f};
+  const vec2 pb = project(s, behind);
+  const Pixels wall = render_sphere(s, behind, 0.06f, s.K.width, s.K.height, {}, plane);
+  const int ub = static_cast<int>(std::lround(pb.x)), vb = static_cast<int>(std::lround(pb.y));
+  EXPECT_TRUE(same(wall.at(ub, vb), s.rgb_at(ub, vb)));
+}
+
+// Planes are n . x = w with a unit normal, at most Renderer::kMaxUnmeasuredPlanes of them.
+TEST(RenderKinectView, UnmeasuredPlanesAreChecked) {
+  SEAMLESS_REQUIRE_EGL();
+  RenderParams p;
+  p.view = RenderView::kinect;
+  Renderer r(p, 32, 24);
+  EXPECT_THROW(r.set_unmeasured_planes({{0.f, 2.f, 0.f, 1.f}}), Error);
+  EXPECT_THROW(r.set_unmeasured_planes(std::vector<vec4>(Renderer::kMaxUnmeasuredPlanes + 1, vec4{0.f, 1.f, 0.f, 0.f})),
+               Error);
+  EXPECT_NO_THROW(r.set_unmeasured_planes({{0.f, 1.f, 0.f, -0.5f}}));
 }
 
 // A framebuffer larger than the sensor image (2x): the intrinsics are scaled, so the sphere lands

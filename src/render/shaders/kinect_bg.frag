@@ -2,14 +2,33 @@
 // image as background, and its registered depth written as this pixel's depth so that virtual
 // objects behind the real surface fail the depth test. No reading (0) means nothing is there.
 // The same depth places the real surface in the world (unprojected with the intrinsics, moved by
-// the tracked pose), where the virtual objects' shadows darken it (shadow.glsl).
+// the tracked pose), where the virtual objects' shadows darken it (shadow.glsl). Where there is no
+// reading but the ray meets a surface the camera did not measure (Renderer::set_unmeasured_planes),
+// that surface is there instead.
 uniform sampler2D u_rgb;
 uniform sampler2D u_depth;  // metres, registered to u_rgb
 uniform mat4 u_world_T_camera;
 uniform vec4 u_crop;        // the part of the image the frame shows: x, y, width, height (image pixels)
 uniform vec2 u_image_size;  // of u_rgb and u_depth
+uniform int u_plane_count;
+uniform vec4 u_planes[4];   // n . x = w in the world: (n, w)
 
 layout(location = 0) out vec4 o_color;
+
+// Camera depth at which pixel px's ray meets the nearest of the unmeasured planes in front of the
+// camera (between the near and far planes), or 0 where it meets none.
+float unmeasured_depth(vec2 px) {
+  vec3 o = u_world_T_camera[3].xyz;
+  vec3 d = mat3(u_world_T_camera) * pixel_ray(px);  // world displacement per metre of camera depth
+  float best = 0.0;
+  for (int i = 0; i < u_plane_count; ++i) {
+    float nd = dot(u_planes[i].xyz, d);
+    if (abs(nd) < 1e-6) continue;  // the ray runs along the plane
+    float t = (u_planes[i].w - dot(u_planes[i].xyz, o)) / nd;
+    if (t > u_near_far.x && t < u_near_far.y && (best == 0.0 || t < best)) best = t;
+  }
+  return best;
+}
 
 void main() {
   vec2 px = frag_pixel();
@@ -18,6 +37,7 @@ void main() {
   vec2 uv = (u_crop.xy + (px + 0.5) * u_crop.zw / u_size) / u_image_size;
   vec3 rgb = texture(u_rgb, uv).rgb;
   float z = texture(u_depth, uv).r;
+  if (z <= 0.0) z = unmeasured_depth(px);
   if (z > 0.0) {
     vec3 world = (u_world_T_camera * vec4(z * pixel_ray(px), 1.0)).xyz;
     rgb = shadowed_srgb(rgb, shadow_light(world, vec3(0.0), gl_FragCoord.xy));
