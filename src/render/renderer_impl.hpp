@@ -170,6 +170,7 @@ struct Renderer::Impl {
   Texture shadow_bits, shadow_thick;  // fluid splat: front depth bits, fixed-point path in fluid
   Texture shadow_fluid;               // RG32F: fluid front depth and path, in the splat's grid
   bool fluid_shadow_live = false;     // this frame's fluid transmits into the map
+  bool opaque_shadow_live = false;    // this frame has opaque casters (meshes, or particles drawn as spheres)
   float list_sphere_r = 0.f;          // this frame's fluid sphere radius (its splat level)
   Framebuffer shadow_fbo;
   int shadow_size = 0;

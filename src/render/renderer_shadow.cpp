@@ -115,6 +115,7 @@ void Renderer::Impl::shadow_uniforms(const Program& prog) const {
   glUniform1i(prog.loc("u_light_bounds"), kLightBoundsUnit);
   glUniform1i(prog.loc("u_fluid_shadow"), kFluidShadowUnit);
   glUniform1i(prog.loc("u_fluid_shadow_on"), fluid_shadow_live);
+  glUniform1i(prog.loc("u_opaque_shadow_on"), opaque_shadow_live);
   glUniform1f(prog.loc("u_fluid_radius"), list_sphere_r);
   glUniform3f(prog.loc("u_shadow_absorption"), p.absorption.x, p.absorption.y, p.absorption.z);
   glUniformMatrix3fv(prog.loc("u_light_R"), 1, GL_FALSE, cols(light_R).data());
@@ -137,7 +138,7 @@ void light_uniforms(const Program& prog, const mat3& R, GLuint bounds, int size)
 }  // namespace
 
 void Renderer::Impl::shadow_pass(const DrawList& list, std::int64_t n) {
-  shadow_live = fluid_shadow_live = false;
+  shadow_live = fluid_shadow_live = opaque_shadow_live = false;
   if (!p.shadows || !has_shadow) return;
   make_shadow_targets();
   light_R = light_frame(p.light_dir);
@@ -274,6 +275,7 @@ void Renderer::Impl::shadow_pass(const DrawList& list, std::int64_t n) {
   glViewport(0, 0, w, h);
   shadow_live = true;
   fluid_shadow_live = fluid && ssfr;
+  opaque_shadow_live = meshes || (fluid && !ssfr);
 }
 
 }  // namespace seamless

@@ -208,5 +208,48 @@ TEST(RenderShadow, ASpreadLayerCastsOneEvenShadow) {
   EXPECT_GT(spheres.brightest, hole);
 }
 
+
+// Particles drawn as spheres (render.fluid: particles) are opaque casters: a slab of them 0.15 m
+// above the floor leaves the floor under its interior at (1 - shadow_strength) of its linear
+// colour, as a cube does (the margin as there: penumbra and texels), not the water's tint.
+TEST(RenderShadow, ParticlesDrawnAsSpheresCastAnOpaqueShadow) {
+  SEAMLESS_REQUIRE_EGL();
+  RenderParams p = down_light();
+  p.fluid = FluidDraw::particles;
+  Renderer r(p, 240, 180);
+  const uchar3 floor_colour{200, 180, 160};
+  r.set_scene_mesh(floor_scan(floor_colour));
+  const float rad = 0.02f;
+  const int n = 12;
+  std::vector<vec3> x;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) x.push_back({(i - 0.5f * (n - 1)) * 2 * rad, 0.15f, (j - 0.5f * (n - 1)) * 2 * rad});
+  const std::vector<std::uint32_t> ph(x.size(), phase::kFluid);
+  DrawList list;
+  list.positions = x, list.phases = ph, list.particle_radius = rad;
+  const RenderCamera cam = above();
+  r.params().shadows = false;
+  const Pixels off(r.render(list, cam));
+  r.params().shadows = true;
+  const Pixels on(r.render(list, cam));
+  const float half = n * rad;
+  const float margin = std::tan(0.5f * p.light_angle * std::numbers::pi_v<float> / 180.f) * (0.15f + rad) +
+                       3.f * 2.f * std::sqrt(2.f) * half / (p.shadow_map_size - 4) + rad;
+  int umbra = 0;
+  for (int v = 0; v < on.h; ++v)
+    for (int u = 0; u < on.w; ++u) {
+      if (!same(off.at(u, v), floor_colour)) continue;  // the spheres, or beyond the floor
+      const vec3 q = floor_point(cam, u, v);
+      if (std::max(std::abs(q.x), std::abs(q.z)) > half - margin) continue;
+      ++umbra;
+      const uchar3 c = on.at(u, v);
+      for (int i = 0; i < 3; ++i) {
+        const std::uint8_t got = (&c.x)[i], was = (&floor_colour.x)[i];
+        const float level = linear(got) - linear(static_cast<std::uint8_t>(got - 1));
+        EXPECT_NEAR(linear(got), (1.f - p.shadow_strength) * linear(was), level) << u << "," << v << " channel " << i;
+      }
+    }
+  EXPECT_GT(umbra, 100);
+}
 }  // namespace
 }  // namespace seamless::test

@@ -73,6 +73,7 @@ vec4 light_clip(vec3 world) {
 #else
 uniform bool u_shadow_on;           // a map was made this frame (render.shadows and casters drawn)
 uniform sampler2D u_shadow_map;     // metres below z0 of the nearest opaque caster; 1e30 = none
+uniform bool u_opaque_shadow_on;    // u_shadow_map holds opaque casters this frame (else all 1e30)
 uniform bool u_fluid_shadow_on;     // the fluid is in u_fluid_shadow this frame
 uniform sampler2D u_fluid_shadow;   // in the fluid splat's texel grid: front depth (1e30 = none), path in fluid
 uniform float u_fluid_radius;       // the fluid spheres' radius (their splat level)
@@ -172,7 +173,10 @@ vec3 shadow_light(vec3 world, vec3 n, vec2 pixel) {
   float bias = 1.5 * m.texel * (1.0 + length(slope)) + 1e-3;
   vec3 c = light_coords(m, world);
   if (c.z <= 0.0 || any(lessThan(c.xy, vec2(0.0))) || any(greaterThan(c.xy, vec2(1.0)))) return vec3(1.0);
-  vec3 light = vec3(1.0 - opaque_shadow(m, c, slope, bias, 6.2831853 * shadow_ign(pixel)));
+  // Without opaque casters (fluid alone, drawn as a surface) the map is 1e30 everywhere and the
+  // blocker search could find nothing: its 16 taps a pixel are skipped, with the same result.
+  vec3 light = vec3(1.0);
+  if (u_opaque_shadow_on) light -= opaque_shadow(m, c, slope, bias, 6.2831853 * shadow_ign(pixel));
   if (u_fluid_shadow_on) light *= fluid_transmittance(m, c, bias);
   return light;
 }
