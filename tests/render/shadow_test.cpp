@@ -208,7 +208,6 @@ TEST(RenderShadow, ASpreadLayerCastsOneEvenShadow) {
   EXPECT_GT(spheres.brightest, hole);
 }
 
-
 // Particles drawn as spheres (render.fluid: particles) are opaque casters: a slab of them 0.15 m
 // above the floor leaves the floor under its interior at (1 - shadow_strength) of its linear
 // colour, as a cube does (the margin as there: penumbra and texels), not the water's tint.
