@@ -83,7 +83,7 @@ void log_escaped(const EscapedParticles& x, std::size_t dynamic) {
   if (x.total() == 0) return spdlog::info("physics: none of the {} dynamic particles left the scene", dynamic);
   spdlog::warn(
       "physics: {} of {} dynamic particles left the scene ({} below the floor, {} outside the scanned "
-      "region, {} still falling): holes in the scan (see docs/PLACEMENT.md, 'Physics on real scans')",
+      "region, {} falling through or off the scan): holes in the scan (see docs/PLACEMENT.md, 'Physics on real scans')",
       x.total(), dynamic, x.below_floor, x.outside, x.falling);
 }
 
@@ -181,7 +181,7 @@ RunOutputs run_experiment(RunContext& ctx, const std::string& config) {
                             grid ? &*grid : nullptr, replaying ? &replay : nullptr);
   const SimulationResult& sim = out.simulation;
   summary.physics = sim.stats;
-  summary.escaped = count_escaped(sim.state, bounds, e.solver.particle_diameter);
+  summary.escaped = count_escaped(sim.state, bounds, scan_result.mesh, e.solver.particle_diameter);
   log_escaped(*summary.escaped, sim.state.x.size());
   add_stage_medians(summary, ctx.timer());
   write_summary(ctx.out_path("summary.json"), summary);

@@ -258,7 +258,7 @@ class LiveLoop : public FrameLoop {
       sum.ghost_vertices = ghost_vertices(mesh, e_.input, poses_, groundtruth_, 2 * e_.volume.voxel_size);
     if (seen_.size() > 0) sum.seen_through = seen_through_vertices(mesh, seen_, seen_through_slack(e_.volume));
     if (online_) sum.online_refine = online_->stats();
-    sum.escaped = count_escaped(state, b, e_.solver.particle_diameter);
+    sum.escaped = count_escaped(state, b, mesh, e_.solver.particle_diameter);
     add_stage_medians(sum, ctx_.timer());
     write_summary(ctx_.out_path("summary.json"), sum);
   }

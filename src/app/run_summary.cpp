@@ -16,31 +16,7 @@
 namespace seamless::app {
 
 SceneBounds scene_bounds(const Mesh& mesh, vec3 up, const HorizontalSurface* floor) {
-  SceneBounds b;
-  b.up = up;
-  if (floor) b.floor = floor->height;
-  if (!mesh.positions.empty()) {
-    b.lo = b.hi = mesh.positions[0];
-    for (vec3 p : mesh.positions) b.lo = vmin(b.lo, p), b.hi = vmax(b.hi, p);
-  }
-  return b;
-}
-
-EscapedParticles count_escaped(const ParticleState& s, const SceneBounds& b, float diameter) {
-  EscapedParticles e;
-  const float margin = 2.f * diameter;
-  const vec3 up = normalize(b.up);
-  for (std::size_t i = 0; i < s.x.size(); ++i) {
-    if (s.inv_mass[i] == 0.f) continue;  // pinned cloth corners stay where they were put
-    const vec3 x = s.x[i];
-    const float h = dot(x, up);
-    if (b.floor && h < *b.floor - margin) ++e.below_floor;
-    else if (x.x < b.lo.x - margin || x.y < b.lo.y - margin || x.z < b.lo.z - margin || x.x > b.hi.x + margin ||
-             x.y > b.hi.y + margin || x.z > b.hi.z + margin)
-      ++e.outside;
-    else if (-dot(s.v[i], up) > kFallSpeed) ++e.falling;
-  }
-  return e;
+  return mesh_bounds(mesh, up, floor ? std::optional<float>(floor->height) : std::nullopt);
 }
 
 std::optional<double> mean_dynamic_fraction(const std::vector<FrameRecord>& frames) {

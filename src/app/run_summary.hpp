@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "app/escaped.hpp"
 #include "app/ghost.hpp"
 #include "app/placement.hpp"
 #include "core/intrinsics.hpp"
@@ -15,23 +16,8 @@
 
 namespace seamless::app {
 
-// Dynamic particles that left the scene at the end of a run. A particle counts once, in the
-// first class it falls in: below the floor (more than two diameters under it), outside the
-// scanned region (more than two diameters outside the scan's bounds), or still falling (moving
-// down faster than fall_speed: a particle at rest on a surface moves at most at settling speeds).
-struct EscapedParticles {
-  std::int64_t below_floor = 0, outside = 0, falling = 0;
-  std::int64_t total() const { return below_floor + outside + falling; }
-};
-struct SceneBounds {
-  vec3 lo{0, 0, 0}, hi{0, 0, 0};  // world bounds of the scanned mesh
-  std::optional<float> floor;     // floor height along up, when the floor was seen
-  vec3 up{0, 1, 0};
-};
-// The scanned mesh's bounds, `up`, and the floor's height when `floor` is not null.
+// The scanned mesh's bounds, `up`, and the floor's height when `floor` is not null (app/escaped.hpp).
 SceneBounds scene_bounds(const Mesh& mesh, vec3 up, const HorizontalSurface* floor);
-constexpr float kFallSpeed = 0.5f;  // m/s: free fall reaches it in 0.05 s (12 mm of drop)
-EscapedParticles count_escaped(const ParticleState& s, const SceneBounds& b, float diameter);
 
 struct RunSummary {
   // complete | interrupted | failed | incomplete (README, "Exit codes and interrupted runs");

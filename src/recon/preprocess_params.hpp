@@ -6,12 +6,12 @@ namespace seamless {
 
 struct PreprocessParams {
   bool bilateral = true;
-  float sigma_space = 4.5f;           // pixels
-  float sigma_depth = 0.03f;          // metres
-  int radius = 3;                     // window (2r+1)^2
-  bool bilateral_inline_exp = false;  // range weights from kernels::exp_nonpositive instead of expf
-  float pyramid_max_diff = 0.09f;     // 3 sigma_depth: averaging never bridges larger jumps
-  float max_normal_edge = 0.1f;       // metres; longer neighbour edges are depth discontinuities
+  float sigma_space = 4.5f;          // pixels
+  float sigma_depth = 0.03f;         // metres
+  int radius = 3;                    // window (2r+1)^2
+  bool bilateral_inline_exp = true;  // range weights from kernels::exp_nonpositive instead of expf
+  float pyramid_max_diff = 0.09f;    // 3 sigma_depth: averaging never bridges larger jumps
+  float max_normal_edge = 0.1f;      // metres; longer neighbour edges are depth discontinuities
   int levels = 3;
 
   template <class V> void visit(V& v) {
@@ -21,7 +21,8 @@ struct PreprocessParams {
     v("radius", radius, "bilateral window radius, pixels", Range{1, 15});
     v("bilateral_inline_exp", bilateral_inline_exp,
       "bilateral range weights from an inlined exp (~2 ulp; vectorised on the CPU, 6x fewer filter "
-      "instructions) instead of libm's expf: the filtered depth changes in its last bits");
+      "instructions) instead of libm's expf (false: the old filter, bit for bit); the filtered depth differs "
+      "in its last bits. On CUDA both values evaluate the same expf");
     v("pyramid_max_diff", pyramid_max_diff, "largest depth difference averaged in the pyramid, metres",
       Range{0.001, 1});
     v("max_normal_edge", max_normal_edge, "neighbour distance beyond which no normal is computed, metres",

@@ -4,12 +4,15 @@
 config's own tracker, simulated for 3 s on the CPU without pictures. Checks, from the run's own outputs:
 
 - summary.json: every spawn was placed on the same support surface (the desk, about 0.9 m below the
-  first camera), no dynamic particle escaped, and the counts add up;
+  first camera), no dynamic particle escaped (below the floor, outside the scan, or falling through
+  the scan or over nothing: src/app/escaped.hpp; a splash on the surface is not an escape), and the
+  counts add up;
 - particles.ply against scene_particles.ply: every fluid and cube particle rests on something (a
   scene particle, the floor plane or another dynamic particle within two diameters below it, inside
-  a column one diameter wide); each particle is on the desk or (water that ran over its edge) on the
-  floor, none in between or below; the cube and the cloth stay on the desk; the fluid and the cloth are at rest (median speed below 0.3 m/s) and the cube
-  (the body that creeps first if friction fails) moves slower than 0.2 m/s.
+  a column one diameter wide); the cube and the cloth stay on the desk; the water is on the desk,
+  on the floor, or (where it ran over the desk's edge into the scan's crevices) resting on something
+  in between, never below the floor; the fluid and the cloth are at rest (median speed below 0.3
+  m/s) and the cube (the body that creeps first if friction fails) moves slower than 0.2 m/s.
 
 Usage: real_placement_test.py SEAMLESS ROOT DATA OUT; exit 77 (skip) without the data folder outside CI.
 """
@@ -70,17 +73,23 @@ def main():
     scene = read_ply(os.path.join(out, "scene_particles.ply"))["x"]
     x, v, ph = dyn["x"], dyn["v"], dyn["ph"]
     assert len(x) == p["dynamic"]
-    # Everything is on the desk or, where water ran over its edge, on the floor: a particle centre
-    # resting on the floor is one radius above it, and two diameters allow for the scan's noise at
-    # ~1.5 m (a centimetre or two). The desk's scanned top is not flat to better than a few
-    # centimetres over its metre (noise, tilt of the gravity estimate), so "on the desk" is anything
-    # less than 10 cm below the height where the entries were placed; the rest-on-something check
-    # below pins each particle to the surface under it.
+    # The cube and the cloth stay on the desk. The desk's scanned top is not flat to better than a
+    # few centimetres over its metre (noise, tilt of the gravity estimate), so "on the desk" is
+    # anything less than 10 cm below the height where the entries were placed. Water that runs over
+    # the desk's edge ends on the floor (a particle centre resting on it is one radius above it; two
+    # diameters allow for the scan's noise at ~1.5 m) or on whatever the scan has in between (a
+    # crevice at the desk's edge, a lower surface beside it): where it rests is the scan's shape, not
+    # a failure; the rest-on-something check below pins each such particle to a support under it,
+    # and none may be under the floor.
     floor = s["floor_height"]
     on_desk = x[:, 1] > desk_h - 0.1
     on_floor = np.abs(x[:, 1] - floor) < 2 * diameter
-    assert (on_desk | on_floor).all(), f"particles neither on the desk nor on the floor: {x[~(on_desk | on_floor)][:5]}"
-    assert (ph[on_floor] & RIGID).sum() == 0 and (ph[on_floor] & CLOTH).sum() == 0, "the cube or the cloth fell off"
+    assert (x[:, 1] > floor - 2 * diameter).all(), f"particles below the floor: {x[x[:, 1] <= floor - 2 * diameter][:5]}"
+    solid = (ph & (RIGID | CLOTH)) != 0
+    assert on_desk[solid].all(), f"the cube or the cloth left the desk: {x[solid & ~on_desk][:5]}"
+    between = ~(on_desk | on_floor)
+    print(f"fluid: {int(on_desk.sum() - solid.sum())} on the desk, {int(on_floor.sum())} on the floor, "
+          f"{int(between.sum())} in between")
     # Every fluid and cube particle rests on something within two diameters below it: a scene
     # particle, the floor plane or another particle (nothing floats or hangs in a hole). Cloth is
     # held by its own edges where it drapes over something, so the sheet is checked by its speed.
