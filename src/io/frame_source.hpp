@@ -18,10 +18,13 @@ struct InputParams;
 
 struct RgbdFrame {
   std::int64_t index = 0;  // position in the source's sequence (after skipped frames)
-  double timestamp = 0.0;  // seconds (TUM: UNIX time of the depth image)
-  Image<float> depth;      // host image, metres, 0 = no reading; registered to rgb
-  Image<uchar3> rgb;       // host image, 8-bit R, G, B
-  Intrinsics intrinsics;   // of depth and rgb (undistorted: dist is zero when images are)
+  // Seconds: the time trajectories and ground truth are stamped with (TUM: the colour image's, the
+  // first column of TUM's associations, which its evaluation tools expect; fakenect and a live
+  // Kinect: the depth image's arrival; frame folders: number / fps).
+  double timestamp = 0.0;
+  Image<float> depth;     // host image, metres, 0 = no reading; registered to rgb
+  Image<uchar3> rgb;      // host image, 8-bit R, G, B
+  Intrinsics intrinsics;  // of depth and rgb (undistorted: dist is zero when images are)
   // Specific force measured by the accelerometer, m/s^2, in the camera frame (x right, y down,
   // z forward): at rest it points up, e.g. (0, -9.81, 0) for a level camera.
   std::optional<vec3> accelerometer;
