@@ -10,6 +10,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <regex>
 
 #include "app/commands.hpp"
@@ -119,18 +120,14 @@ class KinectFrames {
 // records its height, and the config's support_plane), for the Kinect view's pixels without depth
 // as in the run (Renderer::set_unmeasured_planes).
 std::vector<vec4> run_planes(const Experiment& e, const std::string& run_dir) {
-  std::vector<float> heights;
+  std::optional<float> floor;
   std::ifstream f(run_dir + "/summary.json");
   if (e.floor_plane && f) {
     const nlohmann::json j = nlohmann::json::parse(f, nullptr, false);
     if (!j.is_discarded() && j.contains("floor_height") && j["floor_height"].is_number())
-      heights.push_back(j["floor_height"].get<float>());
+      floor = j["floor_height"].get<float>();
   }
-  if (!e.support_plane.empty()) heights.push_back(e.support_plane.front());
-  const vec3 up = -normalize(e.solver.gravity);
-  std::vector<vec4> planes;
-  for (float h : heights) planes.push_back({up.x, up.y, up.z, h});
-  return planes;
+  return unmeasured_planes(plane_heights(floor, e.support_plane), -normalize(e.solver.gravity));
 }
 
 SceneCamera mesh_camera(Renderer& r, const RenderOptions& o, const RenderParams& p) {

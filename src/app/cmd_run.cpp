@@ -42,13 +42,6 @@ int dry_run(const CommonOptions& o) {
 // scan without one would stand in the air where the room is empty.
 // `support_plane` adds a plane the user states: a surface the camera does not measure at all (a
 // glossy table seen at a grazing angle returns no depth), which no scan can find.
-std::vector<float> plane_heights(const HorizontalSurface* floor, const std::vector<float>& support) {
-  std::vector<float> heights;
-  if (floor) heights.push_back(floor->height);
-  if (!support.empty()) heights.push_back(support.front());
-  return heights;
-}
-
 std::optional<kernels::SceneSdf> scene_planes(const std::vector<float>& heights, vec3 up) {
   if (heights.empty()) return std::nullopt;
   kernels::SceneSdf sdf{};
@@ -159,13 +152,11 @@ RunOutputs run_experiment(RunContext& ctx, const std::string& config) {
       renderer->set_kinect_frame(scan_result.first_frame, traj.front().se3());
   }
   const HorizontalSurface* floor_surface = e.floor_plane ? find_floor(ps.surfaces) : nullptr;
-  const std::vector<float> heights = plane_heights(floor_surface, e.support_plane);
+  const std::vector<float> heights =
+      plane_heights(floor_surface ? std::optional<float>(floor_surface->height) : std::nullopt, e.support_plane);
   std::optional<kernels::SceneSdf> floor = scene_planes(heights, ps.up);
-  if (renderer) {  // the same planes, where the recording has no depth: they hide and receive shadows
-    std::vector<vec4> planes;
-    for (float h : heights) planes.push_back({ps.up.x, ps.up.y, ps.up.z, h});
-    renderer->set_unmeasured_planes(planes);
-  }
+  // The same planes, where the recording has no depth: they hide and receive shadows.
+  if (renderer) renderer->set_unmeasured_planes(unmeasured_planes(heights, ps.up));
   if (floor_surface) spdlog::info("floor plane at height {:.3f} m along -gravity", floor_surface->height);
   else if (e.floor_plane) spdlog::info("no floor plane: the scan shows no floor");
   if (!e.support_plane.empty())

@@ -27,6 +27,19 @@
 
 namespace seamless::app {
 
+std::vector<float> plane_heights(std::optional<float> floor, const std::vector<float>& support_plane) {
+  std::vector<float> heights;
+  if (floor) heights.push_back(*floor);
+  if (!support_plane.empty()) heights.push_back(support_plane.front());
+  return heights;
+}
+
+std::vector<vec4> unmeasured_planes(const std::vector<float>& heights, vec3 up) {
+  std::vector<vec4> planes;
+  for (float h : heights) planes.push_back({up.x, up.y, up.z, h});
+  return planes;
+}
+
 SceneCamera mesh_view_camera(const Mesh& mesh, const SE3& scan_camera, const RenderParams& p) {
   vec3 lo{1e9f, 1e9f, 1e9f}, hi{-1e9f, -1e9f, -1e9f};
   for (vec3 q : mesh.positions) lo = vmin(lo, q), hi = vmax(hi, q);

@@ -7,6 +7,7 @@
 // render's make_draw_list. Also the cameras that `seamless render` shares with the run.
 #pragma once
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -59,6 +60,12 @@ class RunRenderer {
   // The same for the last draw, waiting for the GPU to finish it (the end of a run).
   virtual std::vector<std::pair<std::string, double>> last_gpu_passes() { return {}; }
 };
+
+// The horizontal planes a scan_then_simulate run's solver collides with besides the scan: the floor
+// plane (its height, where the scan found a floor) and `support_plane` (a surface the camera did
+// not measure). As heights along `up`, and as the renderer takes them (up . x = height).
+std::vector<float> plane_heights(std::optional<float> floor, const std::vector<float>& support_plane);
+std::vector<vec4> unmeasured_planes(const std::vector<float>& heights, vec3 up);
 
 // The camera of the mesh view: at render.eye looking at render.target where given, else looking
 // at the mesh's centre from behind and above the first scanning camera (world up +y: the
