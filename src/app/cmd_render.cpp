@@ -127,7 +127,7 @@ std::vector<vec4> run_planes(const Experiment& e, const std::string& run_dir) {
     if (!j.is_discarded() && j.contains("floor_height") && j["floor_height"].is_number())
       floor = j["floor_height"].get<float>();
   }
-  return unmeasured_planes(plane_heights(floor, e.support_plane), -normalize(e.solver.gravity));
+  return unmeasured_planes(plane_heights(floor, e.support_plane), e.solver.up());
 }
 
 SceneCamera mesh_camera(Renderer& r, const RenderOptions& o, const RenderParams& p) {
@@ -184,7 +184,9 @@ int render_run(const RenderOptions& o) {
       const SceneCamera c = orbit_camera(scene_cam, p, progress);
       cam = RenderCamera::look_at(c.eye, c.target, {0.f, 1.f, 0.f}, p.fov_y, p.width, p.height, p.znear, p.zfar);
     }
-    r.draw(make_draw_list(s, objects, frames, 0.5f * e.solver.particle_diameter), cam);
+    DrawList list = make_draw_list(s, objects, frames, 0.5f * e.solver.particle_diameter);
+    list.up = e.solver.up();
+    r.draw(list, cam);
     out.add(r);
   }
   out.finish();

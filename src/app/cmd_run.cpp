@@ -133,7 +133,7 @@ RunOutputs run_experiment(RunContext& ctx, const std::string& config) {
 
   // The scene's horizontal surfaces with gravity (world -y after the tracker's gravity alignment).
   PlacementScene ps;
-  ps.up = -normalize(e.solver.gravity);
+  ps.up = e.solver.up();
   ps.mesh = &scan_result.mesh;
   ps.surfaces = find_horizontal_surfaces(scan_result.mesh, ps.up, camera_positions(traj));
   ps.scene_points = &points;

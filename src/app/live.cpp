@@ -242,7 +242,7 @@ class LiveLoop : public FrameLoop {
     sum.frames_lost = session_.lost_frames();
     sum.frames_unreadable = source_->skipped_frames();
     for (const FrameRecord& r : records_) sum.frames_fused += r.fused;
-    const vec3 up = -normalize(e_.solver.gravity);
+    const vec3 up = e_.solver.up();
     std::vector<vec3> cameras;
     for (const TumPose& p : poses_) cameras.push_back(p.se3().t);
     sum.surfaces = find_horizontal_surfaces(mesh, up, cameras);
@@ -271,7 +271,7 @@ class LiveLoop : public FrameLoop {
     tried_at_ = fused_;
     const Mesh mesh = volume_->extract_mesh();
     PlacementScene ps;
-    ps.up = -normalize(e_.solver.gravity);
+    ps.up = e_.solver.up();
     ps.mesh = &mesh;
     ps.surfaces = find_horizontal_surfaces(mesh, ps.up, {pose.t});
     if (points_stale_) {

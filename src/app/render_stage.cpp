@@ -72,15 +72,20 @@ class RunDrawState {
   // Host path: the state is downloaded and kept here (the DrawList's spans point into it).
   DrawList host_list(const ParticleSolver& solver) {
     state_ = solver.download_state();
-    return make_draw_list(state_, solver.objects(), solver.rigid_frames(), radius(solver));
+    return with_up(make_draw_list(state_, solver.objects(), solver.rigid_frames(), radius(solver)), solver);
   }
   // Device path: everything but the particles, which the interop buffer holds.
   static DrawList device_list(const ParticleSolver& solver) {
-    return make_draw_list({}, {}, solver.size(), solver.objects(), solver.rigid_frames(), radius(solver));
+    return with_up(make_draw_list({}, {}, solver.size(), solver.objects(), solver.rigid_frames(), radius(solver)),
+                   solver);
   }
 
  private:
   static float radius(const ParticleSolver& s) { return 0.5f * s.params().particle_diameter; }
+  static DrawList with_up(DrawList d, const ParticleSolver& s) {
+    d.up = s.params().up();
+    return d;
+  }
   ParticleState state_;
 };
 

@@ -19,11 +19,6 @@ namespace {
 
 int count_along(float extent, float d) { return std::max(1, static_cast<int>(std::floor(extent / d + 0.5f))); }
 
-vec3 up_from_gravity(vec3 g) {
-  float l = length(g);
-  return l > 0.f ? -g / l : vec3{0.f, 1.f, 0.f};
-}
-
 // Two unit vectors spanning the plane normal to n, (u, w, -n) right-handed: u is the projection of
 // the x axis (the y axis where n is near x) onto the plane, so that a cloth hung under gravity -y
 // spans x (its rows) and z (its columns). In the terms of core's basis (t1, t2, n): u = -t2, w = -t1.
@@ -145,7 +140,7 @@ ParticleBatch make_fluid_block(const SpawnParams& s, const SolverParams& p) {
 
 ParticleBatch make_emitter_layer(const SpawnParams& s, const SolverParams& p) {
   const float d = p.particle_diameter;
-  vec3 dir = length(s.velocity) > 0.f ? normalize(s.velocity) : -up_from_gravity(p.gravity);
+  vec3 dir = length(s.velocity) > 0.f ? normalize(s.velocity) : -p.up();
   vec3 u, w;
   plane_basis(dir, u, w);
   int k = static_cast<int>(std::floor(s.nozzle_radius / d));
@@ -168,7 +163,7 @@ ParticleBatch make_cloth(const SpawnParams& s, const SolverParams& p) {
   ParticleBatch b;
   b.kind = ParticleBatch::kCloth;
   b.self_collide = s.self_collide;
-  vec3 up = up_from_gravity(p.gravity), u, w;
+  vec3 up = p.up(), u, w;
   plane_basis(up, u, w);
   mat3 R = quat_to_mat(euler_to_quat(s.rotation));
   float inv_m = 1.f / (s.density * d * d * d);

@@ -53,6 +53,11 @@ struct SolverParams {
   int iterations = 2;               // constraint (Jacobi) iterations per substep
   int substeps = 1;
   vec3 gravity{0.f, -9.81f, 0.f};  // world frame, m/s^2
+  // Against gravity, unit length (+y without gravity): what lies flat, stands and rests.
+  vec3 up() const {
+    const float l = length(gravity);
+    return l > 0.f ? gravity * (-1.f / l) : vec3{0.f, 1.f, 0.f};
+  }
   std::int64_t max_particles = 1 << 20;
   float static_friction = 0.5f;
   float kinetic_friction = 0.3f;

@@ -31,6 +31,9 @@ struct DrawList {
   // caller has them; empty: the renderer computes them on the CPU if render.fluid_anisotropy is on.
   std::span<const vec4> ellipsoids;
   float particle_radius = 0.02f;  // metres
+  // Against gravity, world (physics' up_from_gravity): a lone drop at rest lies flat across it
+  // (src/render/shaders/splat.glsl, "Lone drops at rest").
+  vec3 up{0.f, 1.f, 0.f};
   std::vector<RigidDraw> rigids;
   std::vector<ClothDraw> cloths;
 };

@@ -114,7 +114,8 @@ struct RenderParams {
   int filter_max_px = 24;          // ... but at most this many pixels
   float filter_depth_sigma = 1.f;  // range sigma of the bilateral filter, in particle radii
   // Gap fill of the depth before smoothing: empty runs between fluid pixels up to this many
-  // particle radii wide (world, at their depth) and at one depth become fluid (0: off).
+  // particle radii wide (world, at their depth) and at one depth become fluid (0: off). Spheres
+  // only: with the anisotropic kernels the layer is closed by its ellipsoids.
   float fluid_gap_fill = 4.f;
   // Anisotropic kernels (Yu & Turk 2013): each fluid particle splatted as an ellipsoid shaped by
   // its neighbours within filter_size radii (compute splats only; the raster path draws spheres).
@@ -230,7 +231,7 @@ struct RenderParams {
     v("filter_depth_sigma", filter_depth_sigma, "bilateral range sigma, particle radii", Range{0.01, 100.0});
     v("fluid_gap_fill", fluid_gap_fill,
       "fluid depth gap fill: empty runs between fluid pixels up to this many particle radii wide become "
-      "fluid at their neighbours' depth, if both agree (0 = off)",
+      "fluid at their neighbours' depth, if both agree (0 = off; spheres only, not with fluid_anisotropy)",
       Range{0.0, 50.0});
     v("fluid_anisotropy", fluid_anisotropy,
       "fluid particles drawn as ellipsoids shaped by their neighbours (Yu & Turk 2013): a spread layer "

@@ -417,6 +417,7 @@ void Renderer::Impl::draw_objects(const DrawList& list, std::int64_t n, const Re
 void Renderer::Impl::draw_frame(const DrawList& list, std::int64_t n, const RenderCamera& cam) {
   timer.begin_frame();
   stages.clear();
+  up = list.up;
   glViewport(0, 0, w, h);
   glBindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
   const vec3 bg = p.background;

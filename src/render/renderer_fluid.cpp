@@ -227,8 +227,12 @@ void Renderer::Impl::fluid_filter_passes(float radius, const RenderCamera& cam) 
   bind_tex(1, GL_TEXTURE_2D, scene_depth);
   glUniform1i(fp.loc("u_scene_depth_w"), 1);
   for (int it = 0; it < p.filter_iterations; ++it) {
-    // The gap fill closes the holes between the particles once; later iterations only smooth.
-    glUniform1f(fp.loc("u_fill_world"), it == 0 ? p.fluid_gap_fill * radius : 0.f);
+    // The gap fill closes the holes between spheres once; later iterations only smooth. The
+    // anisotropic kernels close a spread layer themselves, so what is left between their
+    // ellipsoids is a real gap (a drop beside the puddle), which a fill would bridge with a
+    // rectangle of water along the rows and columns (docs/RENDERING.md, Water: gap fill).
+    const bool fill = it == 0 && !aniso_live;
+    glUniform1f(fp.loc("u_fill_world"), fill ? p.fluid_gap_fill * radius : 0.f);
     filter_pass(fluid_depth[0], fluid_depth[1], fluid_filter_fbo[1], 1, 0, w, h);
     filter_pass(fluid_depth[1], fluid_depth[0], fluid_filter_fbo[0], 0, 1, w, h);
   }

@@ -109,6 +109,7 @@ struct Renderer::Impl {
   // CPU for a host DrawList that has none, or copied in by the CUDA interop.
   FluidEllipsoids cpu_shapes{Device::CPU};
   bool aniso_live = false;            // this frame's splats read part_ell
+  vec3 up{0.f, 1.f, 0.f};             // this frame's DrawList::up
   bool ellipsoids_in_buffer = false;  // part_ell holds the particles' ellipsoids (last upload, or the interop)
   Program filter_cprog, normal_cprog, composite_cprog;  // the full-screen passes as compute
   VertexArray empty_vao;

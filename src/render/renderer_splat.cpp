@@ -80,6 +80,7 @@ void Renderer::Impl::splat_uniforms(const Program& prog, std::int64_t n, float s
   glUniform1f(prog.loc("u_radius"), sphere_r);
   // A lone drop is drawn at the particle's own radius (splat.glsl, "Lone drops").
   glUniform1f(prog.loc("u_drop_radius"), sphere_r / p.fluid_radius_scale);
+  glUniform3f(prog.loc("u_up"), up.x, up.y, up.z);
   glUniform1f(prog.loc("u_fmax"), std::max(cam.K.fx, cam.K.fy));
   glUniform1ui(prog.loc("u_phase_mask"), phase::kFluid);
   glUniform1f(prog.loc("u_max_point_size"), p.max_point_size);

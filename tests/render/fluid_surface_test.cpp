@@ -15,9 +15,11 @@
 //   - a puddle seen at a grazing angle (a table 15 cm below the camera) is as smooth as one seen
 //     face-on: its normals are the plane's within the same kind of bound (no bands from the depth
 //     filter's range), and a blob of water in front of it stays apart from it;
-//   - a lone particle is drawn as a drop of its own radius, with a sphere's normals.
+//   - a lone particle is drawn as a drop of its own radius, with a sphere's normals; lying on a
+//     surface, as a sessile drop of its volume.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "core/phase.hpp"
 #include "physics/fluid_ellipsoids.hpp"
@@ -57,6 +59,14 @@ vec3 linear(uchar3 c) {
 // Filtered eye depth at image pixel (u, v) (the read-back rows run bottom to top).
 float depth_at(const Renderer::FluidImages& f, int u, int v) {
   return f.depth[static_cast<std::size_t>(f.h - 1 - v) * f.w + u];
+}
+
+// Whether a fluid depth carries the lone-drop flag (camera.glsl, with_drop_flag: its least
+// significant mantissa bit).
+bool is_drop_depth(float z) {
+  std::uint32_t b = 0;
+  std::memcpy(&b, &z, sizeof b);
+  return z > 0.f && (b & 1u) != 0u;
 }
 
 // Sphere splats: the gap fill and the shading are checked on their own (anisotropic kernels, which
@@ -713,5 +723,69 @@ TEST(RenderFluidSurface, LoneParticleIsADropOfItsOwnSize) {
   EXPECT_GT(checked, 50);
 }
 
+// A lone particle lying on a surface is a sessile drop, not a bead (splat.glsl, "Lone drops at
+// rest"). The camera looks straight down at a floor 0.5 m away (the Kinect view of a flat depth
+// image; world = eye, so up is -z, towards the camera). A particle of r = 1 cm whose bottom touches
+// the floor is drawn as the upper half of an oblate ellipsoid on the floor: of height H = 3.1 mm and
+// radius a = sqrt(2 r^3 / H) = 2.54 cm, so the fluid covers the disc of radius a around the touch
+// point's pixel (all of it within 0.8 a, none beyond a plus a pixel) and its depth lies between the
+// cap's top, 0.5 - H (less 1 mm for the window depth's steps), and the floor: the depth filter
+// only averages samples of the cap. The same particle 5 cm above the floor is a drop in the air:
+// a bead of its own radius, its depth the sphere's front at the centre (within 1 mm), flagged as a
+// drop for the later passes (the depth's least significant bit).
+TEST(RenderFluidSurface, LoneDropAtRestLiesFlat) {
+  SEAMLESS_REQUIRE_EGL();
+  const Intrinsics K = small_K();
+  const float r = 0.01f, floor_z = 0.5f;
+  const float H = 2.f * 2.7e-3f * std::sin(35.f * 3.14159265f / 180.f), a = std::sqrt(2.f * r * r * r / H);
+  std::vector<uchar3> rgb(static_cast<std::size_t>(kW) * kH, kTableGrey);
+  std::vector<float> depth(rgb.size(), floor_z);
+  RenderParams p = surface_params();
+  p.view = RenderView::kinect;
+  p.fluid_anisotropy = true;
+  auto render = [&](float lift) {
+    Renderer rd(p, kW, kH);
+    rd.set_kinect_view(Image<uchar3>::from_host(rgb, kW, kH, Device::CPU),
+                       Image<float>::from_host(depth, kW, kH, Device::CPU), K, SE3::identity());
+    std::vector<vec3> x = {{0.02f, -0.01f, floor_z - r - lift}};
+    std::vector<std::uint32_t> ph;
+    DrawList d = fluid_list(x, ph, r);
+    d.up = {0.f, 0.f, -1.f};
+    rd.draw(d, RenderCamera{});
+    EXPECT_TRUE(rd.uses_compute_splat());
+    return rd.read_fluid_images();
+  };
+  const float cu = K.cx + K.fx * 0.02f / floor_z, cv = K.cy - K.fy * 0.01f / floor_z;  // the touch point
+  const float R = K.fx * a / floor_z;                                                  // the disc's radius in pixels
+  const Renderer::FluidImages flat = render(0.f);
+  int inside = 0, missing = 0, outside = 0;
+  float nearest = 1e9f;
+  for (int v = 0; v < kH; ++v)
+    for (int u = 0; u < kW; ++u) {
+      const float rho = std::hypot(u - cu, v - cv), d = depth_at(flat, u, v);
+      if (d > 0.f) nearest = std::min(nearest, d), ++inside;
+      if (d > 0.f && rho > R + 1.f) ++outside;
+      if (d <= 0.f && rho < 0.8f * R) ++missing;
+    }
+  const float centre = depth_at(flat, static_cast<int>(std::lround(cu)), static_cast<int>(std::lround(cv)));
+  std::printf(
+      "at rest: disc of %.1f pixels radius, %d pixels drawn, %d missing inside 0.8 a, %d outside a; "
+      "nearest depth %.4f m (cap top %.4f), centre %.4f\n",
+      R, inside, missing, outside, nearest, floor_z - H, centre);
+  EXPECT_GT(inside, 0.6f * 3.14159f * R * R);
+  EXPECT_EQ(missing, 0);
+  EXPECT_EQ(outside, 0);
+  EXPECT_GE(nearest, floor_z - H - 1e-3f);
+  EXPECT_LT(centre, floor_z);
+  EXPECT_FALSE(is_drop_depth(centre)) << "a drop at rest is part of the surface";
+
+  const float lift = 0.05f, z_bead = floor_z - r - lift;
+  const Renderer::FluidImages bead = render(lift);
+  const float bu = K.cx + K.fx * 0.02f / z_bead, bv = K.cy - K.fy * 0.01f / z_bead;
+  const float front = depth_at(bead, static_cast<int>(std::lround(bu)), static_cast<int>(std::lround(bv)));
+  std::printf("in the air: depth %.4f m at the centre (sphere's front %.4f)\n", front, z_bead - r);
+  EXPECT_NEAR(front, z_bead - r, 1e-3f);
+  EXPECT_TRUE(is_drop_depth(front));
+}
 }  // namespace
 }  // namespace seamless::test

@@ -20,6 +20,7 @@ uniform float u_max_point_size;  // pixels (render.max_point_size)
 uniform sampler2D u_scene_depth; // window depth of the scene, full resolution
 uniform bool u_aniso;            // splat b_ell's ellipsoids, not spheres of u_radius
 uniform float u_drop_radius;     // a lone drop's radius, metres: the particle's own (Lone drops below)
+uniform vec3 u_up;               // world, against gravity (Lone drops at rest below)
 
 // One particle's splat in eye space: centre c, bounding radius r; M the ellipsoid's matrix
 // (anisotropic kernels), unused for a sphere (ray_sphere with u_radius); drop: a lone drop.
@@ -45,6 +46,51 @@ struct Splat {
 // (ssfr_filter.glsl) and shade them as beads (ssfr_composite.glsl). With spheres (no
 // anisotropic kernels) there is no neighbourhood to tell, and no particle is a drop.
 
+// Window (framebuffer) texel of image pixel p.
+ivec2 window_texel(ivec2 p) { return ivec2(p.x, int(u_size.y) - 1 - p.y); }
+
+// Lone drops at rest. A lone particle is a parcel of water of the particle's volume, V = 4/3 pi r^3.
+// In the air a bead is right; lying on a surface, water of that volume is a sessile drop. Wider
+// than the capillary length l_c = sqrt(gamma / (rho g)) = 2.7 mm, gravity flattens it into a
+// puddle of height H = 2 l_c sin(theta / 2) whatever its volume (de Gennes, Brochard-Wyart & Quere
+// 2004, "Capillarity and Wetting Phenomena", ch. 2, gravity puddles), theta the contact angle:
+// 70 degrees (water on varnished wood, laminate and plastics lies between about 60 and 90), so
+// H = 3.1 mm. It is drawn as the upper half of an oblate ellipsoid centred where the drop touches
+// the surface (the lower half lies behind the surface, which hides it): semi-axis H along up and
+// a = sqrt(2 r^3 / H) across, which keeps V = 2/3 pi a^2 H (a 1 cm particle: a wet spot 5 cm
+// across). A drop narrower than l_c is not flattened below its radius (H at most r). It is then
+// part of the surface, not a bead: the filter and the composite treat it as a thin layer resting
+// on what is under it.
+// A drop rests when the surface the camera measured (the scene depth, with its unmeasured planes)
+// lies where the drop touches down, q = c - r up: q and the scene's point at q's pixel lie on one
+// ray, and their distance along it, projected on up (the height of q above or below the
+// surface; at most 10 times the distance where the view grazes the surface), must be within a
+// radius plus two steps of a Kinect v1's depth quantisation (2.85e-3 z^2 m each).
+const float kSessileHeight = 2.0 * 2.7e-3 * 0.5736;  // 2 l_c sin(35 degrees), metres
+
+bool rests_on_scene(vec3 c, vec3 up) {
+  vec3 q = c - u_drop_radius * up;
+  if (q.z <= u_near_far.x) return false;
+  vec2 px = vec2(u_K.x * q.x / q.z + u_K.z, u_K.y * q.y / q.z + u_K.w);
+  ivec2 p = ivec2(floor(px + 0.5));
+  if (any(lessThan(p, ivec2(0))) || any(greaterThanEqual(p, ivec2(u_size)))) return false;
+  float w = texelFetch(u_scene_depth, window_texel(p), 0).r;
+  if (w >= 1.0) return false;  // no surface there
+  vec3 ray = pixel_ray(px);
+  float zs = eye_depth(w);
+  float along = abs(q.z - zs) * length(ray);
+  return along * max(abs(dot(ray, up)) / length(ray), 0.1) < u_drop_radius + 0.006 * zs * zs;
+}
+
+// The sessile drop's shape (above) in place of the bead's, for a lone drop s at rest.
+void lie_flat(inout Splat s, vec3 up) {
+  float r = u_drop_radius, H = min(kSessileHeight, r), a = sqrt(2.0 * r * r * r / H);
+  s.c -= r * up;
+  s.r = a;  // a >= sqrt(2) r >= H
+  s.M = mat3(1.0 / (a * a)) + (1.0 / (H * H) - 1.0 / (a * a)) * outerProduct(up, up);
+  s.drop = false;
+}
+
 // This invocation's particle: groups form a 2D grid because one dimension holds at most 65535.
 uint particle_index() {
   return (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
@@ -64,6 +110,8 @@ bool splat_shape(uint i, out Splat s) {
     s.r = s.drop ? u_drop_radius : a.w;
     mat3 Rv = mat3(u_view);  // world -> eye rotation: M_eye = Rv M Rv^T
     s.M = s.drop ? mat3(1.0 / (s.r * s.r)) : Rv * mat3(m.x, m.y, m.z, m.y, m.w, n.x, m.z, n.x, n.y) * transpose(Rv);
+    vec3 up = Rv * u_up;
+    if (s.drop && rests_on_scene(s.c, up)) lie_flat(s, up);
   } else {
     s.c = (u_view * vec4(b_pos[3u * i], b_pos[3u * i + 1u], b_pos[3u * i + 2u], 1.0)).xyz;
     s.r = u_radius;
@@ -98,5 +146,3 @@ bool splat_rect(vec3 c, float r, out ivec2 lo, out ivec2 hi) {
   return all(lessThanEqual(lo, hi));
 }
 
-// Window (framebuffer) texel of image pixel p.
-ivec2 window_texel(ivec2 p) { return ivec2(p.x, int(u_size.y) - 1 - p.y); }
