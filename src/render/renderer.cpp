@@ -63,14 +63,15 @@ void Renderer::Impl::build_programs() {
     return a;
   };
   // Surfaces that receive the virtual objects' shadows (shadow.glsl).
-  const std::vector<std::string> receiver = {"color.glsl", "shadow.glsl", "mesh.frag"};
+  const std::vector<std::string> receiver = {"color.glsl", "shadow.glsl", "occlusion.glsl", "mesh.frag"};
   mesh_prog = Program("mesh", {vs({"mesh.vert"}), fs(receiver)});
   cloth_prog = Program("cloth", {vs({"cloth.vert"}), fs({"color.glsl", "shadow.glsl", "cloth.frag"})});
   particle_prog = Program("particles", {vs({"sphere.vert"}), fs(with(sphere_fs, "particle.frag"))});
   fluid_depth_prog = Program("fluid depth", {vs({"sphere.vert"}), fs(with(sphere_fs, "ssfr_depth.frag"))});
   fluid_thick_prog = Program("fluid thickness", {vs({"sphere.vert"}), fs(with(sphere_fs, "ssfr_thickness.frag"))});
-  kinect_prog = Program("kinect view",
-                        {vs({"fullscreen.vert"}), fs({"camera.glsl", "color.glsl", "shadow.glsl", "kinect_bg.frag"})});
+  kinect_prog = Program(
+      "kinect view",
+      {vs({"fullscreen.vert"}), fs({"camera.glsl", "color.glsl", "shadow.glsl", "occlusion.glsl", "kinect_bg.frag"})});
   auto screen = [&](const char* name, const char* body, const char* main) {
     return Program(name, {vs({"fullscreen.vert"}), fs({"camera.glsl", "color.glsl", body, main})});
   };

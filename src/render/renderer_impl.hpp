@@ -177,6 +177,11 @@ struct Renderer::Impl {
   int shadow_size = 0;
   mat3 light_R = mat3::identity();  // world -> light frame
   bool shadow_live = false;         // this frame's receivers read a map
+  // This frame's rigid bodies as boxes for the real surfaces' contact occlusion (occlusion.glsl):
+  // world -> box frame (column-major) and half extents, at most kMaxOccluders.
+  std::vector<Mat4> occluder_T_world;
+  std::vector<vec3> occluder_half;
+  void set_occluders(const DrawList& list);
 
   std::vector<StageImage> stages;
   std::vector<RenderTiming> timings;

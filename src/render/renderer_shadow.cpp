@@ -24,6 +24,7 @@ namespace seamless {
 namespace {
 
 constexpr int kShadowMapUnit = 6, kLightBoundsUnit = 7, kFluidShadowUnit = 8;  // texture units the receivers read
+constexpr int kMaxOccluders = 16;  // bodies that occlude the real surfaces: occlusion.glsl's arrays
 // Fixed-point path in fluid along the light (as the camera's thickness splat, renderer_splat.cpp):
 // 2^20 units per metre, at most half a unit of rounding per sphere on a ray (0.5 um), and 4096 m
 // of path before the uint32 wraps, far beyond any light path through the fluid.
@@ -122,6 +123,35 @@ void Renderer::Impl::shadow_uniforms(const Program& prog) const {
   glUniform1f(prog.loc("u_shadow_size"), static_cast<float>(shadow_size));
   glUniform1f(prog.loc("u_light_tan"), std::tan(0.5f * p.light_angle * std::numbers::pi_v<float> / 180.f));
   glUniform1f(prog.loc("u_shadow_strength"), p.shadow_strength);
+  const auto boxes = static_cast<GLsizei>(occluder_half.size());
+  glUniform1i(prog.loc("u_occluder_count"), boxes);
+  if (boxes == 0) return;
+  std::vector<float> T, half;
+  for (GLsizei k = 0; k < boxes; ++k) {
+    T.insert(T.end(), occluder_T_world[k].begin(), occluder_T_world[k].end());
+    half.insert(half.end(), {occluder_half[k].x, occluder_half[k].y, occluder_half[k].z});
+  }
+  glUniformMatrix4fv(prog.loc("u_box_T_world"), boxes, GL_FALSE, T.data());
+  glUniform3fv(prog.loc("u_box_half"), boxes, half.data());
+}
+
+// The rigid bodies as occluders of the real surfaces (occlusion.glsl): each body's box, or its
+// mesh's bounds in the body frame; the first kMaxOccluders bodies.
+void Renderer::Impl::set_occluders(const DrawList& list) {
+  occluder_T_world.clear(), occluder_half.clear();
+  if (!p.show_rigid) return;
+  for (const RigidDraw& r : list.rigids) {
+    if (static_cast<int>(occluder_half.size()) == kMaxOccluders) break;
+    vec3 centre{0.f, 0.f, 0.f}, half = r.half_extents;
+    if (r.mesh && !r.mesh->positions.empty()) {
+      vec3 lo = r.mesh->positions[0], hi = lo;
+      for (const vec3& v : r.mesh->positions) lo = vmin(lo, v), hi = vmax(hi, v);
+      centre = (lo + hi) * 0.5f, half = (hi - lo) * 0.5f;
+    }
+    const SE3 world_T_box = r.world_T_body * SE3{mat3::identity(), centre};
+    occluder_T_world.push_back(model_matrix(world_T_box.inverse()));
+    occluder_half.push_back(half);
+  }
 }
 
 namespace {
@@ -139,7 +169,9 @@ void light_uniforms(const Program& prog, const mat3& R, GLuint bounds, int size)
 
 void Renderer::Impl::shadow_pass(const DrawList& list, std::int64_t n) {
   shadow_live = fluid_shadow_live = opaque_shadow_live = false;
+  occluder_T_world.clear(), occluder_half.clear();
   if (!p.shadows || !has_shadow) return;
+  set_occluders(list);
   make_shadow_targets();
   light_R = light_frame(p.light_dir);
   // Casters: the objects drawn as meshes or as fluid spheres this frame.

@@ -36,4 +36,27 @@ mat3 rotation(vec3 axis, float angle) {
   return mat3::identity() + K * std::sin(angle) + (K * K) * (1.f - std::cos(angle));
 }
 
+double box_form_factor(vec3 p, vec3 n, vec3 centre, vec3 half, int cells) {
+  const double pi = 3.14159265358979;
+  double f = 0.0;
+  for (int a = 0; a < 3; ++a)
+    for (int side = -1; side <= 1; side += 2) {
+      const vec3 q = p - centre;
+      if (side * (&q.x)[a] <= (&half.x)[a]) continue;  // p does not see this face
+      const int i = (a + 1) % 3, j = (a + 2) % 3;
+      const double hi = (&half.x)[i], hj = (&half.x)[j], dA = (2 * hi / cells) * (2 * hj / cells);
+      for (int s = 0; s < cells; ++s)
+        for (int t = 0; t < cells; ++t) {
+          double x[3];
+          x[a] = side * (&half.x)[a], x[i] = -hi + (s + 0.5) * 2 * hi / cells, x[j] = -hj + (t + 0.5) * 2 * hj / cells;
+          const double d[3] = {x[0] - q.x, x[1] - q.y, x[2] - q.z};
+          const double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+          const double cos_p = (n.x * d[0] + n.y * d[1] + n.z * d[2]) / std::sqrt(r2);
+          const double cos_f = -side * d[a] / std::sqrt(r2);  // the face's outward normal is side e_a
+          f += cos_p * cos_f / (pi * r2) * dA;
+        }
+    }
+  return f;
+}
+
 }  // namespace seamless::test

@@ -30,17 +30,42 @@ float unmeasured_depth(vec2 px) {
   return best;
 }
 
+// Texture coordinates in the image of frame pixel px: the framebuffer covers the crop
+// (scale_intrinsics: pixel edges map to pixel edges); image rows run down, as uploaded.
+vec2 image_uv(vec2 px) { return (u_crop.xy + (px + 0.5) * u_crop.zw / u_size) / u_image_size; }
+
+// Camera depth of the real surface at frame pixel px: recorded, else an unmeasured plane's, else 0.
+float surface_depth(vec2 px) {
+  float z = texture(u_depth, image_uv(px)).r;
+  return z > 0.0 ? z : unmeasured_depth(px);
+}
+
+// The real surface's world normal at px, from the surface points kNormalStep
+// pixels to each side (a baseline over the Kinect's depth steps), turned towards the camera;
+// (0, 0, 0) where a side has no depth.
+const float kNormalStep = 3.0;
+vec3 surface_normal(vec2 px) {
+  float zr = surface_depth(px + vec2(kNormalStep, 0.0)), zl = surface_depth(px - vec2(kNormalStep, 0.0));
+  float zd = surface_depth(px + vec2(0.0, kNormalStep)), zu = surface_depth(px - vec2(0.0, kNormalStep));
+  if (zr <= 0.0 || zl <= 0.0 || zd <= 0.0 || zu <= 0.0) return vec3(0.0);
+  vec3 dx = zr * pixel_ray(px + vec2(kNormalStep, 0.0)) - zl * pixel_ray(px - vec2(kNormalStep, 0.0));
+  vec3 dy = zd * pixel_ray(px + vec2(0.0, kNormalStep)) - zu * pixel_ray(px - vec2(0.0, kNormalStep));
+  vec3 n = cross(dx, dy);
+  if (dot(n, n) <= 0.0) return vec3(0.0);
+  n = normalize(n);
+  if (dot(n, pixel_ray(px)) > 0.0) n = -n;  // towards the camera
+  return mat3(u_world_T_camera) * n;
+}
+
 void main() {
   vec2 px = frag_pixel();
-  // The framebuffer covers the crop (scale_intrinsics: pixel edges map to pixel edges); image
-  // rows run down, as uploaded.
-  vec2 uv = (u_crop.xy + (px + 0.5) * u_crop.zw / u_size) / u_image_size;
-  vec3 rgb = texture(u_rgb, uv).rgb;
-  float z = texture(u_depth, uv).r;
-  if (z <= 0.0) z = unmeasured_depth(px);
+  vec3 rgb = texture(u_rgb, image_uv(px)).rgb;
+  float z = surface_depth(px);
   if (z > 0.0) {
     vec3 world = (u_world_T_camera * vec4(z * pixel_ray(px), 1.0)).xyz;
-    rgb = shadowed_srgb(rgb, shadow_light(world, vec3(0.0), gl_FragCoord.xy));
+    vec3 n = surface_normal(px);
+    float occluded = dot(n, n) > 0.0 ? occluded_share(world, n) : 0.0;
+    rgb = shadowed_srgb(rgb, shadow_light(world, vec3(0.0), gl_FragCoord.xy), occluded);
   }
   o_color = vec4(rgb, 1.0);
   gl_FragDepth = z > 0.0 ? window_depth(clamp(z, u_near_far.x, u_near_far.y)) : 1.0;

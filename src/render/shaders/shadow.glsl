@@ -183,9 +183,11 @@ vec3 shadow_light(vec3 world, vec3 n, vec2 pixel) {
 
 // What the shadow leaves of a colour whose light is all accounted for (the camera image, the
 // unlit scan): u_shadow_strength is the share of the light at the surface that came from this
-// light, the rest (the room's other light) stays; applied to linear radiance.
-vec3 shadowed_srgb(vec3 srgb, vec3 light) {
-  if (all(greaterThanEqual(light, vec3(1.0)))) return srgb;
-  return linear_to_srgb(srgb_to_linear(srgb) * (1.0 - u_shadow_strength * (1.0 - light)));
+// light, of which `light` is left; the rest is the room's other light, of which the bodies hide
+// the share `occluded` (occlusion.glsl); applied to linear radiance.
+vec3 shadowed_srgb(vec3 srgb, vec3 light, float occluded) {
+  if (all(greaterThanEqual(light, vec3(1.0))) && occluded <= 0.0) return srgb;
+  float s = u_shadow_strength;
+  return linear_to_srgb(srgb_to_linear(srgb) * (s * light + (1.0 - s) * (1.0 - occluded)));
 }
 #endif
