@@ -104,6 +104,9 @@ void Renderer::Impl::make_shadow_targets() {
 
 void Renderer::Impl::shadow_uniforms(const Program& prog) const {
   glUniform1i(prog.loc("u_shadow_on"), shadow_live);
+  // A program keeps its uniforms from frame to frame: the count is set every time.
+  const auto boxes = static_cast<GLsizei>(shadow_live ? occluder_half.size() : 0);
+  glUniform1i(prog.loc("u_occluder_count"), boxes);
   if (!shadow_live) return;
   glActiveTexture(GL_TEXTURE0 + kShadowMapUnit);
   glBindTexture(GL_TEXTURE_2D, shadow_map);
@@ -123,8 +126,6 @@ void Renderer::Impl::shadow_uniforms(const Program& prog) const {
   glUniform1f(prog.loc("u_shadow_size"), static_cast<float>(shadow_size));
   glUniform1f(prog.loc("u_light_tan"), std::tan(0.5f * p.light_angle * std::numbers::pi_v<float> / 180.f));
   glUniform1f(prog.loc("u_shadow_strength"), p.shadow_strength);
-  const auto boxes = static_cast<GLsizei>(occluder_half.size());
-  glUniform1i(prog.loc("u_occluder_count"), boxes);
   if (boxes == 0) return;
   std::vector<float> T, half;
   for (GLsizei k = 0; k < boxes; ++k) {

@@ -1,5 +1,6 @@
 #include "render_test_util.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace seamless::test {
@@ -36,8 +37,13 @@ mat3 rotation(vec3 axis, float angle) {
   return mat3::identity() + K * std::sin(angle) + (K * K) * (1.f - std::cos(angle));
 }
 
-double box_form_factor(vec3 p, vec3 n, vec3 centre, vec3 half, int cells) {
+double box_form_factor(vec3 p, vec3 n, vec3 centre, vec3 half) {
   const double pi = 3.14159265358979;
+  // The distance from p to the box bounds the integrand's scale: cells of at most a quarter of it.
+  const vec3 out = vmax(vmax(p - centre - half, centre - half - p), vec3{0.f, 0.f, 0.f});
+  const double dist = std::max(static_cast<double>(length(out)), 1e-4);
+  const double size = 2.0 * std::max({half.x, half.y, half.z});
+  const int cells = static_cast<int>(std::clamp(std::ceil(4.0 * size / dist), 4.0, 256.0));
   double f = 0.0;
   for (int a = 0; a < 3; ++a)
     for (int side = -1; side <= 1; side += 2) {
@@ -51,7 +57,8 @@ double box_form_factor(vec3 p, vec3 n, vec3 centre, vec3 half, int cells) {
           x[a] = side * (&half.x)[a], x[i] = -hi + (s + 0.5) * 2 * hi / cells, x[j] = -hj + (t + 0.5) * 2 * hj / cells;
           const double d[3] = {x[0] - q.x, x[1] - q.y, x[2] - q.z};
           const double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-          const double cos_p = (n.x * d[0] + n.y * d[1] + n.z * d[2]) / std::sqrt(r2);
+          // Only what lies above p's plane reaches it.
+          const double cos_p = std::max(0.0, (n.x * d[0] + n.y * d[1] + n.z * d[2]) / std::sqrt(r2));
           const double cos_f = -side * d[a] / std::sqrt(r2);  // the face's outward normal is side e_a
           f += cos_p * cos_f / (pi * r2) * dA;
         }

@@ -46,12 +46,13 @@ inline uchar3 to_rgb8(vec3 c) {
 // A flat rectangle [x0, x1] x [y0, y1] at depth z (world = camera frame for an identity pose),
 // one colour, normals facing the camera (-z).
 Mesh rectangle(float x0, float x1, float y0, float y1, float z, uchar3 color);
-// The form factor from a point p (unit normal n) to an axis-aligned box (centre, half extents) that
-// lies wholly above p's plane, by the area integral over the faces p sees:
-// F = sum over faces of the integral of cos(theta_p) cos(theta_face) / (pi r^2) dA, by the midpoint
-// rule on cells x cells per face. An independent check of the renderer's contour integral
-// (occlusion.glsl): for a face d away from p, the rule's relative error is about (cell / d)^2 / 24.
-double box_form_factor(vec3 p, vec3 n, vec3 centre, vec3 half, int cells = 64);
+// The form factor from a point p (unit normal n) to an axis-aligned box (centre, half extents), by
+// the area integral over the faces p sees: F = sum over faces of the integral of
+// max(cos(theta_p), 0) cos(theta_face) / (pi r^2) dA (what lies below p's plane does not count), by the
+// midpoint rule on square cells of at most a quarter of p's distance d to the box (4 to 256 a side):
+// its relative error is about (cell / d)^2 / 24, below 0.3 %. An independent check of the
+// renderer's contour integral (occlusion.glsl).
+double box_form_factor(vec3 p, vec3 n, vec3 centre, vec3 half);
 // Pinhole intrinsics of a w x h image.
 Intrinsics intrinsics(float f, float cx, float cy, int w, int h);
 RenderCamera camera(const Intrinsics& K, const SE3& world_T_camera = SE3::identity());

@@ -44,8 +44,7 @@ RenderParams down_light() {
 // that margin the light's share of the floor's light (shadow_strength k) is gone; outside the
 // square grown by it, none of it is. The room's share, 1 - k, loses the form factor F from the
 // floor point to the cube (contact occlusion, occlusion.glsl), here computed independently by the
-// area integral (box_form_factor, 16 x 16 cells a face: the cube's faces are at least 0.15 m away,
-// so the rule's relative error is below (0.015 / 0.15)^2 / 24 = 4e-4). So the floor's linear colour
+// area integral (box_form_factor, relative error below 0.3 %). So the floor's linear colour
 // is (k L + (1 - k)(1 - F)) of the unshadowed one, L = 0 in the umbra and 1 outside, within one
 // 8-bit level. Under the cube F is 0.44; without the occlusion the floor beside the cube would be
 // brighter than that by several levels.
@@ -82,8 +81,7 @@ TEST(RenderShadow, MeshViewFloorUnderACube) {
       if (m > half - margin && m < half + margin) continue;  // the penumbra
       const bool in_umbra = m < half - margin;
       (in_umbra ? umbra : lit) += 1;
-      const auto F =
-          static_cast<float>(box_form_factor(q, {0.f, 1.f, 0.f}, cube.world_T_body.t, cube.half_extents, 16));
+      const auto F = static_cast<float>(box_form_factor(q, {0.f, 1.f, 0.f}, cube.world_T_body.t, cube.half_extents));
       max_F = std::max(max_F, F);
       const float share = (in_umbra ? 0.f : k) + (1.f - k) * (1.f - F);
       for (int i = 0; i < 3; ++i) {

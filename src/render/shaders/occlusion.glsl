@@ -15,14 +15,22 @@ uniform vec3 u_box_half[kMaxOccluders];     // half extents, metres
 // Lambert's contour integral: F = 1 / (2 pi) sum_i gamma_i n . unit(v_i x v_(i+1)), v_i the unit
 // directions to the corners, gamma_i the angle between consecutive ones (as in Baum, Rushmeier &
 // Winget 1989, "Improving radiosity solutions through the use of analytically determined
-// form-factors"). The corners run counter-clockwise about the direction from the point to the polygon,
-// so F > 0 for a polygon above the point's plane. Not clipped to that plane: a polygon crossing
-// it counts its part below as negative, an underestimate, and one wholly below counts 0.
-float quad_form_factor(vec3 n, vec3 c0, vec3 c1, vec3 c2, vec3 c3) {
-  vec3 v[4] = vec3[4](normalize(c0), normalize(c1), normalize(c2), normalize(c3));
-  float s = 0.0;
+// form-factors"). The corners c (relative to the point) run counter-clockwise about the
+// direction from the point to the polygon, so F > 0. The point sees only what lies above its
+// plane, so the quad is first clipped to n . x >= 0 (Sutherland & Hodgman 1974: one plane cuts a
+// quad into at most 5 corners).
+float quad_form_factor(vec3 n, vec3 c[4]) {
+  vec3 v[5];
+  int m = 0;
   for (int i = 0; i < 4; ++i) {
-    vec3 a = v[i], b = v[(i + 1) & 3], c = cross(a, b);
+    vec3 a = c[i], b = c[(i + 1) & 3];
+    float da = dot(n, a), db = dot(n, b);
+    if (da >= 0.0) v[m++] = a;
+    if ((da >= 0.0) != (db >= 0.0)) v[m++] = a + (b - a) * (da / (da - db));
+  }
+  float s = 0.0;
+  for (int i = 0; i < m; ++i) {
+    vec3 a = normalize(v[i]), b = normalize(v[(i + 1) % m]), c = cross(a, b);
     float l = length(c);
     if (l > 1e-9) s += acos(clamp(dot(a, b), -1.0, 1.0)) * dot(n, c) / l;
   }
@@ -50,7 +58,7 @@ float box_form_factor(int k, vec3 p, vec3 n) {
         corner[a] = s * h[a], corner[i] = u * h[i], corner[j] = w * h[j];
         c[t] = corner - q;
       }
-      f += quad_form_factor(m, c[0], c[1], c[2], c[3]);
+      f += quad_form_factor(m, c);
     }
   return f;
 }
