@@ -61,12 +61,12 @@ float depth_at(const Renderer::FluidImages& f, int u, int v) {
   return f.depth[static_cast<std::size_t>(f.h - 1 - v) * f.w + u];
 }
 
-// Whether a fluid depth carries the lone-drop flag (camera.glsl, with_drop_flag: its least
-// significant mantissa bit).
-bool is_drop_depth(float z) {
+// A fluid depth's lone-drop tag (camera.glsl, with_drop_tag): its least significant mantissa bit
+// for a drop, the next for a drop lying flat.
+std::uint32_t drop_tag(float z) {
   std::uint32_t b = 0;
   std::memcpy(&b, &z, sizeof b);
-  return z > 0.f && (b & 1u) != 0u;
+  return z > 0.f ? b & 3u : 0u;
 }
 
 // Sphere splats: the gap fill and the shading are checked on their own (anisotropic kernels, which
@@ -728,11 +728,12 @@ TEST(RenderFluidSurface, LoneParticleIsADropOfItsOwnSize) {
 // image; world = eye, so up is -z, towards the camera). A particle of r = 1 cm whose bottom touches
 // the floor is drawn as the upper half of an oblate ellipsoid on the floor: of height H = 3.1 mm and
 // radius a = sqrt(2 r^3 / H) = 2.54 cm, so the fluid covers the disc of radius a around the touch
-// point's pixel (all of it within 0.8 a, none beyond a plus a pixel) and its depth lies between the
-// cap's top, 0.5 - H (less 1 mm for the window depth's steps), and the floor: the depth filter
-// only averages samples of the cap. The same particle 5 cm above the floor is a drop in the air:
-// a bead of its own radius, its depth the sphere's front at the centre (within 1 mm), flagged as a
-// drop for the later passes (the depth's least significant bit).
+// point's pixel (all of it within 0.8 a, none beyond a plus a pixel), no depth is nearer than the
+// cap's top, 0.5 - H (less 1 mm), and at the touch point the depth is the cap's top (the filter
+// leaves a drop as splatted; the pixel's ray meets the cap within a few hundredths of a from its
+// axis, where it is lower by less than 1e-3 H: within 0.1 mm), tagged as a drop lying flat. The same
+// particle 5 cm above the floor is a drop in the air: a bead of its own radius, its depth the
+// sphere's front at the centre (within 1 mm), tagged as a drop, not flat.
 TEST(RenderFluidSurface, LoneDropAtRestLiesFlat) {
   SEAMLESS_REQUIRE_EGL();
   const Intrinsics K = small_K();
@@ -776,8 +777,8 @@ TEST(RenderFluidSurface, LoneDropAtRestLiesFlat) {
   EXPECT_EQ(missing, 0);
   EXPECT_EQ(outside, 0);
   EXPECT_GE(nearest, floor_z - H - 1e-3f);
-  EXPECT_LT(centre, floor_z);
-  EXPECT_FALSE(is_drop_depth(centre)) << "a drop at rest is part of the surface";
+  EXPECT_NEAR(centre, floor_z - H, 1e-4f);
+  EXPECT_EQ(drop_tag(centre), 3u) << "a drop at rest is a drop lying flat";
 
   const float lift = 0.05f, z_bead = floor_z - r - lift;
   const Renderer::FluidImages bead = render(lift);
@@ -785,7 +786,7 @@ TEST(RenderFluidSurface, LoneDropAtRestLiesFlat) {
   const float front = depth_at(bead, static_cast<int>(std::lround(bu)), static_cast<int>(std::lround(bv)));
   std::printf("in the air: depth %.4f m at the centre (sphere's front %.4f)\n", front, z_bead - r);
   EXPECT_NEAR(front, z_bead - r, 1e-3f);
-  EXPECT_TRUE(is_drop_depth(front));
+  EXPECT_EQ(drop_tag(front), 1u) << "a drop in the air is a bead";
 }
 }  // namespace
 }  // namespace seamless::test

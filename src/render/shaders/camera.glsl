@@ -28,7 +28,12 @@ float eye_depth(float w) {
 }
 
 // The fluid's depth images (eye z, 0 = no fluid) carry in each depth's least significant mantissa
-// bit whether the nearest splat there is a lone drop (splat.glsl, "Lone drops"); every pass that
-// writes a surface depth clears it.
-float with_drop_flag(float z, bool drop) { return uintBitsToFloat((floatBitsToUint(z) & ~1u) | (drop ? 1u : 0u)); }
+// bit whether the nearest splat there is a lone drop (splat.glsl, "Lone drops"), and in the next
+// whether that drop lies flat on a surface (a sessile drop, "Lone drops at rest"); every pass that
+// writes a surface depth clears both.
+float with_drop_tag(float z, bool drop, bool flat_drop) {
+  return uintBitsToFloat((floatBitsToUint(z) & ~3u) | (drop ? (flat_drop ? 3u : 1u) : 0u));
+}
+float with_drop_flag(float z, bool drop) { return with_drop_tag(z, drop, false); }
 bool is_drop(float z) { return z > 0.0 && (floatBitsToUint(z) & 1u) != 0u; }
+bool is_flat_drop(float z) { return z > 0.0 && (floatBitsToUint(z) & 3u) == 3u; }

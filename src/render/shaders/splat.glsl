@@ -29,6 +29,7 @@ struct Splat {
   float r;
   mat3 M;
   bool drop;
+  bool flat_drop;  // a drop lying flat (Lone drops at rest)
 };
 
 // Lone drops. The splat radius u_radius (fluid_radius_scale particle radii) is larger than a
@@ -58,9 +59,10 @@ ivec2 window_texel(ivec2 p) { return ivec2(p.x, int(u_size.y) - 1 - p.y); }
 // H = 3.1 mm. It is drawn as the upper half of an oblate ellipsoid centred where the drop touches
 // the surface (the lower half lies behind the surface, which hides it): semi-axis H along up and
 // a = sqrt(2 r^3 / H) across, which keeps V = 2/3 pi a^2 H (a 1 cm particle: a wet spot 5 cm
-// across). A drop narrower than l_c is not flattened below its radius (H at most r). It is then
-// part of the surface, not a bead: the filter and the composite treat it as a thin layer resting
-// on what is under it.
+// across). A drop narrower than l_c is not flattened below its radius (H at most r). It stays a
+// drop for the filter (its cap drawn as splatted, so its rim keeps the cap's slope, which a
+// filter as wide as the cap would flatten) and is tagged flat for the composite, which shades it
+// as a thin layer resting on what is under it.
 // A drop rests when the surface the camera measured (the scene depth, with its unmeasured planes)
 // lies where the drop touches down, q = c - r up: q and the scene's point at q's pixel lie on one
 // ray, and their distance along it, projected on up (the height of q above or below the
@@ -88,7 +90,7 @@ void lie_flat(inout Splat s, vec3 up) {
   s.c -= r * up;
   s.r = a;  // a >= sqrt(2) r >= H
   s.M = mat3(1.0 / (a * a)) + (1.0 / (H * H) - 1.0 / (a * a)) * outerProduct(up, up);
-  s.drop = false;
+  s.flat_drop = true;
 }
 
 // This invocation's particle: groups form a 2D grid because one dimension holds at most 65535.
@@ -107,6 +109,7 @@ bool splat_shape(uint i, out Splat s) {
     vec4 a = b_ell[3u * i], m = b_ell[3u * i + 1u], n = b_ell[3u * i + 2u];
     s.c = (u_view * vec4(a.xyz, 1.0)).xyz;
     s.drop = n.z > 0.5;
+    s.flat_drop = false;
     s.r = s.drop ? u_drop_radius : a.w;
     mat3 Rv = mat3(u_view);  // world -> eye rotation: M_eye = Rv M Rv^T
     s.M = s.drop ? mat3(1.0 / (s.r * s.r)) : Rv * mat3(m.x, m.y, m.z, m.y, m.w, n.x, m.z, n.x, n.y) * transpose(Rv);
@@ -116,6 +119,7 @@ bool splat_shape(uint i, out Splat s) {
     s.c = (u_view * vec4(b_pos[3u * i], b_pos[3u * i + 1u], b_pos[3u * i + 2u], 1.0)).xyz;
     s.r = u_radius;
     s.drop = false;
+    s.flat_drop = false;
   }
   return s.c.z > s.r && s.c.z - s.r > u_near_far.x && s.c.z - s.r < u_near_far.y;
 }

@@ -137,8 +137,10 @@ void composite_at(ivec2 p, out vec4 o_color, out vec4 o_reflect, out vec4 o_refr
   // a sphere of u_drop_radius whose depth and normals are its own (the filter leaves it as
   // splatted): the view ray, entering at theta_v to the normal, crosses it over the chord
   // 2 r cos theta_v. (The blurred thickness would spread the drop's chords over the filter's width.)
-  bool drop = is_drop(z);
-  float T = drop ? 2.0 * u_drop_radius * NV : texture(u_thickness, frag / u_size).r;
+  // A drop lying flat (splat.glsl, "Lone drops at rest") is a cap as wide as that blur: its path
+  // is the thickness pass's, and it rests on the surface under it, by construction.
+  bool flat_drop = is_flat_drop(z), bead = is_drop(z) && !flat_drop;
+  float T = bead ? 2.0 * u_drop_radius * NV : texture(u_thickness, frag / u_size).r;
 
   // The water's depth along its normal: the thickness pass measures T, the path of the view ray
   // through the water, and a locally plane-parallel layer of depth h is crossed over h / cos
@@ -164,9 +166,9 @@ void composite_at(ivec2 p, out vec4 o_color, out vec4 o_reflect, out vec4 o_refr
   float z_bg = u_depth_holes && w_bg >= 1.0 ? P.z * (1.0 + T / length(P)) : eye_depth(w_bg);
   float gap = max(z_bg - P.z, 0.0) * length(P) / P.z - T;
   float tol = u_contact + 0.006 * z_bg * z_bg;
-  // A drop is a bead, not a layer, wherever it lies: it is shaded as water in the air (a convex
+  // A bead (a lone drop in the air; at rest it lies flat) is shaded as water in the air (a convex
   // lens: refracted, reflecting at its rim, the light's highlight on it), not as a wet film.
-  float resting = drop ? 0.0 : 1.0 - smoothstep(tol, 3.0 * tol, gap);
+  float resting = bead ? 0.0 : flat_drop ? 1.0 : 1.0 - smoothstep(tol, 3.0 * tol, gap);
 
   // The refracted view ray's path in the water. Water resting on a surface is a layer: the ray
   // bends (Snell, t = refract(-V, N, 1 / n)) and crosses it over h / cos theta_t (at most 1.51 h,

@@ -16,7 +16,7 @@ void main() {
       // Hidden by the scene: the raster path's depth test against the copied scene depth (window
       // depth, GL_LESS), done on the same values.
       if (window_depth(z_in) >= texelFetch(u_scene_depth, t, 0).r) continue;
-      uint bits = floatBitsToUint(with_drop_flag(z_in, s.drop));
+      uint bits = floatBitsToUint(with_drop_tag(z_in, s.drop, s.flat_drop));
       // Depths only decrease, so a stale plain read can only let an atomic through that was not
       // needed; skipping on it is always right, and it saves most atomics inside the fluid.
       if (imageLoad(u_depth_bits, t).r <= bits) continue;
