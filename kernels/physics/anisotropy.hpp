@@ -30,9 +30,14 @@ constexpr float kCentreSmoothing = 0.5f;
 
 // One particle's ellipsoid as the splats read it, 3 vec4 per particle id:
 //   [0] centre (xyz) and the longest semi-axis (w, the splat's screen bound);
-//   [1] M00 M01 M02 M11, [2] M12 M22 lone 0: the symmetric M of the ellipsoid
-//   (x - c)^T M (x - c) <= 1, and 1 for a lone fluid particle (fewer than kMinNeighbours fluid
-//   neighbours: the renderer draws it as a drop of its own size), else 0.
+//   [1] M00 M01 M02 M11, [2] M12 M22 lone offset: the symmetric M of the ellipsoid
+//   (x - c)^T M (x - c) <= 1; lone: 1 for a lone fluid particle (fewer than kMinNeighbours fluid
+//   neighbours: the renderer draws it as a drop of its own size), else 0; offset: how far the
+//   neighbours' weighted mean (eq. 10's) lies from the particle, in units of h: about 0 inside a
+//   body of fluid, whose neighbourhoods are complete on every side, and a fifth of h or more at a
+//   free surface (the usual surface test of SPH particles, e.g. Solenthaler, Schlaefli & Pajarola
+//   2007); 1 for a lone particle or one that is not fluid. The renderer's depth splat draws the
+//   particles of large offset first, as occluders (src/render/shaders/ssfr_depth_splat.comp).
 constexpr int kEllipsoidVec4s = 3;
 
 struct EllipsoidViews {

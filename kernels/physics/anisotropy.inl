@@ -29,10 +29,10 @@ SEAMLESS_HD inline void eigen_sym3(mat3 A, mat3& V, vec3& e) {
   e = {A.m[0][0], A.m[1][1], A.m[2][2]};
 }
 
-SEAMLESS_HD inline void write_ellipsoid(vec4* out, vec3 c, float bound, const mat3& M, bool lone) {
+SEAMLESS_HD inline void write_ellipsoid(vec4* out, vec3 c, float bound, const mat3& M, bool lone, float offset) {
   out[0] = {c.x, c.y, c.z, bound};
   out[1] = {M.m[0][0], M.m[0][1], M.m[0][2], M.m[1][1]};
-  out[2] = {M.m[1][2], M.m[2][2], lone ? 1.f : 0.f, 0.f};
+  out[2] = {M.m[1][2], M.m[2][2], lone ? 1.f : 0.f, offset};
 }
 
 }  // namespace detail
@@ -54,6 +54,7 @@ template <Executor Exec> void Anisotropy<Exec>::ellipsoids(const Exec& ex, const
     float bound = V.radius;
     mat3 M = mat3::identity() * (1.f / (V.radius * V.radius));
     bool lone = false;
+    float offset = 1.f;  // not fluid, or lone: drawn on its own
     if ((me.bits() & V.fluid_mask) != 0u) {
       // Weighted moments of the fluid neighbours' offsets y = x_j - x_i, weight 1 - (d / h)^3
       // (Yu & Turk eq. 11), the particle itself included.
@@ -75,6 +76,7 @@ template <Executor Exec> void Anisotropy<Exec>::ellipsoids(const Exec& ex, const
       lone = neighbours < kMinNeighbours;
       if (!lone) {
         const vec3 mean = sy / sw;
+        offset = length(mean) * inv_h;
         const mat3 C = syy * (1.f / sw) + outer(mean, mean) * -1.f;  // weighted covariance (eq. 10)
         mat3 R;
         vec3 e;
@@ -98,7 +100,7 @@ template <Executor Exec> void Anisotropy<Exec>::ellipsoids(const Exec& ex, const
         }
       }
     }
-    detail::write_ellipsoid(V.ellipsoids + kEllipsoidVec4s * V.id[s], centre, bound, M, lone);
+    detail::write_ellipsoid(V.ellipsoids + kEllipsoidVec4s * V.id[s], centre, bound, M, lone, offset);
   });
 }
 

@@ -120,6 +120,10 @@ struct RenderParams {
   // Anisotropic kernels (Yu & Turk 2013): each fluid particle splatted as an ellipsoid shaped by
   // its neighbours within filter_size radii (compute splats only; the raster path draws spheres).
   bool fluid_anisotropy = true;
+  // The fluid's depth splat in two passes when the anisotropic kernels mark the particles at the
+  // surface: those first, then the others, each skipped when the depth already splatted hides it
+  // across its whole footprint (the same image bit for bit; docs/RENDERING.md, Speed).
+  bool fluid_occluders = true;
   vec3 absorption{2.f, 0.7f, 0.35f};  // Beer-Lambert coefficients per colour channel, 1/m (docs/RENDERING.md, Water)
   float ior = 1.33f;                  // refractive index (water): Snell's law bends the view into the fluid
   float fresnel_f0 = 0.02f;           // reflectance at normal incidence (water: ((1-1.33)/(1+1.33))^2)
@@ -236,6 +240,9 @@ struct RenderParams {
     v("fluid_anisotropy", fluid_anisotropy,
       "fluid particles drawn as ellipsoids shaped by their neighbours (Yu & Turk 2013): a spread layer "
       "becomes one flat sheet (compute splats only)");
+    v("fluid_occluders", fluid_occluders,
+      "fluid depth splat: the surface particles first, then the others unless already hidden (the same image; "
+      "with fluid_anisotropy)");
     v("absorption", absorption, "fluid absorption per channel (Beer-Lambert), 1/m");
     v("ior", ior, "fluid refractive index (Snell's law at the surface)", Range{1.0, 3.0});
     v("fresnel_f0", fresnel_f0, "fluid reflectance at normal incidence", Range{0.0, 1.0});

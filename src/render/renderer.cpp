@@ -527,6 +527,17 @@ std::optional<Renderer::EllipsoidSizes> Renderer::fluid_ellipsoid_sizes(float pa
 }
 void Renderer::use_device_ellipsoids(bool on) { impl_->ellipsoids_in_buffer = on; }
 
+Renderer::OccluderCounts Renderer::fluid_occluder_counts() const {
+  const Impl& m = *impl_;
+  if (!m.has_compute || !m.occluder_passes) return {};
+  GLuint c[2] = {0u, 0u};
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, m.occluders);
+  glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof(c), c);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+  return {c[0], c[1]};
+}
+
 void Renderer::resize(int width, int height) {
   if (width == impl_->w && height == impl_->h) return;
   if (width < 1 || height < 1) return;  // a minimised window

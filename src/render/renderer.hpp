@@ -98,6 +98,13 @@ class Renderer {
     int w = 0, h = 0, tw = 0, th = 0;
   };
   FluidImages read_fluid_images() const;
+  // The last draw's fluid depth splat in two passes (render.fluid_occluders): the particles it
+  // splatted first as occluders, and how many of the others it skipped as hidden behind them;
+  // zeros after a splat in one pass. Waits for the GPU. For tests.
+  struct OccluderCounts {
+    std::int64_t occluders = 0, skipped = 0;
+  };
+  OccluderCounts fluid_occluder_counts() const;
   // Whether the fluid sphere passes run as compute splats (render.fluid_splat: compute and GL 4.3).
   bool uses_compute_splat() const;
   // Copies the last frame to the bound draw framebuffer (0 = the window), scaled to w x h.

@@ -105,6 +105,13 @@ struct Renderer::Impl {
   // Compute splats (render.fluid_splat: compute), built only with GL >= 4.3 (has_compute).
   bool has_compute = false;
   Program depth_splat_prog, thick_splat_prog, resolve_prog;
+  // The depth splat's occluders first (render.fluid_occluders, ssfr_depth_splat.comp): their list
+  // (count, skipped count, indices) and the largest depth of each tile after them.
+  Program occluders_prog, depth_tiles_prog;
+  GlBuffer occluders;
+  std::int64_t occluder_capacity = 0;
+  bool occluder_passes = false;  // the last depth splat ran in two passes
+  Texture depth_tiles;
   // Anisotropic kernels: the fluid's ellipsoids (physics/fluid_ellipsoids.hpp), computed on the
   // CPU for a host DrawList that has none, or copied in by the CUDA interop.
   FluidEllipsoids cpu_shapes{Device::CPU};
@@ -221,6 +228,7 @@ struct Renderer::Impl {
   void resolve_splat(GLuint acc, GLuint out, int iw, int ih, bool depth_bits);
   void dispatch_screen(int iw, int ih);  // 8 x 8 tiles over iw x ih, then the barriers
   void fluid_depth_splat(std::int64_t n, float sphere_r, const RenderCamera& cam);
+  void reserve_occluders(std::int64_t n);
   void upload_ellipsoids(const DrawList& list, std::int64_t n);
   std::optional<Renderer::EllipsoidSizes> ellipsoid_sizes(float radius) const;
   void fluid_thickness_splat(std::int64_t n, float sphere_r, const RenderCamera& low);

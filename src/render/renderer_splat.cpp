@@ -16,6 +16,14 @@ namespace {
 constexpr GLuint kSplatGroup = 64;           // local_size_x of splat.glsl
 constexpr GLuint kResolveGroup = 8;          // local_size_x/y of ssfr_resolve.comp and screen.glsl
 constexpr GLuint kEmptyDepth = 0xffffffffu;  // "no fluid" in the depth-bits image: above every depth
+constexpr int kDepthTile = 4;                // pixels per side of ssfr_depth_tiles.comp's tiles
+// The smallest offset of the neighbours' weighted mean, in h, that makes a particle an occluder
+// of the depth splat (ssfr_occluders.comp). The mean lies 0.23 h inside from a particle on a flat
+// face of a lattice block and 0.07 h from one a spacing further in (h = 3 spacings): the outer
+// layer alone, which on a lattice already covers every ray that crosses the face (its spheres
+// cover the face's plane: 0.75 spacings of radius against 0.71 from a point of the plane to the
+// nearest lattice point). The image does not depend on it, only the cost.
+constexpr float kOccluderOffset = 0.15f;
 
 // Fixed-point thickness: units per metre of path in fluid. Each chord is rounded to the nearest
 // unit, so a pixel's sum is off by at most 0.5 unit per sphere on its ray (2^-21 m = 0.5 um each;
@@ -32,6 +40,10 @@ void Renderer::Impl::build_compute_programs() {
     return ShaderStage{GL_COMPUTE_SHADER, {"camera.glsl", "sphere_hit.glsl", "splat.glsl", main}};
   };
   depth_splat_prog = Program("fluid depth splat", {cs("ssfr_depth_splat.comp")});
+  occluders_prog = Program("fluid depth occluders", {cs("ssfr_occluders.comp")});
+  depth_tiles_prog = Program("fluid depth tiles", {ShaderStage{GL_COMPUTE_SHADER, {"ssfr_depth_tiles.comp"}}});
+  occluders = GlBuffer(new_name(glGenBuffers));
+  reserve_occluders(0);
   thick_splat_prog = Program("fluid thickness splat", {cs("ssfr_thickness_splat.comp")});
   resolve_prog = Program("fluid splat resolve", {ShaderStage{GL_COMPUTE_SHADER, {"ssfr_resolve.comp"}}});
   auto screen = [](const char* name, const char* body, const char* main) {
@@ -71,6 +83,7 @@ Texture make_uint_image(int w, int h, GLuint value) {
 void Renderer::Impl::make_splat_targets() {
   if (!has_compute) return;
   depth_bits = make_uint_image(w, h, kEmptyDepth);
+  depth_tiles = make_texture_2d(GL_R32UI, (w + kDepthTile - 1) / kDepthTile, (h + kDepthTile - 1) / kDepthTile);
   thick_fixed = make_uint_image(tw, th, 0u);
 }
 
@@ -116,11 +129,53 @@ void Renderer::Impl::resolve_splat(GLuint acc, GLuint out, int iw, int ih, bool 
   dispatch_screen(iw, ih);  // its barriers also order the next frame's atomics on `acc`
 }
 
-// SSFR 1, compute: nearest sphere depth per pixel into fluid_depth[0] (0 = no fluid).
+void Renderer::Impl::reserve_occluders(std::int64_t n) {
+  if (n <= occluder_capacity && occluder_capacity > 0) return;
+  occluder_capacity = std::max<std::int64_t>(n, std::max<std::int64_t>(2 * occluder_capacity, 64));
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, occluders);
+  glBufferData(GL_SHADER_STORAGE_BUFFER, (occluder_capacity + 2) * static_cast<GLsizeiptr>(sizeof(GLuint)), nullptr,
+               GL_DYNAMIC_DRAW);
+  const GLuint zero[2] = {0u, 0u};
+  glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof(zero), zero);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+}
+
+// SSFR 1, compute: nearest sphere depth per pixel into fluid_depth[0] (0 = no fluid). With the
+// anisotropic kernels and render.fluid_occluders, in two passes: the particles at the surface,
+// then the others unless hidden behind them (ssfr_depth_splat.comp); the same image.
 void Renderer::Impl::fluid_depth_splat(std::int64_t n, float sphere_r, const RenderCamera& cam) {
+  const bool two_passes = aniso_live && p.fluid_occluders;
+  reserve_occluders(two_passes ? n : 0);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, occluders);
+  const GLuint zero[2] = {0u, 0u};  // occluder count, skipped count
+  glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof(zero), zero);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, occluders);
+  occluder_passes = two_passes;
+  if (two_passes) {
+    splat_uniforms(occluders_prog, n, sphere_r, cam);
+    glUniform1f(occluders_prog.loc("u_occluder_offset"), kOccluderOffset);
+    dispatch_particles(n);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  }
   splat_uniforms(depth_splat_prog, n, sphere_r, cam);
+  glUniform1f(depth_splat_prog.loc("u_occluder_offset"), kOccluderOffset);
   glBindImageTexture(0, depth_bits, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+  glBindImageTexture(1, depth_tiles, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
+  glUniform1i(depth_splat_prog.loc("u_pass"), two_passes ? 1 : 0);
   dispatch_particles(n);
+  if (two_passes) {
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    depth_tiles_prog.use();
+    glBindImageTexture(0, depth_bits, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
+    glBindImageTexture(1, depth_tiles, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32UI);
+    dispatch_screen((w + kDepthTile - 1) / kDepthTile, (h + kDepthTile - 1) / kDepthTile);
+    depth_splat_prog.use();
+    glBindImageTexture(0, depth_bits, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+    glBindImageTexture(1, depth_tiles, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
+    glUniform1i(depth_splat_prog.loc("u_pass"), 2);
+    dispatch_particles(n);
+  }
   resolve_splat(depth_bits, fluid_depth[0], w, h, true);
 }
 

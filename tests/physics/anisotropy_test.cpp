@@ -31,7 +31,8 @@ struct Ellipsoid {
   Eigen::Vector3d centre;
   double bound = 0.0;
   Eigen::Matrix3d M;
-  bool lone = false;  // a fluid particle with fewer than kMinNeighbours fluid neighbours
+  bool lone = false;    // a fluid particle with fewer than kMinNeighbours fluid neighbours
+  double offset = 1.0;  // the neighbours' weighted mean from the particle, in h (1: lone or not fluid)
 };
 
 Ellipsoid ellipsoid(const std::vector<vec4>& e, std::size_t i) {
@@ -41,6 +42,7 @@ Ellipsoid ellipsoid(const std::vector<vec4>& e, std::size_t i) {
   out.bound = a.w;
   out.M << b.x, b.y, b.z, b.y, b.w, c.x, b.z, c.x, c.y;
   out.lone = c.z == 1.f;
+  out.offset = c.w;
   EXPECT_TRUE(c.z == 0.f || c.z == 1.f) << "the lone flag of particle " << i;
   return out;
 }
@@ -110,6 +112,16 @@ TEST(FluidEllipsoids, BulkFluidAndALoneDropStaySpheres) {
   EXPECT_FALSE(bulk.lone);
   EXPECT_EQ(lone.bound, double(kR));
   EXPECT_EQ(lone.centre, Eigen::Vector3d(1.0, 1.0, 1.0));
+  // The neighbours' weighted mean: at the particle inside (symmetry), a fifth of h or more
+  // towards the inside at a face (a half space's neighbourhood: 0.23 h for h = 3 spacings), 1
+  // for the drop.
+  EXPECT_NEAR(bulk.offset, 0.0, 1e-6);
+  EXPECT_EQ(lone.offset, 1.0);
+  const vec3 f = kD * vec3{4.f, 0.f, 0.f};
+  const auto face = static_cast<std::size_t>(
+      std::find_if(x.begin(), x.end(), [&](vec3 p) { return p.x == f.x && p.y == f.y && p.z == f.z; }) - x.begin());
+  ASSERT_LT(face, x.size());
+  EXPECT_NEAR(ellipsoid(e, face).offset, 0.2305, 1e-3);
 }
 
 TEST(FluidEllipsoids, OnlyFluidNeighboursShapeAFluidParticle) {
@@ -156,6 +168,7 @@ Ellipsoid reference(const std::vector<vec3>& x, const std::vector<std::uint32_t>
   out.lone = neighbours < kernels::kMinNeighbours;
   if (out.lone) return out;
   const Eigen::Vector3d mean = sy / sw;
+  out.offset = mean.norm() / kH;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(syy / sw - mean * mean.transpose());
   Eigen::Vector3d sd = es.eigenvalues().cwiseMax(0.0).cwiseSqrt();
   sd = sd.cwiseMax(sd.maxCoeff() / kernels::kMaxAxisRatio);
@@ -193,6 +206,7 @@ TEST(FluidEllipsoids, ARandomCloudMatchesADoublePrecisionReference) {
     ASSERT_NEAR((got.centre - want.centre).norm(), 0.0, 1e-6) << "particle " << i;
     ASSERT_NEAR(got.bound, want.bound, 1e-3 * want.bound) << "particle " << i;
     ASSERT_EQ(got.lone, want.lone) << "particle " << i;
+    ASSERT_NEAR(got.offset, want.offset, 1e-4) << "particle " << i;
   }
   EXPECT_GT(shaped, 500);  // the slab's particles are discs, so the comparison covers shapes
 }

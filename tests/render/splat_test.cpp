@@ -1,9 +1,13 @@
 // The compute splats (render.fluid_splat: compute) against the raster sprites: the same sphere
 // depth image and the same thickness, on the same renderer and particles.
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <random>
 
+#include "core/device.hpp"
 #include "core/phase.hpp"
+#include "physics/fluid_ellipsoids.hpp"
 #include "render_test_util.hpp"
 
 namespace seamless::test {
@@ -235,6 +239,116 @@ TEST(RenderSplat, ComputeScreenPassesGiveTheRasterFrame) {
     }
   EXPECT_GT(fluid, 2000);
   EXPECT_GT(compared, K.width * K.height * 95 / 100);  // depth ties are rare: nearly all compared
+}
+
+}  // namespace
+}  // namespace seamless::test
+
+namespace seamless::test {
+namespace {
+namespace occluders_test {
+
+// A lattice block of side^3 fluid particles (spacing one diameter) turned to show three faces,
+// its centre 1.5 m in front of the camera.
+struct LatticeBlock {
+  std::vector<vec3> x;
+  std::vector<std::uint32_t> ph;
+  float r = 0.01f;
+  // jitter: each particle moved by up to this many spacings along each axis (uniform, seeded).
+  explicit LatticeBlock(int side, float jitter = 0.f) {
+    const mat3 R = rotation(vec3{1.f, 1.f, 0.f}, 0.6f);
+    const float c = 0.5f * static_cast<float>(side - 1);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> u(-jitter, jitter);
+    for (int k = 0; k < side; ++k)
+      for (int j = 0; j < side; ++j)
+        for (int i = 0; i < side; ++i) {
+          const vec3 q{i - c + u(rng), j - c + u(rng), k - c + u(rng)};
+          x.push_back(R * (2.f * r * q) + vec3{0.f, 0.f, 1.5f});
+        }
+    ph.assign(x.size(), phase::kFluid);
+  }
+  DrawList list() const {
+    DrawList d;
+    d.positions = x, d.phases = ph, d.particle_radius = r;
+    return d;
+  }
+};
+
+struct OccluderRun {
+  Renderer::FluidImages fluid;
+  Renderer::OccluderCounts counts;
+  bool compute = false;
+};
+OccluderRun draw_block(const LatticeBlock& b, const Intrinsics& K, bool occluders) {
+  RenderParams p;
+  p.znear = kNear;
+  p.filter_iterations = 0;  // the splat's own depth
+  p.fluid_occluders = occluders;
+  Renderer r(p, K.width, K.height);
+  r.draw(b.list(), camera(K));
+  return {r.read_fluid_images(), r.fluid_occluder_counts(), r.uses_compute_splat()};
+}
+
+}  // namespace occluders_test
+
+// The depth splat with the surface particles first (render.fluid_occluders) against one pass
+// over every particle: the minimum of the same depths, whatever their order, so the same image
+// bit for bit; the occluders are exactly the particles whose kernel put them at the surface, and
+// most of the block's inside is skipped.
+TEST(RenderSplat, OccludersFirstGiveTheSameDepthAndSkipTheHidden) {
+  SEAMLESS_REQUIRE_EGL();
+  using namespace occluders_test;
+  const Intrinsics K = intrinsics(300.f, 79.5f, 59.5f, 160, 120);
+  const LatticeBlock b(14);
+  const OccluderRun one = draw_block(b, K, false), two = draw_block(b, K, true);
+  if (!two.compute) GTEST_SKIP() << "no GL 4.3 compute here";
+  EXPECT_EQ(one.counts.occluders, 0);
+  ASSERT_EQ(one.fluid.depth.size(), two.fluid.depth.size());
+  int fluid = 0;
+  for (std::size_t i = 0; i < one.fluid.depth.size(); ++i) {
+    ASSERT_EQ(std::memcmp(&one.fluid.depth[i], &two.fluid.depth[i], sizeof(float)), 0)
+        << "pixel " << i << ": one pass " << one.fluid.depth[i] << ", occluders first " << two.fluid.depth[i];
+    fluid += one.fluid.depth[i] > 0.f;
+  }
+  EXPECT_GT(fluid, 1000);  // the block covers a good part of the image
+  // The occluders: the particles with the offset of ssfr_occluders.comp, from the kernels on the CPU.
+  RenderParams p;
+  const Renderer probe(p, 8, 8);
+  const auto sizes = probe.fluid_ellipsoid_sizes(b.r);
+  ASSERT_TRUE(sizes.has_value());
+  const std::vector<vec4> e = FluidEllipsoids(Device::CPU).compute_host(b.x, b.ph, sizes->radius, sizes->h);
+  std::int64_t surface = 0;
+  for (std::size_t i = 0; i < b.x.size(); ++i) surface += e[FluidEllipsoids::kVec4s * i + 2].w >= 0.15f;
+  // The outer layer of the 14^3 block (14^3 - 12^3 = 1016 particles: offsets of 0.23 h or more)
+  // and the 8 corners of the next (0.153 h: their neighbourhoods lack a layer on three sides;
+  // the next layer's faces have 0.07 h, its edges 0.11 h).
+  EXPECT_EQ(surface, 14 * 14 * 14 - 12 * 12 * 12 + 8);
+  EXPECT_EQ(two.counts.occluders, surface);
+  const std::int64_t others = static_cast<std::int64_t>(b.x.size()) - surface;
+  std::printf("occluders %lld, skipped %lld of the other %lld\n", static_cast<long long>(two.counts.occluders),
+              static_cast<long long>(two.counts.skipped), static_cast<long long>(others));
+  EXPECT_GT(two.counts.skipped, others / 2);
+}
+
+// The same with the particles jittered by up to 0.45 spacings: the outer layer is ragged, so
+// particles inside show through its gaps and stick out of it in places, and a skip that were not
+// sure (a bound above some entry depth) would leave a pixel too deep.
+TEST(RenderSplat, OccludersFirstGiveTheSameDepthOfARaggedBlock) {
+  SEAMLESS_REQUIRE_EGL();
+  using namespace occluders_test;
+  const Intrinsics K = intrinsics(300.f, 79.5f, 59.5f, 160, 120);
+  const LatticeBlock b(14, 0.45f);
+  const OccluderRun one = draw_block(b, K, false), two = draw_block(b, K, true);
+  if (!two.compute) GTEST_SKIP() << "no GL 4.3 compute here";
+  ASSERT_EQ(one.fluid.depth.size(), two.fluid.depth.size());
+  for (std::size_t i = 0; i < one.fluid.depth.size(); ++i)
+    ASSERT_EQ(std::memcmp(&one.fluid.depth[i], &two.fluid.depth[i], sizeof(float)), 0)
+        << "pixel " << i << ": one pass " << one.fluid.depth[i] << ", occluders first " << two.fluid.depth[i];
+  std::printf("ragged: occluders %lld, skipped %lld\n", static_cast<long long>(two.counts.occluders),
+              static_cast<long long>(two.counts.skipped));
+  EXPECT_GT(two.counts.occluders, 0);
+  EXPECT_GT(two.counts.skipped, 0);
 }
 
 }  // namespace
