@@ -63,8 +63,11 @@ void main() {
   float z = surface_depth(px);
   if (z > 0.0) {
     vec3 world = (u_world_T_camera * vec4(z * pixel_ray(px), 1.0)).xyz;
-    vec3 n = surface_normal(px);
-    float occluded = dot(n, n) > 0.0 ? occluded_share(world, n) : 0.0;
+    float occluded = 0.0;
+    if (u_occluder_count > 0) {  // the normal's four reads only where a body can occlude
+      vec3 n = surface_normal(px);
+      if (dot(n, n) > 0.0) occluded = occluded_share(world, n);
+    }
     rgb = shadowed_srgb(rgb, shadow_light(world, vec3(0.0), gl_FragCoord.xy), occluded);
   }
   o_color = vec4(rgb, 1.0);
