@@ -166,6 +166,7 @@ SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z
   float z_prev = 0.f, f_prev = 0.f;
   bool have_prev = false, prev_near = false;     // prev_near: the last sample's block is near a surface
   bool prev_far = false;                         // the last sample was a far read (one voxel)
+  bool fine = false;                             // this sample trilinear: a far read's step is retaken
   int refine = -1;                               // -1: marching; else regula falsi steps taken
   float ta = 0.f, fa = 0.f, tb = 0.f, fb = 0.f;  // the bracket: fa > 0 at ta, fb <= 0 at tb
   for (int it = 0; refine >= 0 || (it < 8192 && z < z_end); ++it) {
@@ -176,21 +177,25 @@ SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z
     // except for one sample right after a sample in a block near a surface: a crossing between
     // the two (the step from the last sample in front of a surface may land past it) is then
     // bracketed as without the flags (block_near_surface in tsdf.hpp).
-    const bool near = i0 >= 0 && (refine >= 0 || near_surface(a, i0));
+    const bool near = i0 >= 0 && (refine >= 0 || fine || near_surface(a, i0));
     const bool skip = i0 < 0 || (!near && !(have_prev && prev_near));
     // While marching, first the voxel nearest q (one of the cell's 8 corners): unobserved or in no
     // block, the trilinear sample has no value either (an unobserved step, as before); far from the
     // surface it is the sample. Not a far read where it would close a bracket (the previous sample
-    // positive, this one not): the bracket's ends are then trilinear values, as before.
+    // positive, this one not), nor where a far read's step is retaken (below), nor inside the band
+    // (the previous sample trilinear and within half the truncation: the voxel nearest a sample
+    // at the surface can read far where the field is steep): a bracket's ends are trilinear
+    // values, as before.
     float f = 0.f, r = 0.f;  // r: distance from q to a far read's voxel, in voxels
     bool far = false, observed = !skip;
-    if (!skip && refine < 0) {
+    if (!skip && refine < 0 && !fine) {
       const int3 gn = floor_to_int(q + vec3{0.5f, 0.5f, 0.5f}), bn = block_of_voxel(gn);
       const std::int32_t in = bn == b ? i0 : cached_block(a, bn, c);
       const Voxel v =
           in >= 0 ? a.voxels[static_cast<std::int64_t>(in) * kBlockVoxels + local_index(gn)] : Voxel{0.f, 0.f};
       observed = v.weight > 0.f;
-      far = observed && fabsf(v.sdf) >= far_sdf && !(have_prev && f_prev > 0.f && v.sdf <= 0.f);
+      far = observed && fabsf(v.sdf) >= far_sdf && !(have_prev && f_prev > 0.f && v.sdf <= 0.f) &&
+            !(have_prev && !prev_far && fabsf(f_prev) < far_sdf);
       if (far) f = v.sdf, r = length(q - to_vec3(gn));
     }
     // The block just found: no second lookup.
@@ -201,6 +206,16 @@ SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z
       else tb = z, fb = f;
       z = ta + (tb - ta) * fa / (fa - fb);
       if (++refine == kRefineSteps) break;
+      continue;
+    }
+    // A far read's step (below) rests on the field's slope; where the TSDF is steeper (projective
+    // distances at grazing angles, a band cut short by unobserved space) it can land past the
+    // crossing, or where no trilinear value brackets it. The step is then retaken from the far
+    // read's depth with the trilinear sample, as the march without far reads would have stepped
+    // from there; each retake starts at a later far read, so the march still advances.
+    fine = false;
+    if (!skip && prev_far && f_prev > 0.f && !(sampled && f > 0.f)) {
+      z = z_prev, fine = true, prev_far = false;
       continue;
     }
     if (skip) {  // empty space: skip the whole block (Niessner section 4.3)
@@ -214,10 +229,6 @@ SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z
       continue;
     }
     if (have_prev && f_prev > 0.f && f <= 0.f) {
-      // After a far read (only where its step was not conservative enough: rare) the bracket's
-      // front end gets its trilinear value, if it has one of the same sign.
-      float fp = 0.f;
-      if (prev_far && sample_tsdf(a, o + d * z_prev, c, &fp) && fp > 0.f) f_prev = fp;
       ta = z_prev, fa = f_prev, tb = z, fb = f, refine = 0;
       z = ta + (tb - ta) * fa / (fa - fb);
       continue;
