@@ -143,11 +143,6 @@ template <class Acc> SEAMLESS_HD inline bool near_surface(const Acc& a, std::int
 // refined by three steps of regula falsi on the trilinear field, taken by the same loop: its
 // samples then run through the one copy of the sample code (on the GPU the kernel's size, not its
 // arithmetic, held the march back: most warps waited on instruction fetch).
-//
-// Far from the surface a step reads one voxel, the one nearest the sample, instead of the
-// trilinear 8 (InfiniTAM's castRay reads uninterpolated values until near the surface), and steps
-// by it; within half the truncation of the surface it takes the trilinear sample as before, so the
-// crossing is bracketed and refined on the trilinear field.
 template <class Acc>
 SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z_end, BlockCache& c, float* hit) {
   const float dlen = length(d);        // voxels per metre of depth
@@ -159,14 +154,9 @@ SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z
   const float unobserved_step = fmaxf(min_step, 0.5f * a.geom.truncation / (dlen * a.geom.voxel_size));
   const float step_per_sdf = 0.8f / (dlen * a.geom.voxel_size);  // see the step below
   const vec3 inv_d{1.f / d.x, 1.f / d.y, 1.f / d.z};             // +-inf on an axis d does not move along
-  // A far read: |sdf| of the nearest voxel at least half the truncation (see the far step below).
-  const float far_sdf = 0.5f * a.geom.truncation;
-  const float z_per_voxel = 1.f / dlen;
   constexpr int kRefineSteps = 3;
   float z_prev = 0.f, f_prev = 0.f;
   bool have_prev = false, prev_near = false;     // prev_near: the last sample's block is near a surface
-  bool prev_far = false;                         // the last sample was a far read (one voxel)
-  bool fine = false;                             // this sample trilinear: a far read's step is retaken
   int refine = -1;                               // -1: marching; else regula falsi steps taken
   float ta = 0.f, fa = 0.f, tb = 0.f, fb = 0.f;  // the bracket: fa > 0 at ta, fb <= 0 at tb
   for (int it = 0; refine >= 0 || (it < 8192 && z < z_end); ++it) {
@@ -177,45 +167,16 @@ SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z
     // except for one sample right after a sample in a block near a surface: a crossing between
     // the two (the step from the last sample in front of a surface may land past it) is then
     // bracketed as without the flags (block_near_surface in tsdf.hpp).
-    const bool near = i0 >= 0 && (refine >= 0 || fine || near_surface(a, i0));
+    const bool near = i0 >= 0 && (refine >= 0 || near_surface(a, i0));
     const bool skip = i0 < 0 || (!near && !(have_prev && prev_near));
-    // While marching, first the voxel nearest q (one of the cell's 8 corners): unobserved or in no
-    // block, the trilinear sample has no value either (an unobserved step, as before); far from the
-    // surface it is the sample. Not a far read where it would close a bracket (the previous sample
-    // positive, this one not), nor where a far read's step is retaken (below), nor inside the band
-    // (the previous sample trilinear and within half the truncation: the voxel nearest a sample
-    // at the surface can read far where the field is steep): a bracket's ends are trilinear
-    // values, as before.
-    float f = 0.f, r = 0.f;  // r: distance from q to a far read's voxel, in voxels
-    bool far = false, observed = !skip;
-    if (!skip && refine < 0 && !fine) {
-      const int3 gn = floor_to_int(q + vec3{0.5f, 0.5f, 0.5f}), bn = block_of_voxel(gn);
-      const std::int32_t in = bn == b ? i0 : cached_block(a, bn, c);
-      const Voxel v =
-          in >= 0 ? a.voxels[static_cast<std::int64_t>(in) * kBlockVoxels + local_index(gn)] : Voxel{0.f, 0.f};
-      observed = v.weight > 0.f;
-      far = observed && fabsf(v.sdf) >= far_sdf && !(have_prev && f_prev > 0.f && v.sdf <= 0.f) &&
-            !(have_prev && !prev_far && fabsf(f_prev) < far_sdf);
-      if (far) f = v.sdf, r = length(q - to_vec3(gn));
-    }
-    // The block just found: no second lookup.
-    const bool sampled = far || (observed && sample_tsdf_in(a, q, g0, i0, c, &f));
-    if (refine >= 0) {      // regula falsi between the bracket's ends
+    float f = 0.f;
+    const bool sampled = !skip && sample_tsdf_in(a, q, g0, i0, c, &f);  // the block just found: no second lookup
+    if (refine >= 0) {                                                  // regula falsi between the bracket's ends
       if (!sampled) break;  // no value here: the last estimate, z, is the hit
       if (f > 0.f) ta = z, fa = f;
       else tb = z, fb = f;
       z = ta + (tb - ta) * fa / (fa - fb);
       if (++refine == kRefineSteps) break;
-      continue;
-    }
-    // A far read's step (below) rests on the field's slope; where the TSDF is steeper (projective
-    // distances at grazing angles, a band cut short by unobserved space) it can land past the
-    // crossing, or where no trilinear value brackets it. The step is then retaken from the far
-    // read's depth with the trilinear sample, as the march without far reads would have stepped
-    // from there; each retake starts at a later far read, so the march still advances.
-    fine = false;
-    if (!skip && prev_far && f_prev > 0.f && !(sampled && f > 0.f)) {
-      z = z_prev, fine = true, prev_far = false;
       continue;
     }
     if (skip) {  // empty space: skip the whole block (Niessner section 4.3)
@@ -233,21 +194,13 @@ SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z
       z = ta + (tb - ta) * fa / (fa - fb);
       continue;
     }
-    z_prev = z, f_prev = f, have_prev = true, prev_near = near, prev_far = far;
+    z_prev = z, f_prev = f, have_prev = true, prev_near = near;
     // |TSDF| is at most about the distance to the nearest zero crossing (projective distances
     // over-estimate at grazing angles, hence the 0.8), so stepping that far along the ray (|d| s
     // metres per unit of z) cannot jump over one: truncation-sized steps in the band's free-space
     // side (and through the back of a surface a ray enters from behind), shrinking to half a
     // voxel at the surface.
-    //
-    // A far read is the field's value at its voxel x_v, not at q. The same bound at x_v gives
-    // dist(x_v, S) >= 0.8 |sdf_v| (S: the zero crossings, sdf_v in metres), and the triangle
-    // inequality dist(q, S) >= 0.8 |sdf_v| - |q - x_v|: the step is 0.8 |sdf_v| less the distance
-    // to the voxel, r voxels = r / |d| units of z (r <= sqrt(3)/2, half a cell's diagonal; in the
-    // normalised TSDF, sdf / truncation, that is the field changing by at most 1 / (0.8 truncation)
-    // per metre over r voxel_size metres). With |sdf_v| >= truncation / 2 the step is at least
-    // 0.4 truncation - 0.87 voxel_size: 0.73 voxel at 5 mm voxels and a 2 cm truncation.
-    z += far ? max_of(fabsf(f) * step_per_sdf - r * z_per_voxel, min_step) : max_of(fabsf(f) * step_per_sdf, min_step);
+    z += max_of(fabsf(f) * step_per_sdf, min_step);
   }
   if (refine < 0) return false;
   *hit = z;
