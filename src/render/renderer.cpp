@@ -63,7 +63,7 @@ void Renderer::Impl::build_programs() {
     return a;
   };
   // Surfaces that receive the virtual objects' shadows (shadow.glsl).
-  const std::vector<std::string> receiver = {"color.glsl", "shadow.glsl", "occlusion.glsl", "mesh.frag"};
+  const std::vector<std::string> receiver = {"color.glsl", "shadow.glsl", "mesh.frag"};
   mesh_prog = Program("mesh", {vs({"mesh.vert"}), fs(receiver)});
   cloth_prog = Program("cloth", {vs({"cloth.vert"}), fs({"color.glsl", "shadow.glsl", "cloth.frag"})});
   particle_prog = Program("particles", {vs({"sphere.vert"}), fs(with(sphere_fs, "particle.frag"))});

@@ -185,9 +185,9 @@ struct Renderer::Impl {
   mat3 light_R = mat3::identity();  // world -> light frame
   bool shadow_live = false;         // this frame's receivers read a map
   // This frame's rigid bodies as boxes for the real surfaces' contact occlusion (occlusion.glsl):
-  // world -> box frame (column-major) and half extents, at most kMaxOccluders.
-  std::vector<Mat4> occluder_T_world;
-  std::vector<vec3> occluder_half;
+  // how many, and their rows (world -> box frame, half extents) in a 4 x kMaxOccluders texture.
+  int occluder_count = 0;
+  Texture occluder_boxes;
   void set_occluders(const DrawList& list);
 
   std::vector<StageImage> stages;

@@ -23,8 +23,8 @@
 namespace seamless {
 namespace {
 
-constexpr int kShadowMapUnit = 6, kLightBoundsUnit = 7, kFluidShadowUnit = 8;  // texture units the receivers read
-constexpr int kMaxOccluders = 16;  // bodies that occlude the real surfaces: occlusion.glsl's arrays
+constexpr int kShadowMapUnit = 6, kLightBoundsUnit = 7, kFluidShadowUnit = 8, kBoxesUnit = 9;  // the receivers' texture units
+constexpr int kMaxOccluders = 16;  // bodies that occlude the real surfaces: rows of `occluder_boxes`
 // Fixed-point path in fluid along the light (as the camera's thickness splat, renderer_splat.cpp):
 // 2^20 units per metre, at most half a unit of rounding per sphere on a ray (0.5 um), and 4096 m
 // of path before the uint32 wraps, far beyond any light path through the fluid.
@@ -77,6 +77,7 @@ void Renderer::Impl::build_shadow_programs() {
       Program("shadow cloth casters",
               {ShaderStage{GL_VERTEX_SHADER, {"shadow_caster.glsl", "shadow.glsl", "cloth.vert"}}, depth_only});
   light_bounds = make_texture_2d(GL_R32I, 6, 1);
+  occluder_boxes = make_texture_2d(GL_RGBA32F, 4, kMaxOccluders);
 }
 
 // Map-sized targets, (re)made when render.shadow_map_size changes.
@@ -105,8 +106,7 @@ void Renderer::Impl::make_shadow_targets() {
 void Renderer::Impl::shadow_uniforms(const Program& prog) const {
   glUniform1i(prog.loc("u_shadow_on"), shadow_live);
   // A program keeps its uniforms from frame to frame: the count is set every time.
-  const auto boxes = static_cast<GLsizei>(shadow_live ? occluder_half.size() : 0);
-  glUniform1i(prog.loc("u_occluder_count"), boxes);
+  glUniform1i(prog.loc("u_occluder_count"), shadow_live ? occluder_count : 0);
   if (!shadow_live) return;
   glActiveTexture(GL_TEXTURE0 + kShadowMapUnit);
   glBindTexture(GL_TEXTURE_2D, shadow_map);
@@ -126,33 +126,37 @@ void Renderer::Impl::shadow_uniforms(const Program& prog) const {
   glUniform1f(prog.loc("u_shadow_size"), static_cast<float>(shadow_size));
   glUniform1f(prog.loc("u_light_tan"), std::tan(0.5f * p.light_angle * std::numbers::pi_v<float> / 180.f));
   glUniform1f(prog.loc("u_shadow_strength"), p.shadow_strength);
-  if (boxes == 0) return;
-  std::vector<float> T, half;
-  for (GLsizei k = 0; k < boxes; ++k) {
-    T.insert(T.end(), occluder_T_world[k].begin(), occluder_T_world[k].end());
-    half.insert(half.end(), {occluder_half[k].x, occluder_half[k].y, occluder_half[k].z});
-  }
-  glUniformMatrix4fv(prog.loc("u_box_T_world"), boxes, GL_FALSE, T.data());
-  glUniform3fv(prog.loc("u_box_half"), boxes, half.data());
+  glActiveTexture(GL_TEXTURE0 + kBoxesUnit);
+  glBindTexture(GL_TEXTURE_2D, occluder_boxes);
+  glActiveTexture(GL_TEXTURE0);
+  glUniform1i(prog.loc("u_boxes"), kBoxesUnit);
 }
 
 // The rigid bodies as occluders of the real surfaces (occlusion.glsl): each body's box, or its
-// mesh's bounds in the body frame; the first kMaxOccluders bodies.
+// mesh's bounds in the body frame; the first kMaxOccluders bodies, a row of 4 texels each.
 void Renderer::Impl::set_occluders(const DrawList& list) {
-  occluder_T_world.clear(), occluder_half.clear();
+  occluder_count = 0;
   if (!p.show_rigid) return;
+  std::vector<float> rows;
   for (const RigidDraw& r : list.rigids) {
-    if (static_cast<int>(occluder_half.size()) == kMaxOccluders) break;
+    if (occluder_count == kMaxOccluders) break;
     vec3 centre{0.f, 0.f, 0.f}, half = r.half_extents;
     if (r.mesh && !r.mesh->positions.empty()) {
       vec3 lo = r.mesh->positions[0], hi = lo;
       for (const vec3& v : r.mesh->positions) lo = vmin(lo, v), hi = vmax(hi, v);
       centre = (lo + hi) * 0.5f, half = (hi - lo) * 0.5f;
     }
-    const SE3 world_T_box = r.world_T_body * SE3{mat3::identity(), centre};
-    occluder_T_world.push_back(model_matrix(world_T_box.inverse()));
-    occluder_half.push_back(half);
+    const SE3 box_T_world = (r.world_T_body * SE3{mat3::identity(), centre}).inverse();
+    for (int i = 0; i < 3; ++i)
+      rows.insert(rows.end(), {box_T_world.R.m[i][0], box_T_world.R.m[i][1], box_T_world.R.m[i][2],
+                               (&box_T_world.t.x)[i]});
+    rows.insert(rows.end(), {half.x, half.y, half.z, 0.f});
+    ++occluder_count;
   }
+  if (occluder_count == 0) return;
+  glBindTexture(GL_TEXTURE_2D, occluder_boxes);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, 4, occluder_count, GL_RGBA, GL_FLOAT, rows.data());
+  glBindTexture(GL_TEXTURE_2D, 0);
 }
 
 namespace {
@@ -170,7 +174,7 @@ void light_uniforms(const Program& prog, const mat3& R, GLuint bounds, int size)
 
 void Renderer::Impl::shadow_pass(const DrawList& list, std::int64_t n) {
   shadow_live = fluid_shadow_live = opaque_shadow_live = false;
-  occluder_T_world.clear(), occluder_half.clear();
+  occluder_count = 0;
   if (!p.shadows || !has_shadow) return;
   set_occluders(list);
   make_shadow_targets();

@@ -22,7 +22,6 @@ void main() {
     vec3 diffuse = max(dot(n, u_light), 0.0) * light;
     o_color = vec4(v_color * (u_ambient + (1.0 - u_ambient) * diffuse), 1.0);
   } else {
-    // The scan's colours hold its light.
-    o_color = vec4(shadowed_srgb(v_color, light, occluded_share(v_world, nw)), 1.0);
+    o_color = vec4(shadowed_srgb(v_color, light, 0.0), 1.0);  // the scan's colours hold its light
   }
 }
