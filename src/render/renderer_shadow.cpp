@@ -23,7 +23,8 @@
 namespace seamless {
 namespace {
 
-constexpr int kShadowMapUnit = 6, kLightBoundsUnit = 7, kFluidShadowUnit = 8, kBoxesUnit = 9;  // the receivers' texture units
+constexpr int kShadowMapUnit = 6, kLightBoundsUnit = 7, kFluidShadowUnit = 8,
+              kBoxesUnit = 9;      // the receivers' texture units
 constexpr int kMaxOccluders = 16;  // bodies that occlude the real surfaces: rows of `occluder_boxes`
 // Fixed-point path in fluid along the light (as the camera's thickness splat, renderer_splat.cpp):
 // 2^20 units per metre, at most half a unit of rounding per sphere on a ray (0.5 um), and 4096 m
@@ -148,8 +149,8 @@ void Renderer::Impl::set_occluders(const DrawList& list) {
     }
     const SE3 box_T_world = (r.world_T_body * SE3{mat3::identity(), centre}).inverse();
     for (int i = 0; i < 3; ++i)
-      rows.insert(rows.end(), {box_T_world.R.m[i][0], box_T_world.R.m[i][1], box_T_world.R.m[i][2],
-                               (&box_T_world.t.x)[i]});
+      rows.insert(rows.end(),
+                  {box_T_world.R.m[i][0], box_T_world.R.m[i][1], box_T_world.R.m[i][2], (&box_T_world.t.x)[i]});
     rows.insert(rows.end(), {half.x, half.y, half.z, 0.f});
     ++occluder_count;
   }
