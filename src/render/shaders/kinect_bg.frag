@@ -40,9 +40,9 @@ float surface_depth(vec2 px) {
   return z > 0.0 ? z : unmeasured_depth(px);
 }
 
-// The real surface's world normal at px, from the surface points kNormalStep
-// pixels to each side (a baseline over the Kinect's depth steps), turned towards the camera;
-// (0, 0, 0) where a side has no depth.
+// The real surface's world normal at px, from the surface points kNormalStep pixels to each side
+// (a baseline over the Kinect's depth steps), turned towards the camera; (0, 0, 0) where a side
+// has no depth.
 const float kNormalStep = 3.0;
 vec3 surface_normal(vec2 px) {
   float zr = surface_depth(px + vec2(kNormalStep, 0.0)), zl = surface_depth(px - vec2(kNormalStep, 0.0));

@@ -65,9 +65,10 @@ ivec2 window_texel(ivec2 p) { return ivec2(p.x, int(u_size.y) - 1 - p.y); }
 // as a thin layer resting on what is under it.
 // A drop rests when the surface the camera measured (the scene depth, with its unmeasured planes)
 // lies where the drop touches down, q = c - r up: q and the scene's point at q's pixel lie on one
-// ray, and their distance along it, projected on up (the height of q above or below the
-// surface; at most 10 times the distance where the view grazes the surface), must be within a
-// radius plus two steps of a Kinect v1's depth quantisation (2.85e-3 z^2 m each).
+// ray, and their distance along it times the cosine between the ray and up (the height of q
+// above or below the surface; the cosine taken as at least 0.1, so that a grazing view accepts at
+// most ten times the tolerance along the ray) must be within a radius plus two steps of a Kinect
+// v1's depth quantisation (2.85e-3 z^2 m each).
 const float kSessileHeight = 2.0 * 2.7e-3 * 0.5736;  // 2 l_c sin(35 degrees), metres
 
 bool rests_on_scene(vec3 c, vec3 up) {
