@@ -152,8 +152,7 @@ RunOutputs run_experiment(RunContext& ctx, const std::string& config) {
       renderer->set_kinect_frame(scan_result.first_frame, traj.front().se3());
   }
   const HorizontalSurface* floor_surface = e.floor_plane ? find_floor(ps.surfaces) : nullptr;
-  const std::vector<float> heights =
-      plane_heights(floor_surface ? std::optional<float>(floor_surface->height) : std::nullopt, e.support_plane);
+  const std::vector<float> heights = plane_heights(floor_height(floor_surface), e.support_plane);
   std::optional<kernels::SceneSdf> floor = scene_planes(heights, ps.up);
   // The same planes, where the recording has no depth: they hide and receive shadows.
   if (renderer) renderer->set_unmeasured_planes(unmeasured_planes(heights, ps.up));

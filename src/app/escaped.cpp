@@ -10,10 +10,8 @@ SceneBounds mesh_bounds(const Mesh& mesh, vec3 up, std::optional<float> floor) {
   SceneBounds b;
   b.up = up;
   b.floor = floor;
-  if (!mesh.positions.empty()) {
-    b.lo = b.hi = mesh.positions[0];
-    for (vec3 p : mesh.positions) b.lo = vmin(b.lo, p), b.hi = vmax(b.hi, p);
-  }
+  const Box3 bounds = point_bounds(mesh.positions);
+  b.lo = bounds.lo, b.hi = bounds.hi;
   return b;
 }
 

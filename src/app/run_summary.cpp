@@ -15,8 +15,12 @@
 
 namespace seamless::app {
 
+std::optional<float> floor_height(const HorizontalSurface* floor) {
+  return floor ? std::optional<float>(floor->height) : std::nullopt;
+}
+
 SceneBounds scene_bounds(const Mesh& mesh, vec3 up, const HorizontalSurface* floor) {
-  return mesh_bounds(mesh, up, floor ? std::optional<float>(floor->height) : std::nullopt);
+  return mesh_bounds(mesh, up, floor_height(floor));
 }
 
 std::optional<double> mean_dynamic_fraction(const std::vector<FrameRecord>& frames) {

@@ -18,6 +18,8 @@ namespace seamless::app {
 
 // The scanned mesh's bounds, `up`, and the floor's height when `floor` is not null (app/escaped.hpp).
 SceneBounds scene_bounds(const Mesh& mesh, vec3 up, const HorizontalSurface* floor);
+// The floor's height along up, where the scan found a floor.
+std::optional<float> floor_height(const HorizontalSurface* floor);
 
 struct RunSummary {
   // complete | interrupted | failed | incomplete (README, "Exit codes and interrupted runs");

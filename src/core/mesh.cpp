@@ -16,4 +16,12 @@ std::vector<vec3> vertex_normals(const std::vector<vec3>& p, const std::vector<i
   return n;
 }
 
+Box3 point_bounds(const std::vector<vec3>& points) {
+  Box3 b;
+  if (points.empty()) return b;
+  b.lo = b.hi = points[0];
+  for (const vec3& p : points) b.lo = vmin(b.lo, p), b.hi = vmax(b.hi, p);
+  return b;
+}
+
 }  // namespace seamless

@@ -23,6 +23,12 @@ struct BodyMesh {
   std::vector<int3> triangles;
 };
 
+// Axis-aligned bounds of points; lo = hi = (0, 0, 0) for none.
+struct Box3 {
+  vec3 lo{0.f, 0.f, 0.f}, hi{0.f, 0.f, 0.f};
+};
+Box3 point_bounds(const std::vector<vec3>& points);
+
 // Area-weighted vertex normals of a triangle mesh (smooth shading; zero-area or unused vertices
 // get (0, 0, 0)).
 std::vector<vec3> vertex_normals(const std::vector<vec3>& positions, const std::vector<int3>& triangles);

@@ -44,4 +44,9 @@ DrawList make_draw_list(const ParticleState& state, const SceneObjects& objects,
   return make_draw_list(state.x, state.phase, static_cast<std::int64_t>(state.x.size()), objects, frames, radius);
 }
 
+Box3 body_box(const RigidDraw& r) {
+  if (r.mesh && !r.mesh->positions.empty()) return point_bounds(r.mesh->positions);
+  return {r.half_extents * -1.f, r.half_extents};
+}
+
 }  // namespace seamless

@@ -18,6 +18,8 @@ struct RigidDraw {
   vec3 half_extents{0.1f, 0.1f, 0.1f};
   std::shared_ptr<const BodyMesh> mesh;  // null: the box
 };
+// A body's box in its own frame: its mesh's bounds, or +-half_extents without a mesh.
+Box3 body_box(const RigidDraw& r);
 
 // A cloth sheet: triangles indexing DrawList::positions (solver particle ids).
 struct ClothDraw {

@@ -552,8 +552,8 @@ void Renderer::set_scene_mesh(const Mesh& mesh) {
                 std::to_string(mesh.normals.size()) + " normals");
   m.scene.upload(mesh.positions, mesh.normals, mesh.colors, mesh.triangles, GL_STATIC_DRAW);
   m.has_scene = !mesh.triangles.empty();
-  m.scene_lo = m.scene_hi = mesh.positions.empty() ? vec3{0, 0, 0} : mesh.positions[0];
-  for (const vec3& q : mesh.positions) m.scene_lo = vmin(m.scene_lo, q), m.scene_hi = vmax(m.scene_hi, q);
+  const Box3 bounds = point_bounds(mesh.positions);
+  m.scene_lo = bounds.lo, m.scene_hi = bounds.hi;
   m.render_cube_map();
 }
 

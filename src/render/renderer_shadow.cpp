@@ -141,12 +141,8 @@ void Renderer::Impl::set_occluders(const DrawList& list) {
   std::vector<float> rows;
   for (const RigidDraw& r : list.rigids) {
     if (occluder_count == kMaxOccluders) break;
-    vec3 centre{0.f, 0.f, 0.f}, half = r.half_extents;
-    if (r.mesh && !r.mesh->positions.empty()) {
-      vec3 lo = r.mesh->positions[0], hi = lo;
-      for (const vec3& v : r.mesh->positions) lo = vmin(lo, v), hi = vmax(hi, v);
-      centre = (lo + hi) * 0.5f, half = (hi - lo) * 0.5f;
-    }
+    const Box3 box = body_box(r);
+    const vec3 centre = (box.lo + box.hi) * 0.5f, half = (box.hi - box.lo) * 0.5f;
     const SE3 box_T_world = (r.world_T_body * SE3{mat3::identity(), centre}).inverse();
     for (int i = 0; i < 3; ++i)
       rows.insert(rows.end(),
@@ -196,11 +192,8 @@ void Renderer::Impl::shadow_pass(const DrawList& list, std::int64_t n) {
   float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
   if (rigids)
     for (const RigidDraw& r : list.rigids) {
-      vec3 a = -r.half_extents, b = r.half_extents;
-      if (r.mesh && !r.mesh->positions.empty()) {
-        a = b = r.mesh->positions[0];
-        for (const vec3& q : r.mesh->positions) a = vmin(a, q), b = vmax(b, q);
-      }
+      const Box3 box = body_box(r);
+      const vec3 a = box.lo, b = box.hi;
       for (int k = 0; k < 8; ++k) {
         const vec3 corner{(k & 1) ? b.x : a.x, (k & 2) ? b.y : a.y, (k & 4) ? b.z : a.z};
         const vec3 q = light_R * (r.world_T_body * corner);
