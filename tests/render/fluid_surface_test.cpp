@@ -726,29 +726,33 @@ TEST(RenderFluidSurface, LoneParticleIsADropOfItsOwnSize) {
 // A lone particle lying on a surface is a sessile drop, not a bead (splat.glsl, "Lone drops at
 // rest"). The camera looks straight down at a floor 0.5 m away (the Kinect view of a flat depth
 // image; world = eye, so up is -z, towards the camera). A particle of r = 1 cm whose bottom touches
-// the floor is drawn as the upper half of an oblate ellipsoid on the floor: of height H = 3.1 mm and
-// radius a = sqrt(2 r^3 / H) = 2.54 cm, so the fluid covers the disc of radius a around the touch
-// point's pixel (all of it within 0.8 a, none beyond a plus a pixel), no depth is nearer than the
-// cap's top, 0.5 - H (less 1 mm), and at the touch point the depth is the cap's top (the filter
-// leaves a drop as splatted; the pixel's ray meets the cap within a few hundredths of a from its
-// axis, where it is lower by less than 1e-3 H: within 0.1 mm), tagged as a drop lying flat. The same
-// particle 5 cm above the floor is a drop in the air: a bead of its own radius, its depth the
-// sphere's front at the centre (within 1 mm), tagged as a drop, not flat.
+// the floor is drawn as a pancake of height H = 3.1 mm and radius a = sqrt(16 r^3 / (11 H)) =
+// 2.17 cm on the floor, so the fluid covers the disc of radius a around the touch point's pixel
+// (all of it within 0.8 a, none beyond a plus a pixel), no depth is nearer than its top, 0.5 - H
+// (less 1 mm), and at the touch point the depth is the top's (a plane: float rounding only, within
+// 0.1 mm), tagged as a drop lying flat. Two such drops 1.2 a apart overlap, and water that touches
+// is one body. The particles rest 4 mm into and 3 mm above the floor (the solver's particles rest
+// on the scan's bumpy particles; within the rest test's tolerance), and each drop is laid on the
+// measured floor: along the row through their touch points every pixel between them meets the one
+// flat top (each such pixel is within 0.6 a of a touch point, inside either top's sqrt(3)/2 a), so
+// the depth there is 0.5 - H within 0.1 mm. (Two domes would meet in a crease there, 0.2 H = 0.6 mm
+// lower at the midpoint; tops at the particles' heights would be 7 mm apart.) The same particle 5 cm above the floor is
+// a drop in the air: a bead of its own radius, its depth the sphere's front at the centre (within 1 mm), tagged as a
+// drop, not flat.
 TEST(RenderFluidSurface, LoneDropAtRestLiesFlat) {
   SEAMLESS_REQUIRE_EGL();
   const Intrinsics K = small_K();
   const float r = 0.01f, floor_z = 0.5f;
-  const float H = 2.f * 2.7e-3f * std::sin(35.f * 3.14159265f / 180.f), a = std::sqrt(2.f * r * r * r / H);
+  const float H = 2.f * 2.7e-3f * std::sin(35.f * 3.14159265f / 180.f), a = std::sqrt(16.f * r * r * r / (11.f * H));
   std::vector<uchar3> rgb(static_cast<std::size_t>(kW) * kH, kTableGrey);
   std::vector<float> depth(rgb.size(), floor_z);
   RenderParams p = surface_params();
   p.view = RenderView::kinect;
   p.fluid_anisotropy = true;
-  auto render = [&](float lift) {
+  auto render = [&](const std::vector<vec3>& x) {
     Renderer rd(p, kW, kH);
     rd.set_kinect_view(Image<uchar3>::from_host(rgb, kW, kH, Device::CPU),
                        Image<float>::from_host(depth, kW, kH, Device::CPU), K, SE3::identity());
-    std::vector<vec3> x = {{0.02f, -0.01f, floor_z - r - lift}};
     std::vector<std::uint32_t> ph;
     DrawList d = fluid_list(x, ph, r);
     d.up = {0.f, 0.f, -1.f};
@@ -756,22 +760,23 @@ TEST(RenderFluidSurface, LoneDropAtRestLiesFlat) {
     EXPECT_TRUE(rd.uses_compute_splat());
     return rd.read_fluid_images();
   };
-  const float cu = K.cx + K.fx * 0.02f / floor_z, cv = K.cy - K.fy * 0.01f / floor_z;  // the touch point
-  const float R = K.fx * a / floor_z;                                                  // the disc's radius in pixels
-  const Renderer::FluidImages flat = render(0.f);
+  auto pixel = [&](float x, float y, float z) { return vec3{K.cx + K.fx * x / z, K.cy + K.fy * y / z, 0.f}; };
+  const vec3 c = pixel(0.02f, -0.01f, floor_z);  // the touch point
+  const float R = K.fx * a / floor_z;            // the disc's radius in pixels
+  const Renderer::FluidImages flat = render({{0.02f, -0.01f, floor_z - r}});
   int inside = 0, missing = 0, outside = 0;
   float nearest = 1e9f;
   for (int v = 0; v < kH; ++v)
     for (int u = 0; u < kW; ++u) {
-      const float rho = std::hypot(u - cu, v - cv), d = depth_at(flat, u, v);
+      const float rho = std::hypot(u - c.x, v - c.y), d = depth_at(flat, u, v);
       if (d > 0.f) nearest = std::min(nearest, d), ++inside;
       if (d > 0.f && rho > R + 1.f) ++outside;
       if (d <= 0.f && rho < 0.8f * R) ++missing;
     }
-  const float centre = depth_at(flat, static_cast<int>(std::lround(cu)), static_cast<int>(std::lround(cv)));
+  const float centre = depth_at(flat, static_cast<int>(std::lround(c.x)), static_cast<int>(std::lround(c.y)));
   std::printf(
       "at rest: disc of %.1f pixels radius, %d pixels drawn, %d missing inside 0.8 a, %d outside a; "
-      "nearest depth %.4f m (cap top %.4f), centre %.4f\n",
+      "nearest depth %.4f m (top %.4f), centre %.4f\n",
       R, inside, missing, outside, nearest, floor_z - H, centre);
   EXPECT_GT(inside, 0.6f * 3.14159f * R * R);
   EXPECT_EQ(missing, 0);
@@ -780,10 +785,26 @@ TEST(RenderFluidSurface, LoneDropAtRestLiesFlat) {
   EXPECT_NEAR(centre, floor_z - H, 1e-4f);
   EXPECT_EQ(drop_tag(centre), 3u) << "a drop at rest is a drop lying flat";
 
+  const float half = 0.6f * a, y = -0.01f;
+  const Renderer::FluidImages pair = render({{-half, y, floor_z - r + 4e-3f}, {half, y, floor_z - r - 3e-3f}});
+  const vec3 left = pixel(-half, y, floor_z), right = pixel(half, y, floor_z);
+  const int row = static_cast<int>(std::lround(left.y));
+  float worst = 0.f;
+  int checked = 0;
+  for (int u = static_cast<int>(std::ceil(left.x)); u <= static_cast<int>(std::floor(right.x)); ++u, ++checked) {
+    const float d = depth_at(pair, u, row);
+    worst = std::max(worst, std::fabs(d - (floor_z - H)));
+    EXPECT_EQ(drop_tag(d), 3u) << "pixel " << u << "," << row;
+  }
+  std::printf("two drops 1.2 a apart: %d pixels between them, depth at worst %.2f mm from the top\n", checked,
+              worst * 1e3f);
+  EXPECT_GT(checked, static_cast<int>(R));
+  EXPECT_LT(worst, 1e-4f) << "drops that touch are one flat body";
+
   const float lift = 0.05f, z_bead = floor_z - r - lift;
-  const Renderer::FluidImages bead = render(lift);
-  const float bu = K.cx + K.fx * 0.02f / z_bead, bv = K.cy - K.fy * 0.01f / z_bead;
-  const float front = depth_at(bead, static_cast<int>(std::lround(bu)), static_cast<int>(std::lround(bv)));
+  const Renderer::FluidImages bead = render({{0.02f, -0.01f, z_bead}});
+  const vec3 b = pixel(0.02f, -0.01f, z_bead);
+  const float front = depth_at(bead, static_cast<int>(std::lround(b.x)), static_cast<int>(std::lround(b.y)));
   std::printf("in the air: depth %.4f m at the centre (sphere's front %.4f)\n", front, z_bead - r);
   EXPECT_NEAR(front, z_bead - r, 1e-3f);
   EXPECT_EQ(drop_tag(front), 1u) << "a drop in the air is a bead";

@@ -30,6 +30,8 @@ struct Splat {
   mat3 M;
   bool drop;
   bool flat_drop;  // a drop lying flat (Lone drops at rest)
+  vec3 up;         // against gravity, eye space
+  float top;       // a flat drop's top: its height above c (a flat drop's c is its touch-down point)
 };
 
 // Lone drops. The splat radius u_radius (fluid_radius_scale particle radii) is larger than a
@@ -56,22 +58,31 @@ ivec2 window_texel(ivec2 p) { return ivec2(p.x, int(u_size.y) - 1 - p.y); }
 // puddle of height H = 2 l_c sin(theta / 2) whatever its volume (de Gennes, Brochard-Wyart & Quere
 // 2004, "Capillarity and Wetting Phenomena", ch. 2, gravity puddles), theta the contact angle:
 // 70 degrees (water on varnished wood, laminate and plastics lies between about 60 and 90), so
-// H = 3.1 mm. It is drawn as the upper half of an oblate ellipsoid centred where the drop touches
-// the surface (the lower half lies behind the surface, which hides it): semi-axis H along up and
-// a = sqrt(2 r^3 / H) across, which keeps V = 2/3 pi a^2 H (a 1 cm particle: a wet spot 5 cm
-// across). A drop narrower than l_c is not flattened below its radius (H at most r). It stays a
-// drop for the filter (its cap drawn as splatted, so its rim keeps the cap's slope, which a
-// filter as wide as the cap would flatten) and is tagged flat for the composite, which shades it
-// as a thin layer resting on what is under it.
+// H = 3.1 mm. Such a puddle is a pancake: a flat top at H and an edge about l_c wide where the
+// surface turns down to the contact line. It is drawn as an oblate ellipsoid centred where the drop
+// touches the surface (its lower half lies behind the surface, which hides it), semi-axis 2 H along
+// up and a across, cut by the plane at height H: the top is flat out to sqrt(3)/2 a and the edge
+// rises over the last 0.13 a (2.9 mm for a 1 cm particle, about l_c). The cut shape holds
+// 11/12 pi a^2 H, so a = sqrt(16 r^3 / (11 H)) keeps V (a 1 cm particle: a wet spot 4.3 cm
+// across). The flat top is what lets drops that touch merge: two tops at the same height are one
+// surface, where two domes met in a crease and read as stacked coins. A drop narrower than l_c is
+// not flattened below its radius (H at most r). It stays a drop for the filter (its cap drawn as
+// splatted, so its edge keeps its slope, which a filter as wide as the cap would flatten) and is
+// tagged flat for the composite, which shades it as a thin layer resting on what is under it.
 // A drop rests when the surface the camera measured (the scene depth, with its unmeasured planes)
 // lies where the drop touches down, q = c - r up: q and the scene's point at q's pixel lie on one
 // ray, and their distance along it times the cosine between the ray and up (the height of q
 // above or below the surface; the cosine taken as at least 0.1, so that a grazing view accepts at
 // most ten times the tolerance along the ray) must be within a radius plus two steps of a Kinect
-// v1's depth quantisation (2.85e-3 z^2 m each).
+// v1's depth quantisation (2.85e-3 z^2 m each). The drop is then laid on that measured surface,
+// not where the particle rests: the solver's particles rest on the scan's particles, a bumpy
+// lattice, at heights that differ by millimetres, as much as H, and two drops that touch would
+// show the step between their tops as an edge.
 const float kSessileHeight = 2.0 * 2.7e-3 * 0.5736;  // 2 l_c sin(35 degrees), metres
 
-bool rests_on_scene(vec3 c, vec3 up) {
+// Whether a lone drop at eye-space centre c rests on the scene; if so, lift: how far the measured
+// surface lies above its touch-down point along up (negative: below).
+bool rests_on_scene(vec3 c, vec3 up, out float lift) {
   vec3 q = c - u_drop_radius * up;
   if (q.z <= u_near_far.x) return false;
   vec2 px = vec2(u_K.x * q.x / q.z + u_K.z, u_K.y * q.y / q.z + u_K.w);
@@ -79,19 +90,23 @@ bool rests_on_scene(vec3 c, vec3 up) {
   if (any(lessThan(p, ivec2(0))) || any(greaterThanEqual(p, ivec2(u_size)))) return false;
   float w = texelFetch(u_scene_depth, window_texel(p), 0).r;
   if (w >= 1.0) return false;  // no surface there
-  vec3 ray = pixel_ray(px);
+  vec3 ray = pixel_ray(px);    // q = q.z ray
   float zs = eye_depth(w);
+  lift = (zs - q.z) * dot(ray, up);
   float along = abs(q.z - zs) * length(ray);
   return along * max(abs(dot(ray, up)) / length(ray), 0.1) < u_drop_radius + 0.006 * zs * zs;
 }
 
-// The sessile drop's shape (above) in place of the bead's, for a lone drop s at rest.
-void lie_flat(inout Splat s, vec3 up) {
-  float r = u_drop_radius, H = min(kSessileHeight, r), a = sqrt(2.0 * r * r * r / H);
-  s.c -= r * up;
-  s.r = a;  // a >= sqrt(2) r >= H
-  s.M = mat3(1.0 / (a * a)) + (1.0 / (H * H) - 1.0 / (a * a)) * outerProduct(up, up);
+// The sessile drop's shape (above) in place of the bead's, for a lone drop s at rest, its
+// touch-down point lift above or below the measured surface.
+void lie_flat(inout Splat s, float lift) {
+  vec3 up = s.up;
+  float r = u_drop_radius, H = min(kSessileHeight, r), a = sqrt(16.0 * r * r * r / (11.0 * H));
+  s.c += (lift - r) * up;
+  s.r = max(a, 2.0 * H);  // bounds the whole ellipsoid, the part behind the surface included
+  s.M = mat3(1.0 / (a * a)) + (1.0 / (4.0 * H * H) - 1.0 / (a * a)) * outerProduct(up, up);
   s.flat_drop = true;
+  s.top = H;
 }
 
 // This invocation's particle: groups form a 2D grid because one dimension holds at most 65535.
@@ -114,8 +129,10 @@ bool splat_shape(uint i, out Splat s) {
     s.r = s.drop ? u_drop_radius : a.w;
     mat3 Rv = mat3(u_view);  // world -> eye rotation: M_eye = Rv M Rv^T
     s.M = s.drop ? mat3(1.0 / (s.r * s.r)) : Rv * mat3(m.x, m.y, m.z, m.y, m.w, n.x, m.z, n.x, n.y) * transpose(Rv);
-    vec3 up = Rv * u_up;
-    if (s.drop && rests_on_scene(s.c, up)) lie_flat(s, up);
+    s.up = Rv * u_up;
+    s.top = 0.0;
+    float lift;
+    if (s.drop && rests_on_scene(s.c, s.up, lift)) lie_flat(s, lift);
   } else {
     s.c = (u_view * vec4(b_pos[3u * i], b_pos[3u * i + 1u], b_pos[3u * i + 2u], 1.0)).xyz;
     s.r = u_radius;
@@ -129,7 +146,16 @@ bool splat_shape(uint i, out Splat s) {
 // the sphere path stays bit for bit the raster path's).
 bool ray_splat(vec3 d, Splat s, out float z_in, out float z_out) {
   if (!u_aniso) return ray_sphere(d, s.c, z_in, z_out);
-  return ray_quadric(d, s.c, s.M, z_in, z_out);
+  if (!ray_quadric(d, s.c, s.M, z_in, z_out)) return false;
+  if (!s.flat_drop) return true;
+  // A flat drop keeps the part of its ellipsoid at most s.top above c: along the ray z d the
+  // height is z dot(d, up) - dot(c, up), so the plane is crossed at z_top.
+  float du = dot(d, s.up), hc = dot(s.c, s.up);
+  if (abs(du) < 1e-6) return -hc <= s.top;
+  float z_top = (s.top + hc) / du;
+  if (du < 0.0) z_in = max(z_in, z_top);  // looking down: below the plane beyond z_top
+  else z_out = min(z_out, z_top);
+  return z_in <= z_out && z_in > u_near_far.x;
 }
 
 // Image pixels (u right, v down) of sphere.vert's sprite, [lo, hi] inclusive, cut to the image:
