@@ -2,32 +2,12 @@
 #pragma once
 #include <cmath>
 
+#include "core/sym3.hpp"
 #include "kernels/physics/anisotropy.hpp"
 
 namespace seamless::kernels {
 
 namespace detail {
-
-// Symmetric 3 x 3 A = V diag(e) V^T by cyclic Jacobi rotations (each zeroes one off-diagonal
-// element, Golub & Van Loan 8.4.2, sym.schur2); a 3 x 3 matrix converges to float precision in a
-// few sweeps, and six are ample.
-SEAMLESS_HD inline void eigen_sym3(mat3 A, mat3& V, vec3& e) {
-  V = mat3::identity();
-  for (int sweep = 0; sweep < 6; ++sweep)
-    for (int k = 0; k < 3; ++k) {
-      const int p = k == 2 ? 1 : 0, q = k == 0 ? 1 : 2;  // (0,1), (0,2), (1,2)
-      const float apq = A.m[p][q];
-      if (fabsf(apq) < 1e-20f) continue;
-      const float tau = (A.m[q][q] - A.m[p][p]) / (2.f * apq);
-      const float t = (tau >= 0.f ? 1.f : -1.f) / (fabsf(tau) + sqrtf(tau * tau + 1.f));
-      const float c = 1.f / sqrtf(t * t + 1.f), s = t * c;
-      mat3 J = mat3::identity();
-      J.m[p][p] = c, J.m[q][q] = c, J.m[p][q] = s, J.m[q][p] = -s;
-      A = transpose(J) * A * J;
-      V = V * J;
-    }
-  e = {A.m[0][0], A.m[1][1], A.m[2][2]};
-}
 
 SEAMLESS_HD inline void write_ellipsoid(vec4* out, vec3 c, float bound, const mat3& M, bool lone, float offset) {
   out[0] = {c.x, c.y, c.z, bound};
@@ -61,7 +41,7 @@ template <Executor Exec> void Anisotropy<Exec>::ellipsoids(const Exec& ex, const
       const float h2 = V.h * V.h, inv_h = 1.f / V.h;
       float sw = 0.f;
       vec3 sy{0.f, 0.f, 0.f};
-      mat3 syy = mat3::zero();
+      sym3 syy = sym3::zero();  // symmetric: its six distinct terms only
       int neighbours = 0;
       for_each_in_radius(V.grid, V.cell_start, xi, V.h, [&](int j) {
         const Packed o = V.sorted[j];
@@ -70,17 +50,17 @@ template <Executor Exec> void Anisotropy<Exec>::ellipsoids(const Exec& ex, const
         const float d2 = length2(y);
         if (d2 >= h2) return;
         const float q = sqrtf(d2) * inv_h, w = 1.f - q * q * q;
-        sw += w, sy = sy + w * y, syy = syy + outer(y, y) * w;
+        sw += w, sy = sy + w * y, syy = syy + sym_outer(y) * w;
         neighbours += j != static_cast<int>(s) ? 1 : 0;
       });
       lone = neighbours < kMinNeighbours;
       if (!lone) {
         const vec3 mean = sy / sw;
         offset = length(mean) * inv_h;
-        const mat3 C = syy * (1.f / sw) + outer(mean, mean) * -1.f;  // weighted covariance (eq. 10)
+        const sym3 C = syy * (1.f / sw) + sym_outer(mean) * -1.f;  // weighted covariance (eq. 10)
         mat3 R;
         vec3 e;
-        detail::eigen_sym3(C, R, e);
+        eigen_sym3(C, R, e);
         // Axes in proportion to the standard deviations along the principal directions, none
         // below 1 / kMaxAxisRatio of the longest (eq. 12's clamp), scaled to the sphere's volume
         // so that the summed chords stay a path length in fluid (the renderer's thickness pass).

@@ -3,6 +3,12 @@
 foreach(family grid contacts fluid solids integration depth_colliders anisotropy)
   seamless_kernel_family(physics/${family})
 endforeach()
+# The anisotropic kernels' neighbour walk is latency-bound: capped at 40 registers (from 46), six
+# blocks of 256 threads fit a multiprocessor instead of five, at the cost of a few spilled words
+# (docs/PERFORMANCE.md, "The anisotropic kernels' cost").
+if(SEAMLESS_HAS_CUDA)
+  set_source_files_properties(physics/anisotropy_cuda.cu PROPERTIES COMPILE_OPTIONS "-maxrregcount=40")
+endif()
 # The CPU's SIMD tiles (never compiled by nvcc).
 target_sources(seamless_kernels PRIVATE physics/cpu_tiles.cpp)
 # The CPU instantiations without errno for sqrt: the same results (sqrt of a negative is NaN either
