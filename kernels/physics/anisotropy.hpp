@@ -15,13 +15,16 @@
 
 namespace seamless::kernels {
 
-// Yu & Turk's constants (section 4): an axis at most kMaxAxisRatio times shorter than the longest,
-// and at least kMinNeighbours neighbours for a shape. Their N_eps (25) is for a neighbourhood of
-// about twice the particle spacing in bulk; here it must also hold for a spread layer, whose ring
-// within three spacings has about ten: a particle with fewer than 6 has no meaningful plane and
-// stays a sphere (a lone drop, the tip of a filament).
+// Yu & Turk's constants (section 4): an axis at most kMaxAxisRatio times shorter than the longest;
+// the neighbourhood h twice the particle spacing, which at rest is two radii: kNeighbourhoodRadii
+// radii. Their N_eps (25) neighbours for a shape is what that h holds in bulk (about 33); here the
+// count must also hold for a layer spread over a surface, whose particles lie up to 3 radii apart,
+// so that within h a particle inside the layer has its first ring (about 6) and one at the
+// layer's edge half of it. Three neighbours span a plane, the least a flattened shape needs: with
+// fewer a particle stays a sphere (a lone drop, the tip of a filament).
 constexpr float kMaxAxisRatio = 4.f;
-constexpr int kMinNeighbours = 6;
+constexpr float kNeighbourhoodRadii = 4.f;
+constexpr int kMinNeighbours = 3;
 // Their smoothing of the kernel centres towards the neighbourhood's weighted mean (section 5,
 // lambda = 0.9 in the paper): it flattens a layer whose particles lie at slightly different
 // heights. Kept below theirs because their centres feed an isosurface while ours are drawn

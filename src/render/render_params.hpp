@@ -118,7 +118,7 @@ struct RenderParams {
   // only: with the anisotropic kernels the layer is closed by its ellipsoids.
   float fluid_gap_fill = 4.f;
   // Anisotropic kernels (Yu & Turk 2013): each fluid particle splatted as an ellipsoid shaped by
-  // its neighbours within filter_size radii (compute splats only; the raster path draws spheres).
+  // its neighbours within two rest spacings (compute splats only; the raster path draws spheres).
   bool fluid_anisotropy = true;
   // The fluid's depth splat in two passes when the anisotropic kernels mark the particles at the
   // surface: those first, then the others, each skipped when the depth already splatted hides it

@@ -115,9 +115,9 @@ class Renderer {
   unsigned particle_phase_buffer() const;
   unsigned particle_ellipsoid_buffer() const;
   // The anisotropic kernels' sizes for particles of this radius (FluidEllipsoids::compute's radius
-  // and h): the sphere drawn and the neighbourhood, the depth filter's half-width (filter_size
-  // radii: the spacing the surface must span). None when the fluid is drawn as spheres
-  // (render.fluid_anisotropy off, or no compute splats).
+  // and h): the sphere drawn and the neighbourhood (kernels::kNeighbourhoodRadii radii: two rest
+  // spacings). None when the fluid is drawn as spheres (render.fluid_anisotropy off, or no
+  // compute splats).
   struct EllipsoidSizes {
     float radius = 0.f, h = 0.f;
   };

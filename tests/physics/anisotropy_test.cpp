@@ -24,7 +24,7 @@ namespace ellipsoids_test {
 
 constexpr float kR = 0.01f;     // sphere radius drawn
 constexpr float kD = 2.f * kR;  // lattice spacing: one particle diameter
-constexpr float kH = 3.f * kD;  // neighbourhood: the renderer's default (filter_size 6 radii)
+constexpr float kH = 3.f * kD;  // neighbourhood: three spacings (the renderer's is two, kNeighbourhoodRadii)
 constexpr int kV = kernels::kEllipsoidVec4s;
 
 struct Ellipsoid {

@@ -320,10 +320,10 @@ TEST(RenderSplat, OccludersFirstGiveTheSameDepthAndSkipTheHidden) {
   const std::vector<vec4> e = FluidEllipsoids(Device::CPU).compute_host(b.x, b.ph, sizes->radius, sizes->h);
   std::int64_t surface = 0;
   for (std::size_t i = 0; i < b.x.size(); ++i) surface += e[FluidEllipsoids::kVec4s * i + 2].w >= 0.15f;
-  // The outer layer of the 14^3 block (14^3 - 12^3 = 1016 particles: offsets of 0.23 h or more)
-  // and the 8 corners of the next (0.153 h: their neighbourhoods lack a layer on three sides;
-  // the next layer's faces have 0.07 h, its edges 0.11 h).
-  EXPECT_EQ(surface, 14 * 14 * 14 - 12 * 12 * 12 + 8);
+  // The outer layer of the 14^3 block (14^3 - 12^3 = 1016 particles), and none of the next: h is
+  // two spacings, and the layer a particle of the next one lacks lies two spacings away, where the
+  // weight 1 - (d/h)^3 is 0, so its neighbourhood is whole and its offset 0 by symmetry.
+  EXPECT_EQ(surface, 14 * 14 * 14 - 12 * 12 * 12);
   EXPECT_EQ(two.counts.occluders, surface);
   const std::int64_t others = static_cast<std::int64_t>(b.x.size()) - surface;
   std::printf("occluders %lld, skipped %lld of the other %lld\n", static_cast<long long>(two.counts.occluders),
