@@ -21,6 +21,8 @@ class FluidEllipsoids {
  public:
   // vec4 per particle (the layout: kernels/physics/anisotropy.hpp).
   static constexpr int kVec4s = kernels::kEllipsoidVec4s;
+  // The neighbourhood h in particle radii (Yu & Turk's two rest spacings).
+  static constexpr float kNeighbourhoodRadii = kernels::kNeighbourhoodRadii;
   // The longest axis an ellipsoid can have, in sphere radii: two axes at the clamp
   // (kernels::kMaxAxisRatio times shorter than the third) and the sphere's volume kept.
   static float longest_axis() { return std::cbrt(kernels::kMaxAxisRatio * kernels::kMaxAxisRatio); }

@@ -7,7 +7,6 @@
 #include "core/log.hpp"
 #include "core/mesh.hpp"
 #include "core/phase.hpp"
-#include "kernels/physics/anisotropy.hpp"
 #include "render/renderer_impl.hpp"
 
 namespace seamless {
@@ -227,7 +226,7 @@ void Renderer::Impl::upload_particles(const DrawList& list) {
 
 std::optional<Renderer::EllipsoidSizes> Renderer::Impl::ellipsoid_sizes(float radius) const {
   if (!p.fluid_anisotropy || !use_compute_splat() || !(radius > 0.f)) return std::nullopt;
-  return Renderer::EllipsoidSizes{radius * p.fluid_radius_scale, kernels::kNeighbourhoodRadii * radius};
+  return Renderer::EllipsoidSizes{radius * p.fluid_radius_scale, FluidEllipsoids::kNeighbourhoodRadii * radius};
 }
 
 // This frame's fluid ellipsoids for the splats: the list's own, or computed here on the CPU when

@@ -115,7 +115,7 @@ class Renderer {
   unsigned particle_phase_buffer() const;
   unsigned particle_ellipsoid_buffer() const;
   // The anisotropic kernels' sizes for particles of this radius (FluidEllipsoids::compute's radius
-  // and h): the sphere drawn and the neighbourhood (kernels::kNeighbourhoodRadii radii: two rest
+  // and h): the sphere drawn and the neighbourhood (FluidEllipsoids::kNeighbourhoodRadii radii: two rest
   // spacings). None when the fluid is drawn as spheres (render.fluid_anisotropy off, or no
   // compute splats).
   struct EllipsoidSizes {
