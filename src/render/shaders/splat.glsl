@@ -92,9 +92,8 @@ bool rests_on_scene(vec3 c, vec3 up, out float lift) {
   if (w >= 1.0) return false;  // no surface there
   vec3 ray = pixel_ray(px);    // q = q.z ray
   float zs = eye_depth(w);
-  lift = (zs - q.z) * dot(ray, up);
-  float along = abs(q.z - zs) * length(ray);
-  return along * max(abs(dot(ray, up)) / length(ray), 0.1) < u_drop_radius + 0.006 * zs * zs;
+  lift = (zs - q.z) * dot(ray, up);  // the distance along the ray times the cosine with up
+  return max(abs(lift), 0.1 * abs(zs - q.z) * length(ray)) < u_drop_radius + 0.006 * zs * zs;
 }
 
 // The sessile drop's shape (above) in place of the bead's, for a lone drop s at rest, its
