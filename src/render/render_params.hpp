@@ -106,7 +106,7 @@ struct RenderParams {
   float fluid_radius_scale = 1.5f;
   FluidFilter fluid_filter =
       FluidFilter::narrow_range;  // depth smoothing: narrow_range (Truong & Yuksel 2018) or bilateral
-  int filter_iterations = 2;      // separable filter passes (x then y) over the depth
+  int filter_iterations = 2;      // separable filter iterations over the depth (rows and columns, alternating order)
   int filter_max_taps = 12;       // taps per side at most: wider kernels sample every k-th pixel
   // Filter half-width in particle radii (world), projected per pixel: three particle spacings
   // (a diameter each), so that the spheres' bumps average out into one surface.
@@ -228,7 +228,8 @@ struct RenderParams {
     v("fluid_radius_scale", fluid_radius_scale, "fluid sphere size in the SSFR passes, particle radii",
       Range{0.5, 4.0});
     v("fluid_filter", fluid_filter, "fluid depth filter");
-    v("filter_iterations", filter_iterations, "depth filter passes (x then y)", Range{0, 16});
+    v("filter_iterations", filter_iterations, "depth filter iterations (rows then columns, the next columns then rows)",
+      Range{0, 16});
     v("filter_max_taps", filter_max_taps, "depth filter taps per side at most (wider: strided)", Range{1, 128});
     v("filter_size", filter_size, "depth filter half-width, particle radii", Range{0.0, 50.0});
     v("filter_max_px", filter_max_px, "depth filter half-width limit, pixels", Range{1, 128});

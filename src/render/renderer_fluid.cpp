@@ -233,8 +233,14 @@ void Renderer::Impl::fluid_filter_passes(float radius, const RenderCamera& cam) 
     // rectangle of water along the rows and columns (docs/RENDERING.md, Water: gap fill).
     const bool fill = it == 0 && !aniso_live;
     glUniform1f(fp.loc("u_fill_world"), fill ? p.fluid_gap_fill * radius : 0.f);
-    filter_pass(fluid_depth[0], fluid_depth[1], fluid_filter_fbo[1], 1, 0, w, h);
-    filter_pass(fluid_depth[1], fluid_depth[0], fluid_filter_fbo[0], 0, 1, w, h);
+    // Every other iteration runs the columns first, so that the filter ends along the rows. At a
+    // rim the window of the pass across it is one-sided and its result differs from line to line
+    // (each holds other splats' edges); the pass after smooths that along its own direction.
+    // Always ending with the columns left those differences along the rows: a puddle seen at a
+    // grazing angle, whose front rim runs along the rows, showed vertical streaks in its normals.
+    const int first = it % 2;
+    filter_pass(fluid_depth[0], fluid_depth[1], fluid_filter_fbo[1], 1 - first, first, w, h);
+    filter_pass(fluid_depth[1], fluid_depth[0], fluid_filter_fbo[0], first, 1 - first, w, h);
   }
 }
 
