@@ -21,9 +21,10 @@ namespace seamless::kernels {
 constexpr int kBlockSide = 8;
 constexpr int kBlockVoxels = kBlockSide * kBlockSide * kBlockSide;
 
-// 4 bytes: the TSDF and the fusion weight as 16-bit integers (as InfiniTAM stores them, Kaehler et
-// al. 2015): what every stage reads, so the march and fusion, which are bound by voxel loads, move
-// half the bytes of two floats, and a cell's two voxels along x share 8 aligned bytes. A voxel's
+// 4 bytes: the TSDF and the fusion weight as 16-bit integers (the distance as InfiniTAM stores
+// it, Kaehler et al. 2015, whose weight is a byte): what every stage reads, so the march and fusion, which are bound by voxel loads, move
+// half the bytes of two floats, and a cache line holds two of a block's rows along x, so a cell
+// with even y finds its 8 corners in 2 lines instead of 4. A voxel's
 // fused colour is kept in a pool of its own with the same index (the accessors' `colors`), read
 // only by the stages that use colour.
 //

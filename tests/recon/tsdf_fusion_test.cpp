@@ -678,9 +678,10 @@ TEST(VoxelEncoding, RunningAverageConvergesAtTheWeightCap) {
   for (int n = 0; n < 3000; ++n) kernels::fuse_tsdf(v, t, mu, cap);
   EXPECT_LE(std::fabs(v.sdf16 - t / mu * S), bound);
 
-  kernels::Voxel full = kernels::make_voxel(0.f, mu, 65534.f);
-  for (int n = 0; n < 3; ++n) kernels::fuse_tsdf(full, 0.f, mu, 65535.f);
-  EXPECT_EQ(full.weight16, 65535);
+  const float most = kernels::kMaxVoxelWeight;
+  kernels::Voxel full = kernels::make_voxel(0.f, mu, most - 1.f);
+  for (int n = 0; n < 3; ++n) kernels::fuse_tsdf(full, 0.f, mu, most);
+  EXPECT_EQ(kernels::voxel_weight(full), most);
 }
 
 // volume.max_weight must fit the 16-bit count: a whole number (checked by validate) up to 65535
