@@ -22,11 +22,10 @@ constexpr int kBlockSide = 8;
 constexpr int kBlockVoxels = kBlockSide * kBlockSide * kBlockSide;
 
 // 4 bytes: the TSDF and the fusion weight as 16-bit integers (the distance as InfiniTAM stores
-// it, Kaehler et al. 2015, whose weight is a byte): what every stage reads, so the march and fusion, which are bound by voxel loads, move
-// half the bytes of two floats, and a cache line holds two of a block's rows along x, so a cell
-// with even y finds its 8 corners in 2 lines instead of 4. A voxel's
-// fused colour is kept in a pool of its own with the same index (the accessors' `colors`), read
-// only by the stages that use colour.
+// it, Kaehler et al. 2015, whose weight is a byte): what every stage reads, so the march and fusion, which are bound by
+// voxel loads, move half the bytes of two floats, and a cache line holds two of a block's rows along x, so a cell with
+// even y finds its 8 corners in 2 lines instead of 4. A voxel's fused colour is kept in a pool of its own with the same
+// index (the accessors' `colors`), read only by the stages that use colour.
 //
 // Distance: the TSDF divided by the truncation mu as snorm16, round(32767 sdf / mu). Fusion
 // truncates every observation to [-mu, mu] and the running average of such values stays inside,
@@ -58,20 +57,23 @@ constexpr int kMaxVoxelWeight = 65535;
 SEAMLESS_HD inline float voxel_sdf(const Voxel& v, float mu) { return static_cast<float>(v.sdf16) * (mu / kSdfSteps); }
 SEAMLESS_HD inline float voxel_weight(const Voxel& v) { return static_cast<float>(v.weight16); }
 SEAMLESS_HD inline bool voxel_observed(const Voxel& v) { return v.weight16 != 0; }
-// Nearest step of a TSDF given in steps (sdf / mu * kSdfSteps), clamped to the truncation.
+// Nearest step of a TSDF given in steps (sdf / mu * kSdfSteps), clamped to the truncation; ties
+// away from zero. The truncating conversion of steps +- 1/2 is one instruction on either backend.
 SEAMLESS_HD inline std::int16_t sdf_steps(float steps) {
   steps = steps >= -kSdfSteps ? (steps <= kSdfSteps ? steps : kSdfSteps) : -kSdfSteps;
-  return static_cast<std::int16_t>(floor_int(steps + 0.5f));
+  return static_cast<std::int16_t>(static_cast<int>(steps + copysignf(0.5f, steps)));
 }
 // The voxel holding sdf (metres, truncation mu) with weight (a whole count up to kMaxVoxelWeight).
 SEAMLESS_HD inline Voxel make_voxel(float sdf, float mu, float weight) {
-  return {sdf_steps(sdf / mu * kSdfSteps), static_cast<std::uint16_t>(weight)};
+  return {sdf_steps(sdf * (kSdfSteps / mu)), static_cast<std::uint16_t>(weight)};
 }
 // One frame's observation tsdf (metres, in [-mu, mu]) into the running average (Curless & Levoy
-// 1996; KinectFusion eq. 11-12), the weight capped at max_weight (a whole count, see Voxel).
+// 1996; KinectFusion eq. 11-12), the weight capped at max_weight (a whole count, see Voxel). The
+// scale kSdfSteps / mu is the same for every voxel (a caller's loop computes it once): a multiply,
+// not a second division next to the one by w + 1.
 SEAMLESS_HD inline void fuse_tsdf(Voxel& v, float tsdf, float mu, float max_weight) {
   const float w = voxel_weight(v), q = static_cast<float>(v.sdf16);
-  v.sdf16 = sdf_steps(q + (tsdf / mu * kSdfSteps - q) / (w + 1.f));
+  v.sdf16 = sdf_steps(q + (tsdf * (kSdfSteps / mu) - q) / (w + 1.f));
   v.weight16 = static_cast<std::uint16_t>(min_of(w + 1.f, max_weight));
 }
 

@@ -648,7 +648,7 @@ TEST(VoxelEncoding, RoundTripWithinHalfAStep) {
   EXPECT_EQ(kernels::make_voxel(-mu, mu, 1.f).sdf16, -32767);
   EXPECT_EQ(kernels::make_voxel(3.f * mu, mu, 1.f).sdf16, 32767);
   EXPECT_EQ(kernels::make_voxel(-3.f * mu, mu, 1.f).sdf16, -32767);
-  EXPECT_EQ(kernels::voxel_sdf(kernels::make_voxel(mu, mu, 1.f), mu), mu);
+  EXPECT_FLOAT_EQ(kernels::voxel_sdf(kernels::make_voxel(mu, mu, 1.f), mu), mu);
   for (int w : {0, 1, 100, 65535}) EXPECT_EQ(kernels::voxel_weight(kernels::make_voxel(0.f, mu, float(w))), float(w));
   EXPECT_FALSE(kernels::voxel_observed(kernels::Voxel{0, 0}));
 }
