@@ -17,6 +17,17 @@
 
 namespace seamless {
 
+// Threads per work group of splat.glsl's kernels (its local_size_x): the camera's fluid splats and
+// the light's.
+inline constexpr GLuint kSplatGroup = 64;
+// Fixed-point path in fluid (the camera's thickness splat and the light's): units per metre of
+// path. Each chord is rounded to the nearest unit, so a pixel's sum is off by at most 0.5 unit per
+// sphere on its ray (2^-21 m = 0.5 um each; 10^3 spheres on one ray: 0.5 mm, against a path of
+// metres). uint32 then holds 2^32 / 2^20 = 4096 m of path: a ray's path in fluid is at most its
+// length inside the view volume (zfar, 30 m by default, times the ray's length factor, below 2 for
+// any usual field of view), two orders of magnitude beyond a room scene.
+inline constexpr float kFixedPerMetre = 1048576.f;  // 2^20
+
 // Move-only owner of one GL name; Del is the glDelete* function for it.
 template <void (*Del)(GLuint)> class GlName {
  public:

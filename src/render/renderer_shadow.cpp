@@ -24,15 +24,10 @@ namespace seamless {
 namespace {
 
 constexpr int kShadowMapUnit = 6, kLightBoundsUnit = 7, kFluidShadowUnit = 8,
-              kBoxesUnit = 9;      // the receivers' texture units
-constexpr int kMaxOccluders = 16;  // bodies that occlude the real surfaces: rows of `occluder_boxes`
-// Fixed-point path in fluid along the light (as the camera's thickness splat, renderer_splat.cpp):
-// 2^20 units per metre, at most half a unit of rounding per sphere on a ray (0.5 um), and 4096 m
-// of path before the uint32 wraps, far beyond any light path through the fluid.
-constexpr float kFixedPerMetre = 1048576.f;
+              kBoxesUnit = 9;             // the receivers' texture units
+constexpr int kMaxOccluders = 16;         // bodies that occlude the real surfaces: rows of `occluder_boxes`
 constexpr GLuint kBoundsGroup = 256;      // local_size_x of shadow_bounds.comp
 constexpr GLuint kBoundsGroupsMax = 256;  // grid-stride: few atomics on 6 texels
-constexpr GLuint kSplatGroup = 64;        // splat.glsl
 constexpr GLuint kScreenGroup = 8;
 
 // shadow.glsl's order_int: ints ordered like the floats, for atomic min / max of signed values.

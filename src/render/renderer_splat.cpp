@@ -13,7 +13,6 @@
 namespace seamless {
 namespace {
 
-constexpr GLuint kSplatGroup = 64;           // local_size_x of splat.glsl
 constexpr GLuint kResolveGroup = 8;          // local_size_x/y of ssfr_resolve.comp and screen.glsl
 constexpr GLuint kEmptyDepth = 0xffffffffu;  // "no fluid" in the depth-bits image: above every depth
 constexpr int kDepthTile = 4;                // pixels per side of ssfr_depth_tiles.comp's tiles
@@ -24,14 +23,6 @@ constexpr int kDepthTile = 4;                // pixels per side of ssfr_depth_ti
 // cover the face's plane: 0.75 spacings of radius against 0.71 from a point of the plane to the
 // nearest lattice point). The image does not depend on it, only the cost.
 constexpr float kOccluderOffset = 0.15f;
-
-// Fixed-point thickness: units per metre of path in fluid. Each chord is rounded to the nearest
-// unit, so a pixel's sum is off by at most 0.5 unit per sphere on its ray (2^-21 m = 0.5 um each;
-// 10^3 spheres on one ray: 0.5 mm, against a path of metres). uint32 then holds 2^32 / 2^20 =
-// 4096 m of path: a ray's path in fluid is at most its length inside the view volume (zfar, 30 m
-// by default, times the ray's length factor, below 2 for any usual field of view), so a room
-// scene is two orders of magnitude below the wrap-around.
-constexpr float kFixedPerMetre = 1048576.f;  // 2^20
 
 }  // namespace
 
