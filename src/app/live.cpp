@@ -84,20 +84,10 @@ class LiveLoop : public FrameLoop {
       inside_.emplace(radius, e_.solver.collider_thickness, kInsideRestFrames, ctx.device());
   }
 
-  // A copy of frame_ the renderer may still be making (stage_kinect_frame) ends before frame_ goes.
-  ~LiveLoop() override {
-    if (renderer_) renderer_->drop_staged_kinect_frame();
-  }
-
   bool advance() override {
-    // Before frame_ is refilled: a frame staged by an advance that threw is not drawn.
-    if (renderer_) renderer_->drop_staged_kinect_frame();
     if (finished_ || (total_ > 0 && static_cast<std::int64_t>(records_.size()) >= total_) || interrupted() ||
         !source_->next(frame_))
       return !(finished_ = true);
-    // The host's copy of the images for the Kinect view runs on the renderer's worker while the
-    // host mostly waits for the GPU's tracking (docs/PERFORMANCE.md, "The live AR loop").
-    if (renderer_) renderer_->stage_kinect_frame(frame_);
     const FrameRecord rec = session_.process(frame_);
     if (e_.dynamic.write_masks) write_dynamic_mask(ctx_.out_dir(), frame_.index, session_);
     if (online_)

@@ -131,11 +131,6 @@ class GlRunRenderer : public RunRenderer {
     }
   }
 
-  void stage_kinect_frame(const RgbdFrame& frame) override {
-    if (p_.view == RenderView::kinect) renderer_.stage_kinect_images(frame.rgb, frame.depth, region_);
-  }
-  void drop_staged_kinect_frame() override { renderer_.drop_staged_kinect_images(); }
-
   void set_unmeasured_planes(const std::vector<vec4>& world_planes) override {
     renderer_.set_unmeasured_planes(world_planes);
   }

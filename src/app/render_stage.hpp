@@ -49,12 +49,6 @@ class RunRenderer {
   virtual void set_scene(const Mesh& mesh, const SE3& scan_camera) = 0;
   // Kinect view: this frame's colour and depth at its tracked pose.
   virtual void set_kinect_frame(const RgbdFrame& frame, const SE3& world_T_camera) = 0;
-  // Kinect view: starts copying the frame's images for its set_kinect_frame ahead of it
-  // (Renderer::stage_kinect_images); the frame's images must stay unchanged until then, or until
-  // drop_staged_kinect_frame. Renderers that keep nothing ahead do nothing.
-  virtual void stage_kinect_frame(const RgbdFrame&) {}
-  // Waits for a staged copy and forgets it: before the staged frame's images change or go.
-  virtual void drop_staged_kinect_frame() {}
   // Kinect view: the surfaces the camera did not measure (Renderer::set_unmeasured_planes).
   virtual void set_unmeasured_planes(const std::vector<vec4>& world_planes) = 0;
   virtual void draw(const ParticleSolver& solver) = 0;

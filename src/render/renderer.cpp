@@ -16,6 +16,8 @@ vec3 srgb_to_linear(vec3 c) {  // IEC 61966-2-1, as color.glsl
   return {f(c.x), f(c.y), f(c.z)};
 }
 
+namespace {
+
 // The mean of an sRGB image (width w) over the rectangle a, in linear radiance (what the fluid
 // reflects in the Kinect view), from every 4th pixel of every 4th row: a tint, for which 19,200
 // samples of a 640 x 480 frame are plenty, where every pixel cost a share of each live frame.
@@ -32,8 +34,6 @@ vec3 mean_linear_color(const uchar3* c, int w, const PixelRect& a) {
   n = std::max(n, 1.0);
   return {static_cast<float>(r / n), static_cast<float>(g / n), static_cast<float>(b / n)};
 }
-
-namespace {
 
 // Texture tex (w x h) from host pixels through the pixel buffer pbo: the host's part is one copy
 // into a fresh buffer (the last frame's may still be in transfer: orphaned, not waited for), the
@@ -572,33 +572,21 @@ void Renderer::set_kinect_view(const Image<uchar3>& rgb, const Image<float>& dep
     m.kin_depth = make_texture_2d(GL_R32F, K.width, K.height, GL_NEAREST);  // never blend depths
     for (GlBuffer& b : m.kin_pbo) b = GlBuffer(new_name(glGenBuffers));
   }
+  upload_texture(m.kin_pbo[0], m.kin_rgb, K.width, K.height, GL_RGB, GL_UNSIGNED_BYTE, rgb.buffer().data(),
+                 sizeof(uchar3));
+  upload_texture(m.kin_pbo[1], m.kin_depth, K.width, K.height, GL_RED, GL_FLOAT, depth.buffer().data(), sizeof(float));
   const PixelRect whole{0, 0, K.width, K.height};
   const PixelRect& r = colour_region.empty() ? whole : colour_region;
   if (r.x < 0 || r.y < 0 || r.x + r.width > K.width || r.y + r.height > K.height)
     throw Error("render: Kinect view colour region " + std::to_string(r.width) + "x" + std::to_string(r.height) +
                 " at (" + std::to_string(r.x) + ", " + std::to_string(r.y) + ") is not inside the " +
                 std::to_string(K.width) + "x" + std::to_string(K.height) + " image");
-  if (const std::optional<vec3> mean = m.kin_staging.finish(rgb, depth, r, m.kin_rgb, m.kin_depth)) {
-    m.kin_mean = *mean;  // staged: copied and averaged on the worker (stage_kinect_images)
-  } else {
-    upload_texture(m.kin_pbo[0], m.kin_rgb, K.width, K.height, GL_RGB, GL_UNSIGNED_BYTE, rgb.buffer().data(),
-                   sizeof(uchar3));
-    upload_texture(m.kin_pbo[1], m.kin_depth, K.width, K.height, GL_RED, GL_FLOAT, depth.buffer().data(),
-                   sizeof(float));
-    m.kin_mean = mean_linear_color(rgb.buffer().data(), K.width, r);
-  }
   m.kin_K = K;
   m.kin_region = r;
   m.kin_pose = world_T_camera;
+  m.kin_mean = mean_linear_color(rgb.buffer().data(), K.width, r);
   m.has_kinect = true;
 }
-
-bool Renderer::stage_kinect_images(const Image<uchar3>& rgb, const Image<float>& depth,
-                                   const PixelRect& colour_region) {
-  return impl_->kin_staging.start(rgb, depth, colour_region);
-}
-
-void Renderer::drop_staged_kinect_images() { impl_->kin_staging.drop(); }
 
 void Renderer::set_unmeasured_planes(const std::vector<vec4>& world_planes) {
   if (world_planes.size() > static_cast<std::size_t>(kMaxUnmeasuredPlanes))

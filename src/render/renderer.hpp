@@ -62,16 +62,6 @@ class Renderer {
   // undistortion's black border), cut to the framebuffer's aspect ratio.
   void set_kinect_view(const Image<uchar3>& rgb, const Image<float>& depth, const Intrinsics& K,
                        const SE3& world_T_camera, const PixelRect& colour_region = {});
-  // Starts copying the Kinect view's images for a later set_kinect_view on a worker thread and
-  // returns: the live loop stages a frame as soon as it is read, so that the host's copy overlaps
-  // the tracking (docs/PERFORMANCE.md, "The live AR loop"). set_kinect_view with the same images
-  // and colour region then waits for the copy and draws from it; with others it drops it. The
-  // images must stay alive and unchanged until then (or drop_staged_kinect_images). False, with
-  // nothing started, where the context has no persistently mapped buffers (GL 4.4 or
-  // ARB_buffer_storage) or set_kinect_view would refuse the images: it copies them itself then.
-  bool stage_kinect_images(const Image<uchar3>& rgb, const Image<float>& depth, const PixelRect& colour_region = {});
-  // Waits for a staged copy and forgets it: before its images change or go. The destructor does it.
-  void drop_staged_kinect_images();
   // Surfaces the camera did not measure, as planes n . x = w in the world (n a unit vector; at most
   // kMaxUnmeasuredPlanes): in the Kinect view a pixel without recorded depth whose ray meets one
   // in front of the camera takes the nearest such point as its real surface, which then hides what

@@ -3,7 +3,6 @@
 #pragma once
 #include <epoxy/gl.h>
 
-#include <future>
 #include <map>
 #include <memory>
 #include <optional>
@@ -64,9 +63,6 @@ using VertexArray = GlName<gl_delete_vertex_array>;
 
 // sRGB-encoded 0..1 -> linear radiance (the host side of color.glsl).
 vec3 srgb_to_linear(vec3 c);
-// The mean of an sRGB image (width w) over the rectangle a, in linear radiance, from a sparse grid
-// of its pixels (renderer.cpp).
-vec3 mean_linear_color(const uchar3* c, int w, const PixelRect& a);
 
 Texture make_texture_2d(GLenum internal, int w, int h, GLenum filter = GL_NEAREST);
 GLuint new_name(void (*gen)(GLsizei, GLuint*));
@@ -107,52 +103,6 @@ class PassTimer {
   static std::vector<RenderTiming> read(const Frame& f);
   Frame frames_[2];  // this frame's queries and the last frame's
   int current_ = 0;
-};
-
-// The Kinect view's images copied on a worker thread (Renderer::stage_kinect_images,
-// kinect_staging.cpp) into a persistently mapped pixel buffer of two halves used in turn: a fence
-// after the textures' upload from a half keeps the worker from writing it while the GPU may still
-// read it. Only the worker writes the mapped memory; only the GL thread calls GL.
-class KinectStaging {
- public:
-  KinectStaging() = default;
-  ~KinectStaging();  // waits for the worker
-  KinectStaging(const KinectStaging&) = delete;
-  KinectStaging& operator=(const KinectStaging&) = delete;
-  // Drops a copy staged before, then starts copying the images (host, the same size) and computing
-  // their mean colour over colour_region (empty: all of it) on a worker. False, with nothing
-  // started, for images set_kinect_view would refuse or where the context has no persistently
-  // mapped buffers (GL 4.4 or ARB_buffer_storage). The images must stay unchanged until finish or
-  // drop.
-  bool start(const Image<uchar3>& rgb, const Image<float>& depth, const PixelRect& colour_region);
-  // Where the staged copy is of these images and region: waits for it (rethrowing the worker's
-  // exception), fills the textures from the buffer and returns the mean colour. Otherwise drops
-  // any staged copy and returns nothing (the caller copies the images itself).
-  std::optional<vec3> finish(const Image<uchar3>& rgb, const Image<float>& depth, const PixelRect& colour_region,
-                             GLuint rgb_tex, GLuint depth_tex);
-  // Waits for a staged copy and forgets it.
-  void drop() noexcept;
-
- private:
-  struct Staged {
-    const uchar3* rgb;
-    const float* depth;
-    int w, h;
-    PixelRect region;
-    int half;              // which half of the buffer holds the copy
-    std::size_t depth_at;  // the depth image's offset in the half
-  };
-  bool supported();
-  void reserve(std::size_t half_bytes);  // a buffer of two halves of at least half_bytes
-
-  std::optional<bool> supported_;
-  GlBuffer buf_;
-  unsigned char* map_ = nullptr;
-  std::size_t half_bytes_ = 0;
-  GLsync fence_[2] = {nullptr, nullptr};  // the last upload from each half
-  int next_ = 0;                          // the half the next start writes
-  std::optional<Staged> staged_;
-  std::future<vec3> worker_;
 };
 
 struct Renderer::Impl {
@@ -205,8 +155,7 @@ struct Renderer::Impl {
   Texture cube;
   bool has_cube = false;
   Texture kin_rgb, kin_depth;
-  GlBuffer kin_pbo[2];        // their uploads' pixel buffers (upload_texture)
-  KinectStaging kin_staging;  // their copy ahead of set_kinect_view (stage_kinect_images)
+  GlBuffer kin_pbo[2];  // their uploads' pixel buffers (upload_texture)
   Intrinsics kin_K;
   PixelRect kin_region;             // where the image holds colour; the frame shows it cut to the framebuffer's aspect
   vec3 kin_mean{0.5f, 0.5f, 0.5f};  // the image's mean colour, linear
