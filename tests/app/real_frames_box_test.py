@@ -18,32 +18,21 @@ the run's own outputs:
 
 Usage: real_frames_box_test.py SEAMLESS ROOT DATA OUT; exit 77 (skip) without the data folder outside CI.
 """
-import json
 import os
-import shutil
-import subprocess
 import sys
 
 import numpy as np
 
-from real_placement_test import CLOTH, RIGID, read_ply
+from real_placement_test import CLOTH, RIGID, missing, read_ply, run_real_config
 
 
 def main():
     exe, root, data, out = sys.argv[1:5]
     folder = os.path.join(data, "frames_box_50")
-    if not os.path.isdir(folder):
-        print(f"skip: {folder} not found")
-        return 77 if not os.environ.get("CI") else 1
-    shutil.rmtree(out, ignore_errors=True)
-    cmd = [exe, "run", os.path.join(root, "configs/real/frames_box.yaml"), "--device", "cpu", "--out", out,
-           "--set", f"input.path={folder}", "--set", "render.mode=none"]
-    print(" ".join(cmd), flush=True)
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    print(r.stdout[-4000:], r.stderr[-4000:])
-    assert r.returncode == 0, f"seamless run failed with {r.returncode}"
-
-    s = json.load(open(os.path.join(out, "summary.json")))
+    code = missing(folder)
+    if code is not None:
+        return code
+    s = run_real_config(exe, root, "frames_box.yaml", folder, out)
     assert s["frames"]["read"] == 50 and s["frames"]["lost"] == 0, s["frames"]
     assert len(s["spawns"]) == 3 and all("placed" in sp for sp in s["spawns"]), s["spawns"]
     diameter = 0.01  # configs/real/frames_box.yaml solver.particle_diameter
