@@ -567,6 +567,12 @@ void Renderer::set_kinect_view(const Image<uchar3>& rgb, const Image<float>& dep
                 ", depth " + std::to_string(depth.width()) + "x" + std::to_string(depth.height()) +
                 ") must both match the intrinsics' " + std::to_string(K.width) + "x" + std::to_string(K.height) +
                 " (depth registered to rgb)");
+  const PixelRect whole{0, 0, K.width, K.height};
+  const PixelRect& r = colour_region.empty() ? whole : colour_region;
+  if (r.x < 0 || r.y < 0 || r.x + r.width > K.width || r.y + r.height > K.height)
+    throw Error("render: Kinect view colour region " + std::to_string(r.width) + "x" + std::to_string(r.height) +
+                " at (" + std::to_string(r.x) + ", " + std::to_string(r.y) + ") is not inside the " +
+                std::to_string(K.width) + "x" + std::to_string(K.height) + " image");
   if (!m.kin_rgb || m.kin_K.width != K.width || m.kin_K.height != K.height) {
     m.kin_rgb = make_texture_2d(GL_RGB8, K.width, K.height, GL_LINEAR);
     m.kin_depth = make_texture_2d(GL_R32F, K.width, K.height, GL_NEAREST);  // never blend depths
@@ -575,12 +581,6 @@ void Renderer::set_kinect_view(const Image<uchar3>& rgb, const Image<float>& dep
   upload_texture(m.kin_pbo[0], m.kin_rgb, K.width, K.height, GL_RGB, GL_UNSIGNED_BYTE, rgb.buffer().data(),
                  sizeof(uchar3));
   upload_texture(m.kin_pbo[1], m.kin_depth, K.width, K.height, GL_RED, GL_FLOAT, depth.buffer().data(), sizeof(float));
-  const PixelRect whole{0, 0, K.width, K.height};
-  const PixelRect& r = colour_region.empty() ? whole : colour_region;
-  if (r.x < 0 || r.y < 0 || r.x + r.width > K.width || r.y + r.height > K.height)
-    throw Error("render: Kinect view colour region " + std::to_string(r.width) + "x" + std::to_string(r.height) +
-                " at (" + std::to_string(r.x) + ", " + std::to_string(r.y) + ") is not inside the " +
-                std::to_string(K.width) + "x" + std::to_string(K.height) + " image");
   m.kin_K = K;
   m.kin_region = r;
   m.kin_pose = world_T_camera;

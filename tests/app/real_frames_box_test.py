@@ -23,16 +23,11 @@ import sys
 
 import numpy as np
 
-from real_placement_test import CLOTH, RIGID, missing, read_ply, run_real_config
+from real_placement_test import CLOTH, RIGID, read_ply, run_real_config
 
 
 def main():
-    exe, root, data, out = sys.argv[1:5]
-    folder = os.path.join(data, "frames_box_50")
-    code = missing(folder)
-    if code is not None:
-        return code
-    s = run_real_config(exe, root, "frames_box.yaml", folder, out)
+    s, out = run_real_config(sys.argv, "frames_box_50", "frames_box.yaml")
     assert s["frames"]["read"] == 50 and s["frames"]["lost"] == 0, s["frames"]
     assert len(s["spawns"]) == 3 and all("placed" in sp for sp in s["spawns"]), s["spawns"]
     diameter = 0.01  # configs/real/frames_box.yaml solver.particle_diameter

@@ -41,17 +41,15 @@ def read_ply(path):
 FLUID, RIGID, CLOTH = 1 << 24, 1 << 25, 1 << 26
 
 
-def missing(folder):
-    """The exit code when the data folder is not there (77, skip, outside CI; 1 in CI), else None."""
-    if os.path.isdir(folder):
-        return None
-    print(f"skip: {folder} not found")
-    return 77 if not os.environ.get("CI") else 1
-
-
-def run_real_config(exe, root, config, folder, out, sets=()):
-    """`seamless run` of configs/real/CONFIG on the real folder, on the CPU without pictures, into
-    out (emptied first); its summary.json."""
+def run_real_config(argv, folder_name, config, sets=()):
+    """argv: the test's SEAMLESS ROOT DATA OUT. `seamless run` of configs/real/CONFIG on
+    DATA/FOLDER_NAME, on the CPU without pictures, into OUT (emptied first); returns its summary.json
+    and OUT. Without the data folder the test ends here: 77 (skip) outside CI, 1 in CI."""
+    exe, root, data, out = argv[1:5]
+    folder = os.path.join(data, folder_name)
+    if not os.path.isdir(folder):
+        print(f"skip: {folder} not found")
+        sys.exit(77 if not os.environ.get("CI") else 1)
     shutil.rmtree(out, ignore_errors=True)
     cmd = [exe, "run", os.path.join(root, "configs/real", config), "--device", "cpu", "--out", out,
            "--set", f"input.path={folder}", "--set", "render.mode=none"]
@@ -61,16 +59,11 @@ def run_real_config(exe, root, config, folder, out, sets=()):
     r = subprocess.run(cmd, capture_output=True, text=True)
     print(r.stdout[-4000:], r.stderr[-4000:])
     assert r.returncode == 0, f"seamless run failed with {r.returncode}"
-    return json.load(open(os.path.join(out, "summary.json")))
+    return json.load(open(os.path.join(out, "summary.json"))), out
 
 
 def main():
-    exe, root, data, out = sys.argv[1:5]
-    folder = os.path.join(data, "tum_fr1_rpy_000-149")
-    code = missing(folder)
-    if code is not None:
-        return code
-    s = run_real_config(exe, root, "tum_desk.yaml", folder, out, ["frames=60"])
+    s, out = run_real_config(sys.argv, "tum_fr1_rpy_000-149", "tum_desk.yaml", ["frames=60"])
     diameter = 0.02  # configs/real/tum_desk.yaml solver.particle_diameter
     assert s["frames"]["read"] == 60 and s["frames"]["lost"] == 0, s["frames"]
     assert len(s["spawns"]) == 3 and all("placed" in sp for sp in s["spawns"]), s["spawns"]
