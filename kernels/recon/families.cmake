@@ -20,3 +20,9 @@ endif()
 # (floating-point exceptions are never trapped or read here; no value changes).
 set_source_files_properties(recon/preprocess_cpu.cpp PROPERTIES COMPILE_OPTIONS
   "$<$<CXX_COMPILER_ID:GNU,Clang>:-fno-trapping-math>")
+
+# The CPU's fusion rows on SIMD lanes (kernels/recon/tsdf_fusion_simd.hpp; never compiled by nvcc).
+# -Wno-psabi: 32-byte vectors pass between always_inline functions, whose ABI note does not apply.
+target_sources(seamless_kernels PRIVATE recon/tsdf_fusion_simd.cpp)
+set_source_files_properties(recon/tsdf_fusion_simd.cpp PROPERTIES COMPILE_OPTIONS
+  "$<$<CXX_COMPILER_ID:GNU,Clang>:-Wno-psabi>")

@@ -110,6 +110,19 @@ SEAMLESS_HD inline bool voxel_keeps_block(const Voxel& v, float keep_below) {
   return v.weight > 0.f && fabsf(v.sdf) < keep_below;
 }
 
+// Fusion's weighted running average (Curless & Levoy 1996; KinectFusion eq. 11-13) of a value
+// held with weight wt and one new observation of weight 1. T: float, or 8 lanes of floats (the
+// CPU's fusion rows, tsdf_fusion_simd.hpp), which then round exactly as the scalar code.
+template <class T> SEAMLESS_HD inline T running_average(T old, T wt, T obs) { return (old * wt + obs) / (wt + T(1.f)); }
+
+// A voxel's colour after one more observation c, averaged with the voxel's weight wt before it.
+SEAMLESS_HD inline uchar3 blend_color(uchar3 old, uchar3 c, float wt) {
+  auto avg = [&](std::uint8_t o, std::uint8_t obs) {
+    return static_cast<std::uint8_t>(min_of(running_average(float(o), wt, float(obs)) + 0.5f, 255.f));
+  };
+  return {avg(old.x, c.x), avg(old.y, c.y), avg(old.z, c.z)};
+}
+
 // The surface flag of each block of the pool (docs/DYNAMIC.md "The surface flag"): 1
 // while one of its voxels is observed and near a surface (voxel_keeps_block with the band's
 // threshold below = 0.999 truncation, whatever the garbage collection keeps), else 0. It is the

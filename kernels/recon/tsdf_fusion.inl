@@ -2,6 +2,9 @@
 #include <cmath>
 
 #include "kernels/recon/tsdf.hpp"
+#if !defined(__CUDACC__)
+#include "kernels/recon/tsdf_fusion_simd.hpp"
+#endif
 
 namespace seamless::kernels {
 
@@ -227,14 +230,8 @@ SEAMLESS_HD inline void fuse_voxel(Voxel& v, uchar3* v_color, vec3 p_world, cons
   }
   float tsdf = min_of(sdf, mu);
   float wt = v.weight;
-  v.sdf = (v.sdf * wt + tsdf) / (wt + 1.f);
-  if (v_color && in.rgb.data && sdf < mu) {
-    const uchar3 c = in.rgb(u, w), old = *v_color;
-    auto avg = [&](std::uint8_t o, std::uint8_t obs) {
-      return static_cast<std::uint8_t>(min_of((o * wt + obs) / (wt + 1.f) + 0.5f, 255.f));
-    };
-    *v_color = {avg(old.x, c.x), avg(old.y, c.y), avg(old.z, c.z)};
-  }
+  v.sdf = running_average(v.sdf, wt, tsdf);
+  if (v_color && in.rgb.data && sdf < mu) *v_color = blend_color(*v_color, in.rgb(u, w), wt);
   v.weight = min_of(wt + 1.f, max_weight);
 }
 
@@ -244,6 +241,37 @@ void TsdfFusion<Exec>::fuse_hash_blocks(const Exec& ex, HashTableView t, View<co
                                         VoxelGeometry geom, float max_weight, View<std::int32_t> keep, float keep_below,
                                         SurfaceFlags surface) {
   const SE3 camera_T_world = in.world_T_camera.inverse();
+#if !defined(__CUDACC__)
+  // The CPU: a work item per row of a block (its 8 voxels along x, 64 items a block) on 8 SIMD
+  // lanes, the same values as the loop below (tsdf_fusion_simd.hpp). Carving reads 9 pixels a
+  // voxel and takes the loop below.
+  if constexpr (Exec::device == Device::CPU) {
+    if (in.carve <= 0.f && simd::cpu_simd()) {
+      const FuseRowFrame f{in,
+                           camera_T_world,
+                           geom,
+                           max_weight,
+                           keep_below,
+                           surface.below,
+                           keep.data != nullptr,
+                           surface.flag != nullptr};
+      constexpr int kRows = kBlockSide * kBlockSide;
+      ex.for_each(count * kRows, [=](std::int64_t i) {
+        const std::int64_t j = i / kRows;
+        const std::int32_t slot = slots[j];
+        const std::int32_t block = t.values[slot];
+        if (block < 0) return;
+        const int r = static_cast<int>(i % kRows);  // the row's first voxel is r * 8 in the block
+        const std::int64_t first = static_cast<std::int64_t>(block) * kBlockVoxels + r * kBlockSide;
+        const int flags = detail::fuse_row_simd(f, unpack_block(t.keys[slot]), r % kBlockSide, r / kBlockSide,
+                                                voxels + first, colors ? colors + first : nullptr);
+        if (flags & kRowKeeps) set_keep(&keep[j]);
+        if (flags & kRowNearSurface) set_keep(&surface.flag[block]);
+      });
+      return;
+    }
+  }
+#endif
   // One thread per column of a block (its 8 voxels along z, 64 threads a block): the block's slot,
   // index and key are read once per column instead of once per voxel, and the column's 8 voxels
   // are independent work in one thread, so their loads can be in flight together. A warp's 32
