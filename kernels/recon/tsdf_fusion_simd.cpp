@@ -22,10 +22,8 @@ SEAMLESS_SIMD_INL vm operator>=(vi a, int b) { return {a.v >= vi(b).v}; }
 SEAMLESS_SIMD_INL vm operator<(vi a, int b) { return {a.v < vi(b).v}; }
 // min_of(a, b) of core/math.hpp, lane by lane: a < b ? a : b.
 SEAMLESS_SIMD_INL vf min_of(vf a, vf b) { return select(a < b, a, b); }
-SEAMLESS_SIMD_INL vf abs(vf a) {
-  const simd::i8 bits = reinterpret_cast<simd::i8>(a.v) & 0x7fffffff;
-  return vf(reinterpret_cast<simd::f8>(bits));
-}
+// fabsf lane by lane, up to the sign of a zero (which no comparison below sees).
+SEAMLESS_SIMD_INL vf abs(vf a) { return select(a < vf(0.f), -a, a); }
 }  // namespace
 
 int fuse_row_simd(const FuseRowFrame& f, int3 b, int y, int z, Voxel* row, uchar3* colors) {
