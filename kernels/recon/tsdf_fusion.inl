@@ -242,9 +242,9 @@ void TsdfFusion<Exec>::fuse_hash_blocks(const Exec& ex, HashTableView t, View<co
                                         SurfaceFlags surface) {
   const SE3 camera_T_world = in.world_T_camera.inverse();
 #if !defined(__CUDACC__)
-  // The CPU: a work item per row of a block (its 8 voxels along x, 64 items a block) on 8 SIMD
-  // lanes, the same values as the loop below (tsdf_fusion_simd.hpp). Carving reads 9 pixels a
-  // voxel and takes the loop below.
+  // The CPU: a work item per layer of a block (its 64 voxels at one z), fused a row (8 voxels
+  // along x) at a time on 8 SIMD lanes, the same values as the loop below
+  // (tsdf_fusion_simd.hpp). Carving reads 9 pixels a voxel and takes the loop below.
   if constexpr (Exec::device == Device::CPU) {
     if (in.carve <= 0.f && simd::cpu_simd()) {
       const FuseRowFrame f{in,
@@ -255,16 +255,15 @@ void TsdfFusion<Exec>::fuse_hash_blocks(const Exec& ex, HashTableView t, View<co
                            surface.below,
                            keep.data != nullptr,
                            surface.flag != nullptr};
-      constexpr int kRows = kBlockSide * kBlockSide;
-      ex.for_each(count * kRows, [=](std::int64_t i) {
-        const std::int64_t j = i / kRows;
+      ex.for_each(count * kBlockSide, [=](std::int64_t i) {
+        const std::int64_t j = i / kBlockSide;
         const std::int32_t slot = slots[j];
         const std::int32_t block = t.values[slot];
         if (block < 0) return;
-        const int r = static_cast<int>(i % kRows);  // the row's first voxel is r * 8 in the block
-        const std::int64_t first = static_cast<std::int64_t>(block) * kBlockVoxels + r * kBlockSide;
-        const int flags = detail::fuse_row_simd(f, unpack_block(t.keys[slot]), r % kBlockSide, r / kBlockSide,
-                                                voxels + first, colors ? colors + first : nullptr);
+        const int z = static_cast<int>(i % kBlockSide);
+        const std::int64_t first = static_cast<std::int64_t>(block) * kBlockVoxels + z * kBlockSide * kBlockSide;
+        const int flags = detail::fuse_layer_simd(f, unpack_block(t.keys[slot]), z, voxels + first,
+                                                  colors ? colors + first : nullptr);
         if (flags & kRowKeeps) set_keep(&keep[j]);
         if (flags & kRowNearSurface) set_keep(&surface.flag[block]);
       });

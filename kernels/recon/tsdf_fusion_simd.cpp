@@ -26,31 +26,27 @@ SEAMLESS_SIMD_INL vf min_of(vf a, vf b) { return select(a < b, a, b); }
 SEAMLESS_SIMD_INL vf abs(vf a) { return select(a < vf(0.f), -a, a); }
 }  // namespace
 
-int fuse_row_simd(const FuseRowFrame& f, int3 b, int y, int z, Voxel* row, uchar3* colors) {
-  static_assert(simd::kWidth == kBlockSide && sizeof(Voxel) == 2 * sizeof(float));
+// The 8 voxels of row (y, z): row points to them, colors to their colours (nullptr: none). ax:
+// the x terms of camera_T_world's three rows, R[r][0] * x, for the block's 8 x (the same products
+// for every row of the block).
+SEAMLESS_SIMD_INL void fuse_row(const FuseRowFrame& f, const vf ax[3], float py, float pz, Voxel* row, uchar3* colors) {
   const FrameInput& in = f.in;
   const mat3& R = f.camera_T_world.R;
   const vec3 t = f.camera_T_world.t;
   const float mu = f.geom.truncation;
-  // The row's voxel centres in world units, geom.to_world (origin + g * voxel_size) per axis.
-  vf gx;
-  for (int l = 0; l < simd::kWidth; ++l) gx.v[l] = static_cast<float>(b.x * 8 + l);
-  const vf px = vf(f.geom.origin.x) + gx * vf(f.geom.voxel_size);
-  const float py = f.geom.origin.y + static_cast<float>(b.y * 8 + y) * f.geom.voxel_size;
-  const float pz = f.geom.origin.z + static_cast<float>(b.z * 8 + z) * f.geom.voxel_size;
   // camera_T_world * p = R p + t, each row's dot product in core/math.hpp's order.
-  auto camera_axis = [&](int r, float tr) {
-    return vf(R.m[r][0]) * px + vf(R.m[r][1] * py) + vf(R.m[r][2] * pz) + vf(tr);
-  };
-  const vf cx = camera_axis(0, t.x), cy = camera_axis(1, t.y), cz = camera_axis(2, t.z);
+  const vf cx = ax[0] + vf(R.m[0][1] * py) + vf(R.m[0][2] * pz) + vf(t.x);
+  const vf cy = ax[1] + vf(R.m[1][1] * py) + vf(R.m[1][2] * pz) + vf(t.y);
+  const vf cz = ax[2] + vf(R.m[2][1] * py) + vf(R.m[2][2] * pz) + vf(t.z);
   vm m = cz > vf(0.f);
   // K.project, then the nearest pixel (floor_int of +0.5, which also holds a lane behind the
   // camera, inf or NaN, to a far index that the bounds below reject).
   const vi u = simd::floor_int(vf(in.K.fx) * cx / cz + vf(in.K.cx) + vf(0.5f));
   const vi w = simd::floor_int(vf(in.K.fy) * cy / cz + vf(in.K.cy) + vf(0.5f));
   m = m & (u >= 0) & (w >= 0) & (u < in.depth.width) & (w < in.depth.height);
-  vf d(0.f);
   const int in_image = simd::bits(m);
+  if (!in_image) return;
+  vf d(0.f);
   for (int l = 0; l < simd::kWidth; ++l)
     if (in_image >> l & 1) d.v[l] = in.depth(u[l], w[l]);
   m = m & (d >= vf(in.min_depth)) & (d <= vf(in.max_depth));
@@ -73,12 +69,39 @@ int fuse_row_simd(const FuseRowFrame& f, int3 b, int y, int z, Voxel* row, uchar
   hi = __builtin_shufflevector(new_sdf.v, new_wt.v, 4, 12, 5, 13, 6, 14, 7, 15);
   std::memcpy(row, &lo, sizeof lo);
   std::memcpy(row + 4, &hi, sizeof hi);
-  // voxel_keeps_block, lane by lane.
-  const vm observed = new_wt > vf(0.f);
-  const vf a = abs(new_sdf);
+}
+
+// voxel_keeps_block for the 8 voxels at v, as fuse_layer_simd's flag bits.
+SEAMLESS_SIMD_INL int row_flags(const FuseRowFrame& f, const Voxel* v) {
+  simd::f8 lo, hi;
+  std::memcpy(&lo, v, sizeof lo);
+  std::memcpy(&hi, v + 4, sizeof hi);
+  const vm observed = vf(__builtin_shufflevector(lo, hi, 1, 3, 5, 7, 9, 11, 13, 15)) > vf(0.f);
+  const vf a = abs(vf(__builtin_shufflevector(lo, hi, 0, 2, 4, 6, 8, 10, 12, 14)));
   int flags = 0;
   if (f.keep && simd::bits(observed & (a < vf(f.keep_below)))) flags |= kRowKeeps;
   if (f.surface && simd::bits(observed & (a < vf(f.surface_below)))) flags |= kRowNearSurface;
+  return flags;
+}
+
+int fuse_layer_simd(const FuseRowFrame& f, int3 b, int z, Voxel* layer, uchar3* colors) {
+  static_assert(simd::kWidth == kBlockSide && sizeof(Voxel) == 2 * sizeof(float));
+  const mat3& R = f.camera_T_world.R;
+  // The voxel centres in world units, geom.to_world (origin + g * voxel_size) per axis.
+  vf gx;
+  for (int l = 0; l < simd::kWidth; ++l) gx.v[l] = static_cast<float>(b.x * 8 + l);
+  const vf px = vf(f.geom.origin.x) + gx * vf(f.geom.voxel_size);
+  const vf ax[3] = {vf(R.m[0][0]) * px, vf(R.m[1][0]) * px, vf(R.m[2][0]) * px};
+  const float pz = f.geom.origin.z + static_cast<float>(b.z * 8 + z) * f.geom.voxel_size;
+  const int wanted = (f.keep ? kRowKeeps : 0) | (f.surface ? kRowNearSurface : 0);
+  int flags = 0;
+  for (int y = 0; y < kBlockSide; ++y) {
+    const float py = f.geom.origin.y + static_cast<float>(b.y * 8 + y) * f.geom.voxel_size;
+    const int r = y * kBlockSide;  // the row's first voxel in the layer
+    fuse_row(f, ax, py, pz, layer + r, colors ? colors + r : nullptr);
+    // Every row's flags, changed or not, as the scalar loop tests every voxel (until both are set).
+    if (flags != wanted) flags |= row_flags(f, layer + r);
+  }
   return flags;
 }
 

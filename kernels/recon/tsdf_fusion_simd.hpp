@@ -1,11 +1,11 @@
-// The CPU's fusion of a voxel row on 8 SIMD lanes (defined in tsdf_fusion_simd.cpp, compiled for
-// AVX2 where simd::cpu_simd() finds it at run time). Never seen by nvcc.
+// The CPU's fusion of a block layer on 8 SIMD lanes (defined in tsdf_fusion_simd.cpp, compiled for AVX2
+// where simd::cpu_simd() finds it at run time). Never seen by nvcc.
 //
-// A row is the 8 voxels of a block along x at one (y, z): 8 consecutive voxels in the pool, one a
-// lane, each computed with fuse_voxel's expressions in fuse_voxel's order (no FMA contraction:
-// simd.hpp), so the fused values are bit-identical to the scalar loop's (tests compare both). The
-// scalar loop costs ~50 cycles a voxel on the CPU, most of it the chain transform -> projection ->
-// depth read -> average of each voxel in turn; 8 lanes take the chain once for 8 voxels.
+// A layer (the 64 voxels of a block at one z) is fused a row at a time: the 8 voxels along x at one (y, z), 8
+// consecutive voxels in the pool, one a lane, each computed with fuse_voxel's expressions in fuse_voxel's order (no FMA
+// contraction: simd.hpp), so the fused values are bit-identical to the scalar loop's (tests compare
+// both). The scalar loop's chain transform -> projection -> depth read -> average, one voxel after
+// the other, is taken once for 8 voxels (docs/PERFORMANCE.md, "The CPU's fusion on SIMD lanes").
 #pragma once
 #if !defined(__CUDACC__)
 #include "kernels/physics/cpu_simd.hpp"
@@ -13,7 +13,7 @@
 
 namespace seamless::kernels {
 
-// What every row of a frame's fusion reads (fuse_hash_blocks' arguments).
+// What every block of a frame's fusion reads (fuse_hash_blocks' arguments).
 struct FuseRowFrame {
   FrameInput in;
   SE3 camera_T_world;
@@ -24,7 +24,7 @@ struct FuseRowFrame {
   bool keep = false, surface = false;
 };
 
-// Bits of fuse_row_simd's result: a voxel of the row keeps its block (voxel_keeps_block with
+// Bits of fuse_layer_simd's result: a voxel of the layer keeps its block (voxel_keeps_block with
 // keep_below), or is near a surface (with surface_below).
 constexpr int kRowKeeps = 1, kRowNearSurface = 2;
 
@@ -33,9 +33,9 @@ constexpr int kRowKeeps = 1, kRowNearSurface = 2;
 #pragma GCC target("avx2")
 #endif
 namespace detail {
-// Fuses the frame into row (y, z) of block b: row points to its 8 voxels, colors to their colours
-// (nullptr: no colour fused). Not for a frame that carves free space (in.carve > 0).
-int fuse_row_simd(const FuseRowFrame& f, int3 b, int y, int z, Voxel* row, uchar3* colors);
+// Fuses the frame into layer z of block b (its 64 voxels at that z): layer points to them, colors
+// to their colours (nullptr: no colour fused). Not for a frame that carves free space (in.carve > 0).
+int fuse_layer_simd(const FuseRowFrame& f, int3 b, int z, Voxel* layer, uchar3* colors);
 }  // namespace detail
 #if SEAMLESS_SIMD_X86
 #pragma GCC pop_options
