@@ -5,7 +5,7 @@
 
 namespace seamless::kernels {
 
-// ---- the CPU's SIMD tiles (kernels/physics/simd.hpp) ------------------------------------------
+// ---- the CPU's SIMD tiles (core/simd.hpp) ------------------------------------------
 // A tile is 8 consecutive sorted particles, one per lane, each walking its own list in list
 // order; the pair terms are the scalar loops' functions over simd::vf, so the sums and states are
 // bit-identical to the scalar loops. A tile takes the vector path only where all 8 particles are

@@ -3,8 +3,8 @@
 // run them. Never seen by nvcc.
 #pragma once
 #include "core/exec.hpp"
+#include "core/simd.hpp"
 #include "kernels/physics/sim_views.hpp"
-#include "kernels/physics/simd.hpp"
 
 namespace seamless::kernels {
 

@@ -8,8 +8,8 @@
 
 #include "core/atomics.hpp"
 #include "core/exec.hpp"
+#include "core/simd.hpp"
 #include "kernels/physics/constraints.hpp"
-#include "kernels/physics/simd.hpp"
 #include "kernels/physics/solver.hpp"
 
 // Full unrolling of a loop over a register array (CUDA; GCC would warn on the pragma).

@@ -15,7 +15,7 @@ namespace seamless::kernels {
 constexpr float kPi = 3.14159265358979f;
 
 // c ? a : b, for code written once over a float type (SphKernel): the SIMD lanes of the CPU
-// (kernels/physics/simd.hpp) select lane by lane.
+// (core/simd.hpp) select lane by lane.
 SEAMLESS_HD inline float select(bool c, float a, float b) { return c ? a : b; }
 SEAMLESS_HD inline int select(bool c, int a, int b) { return c ? a : b; }
 SEAMLESS_HD inline vec3 select(bool c, vec3 a, vec3 b) { return c ? a : b; }

@@ -4,7 +4,7 @@
 
 #include <cstring>
 
-#include "kernels/physics/simd.hpp"
+#include "core/simd.hpp"
 
 namespace seamless::kernels {
 

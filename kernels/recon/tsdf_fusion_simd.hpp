@@ -8,7 +8,7 @@
 // the other, is taken once for 8 voxels (docs/PERFORMANCE.md, "The CPU's fusion on SIMD lanes").
 #pragma once
 #if !defined(__CUDACC__)
-#include "kernels/physics/cpu_simd.hpp"
+#include "core/cpu_simd.hpp"
 #include "kernels/recon/tsdf.hpp"
 
 namespace seamless::kernels {

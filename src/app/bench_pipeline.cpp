@@ -323,6 +323,13 @@ int run_pipeline_bench(const PipelineBenchOptions& o) {
       device_name(o.device),
       last.peak_rss_bytes < 0 ? "unknown" : (std::to_string(last.peak_rss_bytes >> 20) + " MiB").c_str());
   std::printf("load average %.2f at the start of the last replay, %.2f at its end\n", last.load_start, last.load_end);
+  // A folder shorter than --frames gives figures over fewer (and other) frames than asked for:
+  // said where the figures are read, not only in the log.
+  if (e.frames > 0 && last.frames < e.frames) {
+    std::printf("WARNING: --frames %lld asked for more frames than the source gave: the figures are over %lld\n",
+                static_cast<long long>(e.frames), static_cast<long long>(last.frames));
+    spdlog::warn("bench pipeline: {} frames asked for, {} replayed from {}", e.frames, last.frames, e.input.path);
+  }
   if (o.mode == "live") std::printf("render: %s\n", render_note.empty() ? "measured" : render_note.c_str());
   if (!o.json.empty()) {
     write_json(o.json, o, e, stages, reps, render_note);

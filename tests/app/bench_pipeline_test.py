@@ -88,6 +88,39 @@ class BenchPipeline(unittest.TestCase):
         else:
             self.assertAlmostEqual(total, frame, delta=SUM_TOL * max(1.0, frame))
 
+    def test_fewer_frames_than_asked_for_is_said(self):
+        """A folder of 3 frames replayed with --frames 5: the figures are over 3 frames, and the
+        printed summary says so next to them."""
+        out = os.path.join(OUT, "short")
+        shutil.rmtree(out, ignore_errors=True)
+        seq = os.path.join(out, "tum_fr1_rpy_short")
+        os.makedirs(os.path.join(seq, "rgb"))
+        os.makedirs(os.path.join(seq, "depth"))
+        with open(os.path.join(SEQ, "associations.txt")) as f:
+            pairs = [line for line in f if line.strip() and not line.startswith("#")][:3]
+        for name in ("rgb.txt", "depth.txt"):
+            with open(os.path.join(SEQ, name)) as f:
+                lines = f.readlines()
+            header = [line for line in lines if line.startswith("#")]
+            keep = set(p.split()[1 if name == "rgb.txt" else 3] for p in pairs)
+            with open(os.path.join(seq, name), "w") as f:
+                f.writelines(header + [line for line in lines if not line.startswith("#") and line.split()[1] in keep])
+        with open(os.path.join(seq, "associations.txt"), "w") as f:
+            f.writelines(pairs)
+        for p in pairs:
+            for rel in (p.split()[1], p.split()[3]):
+                shutil.copy(os.path.join(SEQ, rel), os.path.join(seq, rel))
+        shutil.copy(os.path.join(SEQ, "groundtruth.txt"), seq)
+        js = os.path.join(out, "bench.json")
+        r = seamless("bench", "pipeline", "--config", os.path.join(SRC, "configs", "tum_fr1.yaml"), "--data", seq,
+                     "--frames", "5", "--tracker", "icp", "--device", "cpu", "--json", js)
+        with open(js) as f:
+            doc = json.load(f)
+        self.assertEqual(doc["frames_requested"], 5)
+        self.assertEqual(doc["replays"][0]["frames"], 3)
+        self.assertIn("WARNING: --frames 5 asked for more frames than the source gave: the figures are over 3",
+                      r.stdout)
+
     def test_scan_is_seamless_track(self):
         out = os.path.join(OUT, "scan")
         shutil.rmtree(out, ignore_errors=True)

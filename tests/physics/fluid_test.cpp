@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <cstring>
 
-#include "kernels/physics/cpu_simd.hpp"
+#include "core/cpu_simd.hpp"
 #include "physics/particle_solver.hpp"
 #include "physics_test_util.hpp"
 
@@ -123,7 +123,7 @@ TEST(PhysicsFluid, DamBreakFollowsMartinMoyce) {
   EXPECT_EQ(checked, 11);
 }
 
-// The CPU's SIMD tiles (8 particles a vector, kernels/physics/simd.hpp) do the scalar loops'
+// The CPU's SIMD tiles (8 particles a vector, core/simd.hpp) do the scalar loops'
 // float operations in the scalar order, lane by lane, so the states must be equal bit for bit.
 // Scene 1 mixes tiles that take the vector path (fluid with fluid-only lists) with tiles that
 // decline (fluid next to static walls, a rigid cube that falls into the fluid, the cube); scene
@@ -155,9 +155,9 @@ TEST(PhysicsFluid, FrictionOnTheSceneStopsASlideAtCoulombsDistance) {
 }
 
 TEST(FluidSimd, TilesGiveTheScalarLoopsStatesBitForBit) {
-  if (!kernels::simd::cpu_simd()) GTEST_SKIP() << "this CPU has no AVX2: the SIMD tiles do not run";
+  if (!simd::cpu_simd()) GTEST_SKIP() << "this CPU has no AVX2: the SIMD tiles do not run";
   auto run = [](bool simd, bool walls) {
-    kernels::simd::set_cpu_simd(simd);
+    simd::set_cpu_simd(simd);
     SolverParams p;
     const float d = p.particle_diameter;
     const int W = 13, H = 11;  // 1859 fluid particles: the last tile is partial (scalar loops)
@@ -179,7 +179,7 @@ TEST(FluidSimd, TilesGiveTheScalarLoopsStatesBitForBit) {
   };
   for (bool walls : {true, false}) {
     const ParticleState a = run(true, walls), b = run(false, walls);
-    kernels::simd::set_cpu_simd(true);
+    simd::set_cpu_simd(true);
     ASSERT_EQ(a.x.size(), b.x.size());
     EXPECT_EQ(std::memcmp(a.x.data(), b.x.data(), a.x.size() * sizeof(vec3)), 0) << "walls " << walls;
     EXPECT_EQ(std::memcmp(a.v.data(), b.v.data(), a.v.size() * sizeof(vec3)), 0) << "walls " << walls;

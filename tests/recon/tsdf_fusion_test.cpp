@@ -11,12 +11,12 @@
 #include <tuple>
 
 #include "core/buffer.hpp"
+#include "core/cpu_simd.hpp"
 #include "core/device.hpp"
 #include "core/error.hpp"
 #include "core/exec.hpp"
 #include "io/frame_source.hpp"
 #include "io/input_params.hpp"
-#include "kernels/physics/cpu_simd.hpp"
 #include "kernels/recon/tsdf.hpp"
 #include "recon/voxel_hash_volume.hpp"
 #include "tsdf_scene.hpp"
@@ -394,7 +394,7 @@ TEST(TsdfFusion, CullingChangesNothingOnRealFrames) {
 // surface flags must be those of the scalar loop bit for bit, in a band-only volume and in one
 // that stores free space (its surface flags).
 TEST(TsdfFusion, SimdRowsGiveTheScalarLoopsVoxelsBitForBit) {
-  if (!kernels::simd::cpu_simd()) GTEST_SKIP() << "this CPU has no AVX2: the SIMD rows do not run";
+  if (!simd::cpu_simd()) GTEST_SKIP() << "this CPU has no AVX2: the SIMD rows do not run";
   const std::string dir = std::string(SEAMLESS_TEST_DATA) + "/tum_fr1_rpy_000-149";
   if (!std::filesystem::exists(dir)) GTEST_SKIP() << "no test data at " << dir;
   InputParams in;
@@ -410,12 +410,12 @@ TEST(TsdfFusion, SimdRowsGiveTheScalarLoopsVoxelsBitForBit) {
     RgbdFrame f;
     while (src->next(f)) {
       ASSERT_TRUE(f.ground_truth.has_value());
-      kernels::simd::set_cpu_simd(true);
+      simd::set_cpu_simd(true);
       simd.integrate(f.depth, f.rgb, src->intrinsics(), *f.ground_truth);
-      kernels::simd::set_cpu_simd(false);
+      simd::set_cpu_simd(false);
       scalar.integrate(f.depth, f.rgb, src->intrinsics(), *f.ground_truth);
     }
-    kernels::simd::set_cpu_simd(true);
+    simd::set_cpu_simd(true);
     const auto a = simd.download_blocks(), b = scalar.download_blocks();
     ASSERT_EQ(a.size(), b.size()) << "free space " << free_space;
     std::int64_t observed = 0, coloured = 0, flagged = 0;

@@ -1,6 +1,7 @@
-// Whether the CPU's particle solver runs its SIMD tiles (kernels/physics/simd.hpp): AVX2 on
-// x86-64 (checked once), always elsewhere (generic vectors). set_cpu_simd(false) forces the scalar
-// loops, which give bit-identical states (tests compare both). Host code only.
+// Whether the CPU runs its SIMD lanes (core/simd.hpp: the particle solver's tiles, the voxel
+// hash's fusion rows): AVX2 on x86-64 (checked once), always elsewhere (generic vectors).
+// set_cpu_simd(false) forces the scalar loops, which give bit-identical results (tests compare
+// both). Host code only.
 #pragma once
 #include <atomic>
 
@@ -12,7 +13,7 @@
 #define SEAMLESS_SIMD_X86 0
 #endif
 
-namespace seamless::kernels::simd {
+namespace seamless::simd {
 
 inline std::atomic<int>& cpu_simd_flag() {
   static std::atomic<int> flag{-1};
@@ -35,4 +36,4 @@ inline void set_cpu_simd(bool on) {
   if (!on) cpu_simd_flag().store(0);
 }
 
-}  // namespace seamless::kernels::simd
+}  // namespace seamless::simd

@@ -1,32 +1,33 @@
-// SIMD lanes for the CPU's pair loops (kernels/physics/cpu_tiles.cpp): a vector of 8 floats (vf), a
-// lane mask (vm) and a vec3 of vectors (v3), with the operators that the SPH kernels of
+// SIMD lanes for the CPU's loops that run 8 elements at once: the physics' pair loops
+// (kernels/physics/cpu_tiles.cpp, 8 particles) and the voxel hash's fusion (kernels/recon/
+// tsdf_fusion_simd.cpp, a block row of 8 voxels). A vector of 8 floats (vf), a lane mask (vm), a
+// vector of 8 ints (vi) and a vec3 of vectors (v3), with the operators that the SPH kernels of
 // particle_math.hpp (templates over the float type) and the pair terms of the families use, so that
 // one expression serves the scalar code (CUDA, and the CPU where a tile of particles cannot take
-// the vector path) and 8 particles at once on the CPU.
+// the vector path) and 8 elements at once on the CPU.
 //
-// Lanes are particles, not neighbours: lane l of a tile of 8 consecutive sorted particles walks
-// its own neighbour list in list order (the CUDA loops' one lane per particle), so every sum is
-// formed in the scalar order and the states stay bit-identical to the scalar loops (no FMA
-// contraction: the vector code is compiled for AVX2 without FMA, and a * b + c stays two
+// Lanes are elements, not the terms of one element's sum: lane l of a tile of 8 consecutive sorted
+// particles walks its own neighbour list in list order (the CUDA loops' one lane per particle), so
+// every sum is formed in the scalar order and the states stay bit-identical to the scalar loops (no
+// FMA contraction: the vector code is compiled for AVX2 without FMA, and a * b + c stays two
 // roundings as in the scalar code).
 //
-// GCC vector extensions (generic code, GCC 12 or Clang): the tile functions that use them are
-// compiled for AVX2 on x86-64 (a `#pragma GCC target` region in cpu_tiles.cpp, taken where
-// cpu_simd() finds AVX2 at run time; the scalar loops otherwise), for the baseline elsewhere;
-// everything here is always_inline, so it takes the caller's instruction set (the compiler turns
-// the lane loops into vector instructions: the physics CPU files have -fno-math-errno). Never seen by
-// nvcc.
+// GCC vector extensions (generic code, GCC 12 or Clang): the functions that use them are compiled
+// for AVX2 on x86-64 (a `#pragma GCC target` region in their file, taken where cpu_simd() finds
+// AVX2 at run time; the scalar loops otherwise), for the baseline elsewhere; everything here is
+// always_inline, so it takes the caller's instruction set (the compiler turns the lane loops into
+// vector instructions: the physics CPU files have -fno-math-errno). Never seen by nvcc.
 #pragma once
 #if !defined(__CUDACC__)
 #include <cstdint>
 #include <cstring>
 
+#include "core/cpu_simd.hpp"
 #include "core/math.hpp"
-#include "kernels/physics/cpu_simd.hpp"
 
 #define SEAMLESS_SIMD_INL __attribute__((always_inline)) inline
 
-namespace seamless::kernels::simd {
+namespace seamless::simd {
 
 constexpr int kWidth = 8;
 typedef float f8 __attribute__((vector_size(32)));
@@ -195,5 +196,5 @@ SEAMLESS_SIMD_INL v3 load_v3(const vec3* a) {
   return r;
 }
 
-}  // namespace seamless::kernels::simd
+}  // namespace seamless::simd
 #endif
