@@ -14,22 +14,30 @@ namespace seamless::kernels {
 #endif
 namespace detail {
 
-namespace {
 using simd::vf, simd::vi, simd::vm;
 
-SEAMLESS_SIMD_INL vm operator!(vm m) { return {~m.v}; }
-SEAMLESS_SIMD_INL vm operator>=(vi a, int b) { return {a.v >= vi(b).v}; }
-SEAMLESS_SIMD_INL vm operator<(vi a, int b) { return {a.v < vi(b).v}; }
-// min_of(a, b) of core/math.hpp, lane by lane: a < b ? a : b.
-SEAMLESS_SIMD_INL vf min_of(vf a, vf b) { return select(a < b, a, b); }
-// fabsf lane by lane, up to the sign of a zero (which no comparison below sees).
-SEAMLESS_SIMD_INL vf abs(vf a) { return select(a < vf(0.f), -a, a); }
-}  // namespace
+namespace {
+// A row's 8 voxels, {sdf, weight} interleaved in the pool, as two vectors, and back.
+SEAMLESS_SIMD_INL void load_row(const Voxel* v, vf& sdf, vf& wt) {
+  simd::f8 lo, hi;
+  std::memcpy(&lo, v, sizeof lo);
+  std::memcpy(&hi, v + 4, sizeof hi);
+  sdf = __builtin_shufflevector(lo, hi, 0, 2, 4, 6, 8, 10, 12, 14);
+  wt = __builtin_shufflevector(lo, hi, 1, 3, 5, 7, 9, 11, 13, 15);
+}
+SEAMLESS_SIMD_INL void store_row(Voxel* v, vf sdf, vf wt) {
+  const simd::f8 lo = __builtin_shufflevector(sdf.v, wt.v, 0, 8, 1, 9, 2, 10, 3, 11);
+  const simd::f8 hi = __builtin_shufflevector(sdf.v, wt.v, 4, 12, 5, 13, 6, 14, 7, 15);
+  std::memcpy(v, &lo, sizeof lo);
+  std::memcpy(v + 4, &hi, sizeof hi);
+}
 
-// The 8 voxels of row (y, z): row points to them, colors to their colours (nullptr: none). ax:
-// the x terms of camera_T_world's three rows, R[r][0] * x, for the block's 8 x (the same products
-// for every row of the block).
-SEAMLESS_SIMD_INL void fuse_row(const FuseRowFrame& f, const vf ax[3], float py, float pz, Voxel* row, uchar3* colors) {
+// Fuses the frame into the 8 voxels of row (y, z), whose values sdf and wt hold (and then their
+// values after the frame); row points to them in the pool, colors to their colours (nullptr:
+// none). ax: the x terms of camera_T_world's three rows, R[r][0] * x, for the block's 8 x (the
+// same products for every row of the block).
+SEAMLESS_SIMD_INL void fuse_row(const FuseRowFrame& f, const vf ax[3], float py, float pz, Voxel* row, uchar3* colors,
+                                vf& sdf_v, vf& wt) {
   const FrameInput& in = f.in;
   const mat3& R = f.camera_T_world.R;
   const vec3 t = f.camera_T_world.t;
@@ -52,37 +60,27 @@ SEAMLESS_SIMD_INL void fuse_row(const FuseRowFrame& f, const vf ax[3], float py,
   m = m & (d >= vf(in.min_depth)) & (d <= vf(in.max_depth));
   const vf sdf = d - cz;
   m = m & !(sdf < vf(-mu));  // occluded: behind the surface by more than the truncation
-  // The row's voxels, {sdf, weight} interleaved, as two lanes of 8.
-  simd::f8 lo, hi;
-  std::memcpy(&lo, row, sizeof lo);
-  std::memcpy(&hi, row + 4, sizeof hi);
-  const vf old_sdf = __builtin_shufflevector(lo, hi, 0, 2, 4, 6, 8, 10, 12, 14);
-  const vf wt = __builtin_shufflevector(lo, hi, 1, 3, 5, 7, 9, 11, 13, 15);
-  const vf new_sdf = select(m, running_average(old_sdf, wt, min_of(sdf, vf(mu))), old_sdf);
-  const vf new_wt = select(m, min_of(wt + vf(1.f), vf(f.max_weight)), wt);
+  if (!simd::bits(m)) return;
   if (colors && in.rgb.data) {  // colour only near the surface, a few lanes of a row: one at a time
     const int near = simd::bits(m & (sdf < vf(mu)));
     for (int l = 0; l < simd::kWidth; ++l)
       if (near >> l & 1) colors[l] = blend_color(colors[l], in.rgb(u[l], w[l]), wt[l]);
   }
-  lo = __builtin_shufflevector(new_sdf.v, new_wt.v, 0, 8, 1, 9, 2, 10, 3, 11);
-  hi = __builtin_shufflevector(new_sdf.v, new_wt.v, 4, 12, 5, 13, 6, 14, 7, 15);
-  std::memcpy(row, &lo, sizeof lo);
-  std::memcpy(row + 4, &hi, sizeof hi);
+  sdf_v = select(m, running_average(sdf_v, wt, min_of(sdf, vf(mu))), sdf_v);
+  wt = select(m, min_of(wt + vf(1.f), vf(f.max_weight)), wt);
+  store_row(row, sdf_v, wt);
 }
 
-// voxel_keeps_block for the 8 voxels at v, as fuse_layer_simd's flag bits.
-SEAMLESS_SIMD_INL int row_flags(const FuseRowFrame& f, const Voxel* v) {
-  simd::f8 lo, hi;
-  std::memcpy(&lo, v, sizeof lo);
-  std::memcpy(&hi, v + 4, sizeof hi);
-  const vm observed = vf(__builtin_shufflevector(lo, hi, 1, 3, 5, 7, 9, 11, 13, 15)) > vf(0.f);
-  const vf a = abs(vf(__builtin_shufflevector(lo, hi, 0, 2, 4, 6, 8, 10, 12, 14)));
+// voxel_keeps_block for a row's 8 voxels, as fuse_layer_simd's flag bits.
+SEAMLESS_SIMD_INL int row_flags(const FuseRowFrame& f, vf sdf, vf wt) {
+  const vm observed = wt > vf(0.f);
+  const vf a = abs(sdf);
   int flags = 0;
   if (f.keep && simd::bits(observed & (a < vf(f.keep_below)))) flags |= kRowKeeps;
   if (f.surface && simd::bits(observed & (a < vf(f.surface_below)))) flags |= kRowNearSurface;
   return flags;
 }
+}  // namespace
 
 int fuse_layer_simd(const FuseRowFrame& f, int3 b, int z, Voxel* layer, uchar3* colors) {
   static_assert(simd::kWidth == kBlockSide && sizeof(Voxel) == 2 * sizeof(float));
@@ -98,9 +96,11 @@ int fuse_layer_simd(const FuseRowFrame& f, int3 b, int z, Voxel* layer, uchar3* 
   for (int y = 0; y < kBlockSide; ++y) {
     const float py = f.geom.origin.y + static_cast<float>(b.y * 8 + y) * f.geom.voxel_size;
     const int r = y * kBlockSide;  // the row's first voxel in the layer
-    fuse_row(f, ax, py, pz, layer + r, colors ? colors + r : nullptr);
+    vf sdf, wt;
+    load_row(layer + r, sdf, wt);
+    fuse_row(f, ax, py, pz, layer + r, colors ? colors + r : nullptr, sdf, wt);
     // Every row's flags, changed or not, as the scalar loop tests every voxel (until both are set).
-    if (flags != wanted) flags |= row_flags(f, layer + r);
+    if (flags != wanted) flags |= row_flags(f, sdf, wt);
   }
   return flags;
 }

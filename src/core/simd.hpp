@@ -39,6 +39,7 @@ struct vm {
 };
 SEAMLESS_SIMD_INL vm operator&(vm a, vm b) { return {a.v & b.v}; }
 SEAMLESS_SIMD_INL vm operator|(vm a, vm b) { return {a.v | b.v}; }
+SEAMLESS_SIMD_INL vm operator!(vm a) { return {~a.v}; }
 
 struct vf {
   f8 v;
@@ -57,6 +58,9 @@ SEAMLESS_SIMD_INL vm operator>(vf a, vf b) { return {a.v > b.v}; }
 SEAMLESS_SIMD_INL vm operator<=(vf a, vf b) { return {a.v <= b.v}; }
 SEAMLESS_SIMD_INL vm operator>=(vf a, vf b) { return {a.v >= b.v}; }
 SEAMLESS_SIMD_INL vf select(vm m, vf a, vf b) { return m.v ? a.v : b.v; }
+// seamless::min_of lane by lane (a < b ? a : b), and fabsf up to the sign of a zero.
+SEAMLESS_SIMD_INL vf min_of(vf a, vf b) { return select(a < b, a, b); }
+SEAMLESS_SIMD_INL vf abs(vf a) { return select(a < vf(0.f), -a, a); }
 
 struct vi {
   i8 v;
@@ -71,6 +75,7 @@ SEAMLESS_SIMD_INL vm operator==(vi a, vi b) { return {a.v == b.v}; }
 SEAMLESS_SIMD_INL vm operator!=(vi a, vi b) { return {a.v != b.v}; }
 SEAMLESS_SIMD_INL vm operator<(vi a, vi b) { return {a.v < b.v}; }
 SEAMLESS_SIMD_INL vm operator>(vi a, vi b) { return {a.v > b.v}; }
+SEAMLESS_SIMD_INL vm operator>=(vi a, vi b) { return {a.v >= b.v}; }
 SEAMLESS_SIMD_INL vi select(vm m, vi a, vi b) { return m.v ? a.v : b.v; }
 // seamless::floor_int lane by lane (truncation, then one down where that rounded up).
 SEAMLESS_SIMD_INL vi floor_int(vf x) {
