@@ -2,21 +2,10 @@
 #include <cmath>
 
 #include "kernels/recon/tsdf.hpp"
+#include "kernels/recon/tsdf_march.hpp"
+#include "kernels/recon/tsdf_march_simd.hpp"
 
 namespace seamless::kernels {
-
-// Ray parameter at which the ray o + t d (voxel units) leaves block b (slab method); inv_d is
-// 1 / d per axis (computed once per ray: a division is a subroutine on the GPU).
-SEAMLESS_HD inline float block_exit(vec3 o, vec3 d, vec3 inv_d, int3 b) {
-  float t = 1e30f;
-  float lo[3] = {b.x * 8.f, b.y * 8.f, b.z * 8.f};
-  float oo[3] = {o.x, o.y, o.z}, dd[3] = {d.x, d.y, d.z}, ii[3] = {inv_d.x, inv_d.y, inv_d.z};
-  for (int k = 0; k < 3; ++k) {
-    if (dd[k] > 0.f) t = min_of(t, (lo[k] + 8.f - oo[k]) * ii[k]);
-    if (dd[k] < 0.f) t = min_of(t, (lo[k] - oo[k]) * ii[k]);
-  }
-  return t;
-}
 
 // Pixel bounding box and camera-depth range of a block's cell box clipped to the depth slab.
 struct ScreenBounds {
@@ -127,117 +116,6 @@ void TsdfRaycast<Exec, Acc>::fill_block_window(const Exec& ex, HashTableView t, 
   });
 }
 
-// Whether block i (>= 0) may hold a surface for the march: false only where the accessor has
-// near-surface flags (a volume storing free space; block_near_surface in tsdf.hpp) and block i's
-// is 0, so that the march skips it like an unallocated block.
-template <class Acc> SEAMLESS_HD inline bool near_surface(const Acc& a, std::int32_t i) {
-  if constexpr (requires { a.near_surface; }) {
-    return !a.near_surface || a.near_surface[i];
-  } else {
-    return true;
-  }
-}
-
-// Marches the ray o + d z (voxel units, z = camera depth) from z to z_end; on a +/- zero crossing
-// returns true with its refined depth in *hit and the block cache left near it. The crossing is
-// refined by three steps of regula falsi on the trilinear field, taken by the same loop: its
-// samples then run through the one copy of the sample code (on the GPU the kernel's size, not its
-// arithmetic, held the march back: most warps waited on instruction fetch).
-template <class Acc>
-SEAMLESS_HD inline bool march_ray(const Acc& a, vec3 o, vec3 d, float z, float z_end, BlockCache& c, float* hit) {
-  const float dlen = length(d);        // voxels per metre of depth
-  const float min_step = 0.5f / dlen;  // half a voxel
-  // Where a cell is unobserved no crossing can be found, and observed space reaches at least the
-  // truncation distance mu in front of every fused surface (fusion writes every voxel of the
-  // band from +mu on, see fuse_voxel). Steps of mu/2 through unobserved cells therefore land at
-  // least one observed sample in front of the next surface, where the march below takes over.
-  const float unobserved_step = fmaxf(min_step, 0.5f * a.geom.truncation / (dlen * a.geom.voxel_size));
-  const float step_per_sdf = 0.8f / (dlen * a.geom.voxel_size);  // see the step below
-  const vec3 inv_d{1.f / d.x, 1.f / d.y, 1.f / d.z};             // +-inf on an axis d does not move along
-  constexpr int kRefineSteps = 3;
-  float z_prev = 0.f, f_prev = 0.f;
-  bool have_prev = false, prev_near = false;     // prev_near: the last sample's block is near a surface
-  int refine = -1;                               // -1: marching; else regula falsi steps taken
-  float ta = 0.f, fa = 0.f, tb = 0.f, fb = 0.f;  // the bracket: fa > 0 at ta, fb <= 0 at tb
-  for (int it = 0; refine >= 0 || (it < 8192 && z < z_end); ++it) {
-    vec3 q = o + d * z;
-    const int3 g0 = floor_to_int(q), b = block_of_voxel(g0);
-    const std::int32_t i0 = cached_block(a, b, c);
-    // Skipped: unallocated, or not near a surface while marching (not while refining a bracket),
-    // except for one sample right after a sample in a block near a surface: a crossing between
-    // the two (the step from the last sample in front of a surface may land past it) is then
-    // bracketed as without the flags (block_near_surface in tsdf.hpp).
-    const bool near = i0 >= 0 && (refine >= 0 || near_surface(a, i0));
-    const bool skip = i0 < 0 || (!near && !(have_prev && prev_near));
-    float f = 0.f;
-    const bool sampled = !skip && sample_tsdf_in(a, q, g0, i0, c, &f);  // the block just found: no second lookup
-    if (refine >= 0) {                                                  // regula falsi between the bracket's ends
-      if (!sampled) break;  // no value here: the last estimate, z, is the hit
-      if (f > 0.f) ta = z, fa = f;
-      else tb = z, fb = f;
-      z = ta + (tb - ta) * fa / (fa - fb);
-      if (++refine == kRefineSteps) break;
-      continue;
-    }
-    if (skip) {  // empty space: skip the whole block (Niessner section 4.3)
-      z = max_of(block_exit(o, d, inv_d, b), z) + min_step * 0.1f;
-      have_prev = false;
-      continue;
-    }
-    if (!sampled) {
-      z += unobserved_step;
-      have_prev = false;
-      continue;
-    }
-    if (have_prev && f_prev > 0.f && f <= 0.f) {
-      ta = z_prev, fa = f_prev, tb = z, fb = f, refine = 0;
-      z = ta + (tb - ta) * fa / (fa - fb);
-      continue;
-    }
-    z_prev = z, f_prev = f, have_prev = true, prev_near = near;
-    // |TSDF| is at most about the distance to the nearest zero crossing (projective distances
-    // over-estimate at grazing angles, hence the 0.8), so stepping that far along the ray (|d| s
-    // metres per unit of z) cannot jump over one: truncation-sized steps in the band's free-space
-    // side (and through the back of a surface a ray enters from behind), shrinking to half a
-    // voxel at the surface.
-    z += max_of(fabsf(f) * step_per_sdf, min_step);
-  }
-  if (refine < 0) return false;
-  *hit = z;
-  return true;
-}
-
-template <class Acc>
-SEAMLESS_HD inline void raycast_pixel(const Acc& a, int x, int y, const Intrinsics& K, const SE3& world_T_camera,
-                                      float min_depth, float max_depth, const RaycastOutput& out,
-                                      const RayIntervals& iv) {
-  const VoxelGeometry& g = a.geom;
-  // Ray in voxel units, parametrised by camera depth z: point(z) = o + d z.
-  vec3 dir_c = K.unproject(static_cast<float>(x), static_cast<float>(y), 1.f);
-  vec3 o = g.to_voxel(world_T_camera.t);
-  vec3 d = world_T_camera.rotate(dir_c) / g.voxel_size;
-  const float min_step = 0.5f / length(d);  // half a voxel
-  float z = min_depth, z_end = max_depth;
-  if (iv.bits) {  // march only where blocks are (Niessner section 4.3); no block here: no ray
-    const std::int64_t t = iv.tile_of(x, y);
-    const float z_near = bits_float(iv.bits[2 * t]), z_far = bits_float(iv.bits[2 * t + 1]);
-    z = fmaxf(z, z_near - min_step), z_end = z_far > 0.f ? fminf(z_end, z_far + min_step) : 0.f;
-  }
-  BlockCache c;
-  float zh = 0.f, fh = 0.f;
-  vec3 col{0.f, 0.f, 0.f}, vw{0.f, 0.f, 0.f};
-  if (march_ray(a, o, d, z, z_end, c, &zh)) {
-    vec3 qh = o + d * zh;
-    if (out.color.data) sample_tsdf(a, qh, c, &fh, &col);  // no colour wanted: no ninth sample
-    vw = g.to_world(qh);
-  }
-  out.depth(x, y) = zh;  // each output written once; zero where no hit
-  out.vertex(x, y) = vw;
-  if (out.color.data)
-    out.color(x, y) = {static_cast<std::uint8_t>(col.x + 0.5f), static_cast<std::uint8_t>(col.y + 0.5f),
-                       static_cast<std::uint8_t>(col.z + 0.5f)};
-}
-
 // Threads take pixels in 8 x 4 groups (one CUDA warp each), which stay inside one interval tile
 // and see neighbouring surface points: the rays of a warp march alike instead of diverging along
 // a 32-pixel row.
@@ -276,14 +154,40 @@ void TsdfRaycast<Exec, Acc>::raycast(const Exec& ex, Acc a, Intrinsics K, SE3 wo
                                      float max_depth, RaycastOutput out, RayIntervals iv) {
   const int w = out.depth.width, h = out.depth.height;
   const int groups_x = (w + kRayGroupW - 1) / kRayGroupW, groups_y = (h + kRayGroupH - 1) / kRayGroupH;
-  ex.for_each(static_cast<std::int64_t>(groups_x) * groups_y * kRayGroupW * kRayGroupH,
-              [=] SEAMLESS_HD(std::int64_t i) {
-                const std::int64_t group = i / (kRayGroupW * kRayGroupH);
-                const int lane = static_cast<int>(i % (kRayGroupW * kRayGroupH));
-                const int x = static_cast<int>(group % groups_x) * kRayGroupW + lane % kRayGroupW;
-                const int y = static_cast<int>(group / groups_x) * kRayGroupH + lane / kRayGroupW;
-                if (x < w && y < h) raycast_pixel(a, x, y, K, world_T_camera, min_depth, max_depth, out, iv);
-              });
+  const std::int64_t groups = static_cast<std::int64_t>(groups_x) * groups_y;
+  bool marched = false;
+#if !defined(__CUDACC__)
+  // The CPU (with AVX2 and the block window) takes a row of a group at a time, its 8 rays marched
+  // on SIMD lanes: the same samples and hits as raycast_pixel's (tsdf_march_simd.hpp).
+  if constexpr (Exec::device == Device::CPU && std::is_same_v<Acc, WindowedHashAccess>) {
+    if (simd::cpu_simd() && simd_marchable(a)) {
+      static_assert(kRayGroupW == 8);  // a row of a group: the 8 lanes
+      ex.for_each(groups * kRayGroupH, [=](std::int64_t i) {
+        const std::int64_t group = i / kRayGroupH;
+        const int x0 = static_cast<int>(group % groups_x) * kRayGroupW;
+        const int y = static_cast<int>(group / groups_x) * kRayGroupH + static_cast<int>(i % kRayGroupH);
+        if (y >= h) return;
+        const int n = w - x0 < kRayGroupW ? w - x0 : kRayGroupW;
+        PixelRay r[kRayGroupW];
+        for (int l = 0; l < n; ++l) r[l] = pixel_ray(a.geom, x0 + l, y, K, world_T_camera, min_depth, max_depth, iv);
+        bool hit[kRayGroupW];
+        float zh[kRayGroupW];
+        detail::march_rays_simd(a, r, n, hit, zh);
+        BlockCache c;
+        for (int l = 0; l < n; ++l) write_pixel(a, x0 + l, y, r[l], hit[l], zh[l], c, out);
+      });
+      marched = true;
+    }
+  }
+#endif
+  if (!marched)
+    ex.for_each(groups * kRayGroupW * kRayGroupH, [=] SEAMLESS_HD(std::int64_t i) {
+      const std::int64_t group = i / (kRayGroupW * kRayGroupH);
+      const int lane = static_cast<int>(i % (kRayGroupW * kRayGroupH));
+      const int x = static_cast<int>(group % groups_x) * kRayGroupW + lane % kRayGroupW;
+      const int y = static_cast<int>(group / groups_x) * kRayGroupH + lane / kRayGroupW;
+      if (x < w && y < h) raycast_pixel(a, x, y, K, world_T_camera, min_depth, max_depth, out, iv);
+    });
   // Ten pixel footprints at the hit's depth: surfaces up to ~84 degrees from the view direction
   // keep their neighbours; a jump beyond that is a silhouette.
   const float jump_per_metre = 10.f / fminf(K.fx, K.fy);

@@ -1,0 +1,226 @@
+// The CPU's march on 8 lanes (tsdf_march_simd.hpp): march_ray (tsdf_march.hpp) for 8 rays at
+// once, lane l the ray r[l], each lane's state updated by the scalar loop's expressions.
+#include "kernels/recon/tsdf_march_simd.hpp"
+
+#include <cstring>
+
+#include "core/simd.hpp"
+
+#if SEAMLESS_SIMD_X86
+#include <immintrin.h>
+#endif
+
+namespace seamless::kernels {
+
+#if SEAMLESS_SIMD_X86
+#pragma GCC push_options
+#pragma GCC target("avx2")
+#endif
+namespace detail {
+
+using simd::i8, simd::f8, simd::vf, simd::vi, simd::vm, simd::v3;
+
+namespace {
+typedef long long q4 __attribute__((vector_size(32)));
+typedef std::int32_t i4 __attribute__((vector_size(16)));
+typedef unsigned u8 __attribute__((vector_size(32)));  // lanes of unsigned ints
+
+struct vi3 {
+  i8 x, y, z;
+};
+
+// The lanes whose bit is set in b.
+SEAMLESS_SIMD_INL vm lanes(int b) {
+  const i8 bit = {1, 2, 4, 8, 16, 32, 64, 128};
+  return {(bit & b) != 0};
+}
+
+// Lane l: p[idx[l]] where m holds, else -1.
+SEAMLESS_SIMD_INL i8 gather_index(const std::int32_t* p, i8 idx, vm m) {
+#if SEAMLESS_SIMD_X86
+  return reinterpret_cast<i8>(_mm256_mask_i32gather_epi32(reinterpret_cast<__m256i>(i8{} - 1), p,
+                                                          reinterpret_cast<__m256i>(idx),
+                                                          reinterpret_cast<__m256i>(m.v), 4));
+#else
+  i8 r = i8{} - 1;
+  for (int l = 0; l < simd::kWidth; ++l)
+    if (m.v[l]) r[l] = p[idx[l]];
+  return r;
+#endif
+}
+
+// find_block lane by lane for the lanes of m (-1 elsewhere): the window's entry where the block
+// is inside it, the table's answer elsewhere (WindowedHashAccess::find_block).
+SEAMLESS_SIMD_INL i8 find_blocks(const WindowedHashAccess& a, vi3 b, vm m) {
+  const BlockWindow& w = a.window;
+  // Unsigned, as BlockWindow::entry: the compares catch negatives too, and the entry of a lane
+  // outside (not read) wraps harmlessly; inside, it fits in 32 bits (simd_marchable).
+  const u8 x = reinterpret_cast<u8>(b.x) - static_cast<unsigned>(w.origin.x),
+           y = reinterpret_cast<u8>(b.y) - static_cast<unsigned>(w.origin.y),
+           z = reinterpret_cast<u8>(b.z) - static_cast<unsigned>(w.origin.z);
+  const unsigned side = static_cast<unsigned>(w.side);
+  const vm inside{reinterpret_cast<i8>((x < side) & (y < side) & (z < side))};
+  i8 r = gather_index(w.index, reinterpret_cast<i8>(x + side * (y + side * z)), m & inside);
+  const int outside = simd::bits(m & !inside);
+  if (outside)
+    for (int l = 0; l < simd::kWidth; ++l)
+      if (outside >> l & 1) r[l] = a.HashAccess::find_block(int3{b.x[l], b.y[l], b.z[l]});
+  return r;
+}
+
+// near_surface lane by lane for the lanes of m (blocks >= 0); true elsewhere.
+SEAMLESS_SIMD_INL vm near_flags(const WindowedHashAccess& a, i8 block, vm m) {
+  if (!a.near_surface) return {i8{} - 1};
+  return {~m.v | (gather_index(a.near_surface, block, m) != 0)};
+}
+
+// The sdf and weight of voxel block[l] * 512 + local[l] of the pool for the lanes of m, 0 and 0
+// elsewhere. The index is formed in 64 bits: a pool can hold more than 2^31 voxels.
+SEAMLESS_SIMD_INL void load_voxels(const Voxel* pool, i8 block, i8 local, vm m, vf& sdf, vf& wt) {
+  static_assert(sizeof(Voxel) == sizeof(long long) && kBlockVoxels == 512);
+  f8 lo, hi;  // voxels of lanes 0-3 and 4-7 as {sdf, weight} pairs
+#if SEAMLESS_SIMD_X86
+  auto half = [](i8 v, int h) {  // lanes 4h to 4h + 3 as 64-bit ints
+    const i4 p = h ? __builtin_shufflevector(v, v, 4, 5, 6, 7) : __builtin_shufflevector(v, v, 0, 1, 2, 3);
+    return __builtin_convertvector(p, q4);
+  };
+  const long long* base = reinterpret_cast<const long long*>(pool);
+  const q4 i0 = half(block, 0) * 512 + half(local, 0), i1 = half(block, 1) * 512 + half(local, 1);
+  lo = reinterpret_cast<f8>(_mm256_mask_i64gather_epi64(reinterpret_cast<__m256i>(q4{}), base,
+                                                        reinterpret_cast<__m256i>(i0),
+                                                        reinterpret_cast<__m256i>(half(m.v, 0)), 8));
+  hi = reinterpret_cast<f8>(_mm256_mask_i64gather_epi64(reinterpret_cast<__m256i>(q4{}), base,
+                                                        reinterpret_cast<__m256i>(i1),
+                                                        reinterpret_cast<__m256i>(half(m.v, 1)), 8));
+#else
+  Voxel v[simd::kWidth] = {};
+  for (int l = 0; l < simd::kWidth; ++l)
+    if (m.v[l]) v[l] = pool[static_cast<std::int64_t>(block[l]) * kBlockVoxels + local[l]];
+  std::memcpy(&lo, v, sizeof lo);
+  std::memcpy(&hi, v + 4, sizeof hi);
+#endif
+  sdf = __builtin_shufflevector(lo, hi, 0, 2, 4, 6, 8, 10, 12, 14);
+  wt = __builtin_shufflevector(lo, hi, 1, 3, 5, 7, 9, 11, 13, 15);
+}
+
+SEAMLESS_SIMD_INL i8 local_index(i8 x, i8 y, i8 z) { return (x & 7) + 8 * (y & 7) + 64 * (z & 7); }
+
+// sample_tsdf_in (the CPU's order) for the lanes of m: the cell of voxel g0 (in block b, index
+// i0), trilinear at q into f. Returns the lanes that have a value.
+SEAMLESS_SIMD_INL vm sample_lanes(const WindowedHashAccess& a, v3 q, vi3 g0, vi3 b, i8 i0, vm m, vf& f) {
+  if (!simd::bits(m)) return m;
+  // The cell reaches into the next block along the axes where g0 is a block's last voxel (cell_voxels).
+  const i8 ex = (g0.x & 7) == 7, ey = (g0.y & 7) == 7, ez = (g0.z & 7) == 7;  // -1 where true
+  const vm edge = m & vm{ex | ey | ez};
+  // The eight loads go out together, their cache misses overlapping (the scalar loop reads corner
+  // 0 first and stops there when it is unobserved: one wait more a sample, for the lanes a wait
+  // less); a lane has a value when all eight corners are allocated and observed.
+  vf d[8];
+  vm all = m;
+  for (int k = 0; k < 8; ++k) {
+    const i8 ox = k & 1 ? -ex : i8{}, oy = k & 2 ? -ey : i8{}, oz = k & 4 ? -ez : i8{};  // block offsets, 0 or 1
+    i8 ik = i0;
+    const vm other = edge & vm{(ox | oy | oz) != 0};
+    if (simd::bits(other)) ik = select(other, vi(find_blocks(a, vi3{b.x + ox, b.y + oy, b.z + oz}, other)), vi(i0)).v;
+    const vm mk = m & vm{ik >= 0};
+    const i8 local = local_index(g0.x + (k & 1), g0.y + (k >> 1 & 1), g0.z + (k >> 2));
+    vf wk;
+    load_voxels(a.voxels, ik, local, mk, d[k], wk);
+    all = all & mk & (wk > vf(0.f));
+  }
+  const vf fx = q.x - vf(__builtin_convertvector(g0.x, f8)), fy = q.y - vf(__builtin_convertvector(g0.y, f8)),
+           fz = q.z - vf(__builtin_convertvector(g0.z, f8));
+  // Trilinear as 7 lerps along x, then y, then z (sample_tsdf_in's expressions).
+  auto lerp = [](vf p, vf q, vf t) { return p + t * (q - p); };
+  const vf x0 = lerp(d[0], d[1], fx), x1 = lerp(d[2], d[3], fx), x2 = lerp(d[4], d[5], fx), x3 = lerp(d[6], d[7], fx);
+  f = lerp(lerp(x0, x1, fy), lerp(x2, x3, fy), fz);
+  return all;
+}
+
+// block_exit lane by lane.
+SEAMLESS_SIMD_INL vf block_exit_lanes(v3 o, v3 d, v3 inv_d, vi3 b) {
+  vf t(1e30f);
+  const vf lo[3] = {vf(__builtin_convertvector(b.x, f8)) * vf(8.f), vf(__builtin_convertvector(b.y, f8)) * vf(8.f),
+                    vf(__builtin_convertvector(b.z, f8)) * vf(8.f)};
+  const vf oo[3] = {o.x, o.y, o.z}, dd[3] = {d.x, d.y, d.z}, ii[3] = {inv_d.x, inv_d.y, inv_d.z};
+  for (int k = 0; k < 3; ++k) {
+    t = select(dd[k] > vf(0.f), simd::min_of(t, (lo[k] + vf(8.f) - oo[k]) * ii[k]), t);
+    t = select(dd[k] < vf(0.f), simd::min_of(t, (lo[k] - oo[k]) * ii[k]), t);
+  }
+  return t;
+}
+
+SEAMLESS_SIMD_INL vf max_of(vf a, vf b) { return select(a > b, a, b); }  // seamless::max_of on the host
+SEAMLESS_SIMD_INL vm select(vm m, vm a, vm b) { return {m.v ? a.v : b.v}; }
+SEAMLESS_SIMD_INL vi3 floor_lanes(v3 q) {
+  return {simd::floor_int(q.x).v, simd::floor_int(q.y).v, simd::floor_int(q.z).v};
+}
+}  // namespace
+
+void march_rays_simd(const WindowedHashAccess& a, const PixelRay* r, int n, bool* hit, float* zh) {
+  v3 o, d, inv_d;
+  vf z, z_end, min_step, unobserved_step, step_per_sdf;
+  for (int l = 0; l < simd::kWidth; ++l) {
+    const PixelRay& rl = r[l < n ? l : 0];  // lanes >= n repeat ray 0 and stay idle
+    const MarchSteps s = march_steps(a.geom, rl.d);
+    o.x.v[l] = rl.o.x, o.y.v[l] = rl.o.y, o.z.v[l] = rl.o.z;
+    d.x.v[l] = rl.d.x, d.y.v[l] = rl.d.y, d.z.v[l] = rl.d.z;
+    inv_d.x.v[l] = s.inv_d.x, inv_d.y.v[l] = s.inv_d.y, inv_d.z.v[l] = s.inv_d.z;
+    z.v[l] = rl.z, z_end.v[l] = rl.z_end;
+    min_step.v[l] = s.min_step, unobserved_step.v[l] = s.unobserved_step, step_per_sdf.v[l] = s.step_per_sdf;
+  }
+  vf z_prev(0.f), f_prev(0.f), ta(0.f), fa(0.f), tb(0.f), fb(0.f);
+  vi refine(-1);  // -1: marching; else regula falsi steps taken
+  vm have_prev{i8{}}, prev_near{i8{}};
+  int live = (1 << n) - 1, found = 0;  // lanes still going; lanes that ended on a hit
+  for (int it = 0;; ++it) {
+    // march_ray's loop condition, lane by lane.
+    const vm refining = refine >= vi(0);
+    live &= simd::bits(refining | (vm{i8{} - (it < 8192 ? 1 : 0)} & (z < z_end)));
+    if (!live) break;
+    const vm L = lanes(live);
+    const v3 q = o + d * z;
+    const vi3 g0 = floor_lanes(q), b{g0.x >> 3, g0.y >> 3, g0.z >> 3};
+    const i8 i0 = find_blocks(a, b, L);
+    const vm allocated = L & vm{i0 >= 0};
+    const vm near = allocated & (refining | near_flags(a, i0, allocated));
+    const vm skip = (!allocated) | ((!near) & !(have_prev & prev_near));
+    vf f(0.f);
+    const vm sampled = sample_lanes(a, q, g0, b, i0, L & !skip, f);
+
+    // Refining lanes: regula falsi between the bracket's ends; no value ends it at the last estimate.
+    const vm rl = L & refining, rs = rl & sampled, pos = f > vf(0.f);
+    ta = select(rs & pos, z, ta), fa = select(rs & pos, f, fa);
+    tb = select(rs & !pos, z, tb), fb = select(rs & !pos, f, fb);
+    z = select(rs, ta + (tb - ta) * fa / (fa - fb), z);
+    refine = select(rs, refine + vi(1), refine);
+    const int ended = simd::bits((rl & !sampled) | (rs & (refine == vi(kRefineSteps))));
+    found |= ended, live &= ~ended;
+
+    // Marching lanes.
+    const vm ml = L & !refining;
+    const vm ms = ml & skip;  // empty space: skip the whole block
+    z = select(ms, max_of(block_exit_lanes(o, d, inv_d, b), z) + min_step * vf(0.1f), z);
+    const vm mu = ml & !skip & !sampled;  // unobserved: a fixed step
+    z = select(mu, z + unobserved_step, z);
+    have_prev = have_prev & !(ms | mu);
+    const vm msd = ml & sampled;
+    const vm bracket = msd & have_prev & (f_prev > vf(0.f)) & (f <= vf(0.f));
+    ta = select(bracket, z_prev, ta), fa = select(bracket, f_prev, fa);
+    tb = select(bracket, z, tb), fb = select(bracket, f, fb);
+    refine = select(bracket, vi(0), refine);
+    const vm step = msd & !bracket;
+    z_prev = select(step, z, z_prev), f_prev = select(step, f, f_prev);
+    have_prev = have_prev | step, prev_near = select(step, near, prev_near);
+    z = select(bracket, ta + (tb - ta) * fa / (fa - fb),
+               select(step, z + max_of(simd::abs(f) * step_per_sdf, min_step), z));
+  }
+  for (int l = 0; l < n; ++l) hit[l] = found >> l & 1, zh[l] = z[l];
+}
+
+}  // namespace detail
+#if SEAMLESS_SIMD_X86
+#pragma GCC pop_options
+#endif
+
+}  // namespace seamless::kernels

@@ -1,0 +1,38 @@
+// The CPU's march of 8 rays at once on SIMD lanes (defined in tsdf_march_simd.cpp, compiled for
+// AVX2 where simd::cpu_simd() finds it at run time). Never seen by nvcc.
+//
+// The raycast's work item on the CPU is then a row of a ray group (8 neighbouring pixels, which
+// mostly march alike: docs/PERFORMANCE.md, "The CPU's march on SIMD lanes"), lane l the ray of
+// pixel l. Each lane runs march_ray's operations in march_ray's order (tsdf_march.hpp; no FMA
+// contraction: core/simd.hpp) until its own ray ends, so it takes the same samples and finds the
+// same hit as the scalar loop, bit for bit (tests compare both). A step of the scalar march is a
+// chain of dependent loads and about two hundred instructions, one ray after the other; on lanes
+// the arithmetic is shared by 8 rays and their voxel loads go out together as gathers.
+#pragma once
+#if !defined(__CUDACC__)
+#include "core/cpu_simd.hpp"
+#include "kernels/recon/tsdf_march.hpp"
+
+namespace seamless::kernels {
+
+// Whether march_rays_simd can take rays through a: it needs the block window, and reaches its
+// entries with 32-bit indices.
+inline bool simd_marchable(const WindowedHashAccess& a) {
+  return a.window.index && a.window.count() < (std::int64_t{1} << 31);
+}
+
+#if SEAMLESS_SIMD_X86
+#pragma GCC push_options
+#pragma GCC target("avx2")
+#endif
+namespace detail {
+// Marches rays r[0, n) (n <= 8) as march_ray does: hit[l] and zh[l] are what march_ray returns and
+// writes for ray r[l] (zh[l] is left unspecified where there is no hit).
+void march_rays_simd(const WindowedHashAccess& a, const PixelRay* r, int n, bool* hit, float* zh);
+}  // namespace detail
+#if SEAMLESS_SIMD_X86
+#pragma GCC pop_options
+#endif
+
+}  // namespace seamless::kernels
+#endif
