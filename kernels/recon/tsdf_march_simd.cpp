@@ -38,9 +38,8 @@ SEAMLESS_SIMD_INL vm lanes(int b) {
 // Lane l: p[idx[l]] where m holds, else -1.
 SEAMLESS_SIMD_INL i8 gather_index(const std::int32_t* p, i8 idx, vm m) {
 #if SEAMLESS_SIMD_X86
-  return reinterpret_cast<i8>(_mm256_mask_i32gather_epi32(reinterpret_cast<__m256i>(i8{} - 1), p,
-                                                          reinterpret_cast<__m256i>(idx),
-                                                          reinterpret_cast<__m256i>(m.v), 4));
+  return reinterpret_cast<i8>(_mm256_mask_i32gather_epi32(
+      reinterpret_cast<__m256i>(i8{} - 1), p, reinterpret_cast<__m256i>(idx), reinterpret_cast<__m256i>(m.v), 4));
 #else
   i8 r = i8{} - 1;
   for (int l = 0; l < simd::kWidth; ++l)
@@ -137,6 +136,23 @@ SEAMLESS_SIMD_INL vm sample_lanes(const WindowedHashAccess& a, v3 q, vi3 g0, vi3
   return all;
 }
 
+// The march waits on its voxel loads (a frame's fusion has just streamed every visible block
+// through the caches): a lane's first sample in a block asks for the whole block (64 lines), which
+// its next samples and the neighbouring rays' mostly read. The lanes of m sample in blocks i0;
+// last holds each lane's block before (a block is fetched once for the lanes that share it).
+SEAMLESS_SIMD_INL void prefetch_blocks(const WindowedHashAccess& a, i8 i0, vm m, i8& last) {
+  const int fresh = simd::bits(m & vm{i0 != last});
+  if (!fresh) return;
+  std::int32_t fetched = -1;
+  for (int l = 0; l < simd::kWidth; ++l)
+    if ((fresh >> l & 1) && i0[l] != fetched) {
+      fetched = i0[l];
+      const char* p = reinterpret_cast<const char*>(a.voxels + static_cast<std::int64_t>(fetched) * kBlockVoxels);
+      for (int k = 0; k < kBlockVoxels * static_cast<int>(sizeof(Voxel)) / 64; ++k) __builtin_prefetch(p + 64 * k);
+    }
+  last = m.v ? i0 : last;
+}
+
 // block_exit lane by lane.
 SEAMLESS_SIMD_INL vf block_exit_lanes(v3 o, v3 d, v3 inv_d, vi3 b) {
   vf t(1e30f);
@@ -173,6 +189,7 @@ void march_rays_simd(const WindowedHashAccess& a, const PixelRay* r, int n, bool
   vi refine(-1);  // -1: marching; else regula falsi steps taken
   vm have_prev{i8{}}, prev_near{i8{}};
   int live = (1 << n) - 1, found = 0;  // lanes still going; lanes that ended on a hit
+  i8 last_block = i8{} - 1;            // the block of each lane's last sample
   for (int it = 0;; ++it) {
     // march_ray's loop condition, lane by lane.
     const vm refining = refine >= vi(0);
@@ -186,6 +203,7 @@ void march_rays_simd(const WindowedHashAccess& a, const PixelRay* r, int n, bool
     const vm near = allocated & (refining | near_flags(a, i0, allocated));
     const vm skip = (!allocated) | ((!near) & !(have_prev & prev_near));
     vf f(0.f);
+    prefetch_blocks(a, i0, L & !skip, last_block);
     const vm sampled = sample_lanes(a, q, g0, b, i0, L & !skip, f);
 
     // Refining lanes: regula falsi between the bracket's ends; no value ends it at the last estimate.
