@@ -11,10 +11,7 @@ namespace seamless::kernels {
 // bit-identical to the scalar loops. A tile takes the vector path only where all 8 particles are
 // fluid with fluid-only lists (the fluid's interior and surface; mixed tiles run the scalar
 // loops). Compiled for AVX2 (simd::cpu_simd() checks the CPU at run time).
-#if SEAMLESS_SIMD_X86
-#pragma GCC push_options
-#pragma GCC target("avx2")
-#endif
+SEAMLESS_SIMD_TARGET_BEGIN
 namespace detail {
 // The tile at s0 if it can take the vector path: its list lengths, the shortest and the longest.
 struct Tile {
@@ -443,8 +440,6 @@ bool neighbors_tile(const SimViews& S, int s0) {
   return true;
 }
 }  // namespace detail
-#if SEAMLESS_SIMD_X86
-#pragma GCC pop_options
-#endif
+SEAMLESS_SIMD_TARGET_END
 
 }  // namespace seamless::kernels

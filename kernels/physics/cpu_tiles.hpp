@@ -10,10 +10,7 @@ namespace seamless::kernels {
 
 #if !defined(__CUDACC__)
 // The CPU's SIMD tiles (defined at the end of this file).
-#if SEAMLESS_SIMD_X86
-#pragma GCC push_options
-#pragma GCC target("avx2")
-#endif
+SEAMLESS_SIMD_TARGET_BEGIN
 namespace detail {
 bool vorticity_tile(const SimViews& S, int s0);
 bool density_tile(const SimViews& S, int s0);
@@ -23,9 +20,7 @@ int scan_candidates_simd(const SimViews& S, vec3 p, float R2, int s, const int* 
 int scan_runs_simd(const SimViews& S, vec3 p, float R, int s, int* list, int cap);
 bool neighbors_tile(const SimViews& S, int s0);
 }  // namespace detail
-#if SEAMLESS_SIMD_X86
-#pragma GCC pop_options
-#endif
+SEAMLESS_SIMD_TARGET_END
 
 // Runs tile(S, s0) for the tiles of 8 particles and one(s) for the particles of tiles it
 // declines, on the CPU when the SIMD lanes are available; false otherwise (the caller then runs

@@ -8,10 +8,7 @@
 
 namespace seamless::kernels {
 
-#if SEAMLESS_SIMD_X86
-#pragma GCC push_options
-#pragma GCC target("avx2")
-#endif
+SEAMLESS_SIMD_TARGET_BEGIN
 namespace detail {
 
 using simd::vf, simd::vi, simd::vm;
@@ -106,8 +103,6 @@ int fuse_layer_simd(const FuseRowFrame& f, int3 b, int z, Voxel* layer, uchar3* 
 }
 
 }  // namespace detail
-#if SEAMLESS_SIMD_X86
-#pragma GCC pop_options
-#endif
+SEAMLESS_SIMD_TARGET_END
 
 }  // namespace seamless::kernels

@@ -28,18 +28,13 @@ struct FuseRowFrame {
 // keep_below), or is near a surface (with surface_below).
 constexpr int kRowKeeps = 1, kRowNearSurface = 2;
 
-#if SEAMLESS_SIMD_X86
-#pragma GCC push_options
-#pragma GCC target("avx2")
-#endif
+SEAMLESS_SIMD_TARGET_BEGIN
 namespace detail {
 // Fuses the frame into layer z of block b (its 64 voxels at that z): layer points to them, colors
 // to their colours (nullptr: no colour fused). Not for a frame that carves free space (in.carve > 0).
 int fuse_layer_simd(const FuseRowFrame& f, int3 b, int z, Voxel* layer, uchar3* colors);
 }  // namespace detail
-#if SEAMLESS_SIMD_X86
-#pragma GCC pop_options
-#endif
+SEAMLESS_SIMD_TARGET_END
 
 }  // namespace seamless::kernels
 #endif

@@ -12,10 +12,7 @@
 
 namespace seamless::kernels {
 
-#if SEAMLESS_SIMD_X86
-#pragma GCC push_options
-#pragma GCC target("avx2")
-#endif
+SEAMLESS_SIMD_TARGET_BEGIN
 namespace detail {
 
 using simd::i8, simd::f8, simd::vf, simd::vi, simd::vm, simd::v3;
@@ -237,8 +234,6 @@ void march_rays_simd(const WindowedHashAccess& a, const PixelRay* r, int n, bool
 }
 
 }  // namespace detail
-#if SEAMLESS_SIMD_X86
-#pragma GCC pop_options
-#endif
+SEAMLESS_SIMD_TARGET_END
 
 }  // namespace seamless::kernels

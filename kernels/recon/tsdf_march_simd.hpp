@@ -21,18 +21,13 @@ inline bool simd_marchable(const WindowedHashAccess& a) {
   return a.window.index && a.window.count() < (std::int64_t{1} << 31);
 }
 
-#if SEAMLESS_SIMD_X86
-#pragma GCC push_options
-#pragma GCC target("avx2")
-#endif
+SEAMLESS_SIMD_TARGET_BEGIN
 namespace detail {
 // Marches rays r[0, n) (n <= 8) as march_ray does: hit[l] and zh[l] are what march_ray returns and
 // writes for ray r[l] (zh[l] is left unspecified where there is no hit).
 void march_rays_simd(const WindowedHashAccess& a, const PixelRay* r, int n, bool* hit, float* zh);
 }  // namespace detail
-#if SEAMLESS_SIMD_X86
-#pragma GCC pop_options
-#endif
+SEAMLESS_SIMD_TARGET_END
 
 }  // namespace seamless::kernels
 #endif

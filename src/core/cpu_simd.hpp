@@ -13,6 +13,17 @@
 #define SEAMLESS_SIMD_X86 0
 #endif
 
+// A region of functions on the lanes, compiled for AVX2 on x86-64 (taken where cpu_simd() finds
+// it at run time) and for the baseline elsewhere: SEAMLESS_SIMD_TARGET_BEGIN before them,
+// SEAMLESS_SIMD_TARGET_END after.
+#if SEAMLESS_SIMD_X86
+#define SEAMLESS_SIMD_TARGET_BEGIN _Pragma("GCC push_options") _Pragma("GCC target(\"avx2\")")
+#define SEAMLESS_SIMD_TARGET_END _Pragma("GCC pop_options")
+#else
+#define SEAMLESS_SIMD_TARGET_BEGIN
+#define SEAMLESS_SIMD_TARGET_END
+#endif
+
 namespace seamless::simd {
 
 inline std::atomic<int>& cpu_simd_flag() {

@@ -393,14 +393,22 @@ TEST(TsdfFusion, CullingChangesNothingOnRealFrames) {
 // speed; holes, far noisy depth and the image border included) the voxels, colours, kept blocks and
 // surface flags must be those of the scalar loop bit for bit, in a band-only volume and in one
 // that stores free space (its surface flags).
-TEST(TsdfFusion, SimdRowsGiveTheScalarLoopsVoxelsBitForBit) {
-  if (!simd::cpu_simd()) GTEST_SKIP() << "this CPU has no AVX2: the SIMD rows do not run";
-  const std::string dir = std::string(SEAMLESS_TEST_DATA) + "/tum_fr1_rpy_000-149";
-  if (!std::filesystem::exists(dir)) GTEST_SKIP() << "no test data at " << dir;
+// The first n frames of tum_fr1_rpy_000-149 for the SIMD tests below, or why they cannot run
+// here (no AVX2, no data) in *skip.
+InputParams simd_test_frames(int n, std::string* skip) {
   InputParams in;
   in.source = InputSource::tum;
-  in.path = dir;
-  in.max_frames = 8;
+  in.path = std::string(SEAMLESS_TEST_DATA) + "/tum_fr1_rpy_000-149";
+  in.max_frames = n;
+  if (!simd::cpu_simd()) *skip = "this CPU has no AVX2: the SIMD lanes do not run";
+  else if (!std::filesystem::exists(in.path)) *skip = "no test data at " + in.path;
+  return in;
+}
+
+TEST(TsdfFusion, SimdRowsGiveTheScalarLoopsVoxelsBitForBit) {
+  std::string skip;
+  const InputParams in = simd_test_frames(8, &skip);
+  if (!skip.empty()) GTEST_SKIP() << skip;
   VolumeParams p;
   p.voxel_size = 0.01f, p.truncation = 0.04f;
   for (bool free_space : {false, true}) {
@@ -446,13 +454,9 @@ TEST(TsdfFusion, SimdRowsGiveTheScalarLoopsVoxelsBitForBit) {
 // edge), with the window over the frustum and cut down to 2 blocks (most lookups then fall back to
 // the hash table), and with free space stored (the march's near-surface flags) or not.
 TEST(TsdfRaycast, SimdMarchGivesTheScalarMarchsMapsBitForBit) {
-  if (!simd::cpu_simd()) GTEST_SKIP() << "this CPU has no AVX2: the SIMD march does not run";
-  const std::string dir = std::string(SEAMLESS_TEST_DATA) + "/tum_fr1_rpy_000-149";
-  if (!std::filesystem::exists(dir)) GTEST_SKIP() << "no test data at " << dir;
-  InputParams in;
-  in.source = InputSource::tum;
-  in.path = dir;
-  in.max_frames = 3;
+  std::string skip;
+  const InputParams in = simd_test_frames(3, &skip);
+  if (!skip.empty()) GTEST_SKIP() << skip;
   for (bool free_space : {false, true})
     for (int window : {VolumeParams{}.raycast_window, 2}) {
       VolumeParams p;
