@@ -19,8 +19,7 @@ SEAMLESS_SIMD_INL void load_row(const Voxel* v, vf& sdf, vf& wt) {
   simd::f8 lo, hi;
   std::memcpy(&lo, v, sizeof lo);
   std::memcpy(&hi, v + 4, sizeof hi);
-  sdf = __builtin_shufflevector(lo, hi, 0, 2, 4, 6, 8, 10, 12, 14);
-  wt = __builtin_shufflevector(lo, hi, 1, 3, 5, 7, 9, 11, 13, 15);
+  simd::deinterleave(lo, hi, sdf, wt);
 }
 SEAMLESS_SIMD_INL void store_row(Voxel* v, vf sdf, vf wt) {
   const simd::f8 lo = __builtin_shufflevector(sdf.v, wt.v, 0, 8, 1, 9, 2, 10, 3, 11);

@@ -85,8 +85,8 @@ SEAMLESS_HD inline MarchSteps march_steps(const VoxelGeometry& g, vec3 d) {
   return s;
 }
 
-// Steps of regula falsi that refine a bracketed crossing.
-constexpr int kRefineSteps = 3;
+// Steps of regula falsi that refine a bracketed crossing, and the most steps a ray takes.
+constexpr int kRefineSteps = 3, kMaxMarchSteps = 8192;
 
 // Marches the ray r from r.z to r.z_end; on a +/- zero crossing returns true with its refined
 // depth in *hit and the block cache left near it. The crossing is refined by kRefineSteps steps of
@@ -101,7 +101,7 @@ template <class Acc> SEAMLESS_HD inline bool march_ray(const Acc& a, const Pixel
   bool have_prev = false, prev_near = false;     // prev_near: the last sample's block is near a surface
   int refine = -1;                               // -1: marching; else regula falsi steps taken
   float ta = 0.f, fa = 0.f, tb = 0.f, fb = 0.f;  // the bracket: fa > 0 at ta, fb <= 0 at tb
-  for (int it = 0; refine >= 0 || (it < 8192 && z < r.z_end); ++it) {
+  for (int it = 0; refine >= 0 || (it < kMaxMarchSteps && z < r.z_end); ++it) {
     vec3 q = o + d * z;
     const int3 g0 = floor_to_int(q), b = block_of_voxel(g0);
     const std::int32_t i0 = cached_block(a, b, c);

@@ -26,12 +26,6 @@ struct vi3 {
   i8 x, y, z;
 };
 
-// The lanes whose bit is set in b.
-SEAMLESS_SIMD_INL vm lanes(int b) {
-  const i8 bit = {1, 2, 4, 8, 16, 32, 64, 128};
-  return {(bit & b) != 0};
-}
-
 // Lane l: p[idx[l]] where m holds, else -1.
 SEAMLESS_SIMD_INL i8 gather_index(const std::int32_t* p, i8 idx, vm m) {
 #if SEAMLESS_SIMD_X86
@@ -95,8 +89,7 @@ SEAMLESS_SIMD_INL void load_voxels(const Voxel* pool, i8 block, i8 local, vm m, 
   std::memcpy(&lo, v, sizeof lo);
   std::memcpy(&hi, v + 4, sizeof hi);
 #endif
-  sdf = __builtin_shufflevector(lo, hi, 0, 2, 4, 6, 8, 10, 12, 14);
-  wt = __builtin_shufflevector(lo, hi, 1, 3, 5, 7, 9, 11, 13, 15);
+  simd::deinterleave(lo, hi, sdf, wt);
 }
 
 SEAMLESS_SIMD_INL i8 local_index(i8 x, i8 y, i8 z) { return (x & 7) + 8 * (y & 7) + 64 * (z & 7); }
@@ -163,8 +156,6 @@ SEAMLESS_SIMD_INL vf block_exit_lanes(v3 o, v3 d, v3 inv_d, vi3 b) {
   return t;
 }
 
-SEAMLESS_SIMD_INL vf max_of(vf a, vf b) { return select(a > b, a, b); }  // seamless::max_of on the host
-SEAMLESS_SIMD_INL vm select(vm m, vm a, vm b) { return {m.v ? a.v : b.v}; }
 SEAMLESS_SIMD_INL vi3 floor_lanes(v3 q) {
   return {simd::floor_int(q.x).v, simd::floor_int(q.y).v, simd::floor_int(q.z).v};
 }
@@ -190,9 +181,9 @@ void march_rays_simd(const WindowedHashAccess& a, const PixelRay* r, int n, bool
   for (int it = 0;; ++it) {
     // march_ray's loop condition, lane by lane.
     const vm refining = refine >= vi(0);
-    live &= simd::bits(refining | (vm{i8{} - (it < 8192 ? 1 : 0)} & (z < z_end)));
+    live &= simd::bits(refining | (vm{i8{} - (it < kMaxMarchSteps ? 1 : 0)} & (z < z_end)));
     if (!live) break;
-    const vm L = lanes(live);
+    const vm L = simd::from_bits(live);
     const v3 q = o + d * z;
     const vi3 g0 = floor_lanes(q), b{g0.x >> 3, g0.y >> 3, g0.z >> 3};
     const i8 i0 = find_blocks(a, b, L);
@@ -215,7 +206,7 @@ void march_rays_simd(const WindowedHashAccess& a, const PixelRay* r, int n, bool
     // Marching lanes.
     const vm ml = L & !refining;
     const vm ms = ml & skip;  // empty space: skip the whole block
-    z = select(ms, max_of(block_exit_lanes(o, d, inv_d, b), z) + min_step * vf(0.1f), z);
+    z = select(ms, simd::max_of(block_exit_lanes(o, d, inv_d, b), z) + min_step * vf(0.1f), z);
     const vm mu = ml & !skip & !sampled;  // unobserved: a fixed step
     z = select(mu, z + unobserved_step, z);
     have_prev = have_prev & !(ms | mu);
@@ -228,7 +219,7 @@ void march_rays_simd(const WindowedHashAccess& a, const PixelRay* r, int n, bool
     z_prev = select(step, z, z_prev), f_prev = select(step, f, f_prev);
     have_prev = have_prev | step, prev_near = select(step, near, prev_near);
     z = select(bracket, ta + (tb - ta) * fa / (fa - fb),
-               select(step, z + max_of(simd::abs(f) * step_per_sdf, min_step), z));
+               select(step, z + simd::max_of(simd::abs(f) * step_per_sdf, min_step), z));
   }
   for (int l = 0; l < n; ++l) hit[l] = found >> l & 1, zh[l] = z[l];
 }

@@ -58,8 +58,10 @@ SEAMLESS_SIMD_INL vm operator>(vf a, vf b) { return {a.v > b.v}; }
 SEAMLESS_SIMD_INL vm operator<=(vf a, vf b) { return {a.v <= b.v}; }
 SEAMLESS_SIMD_INL vm operator>=(vf a, vf b) { return {a.v >= b.v}; }
 SEAMLESS_SIMD_INL vf select(vm m, vf a, vf b) { return m.v ? a.v : b.v; }
-// seamless::min_of lane by lane (a < b ? a : b), and fabsf up to the sign of a zero.
+SEAMLESS_SIMD_INL vm select(vm m, vm a, vm b) { return {m.v ? a.v : b.v}; }
+// seamless::min_of and max_of (the host's) lane by lane, and fabsf up to the sign of a zero.
 SEAMLESS_SIMD_INL vf min_of(vf a, vf b) { return select(a < b, a, b); }
+SEAMLESS_SIMD_INL vf max_of(vf a, vf b) { return select(a > b, a, b); }
 SEAMLESS_SIMD_INL vf abs(vf a) { return select(a < vf(0.f), -a, a); }
 
 struct vi {
@@ -121,6 +123,18 @@ SEAMLESS_SIMD_INL int bits(vm m) {
   return b;
 }
 #endif
+
+// The mask of the lanes whose bit is set in b (bits' inverse).
+SEAMLESS_SIMD_INL vm from_bits(int b) {
+  const i8 bit = {1, 2, 4, 8, 16, 32, 64, 128};
+  return {(bit & b) != 0};
+}
+
+// The even and odd elements of the 16 floats lo, hi (pairs such as a voxel's {sdf, weight}).
+SEAMLESS_SIMD_INL void deinterleave(f8 lo, f8 hi, vf& even, vf& odd) {
+  even = __builtin_shufflevector(lo, hi, 0, 2, 4, 6, 8, 10, 12, 14);
+  odd = __builtin_shufflevector(lo, hi, 1, 3, 5, 7, 9, 11, 13, 15);
+}
 
 // Left-packing of the lanes that a mask keeps (in lane order): lane[bits] moves them to the front
 // (the other lanes follow), count[bits] is how many.
