@@ -83,11 +83,12 @@ SEAMLESS_HD inline SpaceEvidence space_evidence(const Acc& a, vec3 p_world, floa
   const Voxel* v[8];
   if (!cell_voxels(a, g0, c, v)) return SpaceEvidence::unknown;
   for (int k = 0; k < 8; ++k)
-    if (!(v[k]->weight > 0.f && v[k]->weight >= min_weight)) return SpaceEvidence::unknown;
+    if (!(voxel_observed(*v[k]) && voxel_weight(*v[k]) >= min_weight)) return SpaceEvidence::unknown;
   const vec3 f = q - to_vec3(g0);
   float sdf = 0.f;
   for (int k = 0; k < 8; ++k)
-    sdf += v[k]->sdf * (k & 1 ? f.x : 1.f - f.x) * ((k >> 1) & 1 ? f.y : 1.f - f.y) * (k >> 2 ? f.z : 1.f - f.z);
+    sdf += voxel_sdf(*v[k], a.geom.truncation) * (k & 1 ? f.x : 1.f - f.x) * ((k >> 1) & 1 ? f.y : 1.f - f.y) *
+           (k >> 2 ? f.z : 1.f - f.z);
   return sdf >= 0.5f * a.geom.truncation ? SpaceEvidence::seen_free : SpaceEvidence::occupied;
 }
 

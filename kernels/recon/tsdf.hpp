@@ -104,10 +104,10 @@ struct DepthTiles : TileGrid {
   std::int32_t* zmax = nullptr;  // nullptr: no tiles, nothing is culled
 };
 // A block is worth keeping while one of its voxels is observed (weight > 0) and near a surface
-// (|sdf| < keep_below, metres); a block of free space or never-observed voxels can go. (A volume
-// that stores free space passes the largest float: every observed block stays.)
-SEAMLESS_HD inline bool voxel_keeps_block(const Voxel& v, float keep_below) {
-  return v.weight > 0.f && fabsf(v.sdf) < keep_below;
+// (|sdf| < keep_below, metres; mu: the truncation); a block of free space or never-observed voxels
+// can go. (A volume that stores free space passes the largest float: every observed block stays.)
+SEAMLESS_HD inline bool voxel_keeps_block(const Voxel& v, float keep_below, float mu) {
+  return voxel_observed(v) && fabsf(voxel_sdf(v, mu)) < keep_below;
 }
 
 // Fusion's weighted running average (Curless & Levoy 1996; KinectFusion eq. 11-13) of a value
@@ -193,14 +193,14 @@ template <Executor Exec> struct TsdfFusion {
   static void fuse_dense_blocks(const Exec& ex, DenseAccess grid, FrameInput in, float max_weight, bool color);
 
   // keep[j] = 1 if listed block j has a voxel that keeps it (the caller zeroes keep), one thread
-  // per voxel: the stand-alone version of the marking that fuse_hash_blocks does.
+  // per voxel: the stand-alone version of the marking that fuse_hash_blocks does. mu: the truncation.
   static void mark_kept_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots, std::int64_t count,
-                               const Voxel* voxels, View<std::int32_t> keep, float keep_below);
+                               const Voxel* voxels, View<std::int32_t> keep, float keep_below, float mu);
 
   // surface.flag[blocks[i]] = whether block blocks[i] (skipped when < 0) has a voxel near a
-  // surface, one thread per block: for blocks whose voxels were copied in (streaming).
+  // surface, one thread per block: for blocks whose voxels were copied in (streaming). mu: the truncation.
   static void mark_surface_blocks(const Exec& ex, View<const std::int32_t> blocks, const Voxel* voxels,
-                                  SurfaceFlags surface);
+                                  SurfaceFlags surface, float mu);
 
   // Frees the listed blocks whose keep flag is 0: zeroes their voxels and colours, tombstones their
   // keys and pushes them on the free list (counters->removed counts). A few threads per block.

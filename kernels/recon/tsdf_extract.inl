@@ -29,23 +29,25 @@ template <class Acc> SEAMLESS_HD inline int mc_cube(const Acc& a, int3 g, BlockC
   const float trunc = 0.999f * a.geom.truncation;
   if (!cell_voxels(a, g, c, v)) return -1;
   for (int k = 0; k < 8; ++k) {
-    if (!(v[k]->weight > 0.f)) return -1;
-    if (v[k]->sdf < 0.f) cube |= 1 << k;
-    if (fabsf(v[k]->sdf) >= trunc) truncated = true;
+    if (!voxel_observed(*v[k])) return -1;
+    const float s = voxel_sdf(*v[k], a.geom.truncation);
+    if (s < 0.f) cube |= 1 << k;
+    if (fabsf(s) >= trunc) truncated = true;
   }
   if (cube == 0 || cube == 255) return 0;
   return truncated ? -1 : cube;
 }
 
 // Gradient of the trilinear interpolant of one cell's corners at local position f in [0,1]^3:
-// the normal where the wider central difference has a missing neighbour (edges of the model).
+// the normal where the wider central difference has a missing neighbour (edges of the model). In
+// snorm16 steps (Voxel): the caller only needs its direction.
 SEAMLESS_HD inline vec3 cell_gradient(const Voxel* const v[8], vec3 f) {
   vec3 g{0.f, 0.f, 0.f};
   for (int k = 0; k < 8; ++k) {
     int3 o = mc_corner(k);
     float wx = o.x ? f.x : 1.f - f.x, wy = o.y ? f.y : 1.f - f.y, wz = o.z ? f.z : 1.f - f.z;
     float sx = o.x ? 1.f : -1.f, sy = o.y ? 1.f : -1.f, sz = o.z ? 1.f : -1.f;
-    g += vec3{sx * wy * wz, sy * wx * wz, sz * wx * wy} * v[k]->sdf;
+    g += vec3{sx * wy * wz, sy * wx * wz, sz * wx * wy} * static_cast<float>(v[k]->sdf16);
   }
   return g;
 }
@@ -93,7 +95,7 @@ void TsdfExtract<Exec, Acc>::mesh_emit(const Exec& ex, Acc a, View<const int3> b
     for (int k = 0; k < kMcRow && table[cube * kMcRow + k] >= 0; ++k, ++out) {
       int e = table[cube * kMcRow + k], c0, c1;
       mc_edge(e, &c0, &c1);
-      float f0 = v[c0]->sdf, f1 = v[c1]->sdf;
+      const float f0 = voxel_sdf(*v[c0], a.geom.truncation), f1 = voxel_sdf(*v[c1], a.geom.truncation);
       float t = f0 / (f0 - f1);  // linear interpolation of the zero crossing along the edge
       vec3 q = to_vec3(g + mc_corner(c0)) * (1.f - t) + to_vec3(g + mc_corner(c1)) * t;
       positions[out] = a.geom.to_world(q);
@@ -186,7 +188,7 @@ template <class Acc> SEAMLESS_HD inline int sample_state(const Acc& a, vec3 p, B
   const Voxel* corner[8];
   if (!cell_voxels(a, floor_to_int(q), c, corner)) return kUnallocated;
   for (int k = 0; k < 8; ++k)
-    if (!(corner[k]->weight > 0.f)) return kUnseen;
+    if (!voxel_observed(*corner[k])) return kUnseen;
   sample_tsdf(a, q, c, v);
   return *v < 0.f ? kSolid : kFree;
 }

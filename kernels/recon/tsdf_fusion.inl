@@ -211,7 +211,8 @@ SEAMLESS_HD inline bool carved(const FrameInput& in, int u, int v, float z) {
 // Weighted running average of the truncated signed distance (Curless & Levoy 1996; KinectFusion
 // eq. 11-13) with the weight capped at max_weight so the model can follow change. The distance is
 // projective (along z), as in KinectFusion and Niessner; colour is averaged only near the surface.
-// v_color: the voxel's colour (nullptr: no colour fused).
+// The average is kept in snorm16 steps, rounded to nearest (fuse_tsdf, Voxel). v_color: the
+// voxel's colour (nullptr: no colour fused).
 SEAMLESS_HD inline void fuse_voxel(Voxel& v, uchar3* v_color, vec3 p_world, const FrameInput& in,
                                    const SE3& camera_T_world, float mu, float max_weight) {
   vec3 pc = camera_T_world * p_world;
@@ -224,15 +225,12 @@ SEAMLESS_HD inline void fuse_voxel(Voxel& v, uchar3* v_color, vec3 p_world, cons
   float sdf = d - pc.z;
   if (sdf < -mu) return;  // occluded: behind the surface by more than the truncation
   if (in.carve > 0.f && sdf > in.carve && carved(in, u, w, pc.z)) {
-    v.sdf = mu;  // what a voxel never seen before holds after this frame: free, weight 1
-    v.weight = 1.f;
+    v = make_voxel(mu, mu, 1.f);  // what a voxel never seen before holds after this frame: free, weight 1
     return;
   }
-  float tsdf = min_of(sdf, mu);
-  float wt = v.weight;
-  v.sdf = running_average(v.sdf, wt, tsdf);
+  const float wt = voxel_weight(v);
+  fuse_tsdf(v, min_of(sdf, mu), mu, max_weight);
   if (v_color && in.rgb.data && sdf < mu) *v_color = blend_color(*v_color, in.rgb(u, w), wt);
-  v.weight = min_of(wt + 1.f, max_weight);
 }
 
 template <Executor Exec>
@@ -298,8 +296,8 @@ void TsdfFusion<Exec>::fuse_hash_blocks(const Exec& ex, HashTableView t, View<co
       Voxel& vz = v[kColumns * z];
       fuse_voxel(vz, vc ? vc + kColumns * z : nullptr, geom.to_world(g), in, camera_T_world, geom.truncation,
                  max_weight);
-      kept = kept || (keep.data && voxel_keeps_block(vz, keep_below));
-      surface_near = surface_near || (surface.flag && voxel_keeps_block(vz, surface.below));
+      kept = kept || (keep.data && voxel_keeps_block(vz, keep_below, geom.truncation));
+      surface_near = surface_near || (surface.flag && voxel_keeps_block(vz, surface.below, geom.truncation));
     }
     if (kept) set_keep(&keep[j]);
     if (surface_near) set_keep(&surface.flag[block]);
@@ -326,25 +324,25 @@ void TsdfFusion<Exec>::fuse_dense_blocks(const Exec& ex, DenseAccess grid, Frame
 template <Executor Exec>
 void TsdfFusion<Exec>::mark_kept_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> slots,
                                         std::int64_t count, const Voxel* voxels, View<std::int32_t> keep,
-                                        float keep_below) {
+                                        float keep_below, float mu) {
   ex.for_each(count * kBlockVoxels, [=] SEAMLESS_HD(std::int64_t i) {
     const std::int64_t j = i / kBlockVoxels;
     std::int32_t block = t.values[slots[j]];
     if (block < 0) return;
-    if (voxel_keeps_block(voxels[static_cast<std::int64_t>(block) * kBlockVoxels + i % kBlockVoxels], keep_below))
+    if (voxel_keeps_block(voxels[static_cast<std::int64_t>(block) * kBlockVoxels + i % kBlockVoxels], keep_below, mu))
       set_keep(&keep[j]);
   });
 }
 
 template <Executor Exec>
 void TsdfFusion<Exec>::mark_surface_blocks(const Exec& ex, View<const std::int32_t> blocks, const Voxel* voxels,
-                                           SurfaceFlags surface) {
+                                           SurfaceFlags surface, float mu) {
   ex.for_each(blocks.size, [=] SEAMLESS_HD(std::int64_t i) {
     const std::int32_t block = blocks[i];
     if (block < 0) return;
     const Voxel* v = voxels + static_cast<std::int64_t>(block) * kBlockVoxels;
     std::int32_t flag = 0;
-    for (int k = 0; k < kBlockVoxels && !flag; ++k) flag = voxel_keeps_block(v[k], surface.below) ? 1 : 0;
+    for (int k = 0; k < kBlockVoxels && !flag; ++k) flag = voxel_keeps_block(v[k], surface.below, mu) ? 1 : 0;
     surface.flag[block] = flag;
   });
 }
@@ -354,7 +352,7 @@ void TsdfFusion<Exec>::remove_unkept_blocks(const Exec& ex, HashTableView t, Vie
                                             std::int64_t count, View<const std::int32_t> keep, Voxel* voxels,
                                             uchar3* colors, View<std::int32_t> free_list, HashCounters* counters) {
   // kParts threads per block, each zeroing 512 / kParts voxels: one thread clearing a whole block
-  // (5.5 KiB with its colours) would hold up the kernel. Part 0 also frees the slot and the block; the block is not
+  // (3.5 KiB with its colours) would hold up the kernel. Part 0 also frees the slot and the block; the block is not
   // handed out again before the next allocation kernel, after this one has finished. The slot's
   // value is left as it is (as hash_erase does): nobody reads the value of a tombstone.
   constexpr int kParts = 8, kPerPart = kBlockVoxels / kParts;
@@ -366,7 +364,7 @@ void TsdfFusion<Exec>::remove_unkept_blocks(const Exec& ex, HashTableView t, Vie
     std::int32_t block = t.values[slot];
     if (block < 0) return;
     const std::int64_t first = static_cast<std::int64_t>(block) * kBlockVoxels + part * kPerPart;
-    for (int k = 0; k < kPerPart; ++k) voxels[first + k] = Voxel{0.f, 0.f}, colors[first + k] = uchar3{0, 0, 0};
+    for (int k = 0; k < kPerPart; ++k) voxels[first + k] = Voxel{0, 0}, colors[first + k] = uchar3{0, 0, 0};
     if (part != 0) return;
     atomic_exch(&t.keys[slot], kTombstone);
     pool_push(counters, free_list.data, block);

@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "core/simd.hpp"
+#include "kernels/recon/voxel_simd.hpp"
 
 namespace seamless::kernels {
 
@@ -14,26 +15,23 @@ namespace detail {
 using simd::vf, simd::vi, simd::vm;
 
 namespace {
-// A row's 8 voxels, {sdf, weight} interleaved in the pool, as two vectors, and back.
-SEAMLESS_SIMD_INL void load_row(const Voxel* v, vf& sdf, vf& wt) {
-  simd::f8 lo, hi;
-  std::memcpy(&lo, v, sizeof lo);
-  std::memcpy(&hi, v + 4, sizeof hi);
-  simd::deinterleave(lo, hi, sdf, wt);
+// A row's 8 voxels (tsdf_fusion_simd.hpp) as their distances in steps and their weights, and back.
+SEAMLESS_SIMD_INL void load_row(const Voxel* v, vf& steps, vf& wt) {
+  simd::i8 raw;
+  std::memcpy(&raw, v, sizeof raw);
+  steps = voxel_steps(raw), wt = __builtin_convertvector(voxel_weights(raw), simd::f8);
 }
-SEAMLESS_SIMD_INL void store_row(Voxel* v, vf sdf, vf wt) {
-  const simd::f8 lo = __builtin_shufflevector(sdf.v, wt.v, 0, 8, 1, 9, 2, 10, 3, 11);
-  const simd::f8 hi = __builtin_shufflevector(sdf.v, wt.v, 4, 12, 5, 13, 6, 14, 7, 15);
-  std::memcpy(v, &lo, sizeof lo);
-  std::memcpy(v + 4, &hi, sizeof hi);
+SEAMLESS_SIMD_INL void store_row(Voxel* v, simd::i8 steps, vf wt) {
+  const simd::i8 raw = pack_voxels(steps, __builtin_convertvector(wt.v, simd::i8));
+  std::memcpy(v, &raw, sizeof raw);
 }
 
-// Fuses the frame into the 8 voxels of row (y, z), whose values sdf and wt hold (and then their
-// values after the frame); row points to them in the pool, colors to their colours (nullptr:
+// Fuses the frame into the 8 voxels of row (y, z), whose distances (in steps) and weights steps and
+// wt hold (and then their values after the frame); row points to them in the pool, colors to their colours (nullptr:
 // none). ax: the x terms of camera_T_world's three rows, R[r][0] * x, for the block's 8 x (the
 // same products for every row of the block).
 SEAMLESS_SIMD_INL void fuse_row(const FuseRowFrame& f, const vf ax[3], float py, float pz, Voxel* row, uchar3* colors,
-                                vf& sdf_v, vf& wt) {
+                                vf& steps, vf& wt) {
   const FrameInput& in = f.in;
   const mat3& R = f.camera_T_world.R;
   const vec3 t = f.camera_T_world.t;
@@ -62,15 +60,18 @@ SEAMLESS_SIMD_INL void fuse_row(const FuseRowFrame& f, const vf ax[3], float py,
     for (int l = 0; l < simd::kWidth; ++l)
       if (near >> l & 1) colors[l] = blend_color(colors[l], in.rgb(u[l], w[l]), wt[l]);
   }
-  sdf_v = select(m, running_average(sdf_v, wt, min_of(sdf, vf(mu))), sdf_v);
+  // fuse_tsdf: the running average in steps, rounded to the nearest step.
+  const vf to_steps(kSdfSteps / mu), q = steps;
+  const simd::i8 fused = sdf_steps(q + (min_of(sdf, vf(mu)) * to_steps - q) / (wt + vf(1.f)));
+  steps = select(m, vf(__builtin_convertvector(fused, simd::f8)), q);
   wt = select(m, min_of(wt + vf(1.f), vf(f.max_weight)), wt);
-  store_row(row, sdf_v, wt);
+  store_row(row, __builtin_convertvector(steps.v, simd::i8), wt);
 }
 
 // voxel_keeps_block for a row's 8 voxels, as fuse_layer_simd's flag bits.
-SEAMLESS_SIMD_INL int row_flags(const FuseRowFrame& f, vf sdf, vf wt) {
+SEAMLESS_SIMD_INL int row_flags(const FuseRowFrame& f, vf steps, vf wt) {
   const vm observed = wt > vf(0.f);
-  const vf a = abs(sdf);
+  const vf a = abs(steps * vf(f.geom.truncation / kSdfSteps));  // voxel_sdf
   int flags = 0;
   if (f.keep && simd::bits(observed & (a < vf(f.keep_below)))) flags |= kRowKeeps;
   if (f.surface && simd::bits(observed & (a < vf(f.surface_below)))) flags |= kRowNearSurface;
@@ -79,7 +80,7 @@ SEAMLESS_SIMD_INL int row_flags(const FuseRowFrame& f, vf sdf, vf wt) {
 }  // namespace
 
 int fuse_layer_simd(const FuseRowFrame& f, int3 b, int z, Voxel* layer, uchar3* colors) {
-  static_assert(simd::kWidth == kBlockSide && sizeof(Voxel) == 2 * sizeof(float));
+  static_assert(simd::kWidth == kBlockSide);
   const mat3& R = f.camera_T_world.R;
   // The voxel centres in world units, geom.to_world (origin + g * voxel_size) per axis.
   vf gx;
@@ -92,11 +93,11 @@ int fuse_layer_simd(const FuseRowFrame& f, int3 b, int z, Voxel* layer, uchar3* 
   for (int y = 0; y < kBlockSide; ++y) {
     const float py = f.geom.origin.y + static_cast<float>(b.y * 8 + y) * f.geom.voxel_size;
     const int r = y * kBlockSide;  // the row's first voxel in the layer
-    vf sdf, wt;
-    load_row(layer + r, sdf, wt);
-    fuse_row(f, ax, py, pz, layer + r, colors ? colors + r : nullptr, sdf, wt);
+    vf steps, wt;
+    load_row(layer + r, steps, wt);
+    fuse_row(f, ax, py, pz, layer + r, colors ? colors + r : nullptr, steps, wt);
     // Every row's flags, changed or not, as the scalar loop tests every voxel (until both are set).
-    if (flags != wanted) flags |= row_flags(f, sdf, wt);
+    if (flags != wanted) flags |= row_flags(f, steps, wt);
   }
   return flags;
 }

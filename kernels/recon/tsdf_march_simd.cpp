@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "core/simd.hpp"
+#include "kernels/recon/voxel_simd.hpp"
 
 #if SEAMLESS_SIMD_X86
 #include <immintrin.h>
@@ -64,32 +65,32 @@ SEAMLESS_SIMD_INL vm near_flags(const WindowedHashAccess& a, i8 block, vm m) {
   return {~m.v | (gather_index(a.near_surface, block, m) != 0)};
 }
 
-// The sdf and weight of voxel block[l] * 512 + local[l] of the pool for the lanes of m, 0 and 0
-// elsewhere. The index is formed in 64 bits: a pool can hold more than 2^31 voxels.
-SEAMLESS_SIMD_INL void load_voxels(const Voxel* pool, i8 block, i8 local, vm m, vf& sdf, vf& wt) {
-  static_assert(sizeof(Voxel) == sizeof(long long) && kBlockVoxels == 512);
-  f8 lo, hi;  // voxels of lanes 0-3 and 4-7 as {sdf, weight} pairs
+// The words (Voxel, voxel_simd.hpp) of voxel block[l] * 512 + local[l] of the pool for the lanes
+// of m, 0 (unobserved) elsewhere. The index is formed in 64 bits: a pool can hold more than 2^31
+// voxels.
+SEAMLESS_SIMD_INL i8 load_voxels(const Voxel* pool, i8 block, i8 local, vm m) {
+  static_assert(kBlockVoxels == 512);
 #if SEAMLESS_SIMD_X86
   auto half = [](i8 v, int h) {  // lanes 4h to 4h + 3 as 64-bit ints
     const i4 p = h ? __builtin_shufflevector(v, v, 4, 5, 6, 7) : __builtin_shufflevector(v, v, 0, 1, 2, 3);
     return __builtin_convertvector(p, q4);
   };
-  const long long* base = reinterpret_cast<const long long*>(pool);
+  auto mask = [](i8 v, int h) {  // lanes 4h to 4h + 3
+    return h ? __builtin_shufflevector(v, v, 4, 5, 6, 7) : __builtin_shufflevector(v, v, 0, 1, 2, 3);
+  };
+  const int* base = reinterpret_cast<const int*>(pool);
   const q4 i0 = half(block, 0) * 512 + half(local, 0), i1 = half(block, 1) * 512 + half(local, 1);
-  lo = reinterpret_cast<f8>(_mm256_mask_i64gather_epi64(reinterpret_cast<__m256i>(q4{}), base,
-                                                        reinterpret_cast<__m256i>(i0),
-                                                        reinterpret_cast<__m256i>(half(m.v, 0)), 8));
-  hi = reinterpret_cast<f8>(_mm256_mask_i64gather_epi64(reinterpret_cast<__m256i>(q4{}), base,
-                                                        reinterpret_cast<__m256i>(i1),
-                                                        reinterpret_cast<__m256i>(half(m.v, 1)), 8));
+  const i4 lo = reinterpret_cast<i4>(_mm256_mask_i64gather_epi32(
+      _mm_setzero_si128(), base, reinterpret_cast<__m256i>(i0), reinterpret_cast<__m128i>(mask(m.v, 0)), 4));
+  const i4 hi = reinterpret_cast<i4>(_mm256_mask_i64gather_epi32(
+      _mm_setzero_si128(), base, reinterpret_cast<__m256i>(i1), reinterpret_cast<__m128i>(mask(m.v, 1)), 4));
+  return __builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7);
 #else
-  Voxel v[simd::kWidth] = {};
+  i8 r = {};
   for (int l = 0; l < simd::kWidth; ++l)
-    if (m.v[l]) v[l] = pool[static_cast<std::int64_t>(block[l]) * kBlockVoxels + local[l]];
-  std::memcpy(&lo, v, sizeof lo);
-  std::memcpy(&hi, v + 4, sizeof hi);
+    if (m.v[l]) std::memcpy(&r[l], pool + static_cast<std::int64_t>(block[l]) * kBlockVoxels + local[l], 4);
+  return r;
 #endif
-  simd::deinterleave(lo, hi, sdf, wt);
 }
 
 SEAMLESS_SIMD_INL i8 local_index(i8 x, i8 y, i8 z) { return (x & 7) + 8 * (y & 7) + 64 * (z & 7); }
@@ -113,21 +114,21 @@ SEAMLESS_SIMD_INL vm sample_lanes(const WindowedHashAccess& a, v3 q, vi3 g0, vi3
     if (simd::bits(other)) ik = select(other, vi(find_blocks(a, vi3{b.x + ox, b.y + oy, b.z + oz}, other)), vi(i0)).v;
     const vm mk = m & vm{ik >= 0};
     const i8 local = local_index(g0.x + (k & 1), g0.y + (k >> 1 & 1), g0.z + (k >> 2));
-    vf wk;
-    load_voxels(a.voxels, ik, local, mk, d[k], wk);
-    all = all & mk & (wk > vf(0.f));
+    const i8 raw = load_voxels(a.voxels, ik, local, mk);
+    d[k] = voxel_steps(raw);
+    all = all & mk & vm{voxel_weights(raw) != 0};  // voxel_observed
   }
   const vf fx = q.x - vf(__builtin_convertvector(g0.x, f8)), fy = q.y - vf(__builtin_convertvector(g0.y, f8)),
            fz = q.z - vf(__builtin_convertvector(g0.z, f8));
-  // Trilinear as 7 lerps along x, then y, then z (sample_tsdf_in's expressions).
+  // Trilinear as 7 lerps along x, then y, then z, in steps, then in metres (sample_tsdf_in's expressions).
   auto lerp = [](vf p, vf q, vf t) { return p + t * (q - p); };
   const vf x0 = lerp(d[0], d[1], fx), x1 = lerp(d[2], d[3], fx), x2 = lerp(d[4], d[5], fx), x3 = lerp(d[6], d[7], fx);
-  f = lerp(lerp(x0, x1, fy), lerp(x2, x3, fy), fz);
+  f = lerp(lerp(x0, x1, fy), lerp(x2, x3, fy), fz) * vf(a.geom.truncation / kSdfSteps);
   return all;
 }
 
 // The march waits on its voxel loads (a frame's fusion has just streamed every visible block
-// through the caches): a lane's first sample in a block asks for the whole block (64 lines), which
+// through the caches): a lane's first sample in a block asks for the whole block (32 lines), which
 // its next samples and the neighbouring rays' mostly read. The lanes of m sample in blocks i0;
 // last holds each lane's block before (a block is fetched once for the lanes that share it).
 SEAMLESS_SIMD_INL void prefetch_blocks(const WindowedHashAccess& a, i8 i0, vm m, i8& last) {

@@ -21,14 +21,61 @@ namespace seamless::kernels {
 constexpr int kBlockSide = 8;
 constexpr int kBlockVoxels = kBlockSide * kBlockSide * kBlockSide;
 
-// 8 bytes: metric TSDF (truncated to [-mu, mu]) and fusion weight (0 = never observed): what every
-// stage reads. A voxel's fused colour is kept in a pool of its own with the same index (the
-// accessors' `colors`), read only by the stages that use colour: the march and fusion of depth
-// then move 8 bytes a voxel instead of 12, and a cell's two voxels along x share 16 aligned bytes.
+// 4 bytes: the TSDF and the fusion weight as 16-bit integers (the distance as InfiniTAM stores
+// it, Kaehler et al. 2015, whose weight is a byte): what every stage reads, so the march and fusion, which are bound by
+// voxel loads, move half the bytes of two floats, and a cache line holds two of a block's rows along x, so a cell with
+// even y finds its 8 corners in 2 lines instead of 4. A voxel's fused colour is kept in a pool of its own with the same
+// index (the accessors' `colors`), read only by the stages that use colour.
+//
+// Distance: the TSDF divided by the truncation mu as snorm16, round(32767 sdf / mu). Fusion
+// truncates every observation to [-mu, mu] and the running average of such values stays inside,
+// so the full 16 bits cover exactly the range that occurs, uniformly: a step of mu / 32767 (0.6 um
+// at mu = 2 cm), far below an RGB-D camera's depth noise (millimetres). IEEE half
+// instead would be finer near zero but coarser near mu (15 um at 2 cm), and its conversion is a
+// libm sequence on an x86-64 host without F16C, where snorm16 is an integer conversion and a
+// multiply on both backends. Decoding needs mu, which every reader has (VoxelGeometry).
+//
+// Weight: a whole count of fused frames, 0 = never observed, capped at volume.max_weight, which is
+// therefore limited to a whole number up to kMaxVoxelWeight (volume_params.hpp checks it). Every
+// write is +1 (or a reset to 1 or 0), so the count is exact, where a 16-bit float would stall at
+// 2048.
+//
+// The running average in steps is q <- q + (t - q) / (w + 1), rounded to nearest (fuse_tsdf): a
+// change survives the rounding when it is at least half a step, i.e. when the observation t lies
+// (w + 1) / 2 steps or more from the stored q. With the default cap of 100 a constant input is
+// reached to within 51 steps (31 um at mu = 2 cm) and every larger disagreement still moves the
+// value; truncation instead of rounding would stop a whole (w + 1) steps short, and always on
+// the same side.
 struct Voxel {
-  float sdf;
-  float weight;
+  std::int16_t sdf16;      // round(32767 * TSDF / truncation), in [-32767, 32767]
+  std::uint16_t weight16;  // fused frames, at most the weight cap
 };
+constexpr float kSdfSteps = 32767.f;  // snorm16 steps per truncation
+constexpr int kMaxVoxelWeight = 65535;
+
+// TSDF of v in metres (mu: the truncation).
+SEAMLESS_HD inline float voxel_sdf(const Voxel& v, float mu) { return static_cast<float>(v.sdf16) * (mu / kSdfSteps); }
+SEAMLESS_HD inline float voxel_weight(const Voxel& v) { return static_cast<float>(v.weight16); }
+SEAMLESS_HD inline bool voxel_observed(const Voxel& v) { return v.weight16 != 0; }
+// Nearest step of a TSDF given in steps (sdf / mu * kSdfSteps), clamped to the truncation; ties
+// away from zero. The truncating conversion of steps +- 1/2 is one instruction on either backend.
+SEAMLESS_HD inline std::int16_t sdf_steps(float steps) {
+  steps = steps >= -kSdfSteps ? (steps <= kSdfSteps ? steps : kSdfSteps) : -kSdfSteps;
+  return static_cast<std::int16_t>(static_cast<int>(steps + copysignf(0.5f, steps)));
+}
+// The voxel holding sdf (metres, truncation mu) with weight (a whole count up to kMaxVoxelWeight).
+SEAMLESS_HD inline Voxel make_voxel(float sdf, float mu, float weight) {
+  return {sdf_steps(sdf * (kSdfSteps / mu)), static_cast<std::uint16_t>(weight)};
+}
+// One frame's observation tsdf (metres, in [-mu, mu]) into the running average (Curless & Levoy
+// 1996; KinectFusion eq. 11-12), the weight capped at max_weight (a whole count, see Voxel). The
+// scale kSdfSteps / mu is the same for every voxel (a caller's loop computes it once): a multiply,
+// not a second division next to the one by w + 1.
+SEAMLESS_HD inline void fuse_tsdf(Voxel& v, float tsdf, float mu, float max_weight) {
+  const float w = voxel_weight(v), q = static_cast<float>(v.sdf16);
+  v.sdf16 = sdf_steps(q + (tsdf * (kSdfSteps / mu) - q) / (w + 1.f));
+  v.weight16 = static_cast<std::uint16_t>(min_of(w + 1.f, max_weight));
+}
 
 using HashKey = unsigned long long;  // the type CUDA's 64-bit atomicCAS takes
 constexpr HashKey kEmptyKey = ~0ull;
@@ -305,7 +352,7 @@ SEAMLESS_HD inline bool sample_tsdf_in(const Acc& a, vec3 q, int3 g0, std::int32
   // On the CPU, corner 0 first: its block is known, and an unobserved corner means no value (a
   // sixth of the raycast's samples end here, at the edge of what was seen) without the other
   // seven. Not on the GPU, where the other seven loads would wait for this one's latency.
-  if (!(a.voxels[static_cast<std::int64_t>(i0) * kBlockVoxels + local_index(g0)].weight > 0.f)) return false;
+  if (!voxel_observed(a.voxels[static_cast<std::int64_t>(i0) * kBlockVoxels + local_index(g0)])) return false;
 #endif
   const vec3 f = q - to_vec3(g0);
   const Voxel* v[8];
@@ -315,15 +362,15 @@ SEAMLESS_HD inline bool sample_tsdf_in(const Acc& a, vec3 q, int3 g0, std::int32
   } else if (!cell_voxels(a, g0, c, v)) {
     return false;
   }
-  float d[8];
+  float d[8];  // in snorm16 steps (Voxel), scaled to metres once after the interpolation
   bool observed = true;
-  for (int k = 0; k < 8; ++k) observed &= v[k]->weight > 0.f, d[k] = v[k]->sdf;
+  for (int k = 0; k < 8; ++k) observed &= voxel_observed(*v[k]), d[k] = static_cast<float>(v[k]->sdf16);
   if (!observed) return false;
   // Trilinear as 7 lerps along x, then y, then z (the same weights as the 8-product form).
   auto lerp = [](float p, float q, float t) { return p + t * (q - p); };
   const float x0 = lerp(d[0], d[1], f.x), x1 = lerp(d[2], d[3], f.x), x2 = lerp(d[4], d[5], f.x),
               x3 = lerp(d[6], d[7], f.x);
-  *sdf = lerp(lerp(x0, x1, f.y), lerp(x2, x3, f.y), f.z);
+  *sdf = lerp(lerp(x0, x1, f.y), lerp(x2, x3, f.y), f.z) * (a.geom.truncation / kSdfSteps);
   if (!color) return true;
   vec3 col{0.f, 0.f, 0.f};
   for (int k = 0; k < 8; ++k) {

@@ -130,12 +130,6 @@ SEAMLESS_SIMD_INL vm from_bits(int b) {
   return {(bit & b) != 0};
 }
 
-// The even and odd elements of the 16 floats lo, hi (pairs such as a voxel's {sdf, weight}).
-SEAMLESS_SIMD_INL void deinterleave(f8 lo, f8 hi, vf& even, vf& odd) {
-  even = __builtin_shufflevector(lo, hi, 0, 2, 4, 6, 8, 10, 12, 14);
-  odd = __builtin_shufflevector(lo, hi, 1, 3, 5, 7, 9, 11, 13, 15);
-}
-
 // Left-packing of the lanes that a mask keeps (in lane order): lane[bits] moves them to the front
 // (the other lanes follow), count[bits] is how many.
 struct alignas(32) PackTable {

@@ -1,6 +1,7 @@
 // Volume section (`volume:`): the TSDF volume layout and fusion parameters.
 // Voxel hashing after Niessner et al. 2013; the dense grid is the KinectFusion comparator.
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -38,10 +39,10 @@ struct VolumeParams {
   float stream_step = 0.25f;   // camera travel (metres) between two streaming passes
 
   // The pool a voxel-hashed volume starts with. capacity 0 chooses by the device: on CUDA 2^18
-  // blocks (1.4 GiB of 8-byte voxels and 3-byte colours), reserved up front because growing there stops the frame
-  // and briefly holds the old and the new pool on the GPU; on the CPU 4096 blocks (22 MiB), grown
+  // blocks (896 MiB of 4-byte voxels and 3-byte colours), reserved up front because growing there stops the frame
+  // and briefly holds the old and the new pool on the GPU; on the CPU 4096 blocks (14 MiB), grown
   // by doubling as the scan needs them (grow_when_full), so a small scan does not reserve and zero
-  // 1.4 GiB of host memory. Without grow_when_full the CPU starts large as well.
+  // 896 MiB of host memory. Without grow_when_full the CPU starts large as well.
   static constexpr std::int64_t kDeviceCapacity = std::int64_t{1} << 18;
   static constexpr std::int64_t kHostStartCapacity = 4096;
   std::int64_t start_capacity(bool on_cuda) const {
@@ -63,16 +64,23 @@ struct VolumeParams {
                          "volume.voxel_size = " + std::to_string(2.f * voxel_size) +
                          " m): the truncation band must reach the voxels on both sides of the surface");
     if (capacity > (std::int64_t{1} << 30)) problems.push_back("volume.capacity must be below 2^30 blocks");
+    if (max_weight != std::floor(max_weight))
+      problems.push_back("volume.max_weight (" + std::to_string(max_weight) +
+                         ") must be a whole number: a voxel stores its weight as a 16-bit count of fused frames");
   }
 
   template <class V> void visit(V& v) {
     v("layout", layout, "volume layout: voxel hashing or dense grid");
     v("voxel_size", voxel_size, "voxel edge length, metres", Range{0.0005, 1.0});
     v("truncation", truncation, "TSDF truncation distance, metres", Range{0.001, 2.0});
-    v("max_weight", max_weight, "maximum fusion weight per voxel", Range{1.0, 1e6});
+    // At most 65535 (kernels::kMaxVoxelWeight): the voxel's weight is a 16-bit count (voxel_hash.hpp).
+    v("max_weight", max_weight,
+      "maximum fusion weight per voxel, a whole count of frames (16 bits; the running average stops following "
+      "an observation closer than (max_weight + 1) / 2 steps of truncation / 32767 to the stored distance)",
+      Range{1.0, 65535.0});
     v("hash_buckets", hash_buckets, "hash table buckets (hash layout)", Range{1024, 1e9});
     v("capacity", capacity,
-      "voxel blocks the pool starts with (hash layout); 0: by the device, 262144 (1.4 GiB) on CUDA, 4096 (22 MiB) "
+      "voxel blocks the pool starts with (hash layout); 0: by the device, 262144 (896 MiB) on CUDA, 4096 (14 MiB) "
       "on the CPU growing as needed (grow_when_full)",
       Range{0, 1e9});
     v("dense_resolution", dense_resolution, "voxels per side (dense layout)", Range{8, 2048});

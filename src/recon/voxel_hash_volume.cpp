@@ -328,7 +328,8 @@ std::int64_t VoxelHashVolume::remove_empty_blocks() {
   const View<const std::int32_t> listed{slots.data(), n};
   with_exec(device_, [&]<class E>(const E& ex) {
     kernels::VoxelHash<E>::reset_frame_counters(ex, counters_.data());
-    kernels::TsdfFusion<E>::mark_kept_blocks(ex, table(), listed, n, voxels_.data(), keep.view(), keep_below());
+    kernels::TsdfFusion<E>::mark_kept_blocks(ex, table(), listed, n, voxels_.data(), keep.view(), keep_below(),
+                                             geom_.truncation);
     kernels::TsdfFusion<E>::remove_unkept_blocks(ex, table(), listed, n, keep.cview(), voxels_.data(), colors_.data(),
                                                  free_list_.view(), counters_.data());
   });

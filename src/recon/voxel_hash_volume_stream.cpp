@@ -195,7 +195,7 @@ void VoxelHashVolume::upload(std::vector<HashKey>& keys, std::vector<Voxel>& vox
                                               View<const HashKey>{dkeys.data(), fit}, blocks.view());
     kernels::VoxelHash<E>::scatter_blocks(ex, voxels_.data(), colors_.data(), blocks.cview(), dvox.cview(),
                                           dcol.cview());
-    kernels::TsdfFusion<E>::mark_surface_blocks(ex, blocks.cview(), voxels_.data(), surface_flags());
+    kernels::TsdfFusion<E>::mark_surface_blocks(ex, blocks.cview(), voxels_.data(), surface_flags(), geom_.truncation);
   });
   const std::vector<std::int32_t> got = blocks.to_host();
   const HashCounters after = read_counters();

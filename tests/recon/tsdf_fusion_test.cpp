@@ -65,10 +65,13 @@ TEST(TsdfFusion, WallVoxelsHoldTheTruncatedDistance) {
       // wall, shifted by at most 0.05 * 0.4/1.2 by the camera motion): every observation read the
       // wall depth 1.6 exactly, so the average is exactly the clamped distance.
       bool far_from_sphere = std::fabs(w.x - s.center.x) > 0.45f || std::fabs(w.y - s.center.y) > 0.45f;
-      if (v.weight < float(poses.size()) || !far_from_sphere) continue;
+      if (kernels::voxel_weight(v) < float(poses.size()) || !far_from_sphere) continue;
       float expect = std::min(s.wall_z - w.z, p.truncation);
-      // Float rounding of the running average over 5 frames: a few ulps of mu.
-      EXPECT_NEAR(v.sdf, expect, 1e-5f) << "voxel at " << w.x << " " << w.y << " " << w.z;
+      // The first frame stores the nearest snorm16 step (half a step, mu / 32767 / 2, from the
+      // distance); the next ones observe the same distance, whose update is below half a step
+      // and rounds back to it. Plus a few ulps of the 1.6 m depth in the observation.
+      const float tol = 0.5f * p.truncation / kernels::kSdfSteps + 1e-6f;
+      EXPECT_NEAR(kernels::voxel_sdf(v, p.truncation), expect, tol) << "voxel at " << w.x << " " << w.y << " " << w.z;
       ++checked;
     }
   EXPECT_GT(checked, 1000);
@@ -196,7 +199,8 @@ TEST(TsdfFusion, StandaloneRemovalFreesExactlyTheEmptyBlocks) {
   std::vector<int3> expect_kept;
   for (const auto& blk : before) {
     bool keep = false;
-    for (const kernels::Voxel& v : blk.voxels) keep |= v.weight > 0.f && std::fabs(v.sdf) < 0.999f * p.truncation;
+    for (const kernels::Voxel& v : blk.voxels)
+      keep |= kernels::voxel_observed(v) && std::fabs(kernels::voxel_sdf(v, p.truncation)) < 0.999f * p.truncation;
     if (keep) expect_kept.push_back(blk.coord);
   }
   ASSERT_LT(expect_kept.size(), before.size());  // the old band emptied
@@ -208,7 +212,7 @@ TEST(TsdfFusion, StandaloneRemovalFreesExactlyTheEmptyBlocks) {
   std::size_t j = 0;
   for (const auto& blk : before) {  // both sorted by coordinate
     if (j == after.size() || !(blk.coord == after[j].coord)) continue;
-    for (int k = 0; k < kernels::kBlockVoxels; ++k) ASSERT_EQ(blk.voxels[k].sdf, after[j].voxels[k].sdf);
+    for (int k = 0; k < kernels::kBlockVoxels; ++k) ASSERT_EQ(blk.voxels[k].sdf16, after[j].voxels[k].sdf16);
     ++j;
   }
   EXPECT_EQ(j, after.size());
@@ -433,7 +437,7 @@ TEST(TsdfFusion, SimdRowsGiveTheScalarLoopsVoxelsBitForBit) {
       ASSERT_EQ(a[i].voxels.size(), b[i].voxels.size());
       ASSERT_EQ(std::memcmp(a[i].voxels.data(), b[i].voxels.data(), a[i].voxels.size() * sizeof(kernels::Voxel)), 0);
       ASSERT_EQ(std::memcmp(a[i].colors.data(), b[i].colors.data(), a[i].colors.size() * sizeof(uchar3)), 0);
-      for (const auto& v : a[i].voxels) observed += v.weight > 1.f;
+      for (const auto& v : a[i].voxels) observed += v.weight16 > 1;
       for (const auto& c : a[i].colors) coloured += c.x + c.y + c.z > 0;
       flagged += a[i].surface;
     }
@@ -550,8 +554,8 @@ TEST(TsdfFusion, StoredFreeSpaceFillsTheViewInFrontOfTheWall) {
     if (!in_front_of_the_wall(blk.coord)) continue;
     ++found;
     for (const kernels::Voxel& v : blk.voxels) {
-      ASSERT_EQ(v.weight, 3.f);
-      ASSERT_NEAR(v.sdf, 0.04f, 1e-6f);  // (mu + mu) / 2, then (2 mu + mu) / 3: an ulp at most
+      ASSERT_EQ(v.weight16, 3);
+      ASSERT_EQ(v.sdf16, 32767);  // +truncation, the last step exactly: mu / mu * 32767 each frame
     }
   }
   EXPECT_EQ(found, front);
@@ -566,7 +570,7 @@ TEST(TsdfFusion, StoredFreeSpaceFillsTheViewInFrontOfTheWall) {
 // surface flag's definition, kernels::SurfaceFlags, evaluated on the downloaded voxels).
 bool has_voxel_near_surface(const VoxelHashVolume::HostBlock& b, float truncation) {
   for (const kernels::Voxel& v : b.voxels)
-    if (v.weight > 0.f && std::fabs(v.sdf) < 0.999f * truncation) return true;
+    if (kernels::voxel_observed(v) && std::fabs(kernels::voxel_sdf(v, truncation)) < 0.999f * truncation) return true;
   return false;
 }
 
@@ -741,4 +745,66 @@ TEST(TsdfParity, SameBlocksAndValues) {
 }
 
 }  // namespace
+// The 4-byte voxel's encoding (kernels::Voxel): a distance stored and read back is the nearest
+// snorm16 step, within half a step of mu / 32767 (plus the float roundings of the conversions, a
+// few 32767 * 2^-24 steps: under a hundredth); distances beyond the truncation clamp to it; the weight is an exact
+// count.
+TEST(VoxelEncoding, RoundTripWithinHalfAStep) {
+  const float mu = 0.02f, step = mu / kernels::kSdfSteps;
+  constexpr int n = 200001;
+  for (int i = 0; i < n; ++i) {
+    const float sdf = mu * (2.f * static_cast<float>(i) / (n - 1) - 1.f);
+    const kernels::Voxel v = kernels::make_voxel(sdf, mu, 1.f);
+    ASSERT_LE(std::fabs(kernels::voxel_sdf(v, mu) - sdf), 0.51f * step) << sdf;
+  }
+  EXPECT_EQ(kernels::make_voxel(mu, mu, 1.f).sdf16, 32767);
+  EXPECT_EQ(kernels::make_voxel(-mu, mu, 1.f).sdf16, -32767);
+  EXPECT_EQ(kernels::make_voxel(3.f * mu, mu, 1.f).sdf16, 32767);
+  EXPECT_EQ(kernels::make_voxel(-3.f * mu, mu, 1.f).sdf16, -32767);
+  EXPECT_FLOAT_EQ(kernels::voxel_sdf(kernels::make_voxel(mu, mu, 1.f), mu), mu);
+  for (int w : {0, 1, 100, 65535}) EXPECT_EQ(kernels::voxel_weight(kernels::make_voxel(0.f, mu, float(w))), float(w));
+  EXPECT_FALSE(kernels::voxel_observed(kernels::Voxel{0, 0}));
+}
+
+// The running average at the weight cap still follows its input: a voxel at -mu with the default
+// cap of 100 sees a constant +0.3 mu for 3000 frames. The exact average x_n approaches it as
+// (100/101)^n; the stored q_n = round(q + (t - q) / 101) differs from it by e_{n+1} = e_n 100/101
+// + r with |r| <= 1/2 step, so |e_n| <= 101/2 steps at every frame, and at the end q is within
+// 101/2 steps of t. Truncating instead of rounding would stall 101 steps short of t (a change
+// under one step dropped), beyond the bound. The count saturates at the cap (no wrap at 2^16).
+TEST(VoxelEncoding, RunningAverageConvergesAtTheWeightCap) {
+  const float mu = 0.02f, cap = 100.f, t = 0.3f * mu;
+  const double S = kernels::kSdfSteps;
+  kernels::Voxel v = kernels::make_voxel(-mu, mu, cap);
+  double x = -S;  // the exact running average, in steps
+  const double bound = (cap + 1.) / 2. + 1e-3;
+  for (int n = 0; n < 3000; ++n) {
+    kernels::fuse_tsdf(v, t, mu, cap);
+    x += (t / mu * S - x) / (cap + 1.);
+    ASSERT_EQ(v.weight16, 100);
+    ASSERT_LE(std::fabs(v.sdf16 - x), bound) << "frame " << n;
+  }
+  EXPECT_LE(std::fabs(v.sdf16 - t / mu * S), bound);
+  EXPECT_GT(v.sdf16, 0);  // moved the whole way from -mu
+  // From the other side the same.
+  v = kernels::make_voxel(mu, mu, cap);
+  for (int n = 0; n < 3000; ++n) kernels::fuse_tsdf(v, t, mu, cap);
+  EXPECT_LE(std::fabs(v.sdf16 - t / mu * S), bound);
+
+  const float most = kernels::kMaxVoxelWeight;
+  kernels::Voxel full = kernels::make_voxel(0.f, mu, most - 1.f);
+  for (int n = 0; n < 3; ++n) kernels::fuse_tsdf(full, 0.f, mu, most);
+  EXPECT_EQ(kernels::voxel_weight(full), most);
+}
+
+// volume.max_weight must fit the 16-bit count: a whole number (checked by validate) up to 65535
+// (the key's range).
+TEST(VoxelEncoding, MaxWeightMustBeAWholeCount) {
+  VolumeParams p;
+  p.max_weight = 100.5f;
+  EXPECT_THROW(p.validate(), ConfigError);
+  p.max_weight = 65535.f;
+  EXPECT_NO_THROW(p.validate());
+}
+
 }  // namespace seamless

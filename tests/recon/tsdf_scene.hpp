@@ -128,16 +128,21 @@ inline VolumeParams small_volume_params() {
 }
 
 // Two volumes' downloaded blocks (download_blocks(), sorted) hold the same blocks with the same
-// weights and TSDF values (1e-5 m: float reassociation between backends), and, with colour, the
-// same colour within one level. Call through ASSERT_NO_FATAL_FAILURE.
+// weights and TSDF values within one snorm16 step (kernels::Voxel), and, with colour, the same
+// colour within one level. The backends' float arithmetic differs by reassociation (ulps of the
+// observation, a thousandth of a step), which can put the two averages on either side of a
+// rounding boundary: one step apart. The next frame keeps them at most one apart: the two
+// unrounded updates q + (t - q) / (w + 1) then differ by w / (w + 1) < 1 step (plus ulps), and
+// rounding two values less than a step apart gives neighbouring steps at most. Call through
+// ASSERT_NO_FATAL_FAILURE.
 inline void expect_same_blocks(const std::vector<VoxelHashVolume::HostBlock>& a,
                                const std::vector<VoxelHashVolume::HostBlock>& b, bool colour) {
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) {
     ASSERT_TRUE(a[i].coord == b[i].coord);
     for (int k = 0; k < kernels::kBlockVoxels; ++k) {
-      ASSERT_EQ(a[i].voxels[k].weight, b[i].voxels[k].weight);
-      ASSERT_NEAR(a[i].voxels[k].sdf, b[i].voxels[k].sdf, 1e-5f);
+      ASSERT_EQ(a[i].voxels[k].weight16, b[i].voxels[k].weight16);
+      ASSERT_LE(std::abs(int(a[i].voxels[k].sdf16) - int(b[i].voxels[k].sdf16)), 1);
       if (colour) {
         ASSERT_NEAR(a[i].colors[k].x, b[i].colors[k].x, 1);
         ASSERT_NEAR(a[i].colors[k].y, b[i].colors[k].y, 1);

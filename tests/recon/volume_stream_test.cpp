@@ -52,8 +52,8 @@ void expect_same_blocks(const std::vector<VoxelHashVolume::HostBlock>& a,
     // The surface flag of a block streamed back in is recomputed from its voxels (mark_surface_blocks).
     ASSERT_EQ(a[i].surface, b[i].surface) << "block " << i;
     for (int k = 0; k < kernels::kBlockVoxels; ++k) {  // copies: bit-identical
-      ASSERT_EQ(a[i].voxels[k].sdf, b[i].voxels[k].sdf);
-      ASSERT_EQ(a[i].voxels[k].weight, b[i].voxels[k].weight);
+      ASSERT_EQ(a[i].voxels[k].sdf16, b[i].voxels[k].sdf16);
+      ASSERT_EQ(a[i].voxels[k].weight16, b[i].voxels[k].weight16);
       ASSERT_EQ(a[i].colors[k].x, b[i].colors[k].x);
       ASSERT_EQ(a[i].colors[k].y, b[i].colors[k].y);
       ASSERT_EQ(a[i].colors[k].z, b[i].colors[k].z);
