@@ -110,15 +110,12 @@ SEAMLESS_HD inline bool voxel_keeps_block(const Voxel& v, float keep_below, floa
   return voxel_observed(v) && fabsf(voxel_sdf(v, mu)) < keep_below;
 }
 
-// Fusion's weighted running average (Curless & Levoy 1996; KinectFusion eq. 11-13) of a value
-// held with weight wt and one new observation of weight 1. T: float, or 8 lanes of floats (the
-// CPU's fusion rows, tsdf_fusion_simd.hpp), which then round exactly as the scalar code.
-template <class T> SEAMLESS_HD inline T running_average(T old, T wt, T obs) { return (old * wt + obs) / (wt + T(1.f)); }
-
-// A voxel's colour after one more observation c, averaged with the voxel's weight wt before it.
+// A voxel's colour after one more observation c: fusion's weighted running average (Curless & Levoy
+// 1996; KinectFusion eq. 11-13) with the voxel's weight wt before it, rounded to a byte. (The
+// distance's running average is fuse_tsdf, voxel_hash.hpp.)
 SEAMLESS_HD inline uchar3 blend_color(uchar3 old, uchar3 c, float wt) {
   auto avg = [&](std::uint8_t o, std::uint8_t obs) {
-    return static_cast<std::uint8_t>(min_of(running_average(float(o), wt, float(obs)) + 0.5f, 255.f));
+    return static_cast<std::uint8_t>(min_of((float(o) * wt + float(obs)) / (wt + 1.f) + 0.5f, 255.f));
   };
   return {avg(old.x, c.x), avg(old.y, c.y), avg(old.z, c.z)};
 }

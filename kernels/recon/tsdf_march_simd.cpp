@@ -88,7 +88,11 @@ SEAMLESS_SIMD_INL i8 load_voxels(const Voxel* pool, i8 block, i8 local, vm m) {
 #else
   i8 r = {};
   for (int l = 0; l < simd::kWidth; ++l)
-    if (m.v[l]) std::memcpy(&r[l], pool + static_cast<std::int64_t>(block[l]) * kBlockVoxels + local[l], 4);
+    if (m.v[l]) {
+      std::int32_t word;
+      std::memcpy(&word, pool + static_cast<std::int64_t>(block[l]) * kBlockVoxels + local[l], sizeof word);
+      r[l] = word;
+    }
   return r;
 #endif
 }
