@@ -71,19 +71,16 @@ SEAMLESS_SIMD_INL vm near_flags(const WindowedHashAccess& a, i8 block, vm m) {
 SEAMLESS_SIMD_INL i8 load_voxels(const Voxel* pool, i8 block, i8 local, vm m) {
   static_assert(kBlockVoxels == 512);
 #if SEAMLESS_SIMD_X86
-  auto half = [](i8 v, int h) {  // lanes 4h to 4h + 3 as 64-bit ints
-    const i4 p = h ? __builtin_shufflevector(v, v, 4, 5, 6, 7) : __builtin_shufflevector(v, v, 0, 1, 2, 3);
-    return __builtin_convertvector(p, q4);
-  };
-  auto mask = [](i8 v, int h) {  // lanes 4h to 4h + 3
+  auto lanes = [](i8 v, int h) -> i4 {  // lanes 4h to 4h + 3
     return h ? __builtin_shufflevector(v, v, 4, 5, 6, 7) : __builtin_shufflevector(v, v, 0, 1, 2, 3);
   };
+  auto half = [&](i8 v, int h) { return __builtin_convertvector(lanes(v, h), q4); };  // as 64-bit ints
   const int* base = reinterpret_cast<const int*>(pool);
   const q4 i0 = half(block, 0) * 512 + half(local, 0), i1 = half(block, 1) * 512 + half(local, 1);
   const i4 lo = reinterpret_cast<i4>(_mm256_mask_i64gather_epi32(
-      _mm_setzero_si128(), base, reinterpret_cast<__m256i>(i0), reinterpret_cast<__m128i>(mask(m.v, 0)), 4));
+      _mm_setzero_si128(), base, reinterpret_cast<__m256i>(i0), reinterpret_cast<__m128i>(lanes(m.v, 0)), 4));
   const i4 hi = reinterpret_cast<i4>(_mm256_mask_i64gather_epi32(
-      _mm_setzero_si128(), base, reinterpret_cast<__m256i>(i1), reinterpret_cast<__m128i>(mask(m.v, 1)), 4));
+      _mm_setzero_si128(), base, reinterpret_cast<__m256i>(i1), reinterpret_cast<__m128i>(lanes(m.v, 1)), 4));
   return __builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7);
 #else
   i8 r = {};
