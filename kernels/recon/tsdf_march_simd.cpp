@@ -102,17 +102,34 @@ SEAMLESS_SIMD_INL vm sample_lanes(const WindowedHashAccess& a, v3 q, vi3 g0, vi3
   if (!simd::bits(m)) return m;
   // The cell reaches into the next block along the axes where g0 is a block's last voxel (cell_voxels).
   const i8 ex = (g0.x & 7) == 7, ey = (g0.y & 7) == 7, ez = (g0.z & 7) == 7;  // -1 where true
-  const vm edge = m & vm{ex | ey | ez};
   // The eight loads go out together, their cache misses overlapping (the scalar loop reads corner
   // 0 first and stops there when it is unobserved: one wait more a sample, for the lanes a wait
   // less); a lane has a value when all eight corners are allocated and observed.
   vf d[8];
   vm all = m;
+  // blk[k]: the block of corner k, b + (k&1 & ex, k>>1&1 & ey, k>>2 & ez). A lane looks a block up
+  // only for the corners whose offset axes are all its edge axes (mostly corners 1, 2 and 4): a
+  // corner offset along an axis where the lane's cell stays in its block shares the block of the
+  // corner without that offset, found before it (k ^ that axis's bit < k).
+  const vm axis_edge[3] = {m & vm{ex}, m & vm{ey}, m & vm{ez}};
+  i8 blk[8];
+  blk[0] = i0;
+  for (int k = 1; k < 8; ++k) {
+    vm own = m;
+    i8 shared = i0;
+    for (int j = 0; j < 3; ++j)
+      if (k >> j & 1) {
+        own = own & axis_edge[j];
+        shared = select(!axis_edge[j], vi(blk[k ^ (1 << j)]), vi(shared)).v;
+      }
+    blk[k] = shared;
+    if (simd::bits(own)) {
+      const i8 ox = k & 1 ? i8{} + 1 : i8{}, oy = k & 2 ? i8{} + 1 : i8{}, oz = k & 4 ? i8{} + 1 : i8{};
+      blk[k] = select(own, vi(find_blocks(a, vi3{b.x + ox, b.y + oy, b.z + oz}, own)), vi(shared)).v;
+    }
+  }
   for (int k = 0; k < 8; ++k) {
-    const i8 ox = k & 1 ? -ex : i8{}, oy = k & 2 ? -ey : i8{}, oz = k & 4 ? -ez : i8{};  // block offsets, 0 or 1
-    i8 ik = i0;
-    const vm other = edge & vm{(ox | oy | oz) != 0};
-    if (simd::bits(other)) ik = select(other, vi(find_blocks(a, vi3{b.x + ox, b.y + oy, b.z + oz}, other)), vi(i0)).v;
+    const i8 ik = blk[k];
     const vm mk = m & vm{ik >= 0};
     const i8 local = local_index(g0.x + (k & 1), g0.y + (k >> 1 & 1), g0.z + (k >> 2));
     const i8 raw = load_voxels(a.voxels, ik, local, mk);
