@@ -21,9 +21,9 @@ endif()
 set_source_files_properties(recon/preprocess_cpu.cpp PROPERTIES COMPILE_OPTIONS
   "$<$<CXX_COMPILER_ID:GNU,Clang>:-fno-trapping-math>")
 
-# The CPU's fusion rows and raycast march on SIMD lanes (kernels/recon/tsdf_fusion_simd.hpp,
-# tsdf_march_simd.hpp; never compiled by nvcc).
+# The CPU's fusion rows, raycast march and ICP terms on SIMD lanes (kernels/recon/tsdf_fusion_simd.hpp,
+# tsdf_march_simd.hpp, icp_simd.hpp; never compiled by nvcc).
 # -Wno-psabi: 32-byte vectors pass between always_inline functions, whose ABI note does not apply.
-target_sources(seamless_kernels PRIVATE recon/tsdf_fusion_simd.cpp recon/tsdf_march_simd.cpp)
-set_source_files_properties(recon/tsdf_fusion_simd.cpp recon/tsdf_march_simd.cpp PROPERTIES COMPILE_OPTIONS
+target_sources(seamless_kernels PRIVATE recon/tsdf_fusion_simd.cpp recon/tsdf_march_simd.cpp recon/icp_simd.cpp)
+set_source_files_properties(recon/tsdf_fusion_simd.cpp recon/tsdf_march_simd.cpp recon/icp_simd.cpp PROPERTIES COMPILE_OPTIONS
   "$<$<CXX_COMPILER_ID:GNU,Clang>:-Wno-psabi>")

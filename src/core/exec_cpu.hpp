@@ -87,21 +87,30 @@ template <class K, class V> void CpuExec::sort_by_key(K* keys, V* values, std::i
   }
 }
 
-// Per-thread partial sums combined in thread order: deterministic for a fixed thread count.
-template <class T, class F> T CpuExec::transform_reduce(std::int64_t n, T init, F fn) const {
-  int threads = n < 2048 ? 1 : omp_get_max_threads();
+// Per-thread partial sums combined in thread order: deterministic for a fixed thread count. Thread
+// t of T takes one contiguous share, the first n % T threads one element more (OpenMP's static
+// schedule as libgomp deals it, written out so that reduce_ranges' callers get the same shares).
+template <class T, class F> T CpuExec::reduce_ranges(std::int64_t n, T init, F add) const {
+  const int threads = n < 2048 ? 1 : omp_get_max_threads();
   std::vector<T> partial(static_cast<std::size_t>(threads), T{});
 #pragma omp parallel num_threads(threads)
   {
-    int t = omp_get_thread_num();
+    const std::int64_t t = omp_get_thread_num(), team = omp_get_num_threads();
+    const std::int64_t q = n / team, r = n % team;
+    const std::int64_t begin = t * q + std::min(t, r), end = begin + q + (t < r ? 1 : 0);
     T local{};
-#pragma omp for schedule(static)
-    for (std::int64_t i = 0; i < n; ++i) local = local + fn(i);
+    add(begin, end, local);
     partial[t] = local;
   }
   T sum = init;
   for (const T& p : partial) sum = sum + p;
   return sum;
+}
+
+template <class T, class F> T CpuExec::transform_reduce(std::int64_t n, T init, F fn) const {
+  return reduce_ranges(n, init, [&](std::int64_t begin, std::int64_t end, T& local) {
+    for (std::int64_t i = begin; i < end; ++i) local = local + fn(i);
+  });
 }
 
 template <class T, class F, class G> void CpuExec::transform_reduce_into(std::int64_t n, F fn, T* out, G then) const {

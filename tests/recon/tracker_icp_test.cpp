@@ -4,10 +4,15 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <functional>
 #include <vector>
 
+#include "core/cpu_simd.hpp"
 #include "core/exec.hpp"
+#include "io/frame_source.hpp"
+#include "io/input_params.hpp"
 #include "io/synthetic_source.hpp"
 #include "kernels/recon/preprocess.hpp"
 #include "kernels/recon/rgbd.hpp"
@@ -462,6 +467,57 @@ TEST(Icp, FlatWallIsDegenerate) {
   ref.set_from_frame(pyr, SE3::identity());
   TrackResult r = tracker.track(pyr, ref, perturbation(0.5, 0.01));
   EXPECT_EQ(r.status, TrackStatus::degenerate) << "condition " << r.condition;
+}
+
+TEST(Icp, SimdLanesGiveTheScalarSumsBitForBit) {
+  // Real Kinect frames (tum_fr1_rpy_000-149, frames 0 and 6: noise, holes and depth edges) tracked
+  // with the CPU's ICP terms on SIMD lanes and with the scalar loop: every level's normal
+  // equations, at the truth and 2 degrees / 2 cm off, and the tracked pose must be the same bits
+  // (icp_simd.hpp adds the lanes' terms in the scalar loop's order; max_depth and the pixel stride
+  // take their branches).
+  InputParams in;
+  in.source = InputSource::tum;
+  in.path = std::string(SEAMLESS_TEST_DATA) + "/tum_fr1_rpy_000-149";
+  in.max_frames = 7;
+  if (!simd::cpu_simd()) GTEST_SKIP() << "this CPU has no AVX2: the SIMD lanes do not run";
+  if (!std::filesystem::exists(in.path)) GTEST_SKIP() << "no test data at " << in.path;
+  auto src = make_source(in, Device::CPU);
+  std::vector<std::unique_ptr<FramePyramid>> pyr;
+  std::vector<SE3> truth;
+  RgbdFrame f;
+  while (src->next(f)) {
+    ASSERT_TRUE(f.ground_truth.has_value());
+    pyr.push_back(std::make_unique<FramePyramid>(Device::CPU, src->intrinsics(), 3));
+    pyr.back()->build(f.depth, nullptr, PreprocessParams{});
+    truth.push_back(*f.ground_truth);
+  }
+  ASSERT_EQ(pyr.size(), 7u);
+  TrackerParams tp;
+  tp.pixel_stride = {2, 1, 1};
+  tp.max_depth = 2.5f;
+  Tracker tracker(tp, Device::CPU);
+  ReferenceMaps ref;
+  ref.set_from_frame(*pyr[0], truth[0]);
+  const SE3 rel = truth[0].inverse() * truth[6];
+  for (const SE3& pose : {rel, rel * perturbation(2.0, 0.02)})
+    for (int level = 0; level < 3; ++level) {
+      simd::set_cpu_simd(true);
+      const kernels::IcpSums a = tracker.reduce(*pyr[6], ref, level, pose);
+      simd::set_cpu_simd(false);
+      const kernels::IcpSums b = tracker.reduce(*pyr[6], ref, level, pose);
+      simd::set_cpu_simd(true);
+      EXPECT_EQ(std::memcmp(&a, &b, sizeof a), 0) << "level " << level;
+      EXPECT_GT(a.inliers, 0.3 * a.valid) << "level " << level;  // the sums hold many correspondences
+    }
+  const SE3 start = truth[6] * perturbation(1.0, 0.01);
+  simd::set_cpu_simd(true);
+  const TrackResult a = tracker.track(*pyr[6], ref, start);
+  simd::set_cpu_simd(false);
+  const TrackResult b = tracker.track(*pyr[6], ref, start);
+  simd::set_cpu_simd(true);
+  ASSERT_TRUE(a.ok()) << to_string(a.status);
+  EXPECT_EQ(std::memcmp(&a.world_T_camera, &b.world_T_camera, sizeof(SE3)), 0);
+  EXPECT_EQ(a.iterations, b.iterations);
 }
 
 TEST(Gravity, AccelerometerAndFloorMatchGroundTruth) {
