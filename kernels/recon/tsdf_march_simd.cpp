@@ -180,18 +180,37 @@ SEAMLESS_SIMD_INL vi3 floor_lanes(v3 q) {
 }
 }  // namespace
 
-void march_rays_simd(const WindowedHashAccess& a, const PixelRay* r, int n, bool* hit, float* zh) {
-  v3 o, d, inv_d;
-  vf z, z_end, min_step, unobserved_step, step_per_sdf;
-  for (int l = 0; l < simd::kWidth; ++l) {
-    const PixelRay& rl = r[l < n ? l : 0];  // lanes >= n repeat ray 0 and stay idle
-    const MarchSteps s = march_steps(a.geom, rl.d);
-    o.x.v[l] = rl.o.x, o.y.v[l] = rl.o.y, o.z.v[l] = rl.o.z;
-    d.x.v[l] = rl.d.x, d.y.v[l] = rl.d.y, d.z.v[l] = rl.d.z;
-    inv_d.x.v[l] = s.inv_d.x, inv_d.y.v[l] = s.inv_d.y, inv_d.z.v[l] = s.inv_d.z;
-    z.v[l] = rl.z, z_end.v[l] = rl.z_end;
-    min_step.v[l] = s.min_step, unobserved_step.v[l] = s.unobserved_step, step_per_sdf.v[l] = s.step_per_sdf;
+void march_row_simd(const WindowedHashAccess& a, int x0, int y, int n, const Intrinsics& K, const SE3& world_T_camera,
+                    float min_depth, float max_depth, const RayIntervals& iv, PixelRay* r, bool* hit, float* zh) {
+  // pixel_ray and march_steps (tsdf_march.hpp) lane by lane: lane l the ray of pixel (x0 + l, y);
+  // lanes >= n repeat pixel x0 and stay idle.
+  const VoxelGeometry& g = a.geom;
+  vf px;
+  for (int l = 0; l < simd::kWidth; ++l) px.v[l] = static_cast<float>(x0 + (l < n ? l : 0));
+  // K.unproject(x, y, 1): ((u - cx) * 1) / fx
+  const v3 dir_c{(px - vf(K.cx)) * vf(1.f) / vf(K.fx), vf((static_cast<float>(y) - K.cy) * 1.f / K.fy), vf(1.f)};
+  const mat3& R = world_T_camera.R;
+  const vf vs(g.voxel_size);
+  const v3 o = simd::broadcast(g.to_voxel(world_T_camera.t));
+  const v3 d{dot(simd::broadcast(R.row(0)), dir_c) / vs, dot(simd::broadcast(R.row(1)), dir_c) / vs,
+             dot(simd::broadcast(R.row(2)), dir_c) / vs};
+  const vf dlen = simd::length(d);  // voxels per metre of depth
+  const vf min_step = vf(0.5f) / dlen;
+  vf z(min_depth), z_end(max_depth);
+  if (iv.bits) {  // the tile's interval (fmaxf, fminf: never NaN here)
+    vf z_near, z_far;
+    for (int l = 0; l < simd::kWidth; ++l) {
+      const std::int64_t t = iv.tile_of(x0 + (l < n ? l : 0), y);
+      z_near.v[l] = bits_float(iv.bits[2 * t]), z_far.v[l] = bits_float(iv.bits[2 * t + 1]);
+    }
+    z = simd::max_of(z, z_near - min_step);
+    z_end = select(z_far > vf(0.f), simd::min_of(z_end, z_far + min_step), vf(0.f));
   }
+  const vf unobserved_step = simd::max_of(min_step, vf(0.5f * g.truncation) / (dlen * vs));
+  const vf step_per_sdf = vf(0.8f) / (dlen * vs);
+  const v3 inv_d{vf(1.f) / d.x, vf(1.f) / d.y, vf(1.f) / d.z};
+  for (int l = 0; l < n; ++l)
+    r[l].o = simd::lane(o, l), r[l].d = simd::lane(d, l), r[l].z = z[l], r[l].z_end = z_end[l];
   vf z_prev(0.f), f_prev(0.f), ta(0.f), fa(0.f), tb(0.f), fb(0.f);
   vi refine(-1);  // -1: marching; else regula falsi steps taken
   vm have_prev{i8{}}, prev_near{i8{}};

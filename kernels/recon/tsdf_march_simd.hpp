@@ -15,7 +15,7 @@
 
 namespace seamless::kernels {
 
-// Whether march_rays_simd can take rays through a: it needs the block window, and reaches its
+// Whether march_row_simd can take rays through a: it needs the block window, and reaches its
 // entries with 32-bit indices.
 inline bool simd_marchable(const WindowedHashAccess& a) {
   return a.window.index && a.window.count() < (std::int64_t{1} << 31);
@@ -25,7 +25,9 @@ SEAMLESS_SIMD_TARGET_BEGIN
 namespace detail {
 // Marches rays r[0, n) (n <= 8) as march_ray does: hit[l] and zh[l] are what march_ray returns and
 // writes for ray r[l] (zh[l] is left unspecified where there is no hit).
-void march_rays_simd(const WindowedHashAccess& a, const PixelRay* r, int n, bool* hit, float* zh);
+// The rays of pixels (x0 + l, y), l < n, into r[l] (pixel_ray's), marched on lanes.
+void march_row_simd(const WindowedHashAccess& a, int x0, int y, int n, const Intrinsics& K, const SE3& world_T_camera,
+                    float min_depth, float max_depth, const RayIntervals& iv, PixelRay* r, bool* hit, float* zh);
 }  // namespace detail
 SEAMLESS_SIMD_TARGET_END
 

@@ -169,10 +169,9 @@ void TsdfRaycast<Exec, Acc>::raycast(const Exec& ex, Acc a, Intrinsics K, SE3 wo
         if (y >= h) return;
         const int n = w - x0 < kRayGroupW ? w - x0 : kRayGroupW;
         PixelRay r[kRayGroupW];
-        for (int l = 0; l < n; ++l) r[l] = pixel_ray(a.geom, x0 + l, y, K, world_T_camera, min_depth, max_depth, iv);
         bool hit[kRayGroupW];
         float zh[kRayGroupW];
-        detail::march_rays_simd(a, r, n, hit, zh);
+        detail::march_row_simd(a, x0, y, n, K, world_T_camera, min_depth, max_depth, iv, r, hit, zh);
         BlockCache c;
         for (int l = 0; l < n; ++l) write_pixel(a, x0 + l, y, r[l], hit[l], zh[l], c, out);
       });
