@@ -23,9 +23,9 @@ inline bool simd_marchable(const WindowedHashAccess& a) {
 
 SEAMLESS_SIMD_TARGET_BEGIN
 namespace detail {
-// Marches rays r[0, n) (n <= 8) as march_ray does: hit[l] and zh[l] are what march_ray returns and
-// writes for ray r[l] (zh[l] is left unspecified where there is no hit).
-// The rays of pixels (x0 + l, y), l < n, into r[l] (pixel_ray's), marched on lanes.
+// The rays of pixels (x0 + l, y), l < n <= 8, into r[l] (what pixel_ray gives), marched as
+// march_ray marches them: hit[l] and zh[l] are what march_ray returns and writes for ray r[l] (zh[l]
+// is left unspecified where there is no hit).
 void march_row_simd(const WindowedHashAccess& a, int x0, int y, int n, const Intrinsics& K, const SE3& world_T_camera,
                     float min_depth, float max_depth, const RayIntervals& iv, PixelRay* r, bool* hit, float* zh);
 }  // namespace detail
