@@ -189,10 +189,6 @@ struct CudaExec {
   template <class T> T exclusive_scan(const T* in, T* out, std::int64_t n) const;
   template <class K, class V> void sort_by_key(K* keys, V* values, std::int64_t n, int key_bits = 8 * sizeof(K)) const;
   template <class T, class F> T transform_reduce(std::int64_t n, T init, F fn) const;
-  // CPU only: transform_reduce's sum with each thread's share handed over whole, add(begin, end,
-  // local) adding elements begin .. end - 1 into local in order (a vector loop can then take them
-  // several at a time and still form transform_reduce's sums bit for bit).
-  template <class T, class F> T reduce_ranges(std::int64_t n, T init, F add) const;
   template <class T, class F, class G = NoThen>
   void transform_reduce_into(std::int64_t n, F fn, T* out, G then = {}) const;
   template <class T, class F, class G>
