@@ -21,29 +21,16 @@ SEAMLESS_HD inline IcpTerms icp_pixel_terms(const IcpLevel& level, const IcpPose
   return s;
 }
 
-// On the CPU with AVX2, the pixels' terms are summed 8 at a time on SIMD lanes (icp_simd.hpp: the
+// On the CPU with AVX2 the pixels' terms are summed 8 at a time on SIMD lanes (icp_simd.hpp: the
 // same sums as transform_reduce's, bit for bit).
-template <Executor Exec> bool icp_on_lanes(const IcpLevel& L) {
-#if !defined(__CUDACC__)
-  if constexpr (Exec::device == Device::CPU) return simd::cpu_simd() && icp_simd_usable(L);
-#endif
-  return false;
-}
-
-// The sum of icp_pixel_terms over level L at *pose into *out, on the lanes (icp_on_lanes).
-template <Executor Exec> void icp_sum_on_lanes(const Exec& ex, const IcpLevel& L, const IcpPose* pose, IcpSums* out) {
-#if !defined(__CUDACC__)
-  if constexpr (Exec::device == Device::CPU) {
-    const SE3 T = to_se3(*pose);
-    *out = ex.reduce_ranges(level_pixel_count(L), IcpSums{}, [&](std::int64_t begin, std::int64_t end, IcpSums& s) {
-      detail::add_icp_terms_simd(L, T, begin, end, s);
-    });
-  }
-#endif
-}
-
 template <Executor Exec> void Icp<Exec>::icp_reduce_into(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSums* out) {
-  if (icp_on_lanes<Exec>(L)) return icp_sum_on_lanes(ex, L, pose, out);
+#if !defined(__CUDACC__)
+  if constexpr (Exec::device == Device::CPU)
+    if (icp_on_lanes(L)) {
+      *out = ex.reduce_ranges(level_pixel_count(L), IcpSums{}, icp_lanes(L, pose));
+      return;
+    }
+#endif
   ex.transform_reduce_into(
       level_pixel_count(L), [=] SEAMLESS_HD(std::int64_t i) { return icp_pixel_terms(L, *pose, i); }, out);
 }
@@ -54,13 +41,10 @@ void Icp<Exec>::icp_level_steps(const Exec& ex, IcpLevel L, IcpPose* pose, IcpSu
     gauss_newton_update(sum, *pose, level_step(step), L);
     return level_done(*pose);
   };
-  if (icp_on_lanes<Exec>(L)) {  // transform_reduce_rounds' loop
-    for (int r = 0; r < steps; ++r) {
-      icp_sum_on_lanes(ex, L, pose, out);
-      if (then(r, *out)) return;
-    }
-    return;
-  }
+#if !defined(__CUDACC__)
+  if constexpr (Exec::device == Device::CPU)
+    if (icp_on_lanes(L)) return ex.reduce_ranges_rounds(level_pixel_count(L), steps, icp_lanes(L, pose), out, then);
+#endif
   ex.transform_reduce_rounds(
       level_pixel_count(L), steps, [=] SEAMLESS_HD(std::int64_t i) { return icp_pixel_terms(L, *pose, i); }, out, then);
 }

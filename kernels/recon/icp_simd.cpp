@@ -48,7 +48,7 @@ SEAMLESS_SIMD_INL v3 rotate(const mat3& R, v3 v) {
 }
 
 // Entry e of a view (pitch * y + x) as a 32-bit lane: add_icp_terms_simd's caller checks that
-// every entry of the views fits (icp_simd_usable).
+// every entry of the views fits (icp_on_lanes).
 SEAMLESS_SIMD_INL i8 entries(View2D<const vec3> v, i8 x, i8 y) { return y * static_cast<int>(v.pitch) + x; }
 
 // The rows' sums of one pixel, as add_row writes them into its zeroed terms: a geometric row (Jg,

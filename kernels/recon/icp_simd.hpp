@@ -19,15 +19,15 @@
 
 namespace seamless::kernels {
 
-// Whether add_icp_terms_simd (add_rgbd_terms_simd) can take level L (R): it reaches the maps'
-// floats with 32-bit indices.
-inline bool icp_simd_usable(const IcpLevel& L) {
+// Whether the CPU sums level L's (R's) terms on the lanes: it has AVX2, and the lanes reach the
+// maps' floats with 32-bit indices.
+inline bool icp_on_lanes(const IcpLevel& L) {
   auto fits = [](View2D<const vec3> v) { return v.pitch * v.height * 3 < (std::int64_t{1} << 31); };
-  return fits(L.cur_vertex) && fits(L.cur_normal) && fits(L.ref_vertex) && fits(L.ref_normal);
+  return simd::cpu_simd() && fits(L.cur_vertex) && fits(L.cur_normal) && fits(L.ref_vertex) && fits(L.ref_normal);
 }
-inline bool rgbd_simd_usable(const RgbdLevel& R) {
+inline bool rgbd_on_lanes(const RgbdLevel& R) {
   auto fits = [](View2D<const float> v) { return v.pitch * (v.height + 1) < (std::int64_t{1} << 31); };
-  return icp_simd_usable(R.geo) && fits(R.cur_intensity) && fits(R.ref_intensity);
+  return icp_on_lanes(R.geo) && fits(R.cur_intensity) && fits(R.ref_intensity);
 }
 
 SEAMLESS_SIMD_TARGET_BEGIN
@@ -39,6 +39,17 @@ void add_icp_terms_simd(const IcpLevel& L, const SE3& T, std::int64_t begin, std
 void add_rgbd_terms_simd(const RgbdLevel& R, const IcpPose& p, std::int64_t begin, std::int64_t end, RgbdSums& s);
 }  // namespace detail
 SEAMLESS_SIMD_TARGET_END
+
+// The add of CpuExec::reduce_ranges that sums level L's (R's) terms at *pose on the lanes.
+inline auto icp_lanes(const IcpLevel& L, const IcpPose* pose) {
+  return [=](std::int64_t begin, std::int64_t end, IcpSums& s) {
+    detail::add_icp_terms_simd(L, to_se3(*pose), begin, end, s);
+  };
+}
+inline auto rgbd_lanes(const RgbdLevel& R, const IcpPose* pose) {
+  return
+      [=](std::int64_t begin, std::int64_t end, RgbdSums& s) { detail::add_rgbd_terms_simd(R, *pose, begin, end, s); };
+}
 
 }  // namespace seamless::kernels
 #endif

@@ -31,35 +31,18 @@ SEAMLESS_HD inline void rgbd_update(const RgbdLevel& R, const RgbdSums& out, Icp
   if (R.dof > 0.f) update_scale(out, pose);
 }
 
-// On the CPU with AVX2, the pixels' terms are summed 8 at a time on SIMD lanes (icp_simd.hpp: the
+// On the CPU with AVX2 the pixels' terms are summed 8 at a time on SIMD lanes (icp_simd.hpp: the
 // same sums as transform_reduce's, bit for bit).
-template <Executor Exec> bool rgbd_on_lanes(const RgbdLevel& R) {
-#if !defined(__CUDACC__)
-  if constexpr (Exec::device == Device::CPU) return simd::cpu_simd() && rgbd_simd_usable(R);
-#endif
-  return false;
-}
-
-// The sum of rgbd_pixel_terms over level R at *pose into *out, on the lanes (rgbd_on_lanes).
-template <Executor Exec>
-void rgbd_sum_on_lanes(const Exec& ex, const RgbdLevel& R, const IcpPose* pose, RgbdSums* out) {
-#if !defined(__CUDACC__)
-  if constexpr (Exec::device == Device::CPU) {
-    const IcpPose p = *pose;
-    *out = ex.reduce_ranges(
-        level_pixel_count(R.geo), RgbdSums{},
-        [&](std::int64_t begin, std::int64_t end, RgbdSums& s) { detail::add_rgbd_terms_simd(R, p, begin, end, s); });
-  }
-#endif
-}
-
 template <Executor Exec>
 void Rgbd<Exec>::rgbd_reduce_into(const Exec& ex, RgbdLevel R, IcpPose* pose, RgbdSums* out, IcpSums* level_sums) {
   auto then = [=] SEAMLESS_HD { rgbd_update(R, *out, *pose, *level_sums, IcpUpdate::none); };
-  if (rgbd_on_lanes<Exec>(R)) {
-    rgbd_sum_on_lanes(ex, R, pose, out);
-    return then();
-  }
+#if !defined(__CUDACC__)
+  if constexpr (Exec::device == Device::CPU)
+    if (rgbd_on_lanes(R)) {
+      *out = ex.reduce_ranges(level_pixel_count(R.geo), RgbdSums{}, rgbd_lanes(R, pose));
+      return then();
+    }
+#endif
   ex.transform_reduce_into(
       level_pixel_count(R.geo), [=] SEAMLESS_HD(std::int64_t i) { return rgbd_pixel_terms(R, *pose, i); }, out, then);
 }
@@ -71,13 +54,11 @@ void Rgbd<Exec>::rgbd_level_steps(const Exec& ex, RgbdLevel R, IcpPose* pose, Rg
     rgbd_update(R, sum, *pose, *level_sums, level_step(step));
     return level_done(*pose);
   };
-  if (rgbd_on_lanes<Exec>(R)) {  // transform_reduce_rounds' loop
-    for (int r = 0; r < steps; ++r) {
-      rgbd_sum_on_lanes(ex, R, pose, out);
-      if (then(r, *out)) return;
-    }
-    return;
-  }
+#if !defined(__CUDACC__)
+  if constexpr (Exec::device == Device::CPU)
+    if (rgbd_on_lanes(R))
+      return ex.reduce_ranges_rounds(level_pixel_count(R.geo), steps, rgbd_lanes(R, pose), out, then);
+#endif
   ex.transform_reduce_rounds(
       level_pixel_count(R.geo), steps, [=] SEAMLESS_HD(std::int64_t i) { return rgbd_pixel_terms(R, *pose, i); }, out,
       then);

@@ -155,6 +155,9 @@ struct CpuExec {
   // local) adding elements begin .. end - 1 into local in order (a vector loop can then take them
   // several at a time and still form transform_reduce's sums bit for bit).
   template <class T, class F> T reduce_ranges(std::int64_t n, T init, F add) const;
+  // CPU only: transform_reduce_rounds' rounds, each round's sum formed by reduce_ranges(n, T{}, add).
+  template <class T, class F, class G>
+  void reduce_ranges_rounds(std::int64_t n, int rounds, F add, T* out, G then) const;
   template <class T, class F, class G = NoThen>
   void transform_reduce_into(std::int64_t n, F fn, T* out, G then = {}) const;
   template <class T, class F, class G>

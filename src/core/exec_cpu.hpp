@@ -119,11 +119,21 @@ template <class T, class F, class G> void CpuExec::transform_reduce_into(std::in
 }
 
 template <class T, class F, class G>
-void CpuExec::transform_reduce_rounds(std::int64_t n, int rounds, F fn, T* out, G then) const {
+void CpuExec::reduce_ranges_rounds(std::int64_t n, int rounds, F add, T* out, G then) const {
   for (int r = 0; r < rounds; ++r) {
-    *out = transform_reduce(n, T{}, fn);
+    *out = reduce_ranges(n, T{}, add);
     if (then(r, *out)) return;
   }
+}
+
+template <class T, class F, class G>
+void CpuExec::transform_reduce_rounds(std::int64_t n, int rounds, F fn, T* out, G then) const {
+  reduce_ranges_rounds(
+      n, rounds,
+      [&](std::int64_t begin, std::int64_t end, T& local) {
+        for (std::int64_t i = begin; i < end; ++i) local = local + fn(i);
+      },
+      out, then);
 }
 
 }  // namespace seamless
