@@ -51,25 +51,30 @@ SEAMLESS_SIMD_INL v3 rotate(const mat3& R, v3 v) {
 // every entry of the views fits (icp_on_lanes).
 SEAMLESS_SIMD_INL i8 entries(View2D<const vec3> v, i8 x, i8 y) { return y * static_cast<int>(v.pitch) + x; }
 
-// The rows' sums of one pixel, as add_row writes them into its zeroed terms: a geometric row (Jg,
-// rg, wg) where mg holds, then a photometric row (Jp, rp, wp) where mp holds.
+// The rows' sums of one pixel, as add_row writes them into its zeroed terms: first_row puts the row
+// (J, r, w) where m holds (zeros elsewhere), add_row_lanes adds a second one where m holds.
 struct LaneTerms {
   vf jtj[21], jtr[6], error;
 };
-SEAMLESS_SIMD_INL void row_terms(const vf Jg[6], vf rg, vf wg, vm mg, const vf Jp[6], vf rp, vf wp, vm mp,
-                                 LaneTerms& t) {
+SEAMLESS_SIMD_INL void first_row(const vf J[6], vf r, vf w, vm m, LaneTerms& t) {
   const vf zero(0.f);
   for (int i = 0; i < 6; ++i) {
-    const vf wgi = wg * Jg[i], wpi = wp * Jp[i];
-    for (int j = i; j < 6; ++j) {
-      const vf g = select(mg, zero + wgi * Jg[j], zero);
-      t.jtj[i * 6 - i * (i - 1) / 2 + (j - i)] = select(mp, g + wpi * Jp[j], g);
-    }
-    const vf g = select(mg, zero + wgi * rg, zero);
-    t.jtr[i] = select(mp, g + wpi * rp, g);
+    const vf wi = w * J[i];
+    for (int j = i; j < 6; ++j) t.jtj[i * 6 - i * (i - 1) / 2 + (j - i)] = select(m, zero + wi * J[j], zero);
+    t.jtr[i] = select(m, zero + wi * r, zero);
   }
-  const vf g = select(mg, zero + wg * rg * rg, zero);
-  t.error = select(mp, g + wp * rp * rp, g);
+  t.error = select(m, zero + w * r * r, zero);
+}
+SEAMLESS_SIMD_INL void add_row_lanes(const vf J[6], vf r, vf w, vm m, LaneTerms& t) {
+  for (int i = 0; i < 6; ++i) {
+    const vf wi = w * J[i];
+    for (int j = i; j < 6; ++j) {
+      vf& e = t.jtj[i * 6 - i * (i - 1) / 2 + (j - i)];
+      e = select(m, e + wi * J[j], e);
+    }
+    t.jtr[i] = select(m, t.jtr[i] + wi * r, t.jtr[i]);
+  }
+  t.error = select(m, t.error + w * r * r, t.error);
 }
 
 // s += lane l's terms (a pixel with a row); transform_reduce's local = local + terms, component
@@ -185,7 +190,7 @@ void add_icp_terms_simd(const IcpLevel& L, const SE3& T, std::int64_t begin, std
     if (ok_bits) {  // add_point_to_plane: the geometric row, w = 1
       const v3 a = cross(c.q, c.n);
       const vf J[6] = {a.x, a.y, a.z, c.n.x, c.n.y, c.n.z};
-      row_terms(J, dot(c.n, c.q - c.v), vf(1.f), ok, J, vf(0.f), vf(0.f), vm{i8{}}, terms);
+      first_row(J, dot(c.n, c.q - c.v), vf(1.f), ok, terms);
     }
     // A pixel without a correspondence adds zeros to every sum but `valid`: no change.
     for (int l = 0; l < n; ++l) {
@@ -236,7 +241,8 @@ void add_rgbd_terms_simd(const RgbdLevel& R, const IcpPose& p, std::int64_t begi
     const v3 a = cross(c.q, c.n), b = cross(c.q, g);
     const vf Jg[6] = {a.x, a.y, a.z, c.n.x, c.n.y, c.n.z}, Jp[6] = {b.x, b.y, b.z, g.x, g.y, g.z};
     LaneTerms terms;
-    row_terms(Jg, rg, wg, mg, Jp, r, wi, mp, terms);
+    first_row(Jg, rg, wg, mg, terms);
+    if (p_bits) add_row_lanes(Jp, r, wi, mp, terms);
     for (int l = 0; l < n; ++l) {
       if (valid_bits >> l & 1) s.icp.valid = s.icp.valid + 1.0;
       const bool has_g = g_bits >> l & 1, has_p = p_bits >> l & 1;
