@@ -150,9 +150,13 @@ template <Executor Exec> struct TsdfFusion {
 
   // Inserts every block that the truncation band [d - mu, d + mu] of each depth ray passes through
   // (Niessner section 4.1), popping a block from the pool for each new key; failures are counted.
-  // Raises each tile of `tiles` (when given) to the farthest valid reading in it.
+  // Raises each tile of `tiles` (when given) to the farthest valid reading in it. `known` (when
+  // given) must hold every block of the table inside it (the last raycast's window, no block freed
+  // since): a block it holds needs no probe of the table, since its key already has a block; the
+  // window's neighbours lie together in memory where the table scatters them.
   static void allocate_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list,
-                              HashCounters* counters, FrameInput in, VoxelGeometry geom, DepthTiles tiles = {});
+                              HashCounters* counters, FrameInput in, VoxelGeometry geom, DepthTiles tiles = {},
+                              BlockWindow known = {});
 
   // Inserts the blocks in front of the band, from min_depth along the rays of the pixels on a
   // lattice of free_space_stride (above), like allocate_blocks. Run after it (the depth tiles are

@@ -70,7 +70,8 @@ template <class F> SEAMLESS_HD inline void traverse_blocks(vec3 a, vec3 b, F vis
 
 template <Executor Exec>
 void TsdfFusion<Exec>::allocate_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list,
-                                       HashCounters* counters, FrameInput in, VoxelGeometry geom, DepthTiles tiles) {
+                                       HashCounters* counters, FrameInput in, VoxelGeometry geom, DepthTiles tiles,
+                                       BlockWindow known) {
   const int w = in.depth.width;
   const float mu = geom.truncation;
   const float to_block = 1.f / (geom.voxel_size * kBlockSide);
@@ -88,7 +89,11 @@ void TsdfFusion<Exec>::allocate_blocks(const Exec& ex, HashTableView t, View<con
     float r = mu / length(p);  // the band is +-mu along the ray (Niessner section 4.1)
     vec3 a = (in.world_T_camera * (p * (1.f - r)) - geom.origin) * to_block;
     vec3 b = (in.world_T_camera * (p * (1.f + r)) - geom.origin) * to_block;
-    traverse_blocks(a, b, [&](int3 blk) { allocate_block(t, free_list.data, counters, blk); });
+    traverse_blocks(a, b, [&](int3 blk) {
+      const std::int64_t e = known.index ? known.entry(blk) : -1;
+      if (e >= 0 && known.index[e] >= 0) return;  // allocated before this frame
+      allocate_block(t, free_list.data, counters, blk);
+    });
   });
 }
 

@@ -108,6 +108,7 @@ void VoxelHashVolume::integrate(const Image<float>& depth, const Image<uchar3>& 
   if (params_.stream_radius > 0.f) staged(timer, "stream", [&] { maybe_stream(K, world_T_camera.t); });
   maybe_rehash(last_);
   allocate_and_list(in, timer);
+  known_window_ = {};  // fusion may free blocks (remove_unkept_blocks)
   const std::int64_t n = last_.visible;
   // Fusion flags the visible blocks that keep a voxel near a surface, so removing the others
   // needs no second pass over their voxels (one thread per voxel there, not per block).
@@ -148,7 +149,8 @@ void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTime
       kernels::VoxelHash<E>::reset_frame_counters(ex, counters_.data());
       staged(timer, "allocate", [&] {
         if (tiles.zmax) kernels::TsdfFusion<E>::clear_depth_tiles(ex, tiles);
-        kernels::TsdfFusion<E>::allocate_blocks(ex, table(), free_list_.cview(), counters_.data(), in, geom_, tiles);
+        kernels::TsdfFusion<E>::allocate_blocks(ex, table(), free_list_.cview(), counters_.data(), in, geom_, tiles,
+                                                known_window_);
         if (store_free_space_)
           kernels::TsdfFusion<E>::allocate_free_space(ex, table(), free_list_.cview(), counters_.data(), in, geom_);
       });
@@ -256,6 +258,7 @@ std::int64_t VoxelHashVolume::live_slots(Buffer<std::int32_t>& slots) const {
 }
 
 void VoxelHashVolume::rehash(std::int64_t new_slots) {
+  known_window_ = {};
   // Slots are indexed by 32-bit integers in the kernels (HashTable::mask, block slot lists).
   if (new_slots > kMaxSlots)
     throw Error("voxel hashing: the hash table cannot grow beyond " + std::to_string(kMaxSlots) +
@@ -321,6 +324,7 @@ void VoxelHashVolume::grow_pool(std::int64_t blocks) {
 }
 
 std::int64_t VoxelHashVolume::remove_empty_blocks() {
+  known_window_ = {};
   Buffer<std::int32_t> slots;
   const std::int64_t n = live_slots(slots);
   Buffer<std::int32_t> keep(n, device_);
@@ -421,6 +425,7 @@ void VoxelHashVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, Ra
   with_exec(device_, [&]<class E>(const E& ex) {
     staged(timer, "raycast", [&] {
       const kernels::BlockWindow w = raycast_window(world_T_camera);
+      known_window_ = {};  // until the window is filled below
       if (iv.bits)                            // one pass over the slots splats the intervals and fills the window
         staged(timer, "raycast_splat", [&] {  // part of "raycast"
           kernels::TsdfRaycast<E>::clear_ray_intervals(ex, iv, w);
@@ -436,6 +441,7 @@ void VoxelHashVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, Ra
       if (!iv.bits)
         staged(timer, "raycast_window",
                [&] { kernels::TsdfRaycast<E>::fill_block_window(ex, table(), w); });  // part of "raycast"
+      known_window_ = w;  // every block of the table inside it
       kernels::TsdfRaycast<E, kernels::WindowedHashAccess>::raycast(
           ex, kernels::WindowedHashAccess{view, w}, K, world_T_camera, params_.min_depth, params_.max_depth, out, iv);
     });

@@ -116,6 +116,9 @@ class VoxelHashVolume final : public Volume {
   Buffer<std::int32_t> intervals_;        // ray-interval tiles (kernels::RayIntervals)
   Buffer<std::int32_t> depth_tiles_;      // the frame's farthest reading per tile (kernels::DepthTiles)
   Buffer<std::int32_t> window_;           // the raycast's block-index window (kernels::BlockWindow)
+  // The last raycast's window while it still holds every block in it (no block freed since), for
+  // the next frame's allocation to skip the table's probes; empty otherwise.
+  kernels::BlockWindow known_window_{};
   mutable Buffer<std::int32_t> scratch_;  // one int per slot for scans
   kernels::HashCounters last_{};          // counters as read at the end of the last frame
   std::int64_t frames_ = 0, retries_ = 0, failed_ = 0;

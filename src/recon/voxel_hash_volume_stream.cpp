@@ -88,6 +88,7 @@ bool VoxelHashVolume::beyond_radius(HashKey key, const vec3& camera_position) co
 // them on the device (key tombstoned, block zeroed and pushed on the free list) in one step, so a
 // block is never on both sides.
 void VoxelHashVolume::stream_out(const vec3& camera_position) {
+  known_window_ = {};  // blocks leave the table
   Buffer<std::int32_t> slots(free_list_.size(), device_);
   const float radius = params_.stream_radius / geom_.voxel_size;
   const std::int64_t n = with_exec(device_, [&]<class E>(const E& ex) {

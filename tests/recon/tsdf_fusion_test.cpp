@@ -392,6 +392,49 @@ TEST(TsdfFusion, CullingChangesNothingOnRealFrames) {
   ASSERT_NO_FATAL_FAILURE(test::expect_same_blocks(a.download_blocks(), b.download_blocks(), true));
 }
 
+// Allocation skips the table's probes for the blocks the last raycast's window holds: on real
+// Kinect frames (ground-truth poses, 1 cm voxels for speed), a volume raycast after every frame
+// must end with the blocks and voxels of one without a window, also when blocks are freed between
+// the raycast and the next frame (remove_empty_blocks), which the window must then not vouch for.
+void same_blocks_with_and_without_the_window(Device dev) {
+  const std::string dir = std::string(SEAMLESS_TEST_DATA) + "/tum_fr1_rpy_000-149";
+  if (!std::filesystem::exists(dir)) GTEST_SKIP() << "no test data at " << dir;
+  InputParams in;
+  in.source = InputSource::tum;
+  in.path = dir;
+  in.max_frames = 8;
+  auto src = make_source(in, Device::CPU);
+  VolumeParams with;
+  with.voxel_size = 0.01f, with.truncation = 0.04f;
+  with.remove_empty_blocks = false;  // freed by the calls below instead, after the raycast
+  VolumeParams without = with;
+  without.raycast_window = 0;
+  VoxelHashVolume a(with, dev), b(without, dev);
+  RgbdFrame f;
+  std::int64_t freed = 0;
+  while (src->next(f)) {
+    ASSERT_TRUE(f.ground_truth.has_value());
+    for (VoxelHashVolume* v : {&a, &b}) {
+      v->integrate(f.depth, f.rgb, src->intrinsics(), *f.ground_truth);
+      v->raycast(src->intrinsics(), *f.ground_truth);
+    }
+    const std::int64_t n = a.remove_empty_blocks();
+    ASSERT_EQ(n, b.remove_empty_blocks());
+    freed += n;
+  }
+  EXPECT_GT(freed, 0);  // blocks left the table while a window held them
+  ASSERT_NO_FATAL_FAILURE(test::expect_same_blocks(a.download_blocks(), b.download_blocks(), true));
+}
+
+TEST(TsdfFusion, AllocationThroughTheRaycastWindowChangesNothing) {
+  same_blocks_with_and_without_the_window(Device::CPU);
+}
+
+TEST(TsdfParity, AllocationThroughTheRaycastWindowOnCuda) {
+  if (!cuda_available()) GTEST_SKIP() << "no CUDA device";
+  same_blocks_with_and_without_the_window(Device::CUDA);
+}
+
 // The CPU fuses a block row on 8 SIMD lanes (kernels/recon/tsdf_fusion_simd.hpp) with the scalar
 // loop's expressions in its order: on real Kinect frames (ground-truth poses, 1 cm voxels for
 // speed; holes, far noisy depth and the image border included) the voxels, colours, kept blocks and
