@@ -121,12 +121,6 @@ void TsdfRaycast<Exec, Acc>::fill_block_window(const Exec& ex, HashTableView t, 
 // a 32-pixel row.
 constexpr int kRayGroupW = 8, kRayGroupH = 4;
 
-// Blocks of the executor's threads the march asks to keep resident per multiprocessor (a register
-// cap on CUDA, MinBlocks; 0: none).
-#ifndef SEAMLESS_RAYCAST_MIN_BLOCKS
-#define SEAMLESS_RAYCAST_MIN_BLOCKS 0
-#endif
-
 // Normal of pixel (x, y) from its neighbours' vertices (as InfiniTAM does after its raycast): the
 // cross product of central differences along the image axes (one-sided at a missing neighbour),
 // facing the camera at eye. A neighbour farther than max_jump is across a depth discontinuity and
@@ -186,16 +180,13 @@ void TsdfRaycast<Exec, Acc>::raycast(const Exec& ex, Acc a, Intrinsics K, SE3 wo
   }
 #endif
   if (!marched)
-    ex.for_each_grouped(
-        groups * kRayGroupW * kRayGroupH, 1,
-        [=] SEAMLESS_HD(std::int64_t i, Lanes) {
-          const std::int64_t group = i / (kRayGroupW * kRayGroupH);
-          const int lane = static_cast<int>(i % (kRayGroupW * kRayGroupH));
-          const int x = static_cast<int>(group % groups_x) * kRayGroupW + lane % kRayGroupW;
-          const int y = static_cast<int>(group / groups_x) * kRayGroupH + lane / kRayGroupW;
-          if (x < w && y < h) raycast_pixel(a, x, y, K, world_T_camera, min_depth, max_depth, out, iv);
-        },
-        MinBlocks<SEAMLESS_RAYCAST_MIN_BLOCKS>{});
+    ex.for_each(groups * kRayGroupW * kRayGroupH, [=] SEAMLESS_HD(std::int64_t i) {
+      const std::int64_t group = i / (kRayGroupW * kRayGroupH);
+      const int lane = static_cast<int>(i % (kRayGroupW * kRayGroupH));
+      const int x = static_cast<int>(group % groups_x) * kRayGroupW + lane % kRayGroupW;
+      const int y = static_cast<int>(group / groups_x) * kRayGroupH + lane / kRayGroupW;
+      if (x < w && y < h) raycast_pixel(a, x, y, K, world_T_camera, min_depth, max_depth, out, iv);
+    });
   // Ten pixel footprints at the hit's depth: surfaces up to ~84 degrees from the view direction
   // keep their neighbours; a jump beyond that is a silhouette.
   const float jump_per_metre = 10.f / fminf(K.fx, K.fy);
