@@ -131,6 +131,70 @@ struct SurfaceFlags {
   float below = 0.f;             // metres
 };
 
+// A walk over the block grid along a segment a -> b (block units; Amanatides & Woo 1987): from
+// block c to block e, stepping s along the axis whose next face comes first (t: the segment's
+// parameter at each axis's next face, dt: between faces; inf where the segment does not move
+// along the axis). A walk from c to e takes |e - c|_1 steps; n_max only stops one that float
+// rounding carries past e (which otherwise ends once t passes 1), and is never below 64, the
+// bound of the truncation band's short segments.
+struct BlockWalk {
+  int3 c, e, s;
+  vec3 t, dt;
+  int n_max;
+};
+
+SEAMLESS_HD inline BlockWalk block_walk(vec3 a, vec3 b) {
+  BlockWalk w;
+  w.c = floor_to_int(a), w.e = floor_to_int(b);
+  const int3 span{w.e.x - w.c.x, w.e.y - w.c.y, w.e.z - w.c.z};
+  const int steps =
+      (span.x < 0 ? -span.x : span.x) + (span.y < 0 ? -span.y : span.y) + (span.z < 0 ? -span.z : span.z) + 1;
+  w.n_max = steps > 64 ? steps : 64;
+  const vec3 d = b - a;
+  const float inf = 1e30f;
+  w.s = {d.x > 0 ? 1 : -1, d.y > 0 ? 1 : -1, d.z > 0 ? 1 : -1};
+  w.t = {d.x != 0.f ? ((w.c.x + (w.s.x > 0)) - a.x) / d.x : inf, d.y != 0.f ? ((w.c.y + (w.s.y > 0)) - a.y) / d.y : inf,
+         d.z != 0.f ? ((w.c.z + (w.s.z > 0)) - a.z) / d.z : inf};
+  w.dt = {d.x != 0.f ? fabsf(1.f / d.x) : inf, d.y != 0.f ? fabsf(1.f / d.y) : inf,
+          d.z != 0.f ? fabsf(1.f / d.z) : inf};
+  return w;
+}
+
+// Visits every block of the walk, in order.
+template <class F> SEAMLESS_HD inline void walk_blocks(BlockWalk w, F visit) {
+  int3 c = w.c;
+  float tx = w.t.x, ty = w.t.y, tz = w.t.z;
+  for (int n = 0; n < w.n_max; ++n) {
+    visit(c);
+    if (c == w.e) return;
+    if (tx <= ty && tx <= tz) {
+      if (tx > 1.f) return;
+      c.x += w.s.x;
+      tx += w.dt.x;
+    } else if (ty <= tz) {
+      if (ty > 1.f) return;
+      c.y += w.s.y;
+      ty += w.dt.y;
+    } else {
+      if (tz > 1.f) return;
+      c.z += w.s.z;
+      tz += w.dt.z;
+    }
+  }
+}
+
+// The walk over the blocks of pixel (x, y)'s truncation band, [d - mu, d + mu] along its ray
+// (Niessner section 4.1), d its reading. Voxel g sits at origin + g s and block b holds voxels
+// 8b .. 8b + 7, so in block units a world point p lies in block floor((p - origin) / (8 s)).
+SEAMLESS_HD inline BlockWalk band_walk(const FrameInput& in, const VoxelGeometry& geom, int x, int y, float d) {
+  const vec3 p = in.K.unproject(static_cast<float>(x), static_cast<float>(y), d);
+  const float r = geom.truncation / length(p);
+  const float to_block = 1.f / (geom.voxel_size * kBlockSide);
+  const vec3 a = (in.world_T_camera * (p * (1.f - r)) - geom.origin) * to_block;
+  const vec3 b = (in.world_T_camera * (p * (1.f + r)) - geom.origin) * to_block;
+  return block_walk(a, b);
+}
+
 // Free space in the voxel-hashed volume (docs/DYNAMIC.md "Evidence of free space"): as in
 // ReFusion (Palazzolo et al. 2019), the blocks along the whole ray in front of a reading are
 // allocated, so fusion stores the free space (+truncation) there, not only the band around the

@@ -33,39 +33,9 @@ SEAMLESS_HD inline void allocate_block(HashTableView t, const std::int32_t* free
 }
 
 // Amanatides & Woo (1987) traversal of the block grid along the segment a -> b (block units):
-// visits every block the segment touches, in order. A walk from c to e takes |e - c|_1 steps; the
-// bound only stops one that float rounding carries past e (which otherwise ends once t passes 1),
-// and is never below 64, the bound of the truncation band's short segments.
+// visits every block the segment touches, in order (block_walk sets it up, tsdf.hpp).
 template <class F> SEAMLESS_HD inline void traverse_blocks(vec3 a, vec3 b, F visit) {
-  int3 c = floor_to_int(a), e = floor_to_int(b);
-  const int3 span{e.x - c.x, e.y - c.y, e.z - c.z};
-  const int steps =
-      (span.x < 0 ? -span.x : span.x) + (span.y < 0 ? -span.y : span.y) + (span.z < 0 ? -span.z : span.z) + 1;
-  vec3 d = b - a;
-  const float inf = 1e30f;
-  int sx = d.x > 0 ? 1 : -1, sy = d.y > 0 ? 1 : -1, sz = d.z > 0 ? 1 : -1;
-  float tx = d.x != 0.f ? ((c.x + (sx > 0)) - a.x) / d.x : inf;
-  float ty = d.y != 0.f ? ((c.y + (sy > 0)) - a.y) / d.y : inf;
-  float tz = d.z != 0.f ? ((c.z + (sz > 0)) - a.z) / d.z : inf;
-  float dx = d.x != 0.f ? fabsf(1.f / d.x) : inf, dy = d.y != 0.f ? fabsf(1.f / d.y) : inf,
-        dz = d.z != 0.f ? fabsf(1.f / d.z) : inf;
-  for (int n = 0, n_max = steps > 64 ? steps : 64; n < n_max; ++n) {
-    visit(c);
-    if (c == e) return;
-    if (tx <= ty && tx <= tz) {
-      if (tx > 1.f) return;
-      c.x += sx;
-      tx += dx;
-    } else if (ty <= tz) {
-      if (ty > 1.f) return;
-      c.y += sy;
-      ty += dy;
-    } else {
-      if (tz > 1.f) return;
-      c.z += sz;
-      tz += dz;
-    }
-  }
+  walk_blocks(block_walk(a, b), visit);
 }
 
 template <Executor Exec>
@@ -73,27 +43,40 @@ void TsdfFusion<Exec>::allocate_blocks(const Exec& ex, HashTableView t, View<con
                                        HashCounters* counters, FrameInput in, VoxelGeometry geom, DepthTiles tiles,
                                        BlockWindow known) {
   const int w = in.depth.width;
-  const float mu = geom.truncation;
-  const float to_block = 1.f / (geom.voxel_size * kBlockSide);
-  // Voxel g sits at origin + g*s, and block b holds voxels 8b..8b+7: in block units a world point p
-  // lies in block floor((p - origin)/(8s)).
-  ex.for_each(in.depth.count(), [=] SEAMLESS_HD(std::int64_t i) {
-    int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
-    float d = in.depth(x, y);
-    if (!(d >= in.min_depth && d <= in.max_depth)) return;
+  // Pixel (x, y) with its reading d and the walk over its band's blocks: raises its tile, then
+  // claims each block of the walk.
+  auto claim = [=] SEAMLESS_HD(int x, int y, float d, const BlockWalk& walk) {
     if (tiles.zmax) {  // the plain read spares most atomics once the tile holds its far reading
       std::int32_t* tile = tiles.zmax + tiles.tile_of(x, y);
       if (float_bits(d) > atomic_load(tile)) atomic_max(tile, float_bits(d));
     }
-    vec3 p = in.K.unproject(static_cast<float>(x), static_cast<float>(y), d);
-    float r = mu / length(p);  // the band is +-mu along the ray (Niessner section 4.1)
-    vec3 a = (in.world_T_camera * (p * (1.f - r)) - geom.origin) * to_block;
-    vec3 b = (in.world_T_camera * (p * (1.f + r)) - geom.origin) * to_block;
-    traverse_blocks(a, b, [&](int3 blk) {
+    walk_blocks(walk, [&](int3 blk) {
       const std::int64_t e = known.index ? known.entry(blk) : -1;
       if (e >= 0 && known.index[e] >= 0) return;  // allocated before this frame
       allocate_block(t, free_list.data, counters, blk);
     });
+  };
+#if !defined(__CUDACC__)
+  // The CPU with AVX2 sets up the walks of 8 pixels of a row at once (tsdf_fusion_simd.hpp: the
+  // same walks bit for bit), then walks them one by one.
+  if constexpr (Exec::device == Device::CPU)
+    if (simd::cpu_simd()) {
+      constexpr int kLanes = detail::kBandLanes;
+      const int groups = (w + kLanes - 1) / kLanes;
+      ex.for_each(static_cast<std::int64_t>(groups) * in.depth.height, [=](std::int64_t i) {
+        const int x0 = static_cast<int>(i % groups) * kLanes, y = static_cast<int>(i / groups);
+        BlockWalk walks[kLanes];
+        const int lanes = detail::band_walks_simd(in, geom, x0, y, walks);
+        for (int l = 0; l < kLanes; ++l)
+          if (lanes >> l & 1) claim(x0 + l, y, in.depth(x0 + l, y), walks[l]);
+      });
+      return;
+    }
+#endif
+  ex.for_each(in.depth.count(), [=] SEAMLESS_HD(std::int64_t i) {
+    const int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
+    const float d = in.depth(x, y);
+    if (d >= in.min_depth && d <= in.max_depth) claim(x, y, d, band_walk(in, geom, x, y, d));
   });
 }
 

@@ -33,6 +33,13 @@ namespace detail {
 // Fuses the frame into layer z of block b (its 64 voxels at that z): layer points to them, colors
 // to their colours (nullptr: no colour fused). Not for a frame that carves free space (in.carve > 0).
 int fuse_layer_simd(const FuseRowFrame& f, int3 b, int z, Voxel* layer, uchar3* colors);
+
+// allocate_blocks' walks over the truncation bands of the 8 pixels (x0 + l, y) of a row, with its
+// expressions in its order, so each walk is the scalar code's bit for bit: walks[l] is lane l's
+// where bit l of the result is set (x0 + l inside the image, its reading within [min_depth,
+// max_depth]); the other entries are left as they were.
+constexpr int kBandLanes = 8;  // simd::kWidth
+int band_walks_simd(const FrameInput& in, const VoxelGeometry& geom, int x0, int y, BlockWalk walks[kBandLanes]);
 }  // namespace detail
 SEAMLESS_SIMD_TARGET_END
 

@@ -425,7 +425,7 @@ void VoxelHashVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, Ra
   with_exec(device_, [&]<class E>(const E& ex) {
     staged(timer, "raycast", [&] {
       const kernels::BlockWindow w = raycast_window(world_T_camera);
-      known_window_ = {};  // until the window is filled below
+      known_window_ = {};                     // until the window is filled below
       if (iv.bits)                            // one pass over the slots splats the intervals and fills the window
         staged(timer, "raycast_splat", [&] {  // part of "raycast"
           kernels::TsdfRaycast<E>::clear_ray_intervals(ex, iv, w);

@@ -110,12 +110,12 @@ class VoxelHashVolume final : public Volume {
   Buffer<std::int32_t> free_list_;
   Buffer<kernels::HashCounters> counters_;
   Buffer<std::int32_t> visible_;
-  Buffer<std::int32_t> keep_;             // per visible block: 1 = has a voxel near a surface
-  Buffer<std::int32_t> surface_;          // per pool block: its surface flag (kernels::SurfaceFlags)
-  Buffer<std::int32_t> near_;             // per pool block, per raycast: kernels::block_near_surface
-  Buffer<std::int32_t> intervals_;        // ray-interval tiles (kernels::RayIntervals)
-  Buffer<std::int32_t> depth_tiles_;      // the frame's farthest reading per tile (kernels::DepthTiles)
-  Buffer<std::int32_t> window_;           // the raycast's block-index window (kernels::BlockWindow)
+  Buffer<std::int32_t> keep_;         // per visible block: 1 = has a voxel near a surface
+  Buffer<std::int32_t> surface_;      // per pool block: its surface flag (kernels::SurfaceFlags)
+  Buffer<std::int32_t> near_;         // per pool block, per raycast: kernels::block_near_surface
+  Buffer<std::int32_t> intervals_;    // ray-interval tiles (kernels::RayIntervals)
+  Buffer<std::int32_t> depth_tiles_;  // the frame's farthest reading per tile (kernels::DepthTiles)
+  Buffer<std::int32_t> window_;       // the raycast's block-index window (kernels::BlockWindow)
   // The last raycast's window while it still holds every block in it (no block freed since), for
   // the next frame's allocation to skip the table's probes; empty otherwise.
   kernels::BlockWindow known_window_{};
