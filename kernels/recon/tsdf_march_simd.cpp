@@ -262,6 +262,59 @@ void march_row_simd(const WindowedHashAccess& a, int x0, int y, int n, const Int
   for (int l = 0; l < n; ++l) hit[l] = found >> l & 1, zh[l] = z[l];
 }
 
+namespace {
+// Vertices and depths of pixels (x0 - 1 + k, yy), k < m, on lanes (lane k of v and z, or of the
+// shifted copies the caller takes); pixels outside the image read as no reading (depth 0), which
+// vertex_map_normal treats as it treats an outside neighbour.
+template <int M> struct RowCopy {
+  vec3 v[M];
+  float z[M];
+  RowCopy(View2D<const vec3> vtx, View2D<const float> depth, int x_first, int yy) {
+    for (int k = 0; k < M; ++k) {
+      const int x = x_first + k;
+      const bool in = vtx.inside(x, yy);
+      v[k] = in ? vtx(x, yy) : vec3{0.f, 0.f, 0.f};
+      z[k] = in ? depth(x, yy) : 0.f;
+    }
+  }
+  v3 lanes_v(int k0) const { return simd::load_v3(v + k0); }
+  vf lanes_z(int k0) const {
+    vf r;
+    std::memcpy(&r.v, z + k0, sizeof r.v);
+    return r;
+  }
+};
+
+// vertex_map_normal's axis_diff on lanes: the difference along an axis from the neighbours p (+)
+// and m (-) with depths zp and zm, each usable when it has a reading and lies within the jump.
+SEAMLESS_SIMD_INL vm axis_lanes(v3 v, v3 p, vf zp, v3 m, vf zm, vf jump2, v3& d) {
+  const vm hp = (zp > vf(0.f)) & (length2(p - v) <= jump2), hm = (zm > vf(0.f)) & (length2(m - v) <= jump2);
+  d = select(hp & hm, p - m, select(hp, p - v, v - m));
+  return hp | hm;
+}
+}  // namespace
+
+void normals_row_simd(View2D<const vec3> vtx, View2D<const float> depth, int x0, int y, int n, vec3 eye,
+                      float jump_per_metre, View2D<vec3> normal) {
+  const RowCopy<simd::kWidth + 2> row(vtx, depth, x0 - 1, y);
+  const RowCopy<simd::kWidth> up(vtx, depth, x0, y - 1), down(vtx, depth, x0, y + 1);
+  const v3 v = row.lanes_v(1);
+  const vf z = row.lanes_z(1);
+  const vf jump = vf(jump_per_metre) * z, jump2 = jump * jump;
+  v3 du, dv;
+  const vm ok = (z > vf(0.f)) &
+                axis_lanes(v, row.lanes_v(2), row.lanes_z(2), row.lanes_v(0), row.lanes_z(0), jump2, du) &
+                axis_lanes(v, down.lanes_v(0), down.lanes_z(0), up.lanes_v(0), up.lanes_z(0), jump2, dv);
+  // normalize(cross(dv, du)), facing the eye.
+  const v3 c = cross(dv, du);
+  const vf len = simd::length(c);
+  const vm long_enough = len > vf(0.f);
+  v3 nrm = select(long_enough, v3{c.x / len, c.y / len, c.z / len}, v3{vf(0.f), vf(0.f), vf(0.f)});
+  nrm = select(dot(nrm, simd::broadcast(eye) - v) < vf(0.f), nrm * vf(-1.f), nrm);
+  nrm = select(ok, nrm, v3{vf(0.f), vf(0.f), vf(0.f)});
+  for (int l = 0; l < n; ++l) normal(x0 + l, y) = simd::lane(nrm, l);
+}
+
 }  // namespace detail
 SEAMLESS_SIMD_TARGET_END
 

@@ -28,6 +28,11 @@ namespace detail {
 // is left unspecified where there is no hit).
 void march_row_simd(const WindowedHashAccess& a, int x0, int y, int n, const Intrinsics& K, const SE3& world_T_camera,
                     float min_depth, float max_depth, const RayIntervals& iv, PixelRay* r, bool* hit, float* zh);
+
+// pixel_normal (tsdf_march.hpp) of pixels (x0 + l, y), l < n <= 8, into normal(x0 + l, y), with its
+// expressions in its order on the lanes: the same normals bit for bit.
+void normals_row_simd(View2D<const vec3> vtx, View2D<const float> depth, int x0, int y, int n, vec3 eye,
+                      float jump_per_metre, View2D<vec3> normal);
 }  // namespace detail
 SEAMLESS_SIMD_TARGET_END
 

@@ -121,34 +121,6 @@ void TsdfRaycast<Exec, Acc>::fill_block_window(const Exec& ex, HashTableView t, 
 // a 32-pixel row.
 constexpr int kRayGroupW = 8, kRayGroupH = 4;
 
-// Normal of pixel (x, y) from its neighbours' vertices (as InfiniTAM does after its raycast): the
-// cross product of central differences along the image axes (one-sided at a missing neighbour),
-// facing the camera at eye. A neighbour farther than max_jump is across a depth discontinuity and
-// not used; zero where either axis has no usable neighbour. On the raycast's smooth TSDF surface
-// this costs one pass over the image, where the TSDF gradient (six more trilinear samples per
-// hit, often in other blocks) took half of the raycast's GPU time.
-SEAMLESS_HD inline vec3 vertex_map_normal(View2D<const vec3> vtx, View2D<const float> depth, int x, int y, vec3 eye,
-                                          float max_jump) {
-  const vec3 v = vtx(x, y);
-  auto neighbour = [&](int xx, int yy, vec3* out) {
-    if (!vtx.inside(xx, yy) || !(depth(xx, yy) > 0.f)) return false;
-    *out = vtx(xx, yy);
-    return length2(*out - v) <= max_jump * max_jump;
-  };
-  auto axis_diff = [&](int dx, int dy, vec3* d) {
-    vec3 p{}, m{};  // set by neighbour() when it returns true; zeroed for the compiler's flow analysis
-    const bool hp = neighbour(x + dx, y + dy, &p), hm = neighbour(x - dx, y - dy, &m);
-    if (hp && hm) *d = p - m;
-    else if (hp) *d = p - v;
-    else if (hm) *d = v - m;
-    return hp || hm;
-  };
-  vec3 du, dv;
-  if (!axis_diff(1, 0, &du) || !axis_diff(0, 1, &dv)) return {0.f, 0.f, 0.f};
-  vec3 n = normalize(cross(dv, du));
-  return dot(n, eye - v) < 0.f ? n * -1.f : n;
-}
-
 template <Executor Exec, class Acc>
 void TsdfRaycast<Exec, Acc>::raycast(const Exec& ex, Acc a, Intrinsics K, SE3 world_T_camera, float min_depth,
                                      float max_depth, RaycastOutput out, RayIntervals iv) {
@@ -193,10 +165,21 @@ void TsdfRaycast<Exec, Acc>::raycast(const Exec& ex, Acc a, Intrinsics K, SE3 wo
   const vec3 eye = world_T_camera.t;
   View2D<const vec3> vtx = out.vertex;
   View2D<const float> depth = out.depth;
+#if !defined(__CUDACC__)
+  if constexpr (Exec::device == Device::CPU)
+    if (simd::cpu_simd()) {  // 8 pixels of a row at a time: the same normals bit for bit (tsdf_march_simd.hpp)
+      const int runs = (w + kRayGroupW - 1) / kRayGroupW;
+      ex.for_each(static_cast<std::int64_t>(runs) * h, [=](std::int64_t i) {
+        const int x0 = static_cast<int>(i % runs) * kRayGroupW, y = static_cast<int>(i / runs);
+        detail::normals_row_simd(vtx, depth, x0, y, w - x0 < kRayGroupW ? w - x0 : kRayGroupW, eye, jump_per_metre,
+                                 out.normal);
+      });
+      return;
+    }
+#endif
   ex.for_each(static_cast<std::int64_t>(w) * h, [=] SEAMLESS_HD(std::int64_t i) {
     const int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
-    const float z = depth(x, y);
-    out.normal(x, y) = z > 0.f ? vertex_map_normal(vtx, depth, x, y, eye, jump_per_metre * z) : vec3{0.f, 0.f, 0.f};
+    out.normal(x, y) = pixel_normal(vtx, depth, x, y, eye, jump_per_metre);
   });
 }
 

@@ -533,7 +533,8 @@ TEST(TsdfFusion, SimdBandWalksAreTheScalarWalksBitForBit) {
   EXPECT_GT(long_walks, walks / 4);  // bands that cross block faces: the t and dt of the walk matter
 }
 
-// The CPU's march on SIMD lanes (kernels/recon/tsdf_march_simd.hpp) against the scalar march, on
+// The CPU's march on SIMD lanes (kernels/recon/tsdf_march_simd.hpp; its normal map, from the
+// vertex map's neighbours, on lanes too) against the scalar march and normals, on
 // a model of 3 real fr1_rpy frames at 1 cm: depth, vertex, normal and colour maps bit for bit,
 // from each frame's pose and from 1.5 m behind it (longer rays, through more of the block window's
 // edge), with the window over the frustum and cut down to 2 blocks (most lookups then fall back to
