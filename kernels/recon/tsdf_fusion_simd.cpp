@@ -3,6 +3,9 @@
 #include "kernels/recon/tsdf_fusion_simd.hpp"
 
 #include <cstring>
+#if SEAMLESS_SIMD_X86
+#include <immintrin.h>
+#endif
 
 #include "core/simd.hpp"
 #include "kernels/recon/voxel_simd.hpp"
@@ -15,6 +18,22 @@ namespace detail {
 using simd::vf, simd::vi, simd::vm, simd::v3;
 
 namespace {
+// in.depth(u, w) lane by lane for the lanes of m (0 elsewhere): one gather instruction instead of
+// eight loads and inserts.
+SEAMLESS_SIMD_INL vf gather_depth(const View2D<const float>& depth, vi u, vi w, vm m) {
+  const simd::i8 idx = w.v * static_cast<std::int32_t>(depth.pitch) + u.v;  // < 2^31: images are small
+#if SEAMLESS_SIMD_X86
+  return reinterpret_cast<simd::f8>(_mm256_mask_i32gather_ps(_mm256_setzero_ps(), depth.data,
+                                                              reinterpret_cast<__m256i>(idx),
+                                                              reinterpret_cast<__m256>(m.v), 4));
+#else
+  vf d(0.f);
+  for (int l = 0; l < simd::kWidth; ++l)
+    if (m.v[l]) d.v[l] = depth.data[idx[l]];
+  return d;
+#endif
+}
+
 // A row's 8 voxels (tsdf_fusion_simd.hpp) as their distances in steps and their weights, and back.
 SEAMLESS_SIMD_INL void load_row(const Voxel* v, vf& steps, vf& wt) {
   simd::i8 raw;
@@ -50,9 +69,7 @@ SEAMLESS_SIMD_INL void fuse_row(const FuseRowFrame& f, const vf ax[3], const vi 
   m = m & (u >= 0) & (w >= 0) & (u < size[0]) & (w < size[1]);
   const int in_image = simd::bits(m);
   if (!in_image) return;
-  vf d(0.f);
-  for (int l = 0; l < simd::kWidth; ++l)
-    if (in_image >> l & 1) d.v[l] = in.depth(u[l], w[l]);
+  const vf d = gather_depth(in.depth, u, w, m);
   m = m & (d >= vf(in.min_depth)) & (d <= vf(in.max_depth));
   const vf sdf = d - cz;
   m = m & !(sdf < vf(-mu));  // occluded: behind the surface by more than the truncation
