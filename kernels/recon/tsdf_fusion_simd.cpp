@@ -23,9 +23,8 @@ namespace {
 SEAMLESS_SIMD_INL vf gather_depth(const View2D<const float>& depth, vi u, vi w, vm m) {
   const simd::i8 idx = w.v * static_cast<std::int32_t>(depth.pitch) + u.v;  // < 2^31: images are small
 #if SEAMLESS_SIMD_X86
-  return reinterpret_cast<simd::f8>(_mm256_mask_i32gather_ps(_mm256_setzero_ps(), depth.data,
-                                                              reinterpret_cast<__m256i>(idx),
-                                                              reinterpret_cast<__m256>(m.v), 4));
+  return reinterpret_cast<simd::f8>(_mm256_mask_i32gather_ps(
+      _mm256_setzero_ps(), depth.data, reinterpret_cast<__m256i>(idx), reinterpret_cast<__m256>(m.v), 4));
 #else
   vf d(0.f);
   for (int l = 0; l < simd::kWidth; ++l)
