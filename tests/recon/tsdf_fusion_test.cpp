@@ -366,15 +366,23 @@ TEST(TsdfFusion, CullingOccludedBlocksChangesNothing) {
   ASSERT_NO_FATAL_FAILURE(test::expect_same_blocks(a.download_blocks(), b.download_blocks(), true));
 }
 
+// The first n frames of tum_fr1_rpy_000-149 (ground-truth poses in them) for the real-frame tests
+// below, or why they cannot be read here in *skip.
+InputParams real_test_frames(int n, std::string* skip) {
+  InputParams in;
+  in.source = InputSource::tum;
+  in.path = std::string(SEAMLESS_TEST_DATA) + "/tum_fr1_rpy_000-149";
+  in.max_frames = n;
+  if (!std::filesystem::exists(in.path)) *skip = "no test data at " + in.path;
+  return in;
+}
+
 // The same on real Kinect frames (tum_fr1_rpy, ground-truth poses, 1 cm voxels for speed): holes,
 // far noisy depth and grazing surfaces included, culling leaves the fused blocks as they were.
 TEST(TsdfFusion, CullingChangesNothingOnRealFrames) {
-  const std::string dir = std::string(SEAMLESS_TEST_DATA) + "/tum_fr1_rpy_000-149";
-  if (!std::filesystem::exists(dir)) GTEST_SKIP() << "no test data at " << dir;
-  InputParams in;
-  in.source = InputSource::tum;
-  in.path = dir;
-  in.max_frames = 12;
+  std::string skip;
+  const InputParams in = real_test_frames(12, &skip);
+  if (!skip.empty()) GTEST_SKIP() << skip;
   auto src = make_source(in, Device::CPU);
   VolumeParams culled;
   culled.voxel_size = 0.01f, culled.truncation = 0.04f;
@@ -398,12 +406,9 @@ TEST(TsdfFusion, CullingChangesNothingOnRealFrames) {
 // must end with the blocks and voxels of one without a window, also when blocks are freed between
 // the raycast and the next frame (remove_empty_blocks), which the window must then not vouch for.
 void same_blocks_with_and_without_the_window(Device dev) {
-  const std::string dir = std::string(SEAMLESS_TEST_DATA) + "/tum_fr1_rpy_000-149";
-  if (!std::filesystem::exists(dir)) GTEST_SKIP() << "no test data at " << dir;
-  InputParams in;
-  in.source = InputSource::tum;
-  in.path = dir;
-  in.max_frames = 8;
+  std::string skip;
+  const InputParams in = real_test_frames(8, &skip);
+  if (!skip.empty()) GTEST_SKIP() << skip;
   auto src = make_source(in, Device::CPU);
   VolumeParams with;
   with.voxel_size = 0.01f, with.truncation = 0.04f;
@@ -444,12 +449,8 @@ TEST(TsdfParity, AllocationThroughTheRaycastWindowOnCuda) {
 // The first n frames of tum_fr1_rpy_000-149 for the SIMD tests below, or why they cannot run
 // here (no AVX2, no data) in *skip.
 InputParams simd_test_frames(int n, std::string* skip) {
-  InputParams in;
-  in.source = InputSource::tum;
-  in.path = std::string(SEAMLESS_TEST_DATA) + "/tum_fr1_rpy_000-149";
-  in.max_frames = n;
+  const InputParams in = real_test_frames(n, skip);
   if (!simd::cpu_simd()) *skip = "this CPU has no AVX2: the SIMD lanes do not run";
-  else if (!std::filesystem::exists(in.path)) *skip = "no test data at " + in.path;
   return in;
 }
 
