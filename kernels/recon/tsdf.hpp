@@ -26,7 +26,8 @@ template <Executor Exec> struct VoxelHash {
   static void pool_append(const Exec& ex, View<std::int32_t> free_list, HashCounters* counters, std::int32_t first,
                           std::int32_t n);
 
-  // Zeroes the per-frame fields of the counters (inserted, collisions, failures, visible, removed).
+  // Zeroes the per-frame fields of the counters (inserted, collisions, failures, visible, removed,
+  // listed).
   static void reset_frame_counters(const Exec& ex, HashCounters* counters);
 
   // Concurrent insert of keys (duplicates allowed); slot_out[i] = slot, result_out[i] = InsertResult.
@@ -45,6 +46,11 @@ template <Executor Exec> struct VoxelHash {
   // must hold one int per slot (scratch).
   static std::int64_t hash_live_slots(const Exec& ex, HashTableView t, View<std::int32_t> flags,
                                       View<std::int32_t> slots_out);
+
+  // Appends every slot holding a live key with a block to slots_out (as many entries as the pool has
+  // blocks), in no particular order, without a trip to the host: counters->listed (zeroed by
+  // reset_frame_counters) is the count. For the passes over the live blocks (SlotRange).
+  static void list_live_slots(const Exec& ex, HashTableView t, HashCounters* counters, View<std::int32_t> slots_out);
 
   // Slots of the live blocks whose centre lies farther than radius from center (both in voxel
   // units), in slot order; returns how many (streaming out, Niessner section 5). flags as above.
@@ -103,6 +109,21 @@ struct TileGrid {
 struct DepthTiles : TileGrid {
   std::int32_t* zmax = nullptr;  // nullptr: no tiles, nothing is culled
 };
+// The slots a pass over the live blocks visits: every slot of the table, or the live slots that
+// list_live_slots listed when `listed` is set. The table keeps its fill at or below a half, and
+// typically holds a live block every 8-10 slots: a pass over it gives 3-4 of a CUDA warp's 32
+// threads a block's work while the warp runs as long as one of them; over the list every thread
+// has a block. The list costs a pass of its own, which pays where more than one pass follows
+// (the visible blocks, then the ray intervals).
+struct SlotRange {
+  const std::int32_t* listed = nullptr;  // nullptr: every slot of the table
+  const int* count = nullptr;            // how many are listed (where the kernels run)
+  std::int64_t bound = 0;                // at least *count (the pool's size): the threads launched
+  std::int64_t threads(const HashTableView& t) const { return listed ? bound : static_cast<std::int64_t>(t.mask) + 1; }
+  // Thread i's slot; -1: none.
+  SEAMLESS_HD std::int64_t slot(std::int64_t i) const { return !listed ? i : i < *count ? listed[i] : -1; }
+};
+
 // A block is worth keeping while one of its voxels is observed (weight > 0) and near a surface
 // (|sdf| < keep_below, metres; mu: the truncation); a block of free space or never-observed voxels
 // can go. (A volume that stores free space passes the largest float: every observed block stays.)
@@ -231,11 +252,11 @@ template <Executor Exec> struct TsdfFusion {
   // Appends to visible_slots every allocated block that the frame may change (counters->visible is
   // the count) and zeroes its keep flag (keep may be empty) and its block's surface flag (surface
   // may be nullptr; fuse_hash_blocks sets it again): blocks whose voxels may project into the
-  // image, less those that tiles (when given) show to be occluded or unobserved. Also clamps
-  // free_top after a failed allocation pass.
+  // image, less those that tiles (when given) show to be occluded or unobserved; over the slots of
+  // `slots` (the whole table by default). Also clamps free_top after a failed allocation pass.
   static void find_visible_blocks(const Exec& ex, HashTableView t, HashCounters* counters, FrameInput in,
                                   VoxelGeometry geom, View<std::int32_t> visible_slots, View<std::int32_t> keep,
-                                  DepthTiles tiles = {}, std::int32_t* surface = nullptr);
+                                  DepthTiles tiles = {}, std::int32_t* surface = nullptr, SlotRange slots = {});
 
   // Reorders the first count visible slots by their block's index in the pool (block_keys:
   // count entries of scratch). Fusing in pool order walks the voxel pool and the depth image with
@@ -327,15 +348,16 @@ template <Executor Exec, class Acc = HashAccess> struct TsdfRaycast {
   // Empties every tile (near = +inf, far = 0), and window w when given (every entry -1).
   static void clear_ray_intervals(const Exec& ex, RayIntervals iv, BlockWindow w = {});
 
-  // One thread per hash slot: each live block's cell box [8b, 8b+8]^3 (voxel units; every sample a
-  // ray can take in the block lies in it), clipped to the depth slab [min_depth, max_depth], is
+  // One thread per hash slot of `slots` (the whole table by default): each live block's cell box [8b, 8b+8]^3 (voxel
+  // units; every sample a ray can take in the block lies in it), clipped to the depth slab [min_depth, max_depth], is
   // projected, and the tiles under its pixel bounding box take the min / max of its depth range.
   // With a window w (cleared by clear_ray_intervals) the same pass fills it, as fill_block_window
   // does: one pass over the slots instead of two. With surface flags (per pool block) the same
   // pass also sets near[block] = block_near_surface(...) and splats only the blocks near a surface.
   static void splat_ray_intervals(const Exec& ex, HashTableView t, VoxelGeometry geom, Intrinsics K, SE3 world_T_camera,
                                   float min_depth, float max_depth, RayIntervals iv, BlockWindow w = {},
-                                  const std::int32_t* surface = nullptr, std::int32_t* near = nullptr);
+                                  const std::int32_t* surface = nullptr, std::int32_t* near = nullptr,
+                                  SlotRange slots = {});
 
   // near[block] = block_near_surface(...) for every live block (one thread per hash slot): the
   // stand-alone version of what splat_ray_intervals does with surface flags.

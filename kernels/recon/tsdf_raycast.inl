@@ -60,12 +60,15 @@ void TsdfRaycast<Exec, Acc>::clear_ray_intervals(const Exec& ex, RayIntervals iv
 template <Executor Exec, class Acc>
 void TsdfRaycast<Exec, Acc>::splat_ray_intervals(const Exec& ex, HashTableView t, VoxelGeometry geom, Intrinsics K,
                                                  SE3 world_T_camera, float min_depth, float max_depth, RayIntervals iv,
-                                                 BlockWindow w, const std::int32_t* surface, std::int32_t* near) {
+                                                 BlockWindow w, const std::int32_t* surface, std::int32_t* near,
+                                                 SlotRange slots) {
   const SE3 camera_T_world = world_T_camera.inverse();
   const float zn = fmaxf(min_depth, 1e-3f);
-  ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
-    HashKey k = t.keys[i];
-    const std::int32_t block = t.values[i];
+  ex.for_each(slots.threads(t), [=] SEAMLESS_HD(std::int64_t i) {
+    const std::int64_t s = slots.slot(i);
+    if (s < 0) return;
+    HashKey k = t.keys[s];
+    const std::int32_t block = t.values[s];
     if (!is_live_key(k) || block < 0) return;
     if (w.index) {
       const std::int64_t e = w.entry(unpack_block(k));
@@ -76,20 +79,24 @@ void TsdfRaycast<Exec, Acc>::splat_ray_intervals(const Exec& ex, HashTableView t
       near[block] = n ? 1 : 0;
       if (!n) return;
     }
-    ScreenBounds s;
-    if (!block_screen_bounds(unpack_block(k), geom, K, camera_T_world, zn, max_depth, &s)) return;
+    ScreenBounds sb;
+    if (!block_screen_bounds(unpack_block(k), geom, K, camera_T_world, zn, max_depth, &sb)) return;
     // Rays go through pixel centres: pixel x can meet the box only if u0 <= x <= u1. Rounding
     // outwards keeps the splat conservative.
-    if (s.u1 < 0.f || s.v1 < 0.f || s.u0 > K.width - 1.f || s.v0 > K.height - 1.f) return;
-    const int x0 = static_cast<int>(floorf(fmaxf(s.u0, 0.f))), x1 = static_cast<int>(ceilf(fminf(s.u1, K.width - 1.f)));
-    const int y0 = static_cast<int>(floorf(fmaxf(s.v0, 0.f))),
-              y1 = static_cast<int>(ceilf(fminf(s.v1, K.height - 1.f)));
-    const std::int32_t z_near = float_bits(s.z0), z_far = float_bits(s.z1);
+    if (sb.u1 < 0.f || sb.v1 < 0.f || sb.u0 > K.width - 1.f || sb.v0 > K.height - 1.f) return;
+    const int x0 = static_cast<int>(floorf(fmaxf(sb.u0, 0.f))),
+              x1 = static_cast<int>(ceilf(fminf(sb.u1, K.width - 1.f)));
+    const int y0 = static_cast<int>(floorf(fmaxf(sb.v0, 0.f))),
+              y1 = static_cast<int>(ceilf(fminf(sb.v1, K.height - 1.f)));
+    const std::int32_t z_near = float_bits(sb.z0), z_far = float_bits(sb.z1);
+    // Many blocks splat onto each tile, and atomics on one address queue behind each other: a
+    // load first spares the atomic where the tile's bound is already as far out (a tile's near
+    // only falls and its far only rises, so a stale load can only send a needless atomic).
     for (int ty = y0 / iv.tile; ty <= y1 / iv.tile; ++ty)
       for (int tx = x0 / iv.tile; tx <= x1 / iv.tile; ++tx) {
         std::int32_t* tile = iv.bits + 2 * iv.tile_of(tx * iv.tile, ty * iv.tile);
-        atomic_min(tile, z_near);
-        atomic_max(tile + 1, z_far);
+        if (z_near < atomic_load(tile)) atomic_min(tile, z_near);
+        if (z_far > atomic_load(tile + 1)) atomic_max(tile + 1, z_far);
       }
   });
 }

@@ -17,7 +17,7 @@ void VoxelHash<Exec>::pool_reset(const Exec& ex, View<std::int32_t> free_list, H
     free_list[i] = static_cast<std::int32_t>(free_list.size - 1 - i);
   });
   const int n = static_cast<int>(free_list.size);
-  ex.for_each(1, [=] SEAMLESS_HD(std::int64_t) { *counters = HashCounters{n, 0, 0, 0, 0, 0, 0, 0}; });
+  ex.for_each(1, [=] SEAMLESS_HD(std::int64_t) { *counters = HashCounters{n, 0, 0, 0, 0, 0, 0, 0, 0}; });
 }
 
 template <Executor Exec>
@@ -34,7 +34,7 @@ void VoxelHash<Exec>::pool_append(const Exec& ex, View<std::int32_t> free_list, 
 template <Executor Exec> void VoxelHash<Exec>::reset_frame_counters(const Exec& ex, HashCounters* counters) {
   ex.for_each(1, [=] SEAMLESS_HD(std::int64_t) {
     HashCounters& c = *counters;
-    c.inserted = c.collisions = c.probe_failures = c.pool_failures = c.visible = c.removed = 0;
+    c.inserted = c.collisions = c.probe_failures = c.pool_failures = c.visible = c.removed = c.listed = 0;
   });
 }
 
@@ -93,6 +93,15 @@ std::int64_t VoxelHash<Exec>::hash_live_slots(const Exec& ex, HashTableView t, V
                                               View<std::int32_t> slots_out) {
   return compact_slots(ex, t, flags, slots_out,
                        [=] SEAMLESS_HD(std::int64_t i) { return is_live_key(t.keys[i]) && t.values[i] >= 0; });
+}
+
+template <Executor Exec>
+void VoxelHash<Exec>::list_live_slots(const Exec& ex, HashTableView t, HashCounters* counters,
+                                      View<std::int32_t> slots_out) {
+  ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
+    if (is_live_key(t.keys[i]) && t.values[i] >= 0)
+      slots_out[atomic_add(&counters->listed, 1)] = static_cast<std::int32_t>(i);
+  });
 }
 
 template <Executor Exec>

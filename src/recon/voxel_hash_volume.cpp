@@ -155,8 +155,9 @@ void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTime
           kernels::TsdfFusion<E>::allocate_free_space(ex, table(), free_list_.cview(), counters_.data(), in, geom_);
       });
       staged(timer, "visible", [&] {
+        const kernels::SlotRange slots = list_live_slots(ex);
         kernels::TsdfFusion<E>::find_visible_blocks(ex, table(), counters_.data(), in, geom_, visible_.view(),
-                                                    keep_.view(), tiles, surface_.data());
+                                                    keep_.view(), tiles, surface_.data(), slots);
       });
     });
     last_ = read_counters();
@@ -205,6 +206,26 @@ void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTime
         "volume.grow_when_full: true",
         failed_, frames_, last_.probe_failures, kMaxProbe, last_.pool_failures, pool, advice);
   }
+}
+
+// On CUDA the frame's passes over the live blocks (the visible list here, the raycast's intervals)
+// run over a list of the live slots (kernels::SlotRange says why); the CPU skips an empty slot in a
+// few cycles, where building the list would cost its two threads more than it saves.
+template <class E> kernels::SlotRange VoxelHashVolume::list_live_slots(const E& ex) {
+  listed_ = false;
+  if constexpr (E::device != Device::CUDA) {
+    return {};
+  } else {
+    live_.reserve_discard(static_cast<std::int64_t>(pool_size()), device_);
+    kernels::VoxelHash<E>::list_live_slots(ex, table(), counters_.data(), live_.view());
+    listed_ = true;
+    return listed();
+  }
+}
+
+kernels::SlotRange VoxelHashVolume::listed() const {
+  if (!listed_) return {};
+  return {live_.data(), &counters_.data()->listed, static_cast<std::int64_t>(pool_size())};
 }
 
 void VoxelHashVolume::handle_failures(const HashCounters& c) {
@@ -259,6 +280,7 @@ std::int64_t VoxelHashVolume::live_slots(Buffer<std::int32_t>& slots) const {
 
 void VoxelHashVolume::rehash(std::int64_t new_slots) {
   known_window_ = {};
+  listed_ = false;  // the keys move to other slots
   // Slots are indexed by 32-bit integers in the kernels (HashTable::mask, block slot lists).
   if (new_slots > kMaxSlots)
     throw Error("voxel hashing: the hash table cannot grow beyond " + std::to_string(kMaxSlots) +
@@ -294,6 +316,7 @@ void VoxelHashVolume::rehash(std::int64_t new_slots) {
 }
 
 void VoxelHashVolume::grow_pool(std::int64_t blocks) {
+  listed_ = false;  // the list's bound is the pool's size
   const std::int64_t old = free_list_.size();
   if (blocks > (1ll << 30))
     throw Error(
@@ -325,6 +348,7 @@ void VoxelHashVolume::grow_pool(std::int64_t blocks) {
 
 std::int64_t VoxelHashVolume::remove_empty_blocks() {
   known_window_ = {};
+  listed_ = false;  // its count is reset below
   Buffer<std::int32_t> slots;
   const std::int64_t n = live_slots(slots);
   Buffer<std::int32_t> keep(n, device_);
@@ -430,7 +454,7 @@ void VoxelHashVolume::raycast(const Intrinsics& K, const SE3& world_T_camera, Ra
         staged(timer, "raycast_splat", [&] {  // part of "raycast"
           kernels::TsdfRaycast<E>::clear_ray_intervals(ex, iv, w);
           kernels::TsdfRaycast<E>::splat_ray_intervals(ex, table(), geom_, K, world_T_camera, params_.min_depth,
-                                                       params_.max_depth, iv, w, surface, near_.data());
+                                                       params_.max_depth, iv, w, surface, near_.data(), listed());
         });
       else if (surface) kernels::TsdfRaycast<E>::mark_near_surface(ex, table(), surface, near_.data());
       if (!w.index) {

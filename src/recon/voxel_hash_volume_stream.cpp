@@ -172,6 +172,7 @@ void VoxelHashVolume::take_from_host(const vec3& camera_position, bool all, std:
 void VoxelHashVolume::upload(std::vector<HashKey>& keys, std::vector<Voxel>& voxels, std::vector<uchar3>& colors) {
   std::int64_t n = static_cast<std::int64_t>(keys.size());
   if (n == 0) return;
+  listed_ = false;  // keys go into slots the list does not hold
   HashCounters c = read_counters();
   const std::int64_t free_blocks = std::max(c.free_top, 0);
   if (free_blocks < n && params_.grow_when_full) {
