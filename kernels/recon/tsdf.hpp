@@ -47,11 +47,6 @@ template <Executor Exec> struct VoxelHash {
   static std::int64_t hash_live_slots(const Exec& ex, HashTableView t, View<std::int32_t> flags,
                                       View<std::int32_t> slots_out);
 
-  // Appends every slot holding a live key with a block to slots_out (as many entries as the pool has
-  // blocks), in no particular order, without a trip to the host: counters->listed (zeroed by
-  // reset_frame_counters) is the count. For the passes over the live blocks (SlotRange).
-  static void list_live_slots(const Exec& ex, HashTableView t, HashCounters* counters, View<std::int32_t> slots_out);
-
   // Slots of the live blocks whose centre lies farther than radius from center (both in voxel
   // units), in slot order; returns how many (streaming out, Niessner section 5). flags as above.
   static std::int64_t hash_slots_beyond(const Exec& ex, HashTableView t, vec3 center, float radius,
@@ -110,11 +105,10 @@ struct DepthTiles : TileGrid {
   std::int32_t* zmax = nullptr;  // nullptr: no tiles, nothing is culled
 };
 // The slots a pass over the live blocks visits: every slot of the table, or the live slots that
-// list_live_slots listed when `listed` is set. The table keeps its fill at or below a half, and
-// typically holds a live block every 8-10 slots: a pass over it gives 3-4 of a CUDA warp's 32
+// find_visible_blocks listed when `listed` is set. The table keeps its fill at or below a half and
+// typically holds a live block every 8-10 slots, so a pass over it gives a few of a CUDA warp's 32
 // threads a block's work while the warp runs as long as one of them; over the list every thread
-// has a block. The list costs a pass of its own, which pays where more than one pass follows
-// (the visible blocks, then the ray intervals).
+// has a block.
 struct SlotRange {
   const std::int32_t* listed = nullptr;  // nullptr: every slot of the table
   const int* count = nullptr;            // how many are listed (where the kernels run)
@@ -252,11 +246,14 @@ template <Executor Exec> struct TsdfFusion {
   // Appends to visible_slots every allocated block that the frame may change (counters->visible is
   // the count) and zeroes its keep flag (keep may be empty) and its block's surface flag (surface
   // may be nullptr; fuse_hash_blocks sets it again): blocks whose voxels may project into the
-  // image, less those that tiles (when given) show to be occluded or unobserved; over the slots of
-  // `slots` (the whole table by default). Also clamps free_top after a failed allocation pass.
+  // image, less those that tiles (when given) show to be occluded or unobserved. When `live` is
+  // given (as many entries as the pool has blocks), the pass also lists every live slot there, in
+  // no particular order (counters->listed, zeroed by reset_frame_counters, counts them): the slots
+  // a later pass over the live blocks may visit instead of the whole table (SlotRange). Also
+  // clamps free_top after a failed allocation pass.
   static void find_visible_blocks(const Exec& ex, HashTableView t, HashCounters* counters, FrameInput in,
                                   VoxelGeometry geom, View<std::int32_t> visible_slots, View<std::int32_t> keep,
-                                  DepthTiles tiles = {}, std::int32_t* surface = nullptr, SlotRange slots = {});
+                                  DepthTiles tiles = {}, std::int32_t* surface = nullptr, View<std::int32_t> live = {});
 
   // Reorders the first count visible slots by their block's index in the pool (block_keys:
   // count entries of scratch). Fusing in pool order walks the voxel pool and the depth image with

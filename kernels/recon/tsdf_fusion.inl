@@ -155,19 +155,18 @@ template <Executor Exec>
 void TsdfFusion<Exec>::find_visible_blocks(const Exec& ex, HashTableView t, HashCounters* counters, FrameInput in,
                                            VoxelGeometry geom, View<std::int32_t> visible_slots,
                                            View<std::int32_t> keep, DepthTiles tiles, std::int32_t* surface,
-                                           SlotRange slots) {
+                                           View<std::int32_t> live) {
   const SE3 camera_T_world = in.world_T_camera.inverse();
-  ex.for_each(slots.threads(t), [=] SEAMLESS_HD(std::int64_t i) {
+  ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
     if (i == 0 && counters->free_top < 0) counters->free_top = 0;  // after failed pops
-    const std::int64_t s = slots.slot(i);
-    if (s < 0) return;
-    HashKey k = t.keys[s];
-    if (!is_live_key(k) || t.values[s] < 0) return;
+    HashKey k = t.keys[i];
+    if (!is_live_key(k) || t.values[i] < 0) return;
+    if (live.data) live[atomic_add(&counters->listed, 1)] = static_cast<std::int32_t>(i);
     if (!block_maybe_visible(unpack_block(k), in, camera_T_world, geom, tiles)) return;
     const int j = atomic_add(&counters->visible, 1);
-    visible_slots[j] = static_cast<std::int32_t>(s);
+    visible_slots[j] = static_cast<std::int32_t>(i);
     if (keep.data) keep[j] = 0;
-    if (surface) surface[t.values[s]] = 0;
+    if (surface) surface[t.values[i]] = 0;
   });
 }
 

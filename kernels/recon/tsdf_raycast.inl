@@ -89,14 +89,11 @@ void TsdfRaycast<Exec, Acc>::splat_ray_intervals(const Exec& ex, HashTableView t
     const int y0 = static_cast<int>(floorf(fmaxf(sb.v0, 0.f))),
               y1 = static_cast<int>(ceilf(fminf(sb.v1, K.height - 1.f)));
     const std::int32_t z_near = float_bits(sb.z0), z_far = float_bits(sb.z1);
-    // Many blocks splat onto each tile, and atomics on one address queue behind each other: a
-    // load first spares the atomic where the tile's bound is already as far out (a tile's near
-    // only falls and its far only rises, so a stale load can only send a needless atomic).
     for (int ty = y0 / iv.tile; ty <= y1 / iv.tile; ++ty)
       for (int tx = x0 / iv.tile; tx <= x1 / iv.tile; ++tx) {
         std::int32_t* tile = iv.bits + 2 * iv.tile_of(tx * iv.tile, ty * iv.tile);
-        if (z_near < atomic_load(tile)) atomic_min(tile, z_near);
-        if (z_far > atomic_load(tile + 1)) atomic_max(tile + 1, z_far);
+        atomic_min(tile, z_near);
+        atomic_max(tile + 1, z_far);
       }
   });
 }

@@ -124,7 +124,7 @@ struct HashCounters {
   int pool_failures;   // insertions that found no free block in the pool
   int visible;         // blocks in the visible list
   int removed;         // blocks freed by garbage collection
-  int listed;          // live slots listed this frame (VoxelHash::list_live_slots)
+  int listed;          // live slots listed this frame (TsdfFusion::find_visible_blocks)
 };
 
 struct HashTableView {

@@ -96,15 +96,6 @@ std::int64_t VoxelHash<Exec>::hash_live_slots(const Exec& ex, HashTableView t, V
 }
 
 template <Executor Exec>
-void VoxelHash<Exec>::list_live_slots(const Exec& ex, HashTableView t, HashCounters* counters,
-                                      View<std::int32_t> slots_out) {
-  ex.for_each(static_cast<std::int64_t>(t.mask) + 1, [=] SEAMLESS_HD(std::int64_t i) {
-    if (is_live_key(t.keys[i]) && t.values[i] >= 0)
-      slots_out[atomic_add(&counters->listed, 1)] = static_cast<std::int32_t>(i);
-  });
-}
-
-template <Executor Exec>
 std::int64_t VoxelHash<Exec>::hash_slots_beyond(const Exec& ex, HashTableView t, vec3 center, float radius,
                                                 View<std::int32_t> flags, View<std::int32_t> slots_out) {
   const float r2 = radius * radius;

@@ -155,9 +155,17 @@ void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTime
           kernels::TsdfFusion<E>::allocate_free_space(ex, table(), free_list_.cview(), counters_.data(), in, geom_);
       });
       staged(timer, "visible", [&] {
-        const kernels::SlotRange slots = list_live_slots(ex);
+        // On CUDA the pass also lists the live slots, which the raycast's interval pass then visits
+        // instead of the whole table (kernels::SlotRange says why). The CPU skips an empty slot in
+        // a few cycles, where appending to one list would cost its threads more than it saves.
+        View<std::int32_t> live;
+        if (device_ == Device::CUDA) {
+          live_.reserve_discard(static_cast<std::int64_t>(pool_size()), device_);
+          live = live_.view();
+        }
         kernels::TsdfFusion<E>::find_visible_blocks(ex, table(), counters_.data(), in, geom_, visible_.view(),
-                                                    keep_.view(), tiles, surface_.data(), slots);
+                                                    keep_.view(), tiles, surface_.data(), live);
+        listed_ = live.data != nullptr;
       });
     });
     last_ = read_counters();
@@ -205,21 +213,6 @@ void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTime
         "{} found the pool of {} blocks full); that part of the frame is not fused. Set {}, or "
         "volume.grow_when_full: true",
         failed_, frames_, last_.probe_failures, kMaxProbe, last_.pool_failures, pool, advice);
-  }
-}
-
-// On CUDA the frame's passes over the live blocks (the visible list here, the raycast's intervals)
-// run over a list of the live slots (kernels::SlotRange says why); the CPU skips an empty slot in a
-// few cycles, where building the list would cost its two threads more than it saves.
-template <class E> kernels::SlotRange VoxelHashVolume::list_live_slots(const E& ex) {
-  listed_ = false;
-  if constexpr (E::device != Device::CUDA) {
-    return {};
-  } else {
-    live_.reserve_discard(static_cast<std::int64_t>(pool_size()), device_);
-    kernels::VoxelHash<E>::list_live_slots(ex, table(), counters_.data(), live_.view());
-    listed_ = true;
-    return listed();
   }
 }
 

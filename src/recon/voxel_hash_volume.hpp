@@ -80,10 +80,7 @@ class VoxelHashVolume final : public Volume {
   std::uint64_t pool_size() const;  // blocks in the pool: every block index is below it
   kernels::HashCounters read_counters() const;
   void allocate_and_list(const kernels::FrameInput& in, StageTimer* timer);
-  // Lists the live slots for the passes over the live blocks where that pays (CUDA); returns the
-  // range to pass (empty: the whole table).
-  template <class E> kernels::SlotRange list_live_slots(const E& ex);
-  kernels::SlotRange listed() const;  // the list while it holds (listed_), else empty
+  kernels::SlotRange listed() const;  // the frame's list of live slots while it holds (listed_), else empty
   void handle_failures(const kernels::HashCounters& c);
   void maybe_rehash(const kernels::HashCounters& c, std::int64_t extra = 0);
   void rehash(std::int64_t slots);
@@ -123,7 +120,7 @@ class VoxelHashVolume final : public Volume {
   // The last raycast's window while it still holds every block in it (no block freed since), for
   // the next frame's allocation to skip the table's probes; empty otherwise.
   kernels::BlockWindow known_window_{};
-  // The frame's list of live slots (list_live_slots, CUDA only) while it still holds every live
+  // The frame's list of live slots (find_visible_blocks, CUDA only) while it still holds every live
   // block: no key inserted or moved since (freed ones may stay on it: the passes check each key).
   Buffer<std::int32_t> live_;
   bool listed_ = false;

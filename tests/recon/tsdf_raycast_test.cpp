@@ -248,67 +248,55 @@ TEST(TsdfRaycastSurfaceFlags, SameSurfacesAsTheMarchThroughTheFreeSpace) {
   }
 }
 
-// The passes over the live blocks (the visible list, the ray intervals with the block window) over
-// the list of live slots (SlotRange, what the volume passes on CUDA) give what they give over the
-// whole table: the same visible slots as a set (their order comes from atomics either way), the
-// same interval tiles and window entries bit for bit (minima and maxima do not depend on the
-// order). The table holds the blocks of the fused scene at a fill of 1/8 with a fifth of them
-// erased again (tombstones, which the list keeps out; the passes check each key anyway), seen
-// from a view inside the model and one looking past it.
+// The visible pass lists the live slots (what the volume asks for on CUDA), and the interval pass
+// over that list gives what it gives over the whole table: the list holds each live slot once
+// (tombstones left out), the visible slots are the same with and without listing, and the
+// interval tiles and window entries are the same bit for bit (minima and maxima do not depend on
+// the order). The table holds the blocks of the fused scene at a fill of 1/8 with a fifth of them
+// erased again, seen from a view inside the model and one looking past it.
 void expect_listed_slots_give_the_tables_results(Device dev) {
   const Intrinsics K = test::camera(200, 150, 170.f);
   VoxelHashVolume vol(params_with_tile(8), Device::CPU);
   fuse(vol, scene(), K);
+  const kernels::VoxelGeometry geom = vol.device_view().geom;
   const std::vector<int3> blocks = vol.allocated_block_coords();
   ASSERT_GT(blocks.size(), 500u);
   std::int64_t slots = 1;
   while (slots < 8 * static_cast<std::int64_t>(blocks.size())) slots *= 2;
   Buffer<kernels::HashKey> keys(slots, dev);
-  Buffer<std::int32_t> values(slots, dev), free_list(static_cast<std::int64_t>(blocks.size()), dev);
+  const std::int64_t pool = static_cast<std::int64_t>(blocks.size());
+  Buffer<std::int32_t> values(slots, dev), free_list(pool, dev), out(pool, dev), live(pool, dev), visible(pool, dev),
+      keep(pool, dev), flags(slots, dev), in_order(slots, dev);
   Buffer<kernels::HashCounters> counters(1, dev);
   const kernels::HashTableView t{keys.data(), values.data(), static_cast<std::uint32_t>(slots - 1)};
   std::vector<kernels::HashKey> all, erased;
   for (std::size_t i = 0; i < blocks.size(); ++i) (i % 5 == 2 ? erased : all).push_back(kernels::pack_block(blocks[i]));
   all.insert(all.end(), erased.begin(), erased.end());
-  const auto all_d = Buffer<kernels::HashKey>::from_host(all, dev),
-             erased_d = Buffer<kernels::HashKey>::from_host(erased, dev);
-  Buffer<std::int32_t> out(static_cast<std::int64_t>(all.size()), dev), live(free_list.size(), dev);
-  const auto depth = Image<float>::from_host(std::vector<float>(K.width * K.height, 1.f), K.width, K.height, dev);
-  const auto grid = kernels::TileGrid::covering(K.width, K.height, 8);
-  Buffer<std::int32_t> bits(2 * grid.count(), dev), window(16 * 16 * 16, dev), visible(free_list.size(), dev),
-      keep(free_list.size(), dev);
-  with_exec(dev, [&]<class E>(const E& ex) {
+  const auto all_d = Buffer<kernels::HashKey>::from_host(all, dev);
+  const auto erased_d = Buffer<kernels::HashKey>::from_host(erased, dev);
+  const std::int64_t n_live = static_cast<std::int64_t>(all.size() - erased.size());
+  const std::int64_t n = with_exec(dev, [&]<class E>(const E& ex) {
     kernels::VoxelHash<E>::hash_clear(ex, t);
     kernels::VoxelHash<E>::pool_reset(ex, free_list.view(), counters.data());
     kernels::VoxelHash<E>::insert_with_blocks(ex, t, free_list.cview(), counters.data(), all_d.cview(), out.view());
     kernels::VoxelHash<E>::hash_erase(ex, t, erased_d.cview(), out.view(), counters.data());
-    kernels::VoxelHash<E>::reset_frame_counters(ex, counters.data());
-    kernels::VoxelHash<E>::list_live_slots(ex, t, counters.data(), live.view());
-  });
-  const kernels::SlotRange listed{live.data(), &counters.data()->listed, free_list.size()};
-  const std::int64_t n_live = static_cast<std::int64_t>(all.size() - erased.size());
-  ASSERT_EQ(counters.to_host()[0].listed, n_live);
-  std::vector<std::int32_t> l = live.to_host();
-  l.resize(static_cast<std::size_t>(n_live));
-  std::sort(l.begin(), l.end());
-  Buffer<std::int32_t> flags(slots, dev), in_order(slots, dev);
-  const std::int64_t n = with_exec(dev, [&]<class E>(const E& ex) {
     return kernels::VoxelHash<E>::hash_live_slots(ex, t, flags.view(), in_order.view());
   });
   ASSERT_EQ(n, n_live);
   std::vector<std::int32_t> want = in_order.to_host();
   want.resize(static_cast<std::size_t>(n));
-  EXPECT_EQ(l, want) << "the list holds the live slots, each once";
 
+  const auto depth = Image<float>::from_host(std::vector<float>(K.width * K.height, 1.f), K.width, K.height, dev);
+  const auto grid = kernels::TileGrid::covering(K.width, K.height, 8);
+  Buffer<std::int32_t> bits(2 * grid.count(), dev), window(16 * 16 * 16, dev);
   const SE3 views[] = {test::pose({0.02f, 0.01f, 0.03f}, 0.03f, -0.02f), test::pose({0.f, 0.f, 0.f}, 0.6f, 0.1f)};
   for (const SE3& view : views) {
-    kernels::FrameInput in{depth.cview(), {}, K, view, 0.1f, 3.f};
-    auto visible_of = [&](kernels::SlotRange r) {  // as the volume runs them: counters zeroed, listed, passed
+    const kernels::FrameInput in{depth.cview(), {}, K, view, 0.1f, 3.f};
+    auto visible_of = [&](View<std::int32_t> list) {  // as the volume runs it: counters zeroed first
       with_exec(dev, [&]<class E>(const E& ex) {
         kernels::VoxelHash<E>::reset_frame_counters(ex, counters.data());
-        if (r.listed) kernels::VoxelHash<E>::list_live_slots(ex, t, counters.data(), live.view());
-        kernels::TsdfFusion<E>::find_visible_blocks(ex, t, counters.data(), in, vol.device_view().geom, visible.view(),
-                                                    keep.view(), {}, nullptr, r);
+        kernels::TsdfFusion<E>::find_visible_blocks(ex, t, counters.data(), in, geom, visible.view(), keep.view(), {},
+                                                    nullptr, list);
       });
       std::vector<std::int32_t> v = visible.to_host();
       v.resize(static_cast<std::size_t>(counters.to_host()[0].visible));
@@ -316,25 +304,29 @@ void expect_listed_slots_give_the_tables_results(Device dev) {
       return v;
     };
     const auto whole = visible_of({});
-    const auto by_list = visible_of(listed);
+    EXPECT_EQ(counters.to_host()[0].listed, 0);
+    const auto with_list = visible_of(live.view());
     EXPECT_GT(whole.size(), 100u);
     EXPECT_LT(whole.size(), static_cast<std::size_t>(n_live));  // the view must cull some
-    EXPECT_EQ(whole, by_list);
+    EXPECT_EQ(whole, with_list);
+    ASSERT_EQ(counters.to_host()[0].listed, n_live);
+    std::vector<std::int32_t> l = live.to_host();
+    l.resize(static_cast<std::size_t>(n_live));
+    std::sort(l.begin(), l.end());
+    EXPECT_EQ(l, want) << "the list holds the live slots, each once";
 
     // The views look along +z: the window from the camera's block on, 16 blocks deep.
-    const kernels::BlockWindow w{window.data(),
-                                 floor_to_int(vol.device_view().geom.to_voxel(view.t) / 8.f) - int3{8, 8, 1}, 16};
+    const kernels::BlockWindow w{window.data(), floor_to_int(geom.to_voxel(view.t) / 8.f) - int3{8, 8, 1}, 16};
     auto splat = [&](kernels::SlotRange r) {
       with_exec(dev, [&]<class E>(const E& ex) {
         const kernels::RayIntervals iv{grid, bits.data()};
         kernels::TsdfRaycast<E>::clear_ray_intervals(ex, iv, w);
-        kernels::TsdfRaycast<E>::splat_ray_intervals(ex, t, vol.device_view().geom, K, view, 0.1f, 3.f, iv, w, nullptr,
-                                                     nullptr, r);
+        kernels::TsdfRaycast<E>::splat_ray_intervals(ex, t, geom, K, view, 0.1f, 3.f, iv, w, nullptr, nullptr, r);
       });
       return std::make_pair(bits.to_host(), window.to_host());
     };
     const auto [bits_whole, window_whole] = splat({});
-    const auto [bits_listed, window_listed] = splat(listed);
+    const auto [bits_listed, window_listed] = splat({live.data(), &counters.data()->listed, pool});
     EXPECT_EQ(bits_whole, bits_listed);
     EXPECT_EQ(window_whole, window_listed);
     EXPECT_GT(std::count_if(window_whole.begin(), window_whole.end(), [](std::int32_t b) { return b >= 0; }), 50);
