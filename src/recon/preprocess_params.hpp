@@ -15,7 +15,11 @@ struct PreprocessParams {
   int levels = 3;
 
   template <class V> void visit(V& v) {
-    v("bilateral", bilateral, "smooth depth with the bilateral filter before tracking");
+    v("bilateral", bilateral,
+      "smooth depth with the bilateral filter before tracking. Off, the frame's normals come from the raw "
+      "depth, whose steps (a Kinect v1's: about 3 mm at 1 m, against 2 mm between pixels) turn them by tens of "
+      "degrees: the trackers' normal test then rejects most pixels, and frame-to-model tracking loses nearly "
+      "every frame of tum_fr1_rpy");
     v("sigma_space", sigma_space, "bilateral spatial sigma, pixels", Range{0.1, 50});
     v("sigma_depth", sigma_depth, "bilateral depth sigma, metres", Range{0.001, 1});
     v("radius", radius, "bilateral window radius, pixels", Range{1, 15});
