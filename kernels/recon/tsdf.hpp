@@ -345,9 +345,10 @@ template <Executor Exec, class Acc = HashAccess> struct TsdfRaycast {
   // Empties every tile (near = +inf, far = 0), and window w when given (every entry -1).
   static void clear_ray_intervals(const Exec& ex, RayIntervals iv, BlockWindow w = {});
 
-  // One thread per hash slot of `slots` (the whole table by default): each live block's cell box [8b, 8b+8]^3 (voxel
-  // units; every sample a ray can take in the block lies in it), clipped to the depth slab [min_depth, max_depth], is
-  // projected, and the tiles under its pixel bounding box take the min / max of its depth range.
+  // One thread per hash slot of `slots` (the whole table by default): each live block's cell box
+  // [8b, 8b+8]^3 (voxel units; every sample a ray can take in the block lies in it), clipped to the
+  // depth slab [min_depth, max_depth], is projected, and the tiles under its pixel bounding box take
+  // the min / max of its depth range.
   // With a window w (cleared by clear_ray_intervals) the same pass fills it, as fill_block_window
   // does: one pass over the slots instead of two. With surface flags (per pool block) the same
   // pass also sets near[block] = block_near_surface(...) and splats only the blocks near a surface.

@@ -32,12 +32,6 @@ SEAMLESS_HD inline void allocate_block(HashTableView t, const std::int32_t* free
   if (block < 0) atomic_add(&c->pool_failures, 1);
 }
 
-// Amanatides & Woo (1987) traversal of the block grid along the segment a -> b (block units):
-// visits every block the segment touches, in order (block_walk sets it up, tsdf.hpp).
-template <class F> SEAMLESS_HD inline void traverse_blocks(vec3 a, vec3 b, F visit) {
-  walk_blocks(block_walk(a, b), visit);
-}
-
 template <Executor Exec>
 void TsdfFusion<Exec>::allocate_blocks(const Exec& ex, HashTableView t, View<const std::int32_t> free_list,
                                        HashCounters* counters, FrameInput in, VoxelGeometry geom, DepthTiles tiles,
@@ -98,7 +92,7 @@ void TsdfFusion<Exec>::allocate_free_space(const Exec& ex, HashTableView t, View
     if (!(to > from)) return;
     const vec3 a = (in.world_T_camera * (p * from) - geom.origin) * to_block;
     const vec3 b = (in.world_T_camera * (p * to) - geom.origin) * to_block;
-    traverse_blocks(a, b, [&](int3 blk) { allocate_block(t, free_list.data, counters, blk); });
+    walk_blocks(block_walk(a, b), [&](int3 blk) { allocate_block(t, free_list.data, counters, blk); });
   });
 }
 

@@ -155,11 +155,12 @@ void VoxelHashVolume::allocate_and_list(const kernels::FrameInput& in, StageTime
           kernels::TsdfFusion<E>::allocate_free_space(ex, table(), free_list_.cview(), counters_.data(), in, geom_);
       });
       staged(timer, "visible", [&] {
-        // On CUDA the pass also lists the live slots, which the raycast's interval pass then visits
-        // instead of the whole table (kernels::SlotRange says why). The CPU skips an empty slot in
-        // a few cycles, where appending to one list would cost its threads more than it saves.
+        // On CUDA the pass also lists the live slots, which the raycast's interval pass (the only
+        // pass that takes the list) then visits instead of the whole table (kernels::SlotRange says
+        // why). The CPU skips an empty slot in a few cycles, where appending to one list would cost
+        // its threads more than it saves.
         View<std::int32_t> live;
-        if (device_ == Device::CUDA) {
+        if (device_ == Device::CUDA && params_.raycast_tile > 0) {
           live_.reserve_discard(static_cast<std::int64_t>(pool_size()), device_);
           live = live_.view();
         }
