@@ -26,6 +26,13 @@ bool is_pinned(const void* p);  // allocated by allocate_pinned and actually pag
 // there. Host-to-host copies are plain memcpy.
 void copy_async(void* dst, Device dst_dev, const void* src, Device src_dev, std::size_t bytes, void* stream = nullptr);
 void fill_zero(void* p, Device d, std::size_t bytes);
+// Zeroed memory that grow_zeroed extends without a copy where it can: on the host, anonymous pages
+// (mmap) that the kernel zero-fills when they are first written, so nothing is cleared up front,
+// and that mremap extends in place of a copy; on CUDA, cudaMalloc and cudaMemset.
+void* allocate_zeroed(std::size_t bytes, Device d);
+// p (from allocate or allocate_zeroed, old_bytes long) grown to new_bytes >= old_bytes: the first
+// old_bytes kept, the rest zero. Returns the new address; p is no longer valid.
+void* grow_zeroed(void* p, std::size_t old_bytes, std::size_t new_bytes, Device d);
 std::size_t bytes_in_use(Device d);  // live bytes allocated through Buffer on this device
 std::size_t peak_bytes(Device d);    // the most bytes_in_use(d) has been since the start or reset_peak(d)
 void reset_peak(Device d);           // the peak starts again from the bytes in use now
@@ -70,6 +77,19 @@ template <class T> class Buffer {
   View<const T> cview() const { return {data_, size_}; }
 
   void zero() { memory::fill_zero(data_, device_, bytes()); }
+  // n zero elements that grow_zeroed can extend without copying them (memory::allocate_zeroed).
+  static Buffer zeros(std::int64_t n, Device d) {
+    Buffer b;
+    b.device_ = d, b.size_ = n;
+    if (n > 0) b.data_ = static_cast<T*>(memory::allocate_zeroed(sizeof(T) * n, d));
+    return b;
+  }
+  // Grows to n >= size() elements, keeping the contents; the new elements are zero.
+  void grow_zeroed(std::int64_t n) {
+    if (n <= size_) return;
+    data_ = static_cast<T*>(memory::grow_zeroed(data_, bytes(), sizeof(T) * n, device_));
+    size_ = n;
+  }
   void copy_from_host(const T* src, std::int64_t n) { memory::copy(data_, device_, src, Device::CPU, sizeof(T) * n); }
   void copy_from(const Buffer& o) { memory::copy(data_, device_, o.data_, o.device_, std::min(bytes(), o.bytes())); }
   // memory::copy_async's rules: o must stay unchanged until the stream has done the copy.

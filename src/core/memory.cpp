@@ -6,6 +6,8 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include <sys/mman.h>
+
 #include "core/buffer.hpp"
 #include "core/cuda_check.hpp"
 #include "core/error.hpp"
@@ -18,6 +20,7 @@ struct Ledger {
   std::mutex mutex;
   std::unordered_map<void*, std::size_t> sizes;
   std::unordered_set<void*> pinned;  // host allocations from cudaMallocHost (freed by cudaFreeHost)
+  std::unordered_set<void*> mapped;  // host allocations from mmap (allocate_zeroed; freed by munmap)
   std::size_t bytes[2] = {0, 0};
   std::size_t peak[2] = {0, 0};
 };
@@ -25,24 +28,42 @@ Ledger& ledger() {
   static Ledger l;
   return l;
 }
-void record(void* p, std::size_t bytes, Device d, bool pinned = false) {
+// How a live allocation was made, which says how it is freed.
+enum class Kind { plain, pinned, mapped };
+void record(void* p, std::size_t bytes, Device d, Kind k = Kind::plain) {
   Ledger& l = ledger();
   std::lock_guard lock(l.mutex);
   l.sizes[p] = bytes;
   const int i = static_cast<int>(d);
   l.bytes[i] += bytes;
   l.peak[i] = std::max(l.peak[i], l.bytes[i]);
-  if (pinned) l.pinned.insert(p);
+  if (k == Kind::pinned) l.pinned.insert(p);
+  if (k == Kind::mapped) l.mapped.insert(p);
 }
-// Forgets p; true when it was page-locked host memory.
-bool forget(void* p, Device d) {
+// Forgets p; returns how it was allocated and its size.
+struct Forgotten {
+  Kind kind = Kind::plain;
+  std::size_t bytes = 0;
+};
+Forgotten forget(void* p, Device d) {
   Ledger& l = ledger();
   std::lock_guard lock(l.mutex);
   auto it = l.sizes.find(p);
-  if (it == l.sizes.end()) return false;
-  l.bytes[static_cast<int>(d)] -= it->second;
+  if (it == l.sizes.end()) return {};
+  const std::size_t bytes = it->second;
+  l.bytes[static_cast<int>(d)] -= bytes;
   l.sizes.erase(it);
-  return l.pinned.erase(p) > 0;
+  if (l.pinned.erase(p) > 0) return {Kind::pinned, bytes};
+  return {l.mapped.erase(p) > 0 ? Kind::mapped : Kind::plain, bytes};
+}
+bool is_mapped(void* p) {
+  Ledger& l = ledger();
+  std::lock_guard lock(l.mutex);
+  return l.mapped.count(p) > 0;
+}
+std::size_t page_rounded(std::size_t bytes) {
+  constexpr std::size_t kPage = 4096;
+  return (bytes + kPage - 1) / kPage * kPage;
 }
 [[noreturn]] void out_of_memory(std::size_t bytes, Device d) {
   throw Error("out of " + std::string(device_name(d)) + " memory allocating " + std::to_string(bytes >> 20) +
@@ -78,7 +99,7 @@ void* allocate_pinned(std::size_t bytes) {
 #if SEAMLESS_HAS_CUDA
   void* p = nullptr;
   if (cudaMallocHost(&p, bytes) == cudaSuccess) {
-    record(p, bytes, Device::CPU, /*pinned=*/true);
+    record(p, bytes, Device::CPU, Kind::pinned);
     return p;
   }
   cudaGetLastError();  // no GPU or no page-locked memory left: ordinary memory still works
@@ -92,11 +113,48 @@ bool is_pinned(const void* p) {
   return l.pinned.count(const_cast<void*>(p)) > 0;
 }
 
+void* allocate_zeroed(std::size_t bytes, Device d) {
+  if (bytes == 0) return nullptr;
+  if (d != Device::CPU) {
+    void* p = allocate(bytes, d);
+    fill_zero(p, d, bytes);
+    return p;
+  }
+  void* p = mmap(nullptr, page_rounded(bytes), PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  if (p == MAP_FAILED) out_of_memory(bytes, d);
+  // Huge pages where the system gives them on request: a 2 MiB page is zero-filled in one fault
+  // where 4 KiB pages take 512 (the voxel pool is written block by block as the scan grows).
+  madvise(p, page_rounded(bytes), MADV_HUGEPAGE);
+  record(p, bytes, d, Kind::mapped);
+  return p;
+}
+
+void* grow_zeroed(void* p, std::size_t old_bytes, std::size_t new_bytes, Device d) {
+  if (!p) return allocate_zeroed(new_bytes, d);
+  if (d == Device::CPU && is_mapped(p)) {
+    // The kernel moves the pages (a page-table update, no copy) and zero-fills the new ones when
+    // they are first written.
+    void* q = mremap(p, page_rounded(old_bytes), page_rounded(new_bytes), MREMAP_MAYMOVE);
+    if (q == MAP_FAILED) out_of_memory(new_bytes, d);
+    forget(p, d);
+    record(q, new_bytes, d, Kind::mapped);
+    return q;
+  }
+  void* q = allocate_zeroed(new_bytes, d);
+  copy(q, d, p, d, old_bytes);
+  release(p, d);
+  return q;
+}
+
 void release(void* p, Device d) noexcept {
   if (!p) return;
-  [[maybe_unused]] const bool pinned = forget(p, d);  // page-locked memory exists only with CUDA
+  const Forgotten f = forget(p, d);
+  if (f.kind == Kind::mapped) {
+    munmap(p, page_rounded(f.bytes));
+    return;
+  }
 #if SEAMLESS_HAS_CUDA
-  if (pinned) {
+  if (f.kind == Kind::pinned) {
     cudaFreeHost(p);
     return;
   }

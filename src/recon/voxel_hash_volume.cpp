@@ -64,15 +64,14 @@ VoxelHashVolume::VoxelHashVolume(const VolumeParams& p, Device d)
   values_ = Buffer<std::int32_t>(slots, d);
   scratch_ = Buffer<std::int32_t>(slots, d);
   const std::int64_t capacity = params_.capacity;
-  voxels_ = Buffer<kernels::Voxel>(capacity * kBlockVoxels, d);
-  voxels_.zero();
-  colors_ = Buffer<uchar3>(capacity * kBlockVoxels, d);
-  colors_.zero();
+  // The pool's arrays on the host are pages the kernel zero-fills as the scan first writes them,
+  // and grow without a copy (grow_pool).
+  voxels_ = Buffer<kernels::Voxel>::zeros(capacity * kBlockVoxels, d);
+  colors_ = Buffer<uchar3>::zeros(capacity * kBlockVoxels, d);
   free_list_ = Buffer<std::int32_t>(capacity, d);
   visible_ = Buffer<std::int32_t>(capacity, d);
   keep_ = Buffer<std::int32_t>(capacity, d);
-  surface_ = Buffer<std::int32_t>(capacity, d);
-  surface_.zero();
+  surface_ = Buffer<std::int32_t>::zeros(capacity, d);
   counters_ = Buffer<HashCounters>(1, d);
   with_exec(d, [&]<class E>(const E& ex) {
     kernels::VoxelHash<E>::hash_clear(ex, table());
@@ -316,23 +315,14 @@ void VoxelHashVolume::grow_pool(std::int64_t blocks) {
     throw Error(
         "voxel hashing: the block pool cannot grow beyond 2^30 blocks; raise volume.voxel_size or lower "
         "volume.max_depth");
-  Buffer<kernels::Voxel> voxels(blocks * kBlockVoxels, device_);
-  voxels.zero();
-  voxels.copy_from(voxels_);
-  voxels_ = std::move(voxels);
-  Buffer<uchar3> colors(blocks * kBlockVoxels, device_);
-  colors.zero();
-  colors.copy_from(colors_);
-  colors_ = std::move(colors);
+  voxels_.grow_zeroed(blocks * kBlockVoxels);
+  colors_.grow_zeroed(blocks * kBlockVoxels);
+  surface_.grow_zeroed(blocks);
   Buffer<std::int32_t> free_list(blocks, device_);
   free_list.copy_from(free_list_);
   free_list_ = std::move(free_list);
   visible_ = Buffer<std::int32_t>(blocks, device_);
   keep_ = Buffer<std::int32_t>(blocks, device_);
-  Buffer<std::int32_t> surface(blocks, device_);
-  surface.zero();
-  surface.copy_from(surface_);
-  surface_ = std::move(surface);
   with_exec(device_, [&]<class E>(const E& ex) {
     kernels::VoxelHash<E>::pool_append(ex, free_list_.view(), counters_.data(), static_cast<std::int32_t>(old),
                                        static_cast<std::int32_t>(blocks - old));

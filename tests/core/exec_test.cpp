@@ -152,6 +152,33 @@ TEST_P(ExecTest, AtomicsUnderContention) {
 }
 
 // The CUDA instantiation carries "Parity" in its name: it gets the ctest label `gpu`.
+// Buffer::zeros starts zero, and grow_zeroed keeps the contents and zeroes the new elements, from
+// a zeroed buffer (on the host: mapped pages, grown by mremap) and from an ordinary one (copied),
+// the ledger counting the grown size once. The sizes are not whole pages.
+TEST_P(ExecTest, ZeroedBuffersGrowKeepingTheirContents) {
+  const std::size_t before = memory::bytes_in_use(dev());
+  for (bool zeroed : {true, false}) {
+    const std::int64_t n = 3 * 4096 + 5, m = 5 * n + 7;
+    Buffer<std::int32_t> b = zeroed ? Buffer<std::int32_t>::zeros(n, dev()) : Buffer<std::int32_t>(n, dev());
+    if (zeroed) {
+      const auto z = b.to_host();
+      EXPECT_EQ(std::count(z.begin(), z.end(), 0), n);
+    }
+    std::vector<std::int32_t> v(n);
+    std::iota(v.begin(), v.end(), 1);
+    b.copy_from_host(v.data(), n);
+    b.grow_zeroed(m);
+    ASSERT_EQ(b.size(), m);
+    EXPECT_EQ(memory::bytes_in_use(dev()), before + m * sizeof(std::int32_t));
+    const auto h = b.to_host();
+    EXPECT_TRUE(std::equal(v.begin(), v.end(), h.begin())) << "zeroed " << zeroed;
+    EXPECT_EQ(std::count(h.begin() + n, h.end(), 0), m - n) << "zeroed " << zeroed;
+    b.grow_zeroed(n);  // never shrinks
+    EXPECT_EQ(b.size(), m);
+  }
+  EXPECT_EQ(memory::bytes_in_use(dev()), before);
+}
+
 auto device_label = [](const auto& info) { return std::string(device_name(info.param)); };
 INSTANTIATE_TEST_SUITE_P(Cpu, ExecTest, ::testing::Values(Device::CPU), device_label);
 INSTANTIATE_TEST_SUITE_P(CudaParity, ExecTest, ::testing::Values(Device::CUDA), device_label);
