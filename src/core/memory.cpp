@@ -7,6 +7,7 @@
 #include <unordered_set>
 
 #include <sys/mman.h>
+#include <unistd.h>
 
 #include "core/buffer.hpp"
 #include "core/cuda_check.hpp"
@@ -62,8 +63,8 @@ bool is_mapped(void* p) {
   return l.mapped.count(p) > 0;
 }
 std::size_t page_rounded(std::size_t bytes) {
-  constexpr std::size_t kPage = 4096;
-  return (bytes + kPage - 1) / kPage * kPage;
+  static const std::size_t page = static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
+  return (bytes + page - 1) / page * page;
 }
 [[noreturn]] void out_of_memory(std::size_t bytes, Device d) {
   throw Error("out of " + std::string(device_name(d)) + " memory allocating " + std::to_string(bytes >> 20) +

@@ -289,8 +289,8 @@ TEST(TsdfFusion, BlocksFreedAndAllocatedAgainDoNotGrowTheTable) {
   EXPECT_EQ(st.block_capacity, p.capacity);
 }
 
-// volume.capacity 0 on the CPU: a pool of 4096 blocks (24 MiB) that grows as the scan needs,
-// instead of 2^18 blocks (1.5 GiB) reserved and zeroed up front. Growing moves no voxel: the mesh
+// volume.capacity 0 on the CPU: a pool of 4096 blocks (14 MiB) that grows as the scan needs,
+// instead of 2^18 blocks (896 MiB) reserved up front. Growing moves no voxel: the mesh
 // equals that of a pool large enough from the start, vertex for vertex (sorted: the hash table's
 // order of the blocks may differ).
 TEST(TsdfFusion, CpuPoolStartsSmallAndGrowsToTheSameMesh) {
