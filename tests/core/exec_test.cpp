@@ -151,7 +151,6 @@ TEST_P(ExecTest, AtomicsUnderContention) {
   EXPECT_EQ(total.to_host()[0], 100000.0f);
 }
 
-// The CUDA instantiation carries "Parity" in its name: it gets the ctest label `gpu`.
 // Buffer::zeros starts zero, and grow_zeroed keeps the contents and zeroes the new elements, from
 // a zeroed buffer (on the host: mapped pages, grown by mremap) and from an ordinary one (copied),
 // the ledger counting the grown size once. The sizes are not whole pages.
@@ -179,6 +178,7 @@ TEST_P(ExecTest, ZeroedBuffersGrowKeepingTheirContents) {
   EXPECT_EQ(memory::bytes_in_use(dev()), before);
 }
 
+// The CUDA instantiation carries "Parity" in its name: it gets the ctest label `gpu`.
 auto device_label = [](const auto& info) { return std::string(device_name(info.param)); };
 INSTANTIATE_TEST_SUITE_P(Cpu, ExecTest, ::testing::Values(Device::CPU), device_label);
 INSTANTIATE_TEST_SUITE_P(CudaParity, ExecTest, ::testing::Values(Device::CUDA), device_label);
