@@ -39,7 +39,7 @@ void Undistort<Exec>::remap_rgb(const Exec& ex, View2D<const vec2> map, View2D<c
     uchar3 a = in(x0, y0), b = in(x0 + 1, y0), c = in(x0, y0 + 1), d = in(x0 + 1, y0 + 1);
     auto mix = [=](float va, float vb, float vc, float vd) {
       float v = (1 - ay) * ((1 - ax) * va + ax * vb) + ay * ((1 - ax) * vc + ax * vd);
-      return static_cast<std::uint8_t>(fminf(v + 0.5f, 255.f));
+      return static_cast<std::uint8_t>(min_of(v + 0.5f, 255.f));
     };
     out(x, y) = {mix(a.x, b.x, c.x, d.x), mix(a.y, b.y, c.y, d.y), mix(a.z, b.z, c.z, d.z)};
   });

@@ -115,7 +115,7 @@ void Preprocess<Exec>::pyr_down_intensity(const Exec& ex, View2D<const float> in
   ex.for_each(out.count(), [=] SEAMLESS_HD(std::int64_t i) {
     int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
     const float a = in(2 * x, 2 * y), b = in(2 * x + 1, 2 * y), c = in(2 * x, 2 * y + 1), d = in(2 * x + 1, 2 * y + 1);
-    out(x, y) = fminf(fminf(a, b), fminf(c, d)) < 0.f ? -1.f : 0.25f * (a + b + c + d);
+    out(x, y) = a < 0.f || b < 0.f || c < 0.f || d < 0.f ? -1.f : 0.25f * (a + b + c + d);
   });
 }
 

@@ -99,7 +99,7 @@ void TsdfFusion<Exec>::allocate_free_space(const Exec& ex, HashTableView t, View
 // Does some tile in pixels [u0, u1] x [v0, v1] hold a depth reading at or beyond z? A voxel is
 // changed only where the reading d at its pixel has d - z_voxel >= -mu (fuse_voxel).
 SEAMLESS_HD inline bool tiles_reach(const DepthTiles& t, int u0, int u1, int v0, int v1, float z) {
-  const std::int32_t zb = float_bits(fmaxf(z, 0.f));
+  const std::int32_t zb = float_bits(max_of(z, 0.f));
   for (int ty = v0 / t.tile; ty <= v1 / t.tile; ++ty)
     for (int tx = u0 / t.tile; tx <= u1 / t.tile; ++tx)
       if (t.zmax[t.tile_of(tx * t.tile, ty * t.tile)] >= zb) return true;
@@ -120,13 +120,13 @@ SEAMLESS_HD inline bool block_maybe_visible(int3 b, const FrameInput& in, const 
   for (int k = 0; k < 8; ++k) {
     int3 g{b.x * 8 + (k & 1) * 8, b.y * 8 + ((k >> 1) & 1) * 8, b.z * 8 + (k >> 2) * 8};
     vec3 pc = camera_T_world * geom.to_world(to_vec3(g));
-    zmin = fminf(zmin, pc.z);
+    zmin = min_of(pc.z, zmin);
     if (pc.z <= 1e-4f) {
       behind = true;
       continue;
     }
     vec2 uv = in.K.project(pc);
-    umin = fminf(umin, uv.x), umax = fmaxf(umax, uv.x), vmin = fminf(vmin, uv.y), vmax = fmaxf(vmax, uv.y);
+    umin = min_of(uv.x, umin), umax = max_of(uv.x, umax), vmin = min_of(uv.y, vmin), vmax = max_of(uv.y, vmax);
   }
   if (zmin > in.max_depth + geom.truncation) return false;
   if (behind) return umax > -1e29f;  // straddles the camera plane: keep if any corner is in front
@@ -134,10 +134,10 @@ SEAMLESS_HD inline bool block_maybe_visible(int3 b, const FrameInput& in, const 
     return false;
   if (!tiles.zmax) return true;
   const float wl = in.depth.width - 1.f, hl = in.depth.height - 1.f;  // clamped, then rounded as fuse_voxel rounds
-  const int u0 = static_cast<int>(floorf(fmaxf(umin, 0.f) + 0.5f)),
-            u1 = static_cast<int>(floorf(fminf(umax, wl) + 0.5f));
-  const int v0 = static_cast<int>(floorf(fmaxf(vmin, 0.f) + 0.5f)),
-            v1 = static_cast<int>(floorf(fminf(vmax, hl) + 0.5f));
+  const int u0 = static_cast<int>(floorf(max_of(umin, 0.f) + 0.5f)),
+            u1 = static_cast<int>(floorf(min_of(umax, wl) + 0.5f));
+  const int v0 = static_cast<int>(floorf(max_of(vmin, 0.f) + 0.5f)),
+            v1 = static_cast<int>(floorf(min_of(vmax, hl) + 0.5f));
   return tiles_reach(tiles, u0, u1, v0, v1, zmin - geom.truncation);
 }
 

@@ -53,7 +53,7 @@ SEAMLESS_HD inline PixelRay pixel_ray(const VoxelGeometry& g, int x, int y, cons
   if (iv.bits) {
     const std::int64_t t = iv.tile_of(x, y);
     const float z_near = bits_float(iv.bits[2 * t]), z_far = bits_float(iv.bits[2 * t + 1]);
-    r.z = fmaxf(r.z, z_near - min_step), r.z_end = z_far > 0.f ? fminf(r.z_end, z_far + min_step) : 0.f;
+    r.z = max_of(z_near - min_step, r.z), r.z_end = z_far > 0.f ? min_of(z_far + min_step, r.z_end) : 0.f;
   }
   return r;
 }
@@ -74,7 +74,7 @@ SEAMLESS_HD inline MarchSteps march_steps(const VoxelGeometry& g, vec3 d) {
   // truncation distance mu in front of every fused surface (fusion writes every voxel of the
   // band from +mu on, see fuse_voxel). Steps of mu/2 through unobserved cells therefore land at
   // least one observed sample in front of the next surface, where the march takes over.
-  s.unobserved_step = fmaxf(s.min_step, 0.5f * g.truncation / (dlen * g.voxel_size));
+  s.unobserved_step = max_of(s.min_step, 0.5f * g.truncation / (dlen * g.voxel_size));
   // |TSDF| is at most about the distance to the nearest zero crossing (projective distances
   // over-estimate at grazing angles, hence the 0.8), so stepping that far along the ray (|d| s
   // metres per unit of z) cannot jump over one: truncation-sized steps in the band's free-space

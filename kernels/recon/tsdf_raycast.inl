@@ -12,8 +12,8 @@ struct ScreenBounds {
   float u0 = 1e30f, u1 = -1e30f, v0 = 1e30f, v1 = -1e30f, z0 = 1e30f, z1 = -1e30f;
   SEAMLESS_HD void add(vec3 p, const Intrinsics& K) {
     vec2 uv = K.project(p);
-    u0 = fminf(u0, uv.x), u1 = fmaxf(u1, uv.x), v0 = fminf(v0, uv.y), v1 = fmaxf(v1, uv.y);
-    z0 = fminf(z0, p.z), z1 = fmaxf(z1, p.z);
+    u0 = min_of(uv.x, u0), u1 = max_of(uv.x, u1), v0 = min_of(uv.y, v0), v1 = max_of(uv.y, v1);
+    z0 = min_of(p.z, z0), z1 = max_of(p.z, z1);
   }
 };
 
@@ -84,10 +84,10 @@ void TsdfRaycast<Exec, Acc>::splat_ray_intervals(const Exec& ex, HashTableView t
     // Rays go through pixel centres: pixel x can meet the box only if u0 <= x <= u1. Rounding
     // outwards keeps the splat conservative.
     if (sb.u1 < 0.f || sb.v1 < 0.f || sb.u0 > K.width - 1.f || sb.v0 > K.height - 1.f) return;
-    const int x0 = static_cast<int>(floorf(fmaxf(sb.u0, 0.f))),
-              x1 = static_cast<int>(ceilf(fminf(sb.u1, K.width - 1.f)));
-    const int y0 = static_cast<int>(floorf(fmaxf(sb.v0, 0.f))),
-              y1 = static_cast<int>(ceilf(fminf(sb.v1, K.height - 1.f)));
+    const int x0 = static_cast<int>(floorf(max_of(sb.u0, 0.f))),
+              x1 = static_cast<int>(ceilf(min_of(sb.u1, K.width - 1.f)));
+    const int y0 = static_cast<int>(floorf(max_of(sb.v0, 0.f))),
+              y1 = static_cast<int>(ceilf(min_of(sb.v1, K.height - 1.f)));
     const std::int32_t z_near = float_bits(sb.z0), z_far = float_bits(sb.z1);
     for (int ty = y0 / iv.tile; ty <= y1 / iv.tile; ++ty)
       for (int tx = x0 / iv.tile; tx <= x1 / iv.tile; ++tx) {
