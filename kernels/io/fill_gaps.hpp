@@ -31,7 +31,7 @@ SEAMLESS_HD inline float fill_gap_at(View2D<const float> in, int x, int y, float
     const int ax = x - p[0], ay = y - p[1], bx = x + p[0], by = y + p[1];
     if (!in.inside(ax, ay) || !in.inside(bx, by)) continue;
     const float a = in(ax, ay), b = in(bx, by);
-    if (a <= 0.f || b <= 0.f || fabsf(a - b) > max_rel_diff * fminf(a, b)) continue;
+    if (a <= 0.f || b <= 0.f || fabsf(a - b) > max_rel_diff * min_of(a, b)) continue;
     sum += 0.5f * (a + b);
     ++n;
   }
