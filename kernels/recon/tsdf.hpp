@@ -416,11 +416,18 @@ template <Executor Exec, class Acc = HashAccess> struct TsdfExtract {
   static std::int64_t mesh_count(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,
                                  View<std::int32_t> counts);
 
-  // Writes 3 vertices per triangle at 3 * offsets[i]: position (world), normal (TSDF gradient),
-  // colour, and a key naming the voxel edge it lies on (equal keys = the same vertex).
-  static void mesh_emit(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,
-                        View<const std::int32_t> offsets, View<vec3> positions, View<vec3> normals, View<uchar3> colors,
-                        View<std::uint64_t> edge_keys);
+  // The triangles' corners, 3 a triangle at 3 * offsets[i]: the key naming the voxel edge each lies
+  // on (equal keys = the same vertex) and the cell it belongs to (i).
+  static void mesh_edges(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,
+                         View<const std::int32_t> offsets, View<std::uint64_t> edge_keys, View<std::int32_t> cells);
+
+  // Vertex j at corner corners[j] (an index into mesh_edges' output, whose cells it takes): position
+  // (world), normal (TSDF gradient), colour. Computed once a vertex, for the corner that first names
+  // it, rather than once for each of the ~5 triangle corners that share it.
+  static void mesh_vertices(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,
+                            View<const std::int32_t> offsets, View<const std::int32_t> cells,
+                            View<const std::int32_t> corners, View<vec3> positions, View<vec3> normals,
+                            View<uchar3> colors);
 
   // Block coordinates of the given hash slots.
   static void slot_block_coords(const Exec& ex, HashTableView t, View<const std::int32_t> slots, View<int3> out);

@@ -81,34 +81,52 @@ SEAMLESS_HD inline std::uint64_t edge_key(int3 g, int axis) {
 }
 
 template <Executor Exec, class Acc>
-void TsdfExtract<Exec, Acc>::mesh_emit(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,
-                                       View<const std::int32_t> offsets, View<vec3> positions, View<vec3> normals,
-                                       View<uchar3> colors, View<std::uint64_t> edge_keys) {
+void TsdfExtract<Exec, Acc>::mesh_edges(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,
+                                        View<const std::int32_t> offsets, View<std::uint64_t> edge_keys,
+                                        View<std::int32_t> cells) {
   const std::int64_t n = blocks.size * kBlockVoxels;
   ex.for_each(n, [=] SEAMLESS_HD(std::int64_t i) {
     BlockCache c;
     const Voxel* v[8];
-    int3 g = cell_of(blocks, i);
-    int cube = mc_cube(a, g, c, v);
+    const int3 g = cell_of(blocks, i);
+    const int cube = mc_cube(a, g, c, v);
     if (cube <= 0) return;
     std::int64_t out = 3ll * offsets[i];
     for (int k = 0; k < kMcRow && table[cube * kMcRow + k] >= 0; ++k, ++out) {
       int e = table[cube * kMcRow + k], c0, c1;
       mc_edge(e, &c0, &c1);
-      const float f0 = voxel_sdf(*v[c0], a.geom.truncation), f1 = voxel_sdf(*v[c1], a.geom.truncation);
-      float t = f0 / (f0 - f1);  // linear interpolation of the zero crossing along the edge
-      vec3 q = to_vec3(g + mc_corner(c0)) * (1.f - t) + to_vec3(g + mc_corner(c1)) * t;
-      positions[out] = a.geom.to_world(q);
-      bool complete = false;
-      vec3 n = normalize(tsdf_gradient(a, q, 0.f, c, &complete));
-      if (!complete) n = normalize(cell_gradient(v, q - to_vec3(g)));
-      normals[out] = n;
-      const uchar3 k0 = a.colors[v[c0] - a.voxels], k1 = a.colors[v[c1] - a.voxels];
-      colors[out] = {static_cast<std::uint8_t>(k0.x * (1.f - t) + k1.x * t + 0.5f),
-                     static_cast<std::uint8_t>(k0.y * (1.f - t) + k1.y * t + 0.5f),
-                     static_cast<std::uint8_t>(k0.z * (1.f - t) + k1.z * t + 0.5f)};
       edge_keys[out] = edge_key(g + mc_corner(c0), e / 4);
+      cells[out] = static_cast<std::int32_t>(i);
     }
+  });
+}
+
+template <Executor Exec, class Acc>
+void TsdfExtract<Exec, Acc>::mesh_vertices(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,
+                                           View<const std::int32_t> offsets, View<const std::int32_t> cells,
+                                           View<const std::int32_t> corners, View<vec3> positions, View<vec3> normals,
+                                           View<uchar3> colors) {
+  ex.for_each(corners.size, [=] SEAMLESS_HD(std::int64_t j) {
+    const std::int64_t corner = corners[j], i = cells[corner];
+    BlockCache c;
+    const Voxel* v[8];
+    const int3 g = cell_of(blocks, i);
+    const int cube = mc_cube(a, g, c, v);  // > 0: the cell has this corner's triangle
+    int c0, c1;
+    const int e = table[cube * kMcRow + (corner - 3ll * offsets[i])];
+    mc_edge(e, &c0, &c1);
+    const float f0 = voxel_sdf(*v[c0], a.geom.truncation), f1 = voxel_sdf(*v[c1], a.geom.truncation);
+    const float t = f0 / (f0 - f1);  // linear interpolation of the zero crossing along the edge
+    const vec3 q = to_vec3(g + mc_corner(c0)) * (1.f - t) + to_vec3(g + mc_corner(c1)) * t;
+    positions[j] = a.geom.to_world(q);
+    bool complete = false;
+    vec3 n = normalize(tsdf_gradient(a, q, 0.f, c, &complete));
+    if (!complete) n = normalize(cell_gradient(v, q - to_vec3(g)));  // this cell's: one of up to four
+    normals[j] = n;
+    const uchar3 k0 = a.colors[v[c0] - a.voxels], k1 = a.colors[v[c1] - a.voxels];
+    colors[j] = {static_cast<std::uint8_t>(k0.x * (1.f - t) + k1.x * t + 0.5f),
+                 static_cast<std::uint8_t>(k0.y * (1.f - t) + k1.y * t + 0.5f),
+                 static_cast<std::uint8_t>(k0.z * (1.f - t) + k1.z * t + 0.5f)};
   });
 }
 

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <string>
-#include <unordered_map>
 
 #include "core/error.hpp"
 #include "core/exec.hpp"
@@ -72,6 +71,49 @@ std::vector<std::int8_t> build_table() {
   return table;
 }
 
+// Voxel edge key -> vertex index, open addressing with linear probing. std::unordered_map allocated
+// a node a vertex and spent longer than the kernels (millions of corners on a room). A vertex is
+// named by the ~5 triangle corners that share it, mostly close together in the walk over the
+// cells, so after its first lookup its slot is in the cache.
+class EdgeVertices {
+ public:
+  // The vertex of `key`; `fresh` (the index a new vertex takes) when the key is new.
+  std::int32_t find_or_add(std::uint64_t key, std::int32_t fresh) {
+    if (2 * (count_ + 1) > keys_.size()) grow();
+    std::size_t s = slot(key);
+    while (keys_[s] != kEmpty) {
+      if (keys_[s] == key) return values_[s];
+      s = (s + 1) & (keys_.size() - 1);
+    }
+    keys_[s] = key, values_[s] = fresh, ++count_;
+    return fresh;
+  }
+
+ private:
+  static constexpr std::uint64_t kEmpty = ~0ull;  // edge_key uses 62 bits: never all ones
+  std::size_t slot(std::uint64_t key) const {     // Fibonacci hashing: the product's top bits
+    return static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> (64 - bits_));
+  }
+  void grow() {
+    std::vector<std::uint64_t> keys = std::move(keys_);
+    std::vector<std::int32_t> values = std::move(values_);
+    bits_ = keys.empty() ? 16 : bits_ + 1;
+    keys_.assign(std::size_t{1} << bits_, kEmpty);
+    values_.assign(keys_.size(), 0);
+    count_ = 0;
+    for (std::size_t i = 0; i < keys.size(); ++i)
+      if (keys[i] != kEmpty) find_or_add(keys[i], values[i]);
+  }
+  std::vector<std::uint64_t> keys_;
+  std::vector<std::int32_t> values_;
+  std::size_t count_ = 0;
+  int bits_ = 0;
+};
+
+template <class T> void append(std::vector<T>& to, const std::vector<T>& from) {
+  to.insert(to.end(), from.begin(), from.end());
+}
+
 }  // namespace
 
 const std::vector<std::int8_t>& marching_cubes_table() {
@@ -83,8 +125,8 @@ template <class Acc>
 Mesh marching_cubes(Device d, const Acc& a, const Buffer<int3>& blocks, std::int64_t block_count, bool progress) {
   Buffer<std::int8_t> table = Buffer<std::int8_t>::from_host(marching_cubes_table(), d);
   Mesh mesh;
-  std::unordered_map<std::uint64_t, int> index;  // voxel edge -> vertex
-  constexpr std::int64_t kChunk = 8192;          // blocks per pass: bounds the scratch memory
+  EdgeVertices index;
+  constexpr std::int64_t kChunk = 8192;  // blocks per pass: bounds the scratch memory
   Progress bar("mesh", block_count, progress && block_count > kChunk, "blocks/s");
   for (std::int64_t first = 0; first < block_count; first += kChunk) {
     if (first > 0) bar.update(first, std::to_string(mesh.positions.size()) + " vertices");
@@ -95,27 +137,34 @@ Mesh marching_cubes(Device d, const Acc& a, const Buffer<int3>& blocks, std::int
       return kernels::TsdfExtract<E, Acc>::mesh_count(ex, a, chunk, table.data(), offsets.view());
     });
     if (tris == 0) continue;
-    Buffer<vec3> pos(3 * tris, d), nrm(3 * tris, d);
-    Buffer<uchar3> col(3 * tris, d);
     Buffer<std::uint64_t> keys(3 * tris, d);
+    Buffer<std::int32_t> cells(3 * tris, d);
     with_exec(d, [&]<class E>(const E& ex) {
-      kernels::TsdfExtract<E, Acc>::mesh_emit(ex, a, chunk, table.data(), offsets.cview(), pos.view(), nrm.view(),
-                                              col.view(), keys.view());
+      kernels::TsdfExtract<E, Acc>::mesh_edges(ex, a, chunk, table.data(), offsets.cview(), keys.view(), cells.view());
     });
-    auto hp = pos.to_host(), hn = nrm.to_host();
-    auto hc = col.to_host();
-    auto hk = keys.to_host();
+    // Vertices are numbered in the order of the corners that first name them; only those corners
+    // get a vertex computed.
+    const std::vector<std::uint64_t> hk = keys.to_host();
+    std::vector<std::int32_t> firsts;
+    const auto known = static_cast<std::int32_t>(mesh.positions.size());
     int tri[3];
     for (std::int64_t v = 0; v < 3 * tris; ++v) {
-      auto [it, fresh] = index.emplace(hk[v], static_cast<int>(mesh.positions.size()));
-      if (fresh) {
-        mesh.positions.push_back(hp[v]);
-        mesh.normals.push_back(hn[v]);
-        mesh.colors.push_back(hc[v]);
-      }
-      tri[v % 3] = it->second;
+      const auto fresh = known + static_cast<std::int32_t>(firsts.size());
+      tri[v % 3] = index.find_or_add(hk[static_cast<std::size_t>(v)], fresh);
+      if (tri[v % 3] == fresh) firsts.push_back(static_cast<std::int32_t>(v));
       if (v % 3 == 2) mesh.triangles.push_back({tri[0], tri[1], tri[2]});
     }
+    const auto nv = static_cast<std::int64_t>(firsts.size());
+    Buffer<std::int32_t> corners = Buffer<std::int32_t>::from_host(firsts, d);
+    Buffer<vec3> pos(nv, d), nrm(nv, d);
+    Buffer<uchar3> col(nv, d);
+    with_exec(d, [&]<class E>(const E& ex) {
+      kernels::TsdfExtract<E, Acc>::mesh_vertices(ex, a, chunk, table.data(), offsets.cview(), cells.cview(),
+                                                  corners.cview(), pos.view(), nrm.view(), col.view());
+    });
+    append(mesh.positions, pos.to_host());
+    append(mesh.normals, nrm.to_host());
+    append(mesh.colors, col.to_host());
   }
   bar.update(block_count, std::to_string(mesh.positions.size()) + " vertices");
   return mesh;

@@ -1,4 +1,4 @@
-// Marching cubes over voxel blocks (host side of kernels/recon/tsdf.hpp mesh_count / mesh_emit).
+// Marching cubes over voxel blocks (host side of kernels/recon/tsdf.hpp mesh_count / mesh_edges / mesh_vertices).
 #pragma once
 #include <cstdint>
 #include <vector>
