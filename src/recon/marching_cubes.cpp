@@ -97,7 +97,7 @@ class EdgeVertices {
   void grow() {
     std::vector<std::uint64_t> keys = std::move(keys_);
     std::vector<std::int32_t> values = std::move(values_);
-    bits_ = keys.empty() ? 16 : bits_ + 1;
+    bits_ = keys.empty() ? 10 : bits_ + 1;  // small: the tests grow it several times
     keys_.assign(std::size_t{1} << bits_, kEmpty);
     values_.assign(keys_.size(), 0);
     count_ = 0;
