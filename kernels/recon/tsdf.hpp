@@ -416,6 +416,11 @@ template <Executor Exec, class Acc = HashAccess> struct TsdfExtract {
   static std::int64_t mesh_count(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,
                                  View<std::int32_t> counts);
 
+  // Sorts blocks by coordinate (x, then y, then z; keys: scratch of blocks.size): meshed in that
+  // order, the vertices' order follows the scene, not the hash slots, which depend on the table's
+  // size and on which thread inserted a block first.
+  static void sort_blocks(const Exec& ex, View<int3> blocks, View<HashKey> keys);
+
   // The triangles' corners, 3 a triangle at 3 * offsets[i]: the key naming the voxel edge each lies
   // on (equal keys = the same vertex) and the cell it belongs to (i).
   static void mesh_edges(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,

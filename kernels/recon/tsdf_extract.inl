@@ -81,6 +81,12 @@ SEAMLESS_HD inline std::uint64_t edge_key(int3 g, int axis) {
 }
 
 template <Executor Exec, class Acc>
+void TsdfExtract<Exec, Acc>::sort_blocks(const Exec& ex, View<int3> blocks, View<HashKey> keys) {
+  ex.for_each(blocks.size, [=] SEAMLESS_HD(std::int64_t i) { keys[i] = pack_block(blocks[i]); });
+  ex.sort_by_key(keys.data, blocks.data, blocks.size, 3 * kCoordBits);
+}
+
+template <Executor Exec, class Acc>
 void TsdfExtract<Exec, Acc>::mesh_edges(const Exec& ex, Acc a, View<const int3> blocks, const std::int8_t* table,
                                         View<const std::int32_t> offsets, View<std::uint64_t> edge_keys,
                                         View<std::int32_t> cells) {

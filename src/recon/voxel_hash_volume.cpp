@@ -469,6 +469,10 @@ std::int64_t VoxelHashVolume::live_block_coords(Buffer<int3>& coords) const {
 Mesh VoxelHashVolume::extract_mesh(bool progress) {
   Buffer<int3> coords;
   const std::int64_t n = live_block_coords(coords);
+  Buffer<kernels::HashKey> keys(n, device_);
+  with_exec(device_, [&]<class E>(const E& ex) {
+    kernels::TsdfExtract<E>::sort_blocks(ex, View<int3>{coords.data(), n}, keys.view());
+  });
   return marching_cubes(device_, device_view(), coords, n, progress);
 }
 
