@@ -71,8 +71,8 @@ std::vector<std::int8_t> build_table() {
   return table;
 }
 
-// Voxel edge key -> vertex index, open addressing with linear probing. std::unordered_map allocated
-// a node a vertex and spent longer than the kernels (millions of corners on a room). A vertex is
+// Voxel edge key -> vertex index, open addressing with linear probing (std::unordered_map allocates
+// a node a vertex: slower than the kernels on a room's millions of corners). A vertex is
 // named by the ~5 triangle corners that share it, mostly close together in the walk over the
 // cells, so after its first lookup its slot is in the cache.
 class EdgeVertices {
@@ -97,7 +97,7 @@ class EdgeVertices {
   void grow() {
     std::vector<std::uint64_t> keys = std::move(keys_);
     std::vector<std::int32_t> values = std::move(values_);
-    bits_ = keys.empty() ? 10 : bits_ + 1;  // small: the tests grow it several times
+    bits_ = keys.empty() ? 10 : bits_ + 1;  // 1024 slots to start, doubled at half full
     keys_.assign(std::size_t{1} << bits_, kEmpty);
     values_.assign(keys_.size(), 0);
     count_ = 0;
